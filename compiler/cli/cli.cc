@@ -1,0 +1,114 @@
+#include "cli/cli.h"
+
+#include <ostream>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "pipeline/pipeline.h"
+#include "report/report.h"
+
+namespace substratec {
+
+namespace {
+
+struct ReportArgs {
+  std::vector<std::string> files;
+  int budget = 0;
+  int maxClosures = 0;
+  bool fullSimplification = false;
+  bool json = false;
+  std::size_t maxInputSize = 16u << 20;
+  bool printAfterAll = false;
+  bool timePasses = false;
+};
+
+CompileOptions optionsFrom(const ReportArgs& a) {
+  CompileOptions o;
+  if (a.budget > 0) o.budgetOverride = a.budget;
+  if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
+  o.fullSimplification = a.fullSimplification;
+  o.read.maxInputBytes = a.maxInputSize;
+  o.printAfterAll = a.printAfterAll;
+  o.timePasses = a.timePasses;
+  return o;
+}
+
+int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
+  int status = kExitOk;
+  nlohmann::ordered_json all = nlohmann::ordered_json::array();
+  bool first = true;
+  for (const auto& file : a.files) {
+    Diagnostics diags(file);
+    auto result = compileFile(file, optionsFrom(a), diags);
+    err << diags.formatAll();
+    if (!result) {
+      status = kExitBadInput;
+      continue;
+    }
+    if (a.printAfterAll) err << result->debugLog;
+    if (a.timePasses)
+      for (const auto& t : result->timings) err << fmt::format("{}: pass {:<14} {:8.3f} ms\n", file, t.pass, t.milliseconds);
+    if (a.json) {
+      all.push_back(reportJson(*result));
+    } else {
+      if (!first) out << "\n";
+      out << formatReportText(*result);
+    }
+    first = false;
+  }
+  if (a.json) out << (a.files.size() == 1 && !all.empty() ? all[0] : all).dump(2) << "\n";
+  return status;
+}
+
+}  // namespace
+
+int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  CLI::App app{"substratec: compiles Substrate material graphs (substrate-material/1) into priced, simplified, "
+               "flattened shaders",
+               "substratec"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "substratec 0.1.0");
+
+  ReportArgs report;
+  CLI::App* rep = app.add_subcommand("report", "Print the tree, features, byte budget and layout of materials");
+  rep->add_option("files", report.files, "Material files (substrate-material/1 JSON)")->required();
+  rep->add_option("--budget", report.budget, "Bytes per pixel budget (overrides settings.bytes_per_pixel)")
+      ->check(CLI::Range(8, 1024));
+  rep->add_option("--max-closures", report.maxClosures, "Closure budget (overrides settings.max_closures)")
+      ->check(CLI::Range(1, 8));
+  rep->add_flag("--full-simplification", report.fullSimplification, "Collapse everything into one closure");
+  rep->add_flag("--json", report.json, "Print the report as JSON (docs/report.md)");
+  rep->add_option("--max-input-size", report.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+  rep->add_flag("--print-after-all", report.printAfterAll, "Dump the IR after every pass (stderr)");
+  rep->add_flag("--time-passes", report.timePasses, "Print the time of every pass (stderr)");
+
+  std::vector<std::string> argv = args;
+  std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
+  try {
+    app.parse(argv);
+  } catch (const CLI::CallForHelp&) {
+    out << app.help();
+    return kExitOk;
+  } catch (const CLI::CallForAllHelp&) {
+    out << app.help("", CLI::AppFormatMode::All);
+    return kExitOk;
+  } catch (const CLI::CallForVersion&) {
+    out << "substratec 0.1.0\n";
+    return kExitOk;
+  } catch (const CLI::ParseError& e) {
+    err << "substratec: error: " << e.what() << "\n";
+    err << "Run 'substratec --help' for usage.\n";
+    return kExitUsage;
+  }
+  try {
+    if (rep->parsed()) return runReport(report, out, err);
+  } catch (const std::exception& e) {
+    err << "substratec: internal compiler error: " << e.what() << "\n";
+    return kExitInternal;
+  }
+  return kExitUsage;
+}
+
+}  // namespace substratec

@@ -1,0 +1,15 @@
+// The substratec command line, as a library function so tests can drive it
+// without spawning processes. main() is a thin wrapper.
+#pragma once
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace substratec {
+
+/// Exit codes: 0 success, 1 bad input, 2 bad usage, 3 internal compiler error.
+enum ExitCode { kExitOk = 0, kExitBadInput = 1, kExitUsage = 2, kExitInternal = 3 };
+
+int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace substratec

@@ -1,0 +1,37 @@
+// Reading a material file: size limit, a nesting pre-scan, and a strict JSON
+// parse (duplicate keys, byte-order marks and non-finite numbers rejected)
+// into an order-preserving DOM. Syntax errors are reported as file:line:col.
+#pragma once
+#include <cstddef>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "diag/diagnostics.h"
+
+namespace substratec {
+
+using Json = nlohmann::ordered_json;
+
+struct ReadLimits {
+  std::size_t maxInputBytes = 16u << 20;  // 16 MiB
+  std::size_t maxNesting = 128;           // JSON arrays/objects
+  std::size_t maxStringBytes = 1u << 16;  // any single string, in bytes
+};
+
+/// Reads `path` without reading past `limits.maxInputBytes`. Returns nullopt
+/// (with a diagnostic) if the file is missing, unreadable or too large.
+std::optional<std::string> readSourceFile(const std::string& path, const ReadLimits& limits,
+                                          Diagnostics& diags);
+
+/// Parses JSON text. All syntax problems are reported with line:col; values
+/// that parse but are unacceptable (duplicate keys, NaN/Inf, huge strings)
+/// are reported with their JSON pointer. Returns nullopt on any error.
+std::optional<Json> parseJsonDocument(const std::string& text, const ReadLimits& limits,
+                                      Diagnostics& diags);
+
+/// 1-based line and column (in bytes) of a byte offset in text.
+void lineColumnOf(const std::string& text, std::size_t offset, int& line, int& column);
+
+}  // namespace substratec

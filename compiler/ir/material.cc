@@ -1,0 +1,129 @@
+#include "ir/material.h"
+
+#include <fmt/format.h>
+
+namespace substratec {
+
+std::string_view blendModeName(BlendMode m) {
+  switch (m) {
+    case BlendMode::Opaque: return "opaque";
+    case BlendMode::Masked: return "masked";
+    case BlendMode::TranslucentGrey: return "translucent_grey";
+    case BlendMode::TranslucentColored: return "translucent_colored";
+    case BlendMode::ColoredTransmittanceOnly: return "colored_transmittance_only";
+    case BlendMode::AlphaHoldout: return "alpha_holdout";
+  }
+  return "opaque";
+}
+
+namespace {
+constexpr double kInf = 1e300;
+constexpr int kNoGeo = -1;
+// name, type, color, default, geometry default, lo, hi
+const SlabPinInfo kPins[kSlabPinCount] = {
+    {"diffuse_albedo", VType::Vec3, true, 0.18, kNoGeo, 0, 1},
+    {"f0", VType::Vec3, true, 0.04, kNoGeo, 0, 1},
+    {"f90", VType::Vec3, true, 1.0, kNoGeo, 0, 1},
+    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
+    {"anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
+    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1},
+    {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1},
+    {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
+    {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf},
+    {"sss_phase_anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
+    {"emissive", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
+    {"second_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
+    {"second_roughness_weight", VType::Float, false, 0.0, kNoGeo, 0, 1},
+    {"fuzz_amount", VType::Float, false, 0.0, kNoGeo, 0, 1},
+    {"fuzz_color", VType::Vec3, true, 0.0, kNoGeo, 0, 1},
+    {"fuzz_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
+    {"glint_value", VType::Float, false, 1.0, kNoGeo, 0, 1},
+    {"glint_uv", VType::Vec2, false, 0.0, static_cast<int>(GeometryAttr::Uv0), -kInf, kInf},
+};
+}  // namespace
+
+const SlabPinInfo& slabPinInfo(SlabPin p) { return kPins[static_cast<int>(p)]; }
+
+std::optional<SlabPin> slabPinByName(std::string_view name) {
+  for (int i = 0; i < kSlabPinCount; ++i)
+    if (kPins[i].name == name) return static_cast<SlabPin>(i);
+  return std::nullopt;
+}
+
+std::string_view sssTypeName(SssType t) {
+  switch (t) {
+    case SssType::None: return "none";
+    case SssType::Wrap: return "wrap";
+    case SssType::Diffusion: return "diffusion";
+    case SssType::SimpleVolume: return "simple_volume";
+  }
+  return "none";
+}
+
+std::string_view featureName(int bit) {
+  static constexpr std::string_view names[kFeatureCount] = {
+      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium"};
+  return bit >= 0 && bit < kFeatureCount ? names[bit] : "?";
+}
+
+std::string_view treeOpName(TreeOp op) {
+  switch (op) {
+    case TreeOp::Slab: return "SLAB";
+    case TreeOp::Horizontal: return "HORIZONTAL";
+    case TreeOp::Vertical: return "VERTICAL";
+    case TreeOp::Add: return "ADD";
+    case TreeOp::CoverageWeight: return "WEIGHT";
+    case TreeOp::Select: return "SELECT";
+  }
+  return "?";
+}
+
+int Material::inputIndex(std::string_view n) const {
+  for (std::size_t i = 0; i < inputs.size(); ++i)
+    if (inputs[i].name == n) return static_cast<int>(i);
+  return -1;
+}
+
+std::string renderValue(const Material& m, ValueId v, int budget) {
+  const ValueNode& n = m.values.node(v);
+  if (n.op == Op::Input) return "$" + m.inputs[n.attr].name;
+  if (n.op == Op::Const || n.op == Op::Geometry) return m.values.render(v, 0);
+  if (budget <= 0) return "...";
+  std::string s;
+  if (n.op == Op::Sample) {
+    s = fmt::format("texture(${}, ", m.inputs[n.attr].name);
+    return s + renderValue(m, n.args[0], budget - 1) + ")";
+  }
+  s = std::string(opName(n.op));
+  if (n.op == Op::Swizzle) {
+    s += ".";
+    int k = componentCount(n.type);
+    for (int i = 0; i < k; ++i) s += "xyzw"[(n.attr >> (2 * i)) & 3];
+  } else if (isHelper(n.op) && (n.op == Op::MetalnessToDiffuseF0 || n.op == Op::HazinessToSecondRoughness ||
+                                n.op == Op::TransmittanceToMfp || n.op == Op::ThinFilm)) {
+    s += fmt::format("[{}]", n.attr);
+  }
+  s += "(";
+  for (int i = 0; i < n.argCount; ++i) s += (i ? ", " : "") + renderValue(m, n.args[i], budget - 1);
+  return s + ")";
+}
+
+std::vector<int> slabsInTreeOrder(const Material& m) {
+  std::vector<int> out;
+  if (m.root < 0) return out;
+  std::vector<int> stack{m.root};
+  while (!stack.empty()) {
+    int i = stack.back();
+    stack.pop_back();
+    const TreeNode& n = m.nodes[i];
+    if (n.op == TreeOp::Slab) {
+      out.push_back(n.slab);
+      continue;
+    }
+    if (n.right >= 0) stack.push_back(n.right);
+    if (n.left >= 0) stack.push_back(n.left);
+  }
+  return out;
+}
+
+}  // namespace substratec

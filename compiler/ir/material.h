@@ -1,0 +1,139 @@
+// The material IR: settings, inputs, the value DAG and the Substrate tree,
+// plus what the analysis passes attach to it (features, bases, culling notes).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ir/value.h"
+
+namespace substratec {
+
+enum class BlendMode : std::uint8_t {
+  Opaque, Masked, TranslucentGrey, TranslucentColored, ColoredTransmittanceOnly, AlphaHoldout
+};
+std::string_view blendModeName(BlendMode m);
+
+struct Settings {
+  int bytesPerPixel = 80;
+  int maxClosures = 8;
+  bool thinSurface = false;
+  double surfaceThickness = 0.0001;
+  BlendMode blendMode = BlendMode::Opaque;
+};
+
+struct Input {
+  std::string name;
+  VType type = VType::Float;
+  bool isColor = false;
+  std::array<double, 4> defaultValue{0, 0, 0, 0};
+  std::optional<std::array<double, 4>> min, max;  // per component
+  std::string pointer;
+};
+
+/// Slab pins, in the format's order. Every pin always has a value (absent
+/// pins get their default), so analyses never special-case "missing".
+enum class SlabPin : std::uint8_t {
+  DiffuseAlbedo, F0, F90, Roughness, Anisotropy, Normal, Tangent, SssMfp, SssMfpScale,
+  SssPhaseAnisotropy, Emissive, SecondRoughness, SecondRoughnessWeight, FuzzAmount, FuzzColor,
+  FuzzRoughness, GlintValue, GlintUv, Count_
+};
+inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
+
+struct SlabPinInfo {
+  std::string_view name;
+  VType type;
+  bool color;          // a Float broadcasts to grey
+  double defaultValue; // for constant defaults (geometry defaults use `geometryDefault`)
+  int geometryDefault; // -1 or a GeometryAttr
+  double lo, hi;       // legal range of literal values
+};
+const SlabPinInfo& slabPinInfo(SlabPin p);
+std::optional<SlabPin> slabPinByName(std::string_view name);
+
+enum class SssType : std::uint8_t { None, Wrap, Diffusion, SimpleVolume };
+std::string_view sssTypeName(SssType t);
+
+/// Opt-in features (bit flags). A feature is *used* when its gate pin is not a
+/// constant equal to the neutral default (see passes/features.h).
+enum Feature : std::uint16_t {
+  kFeatF90 = 1 << 0,
+  kFeatAnisotropy = 1 << 1,
+  kFeatSss = 1 << 2,      // subsurface medium stored for lighting (bottom slabs)
+  kFeatHaze = 1 << 3,     // second roughness lobe
+  kFeatFuzz = 1 << 4,
+  kFeatGlint = 1 << 5,
+  kFeatSpecularProfile = 1 << 6,
+  kFeatEmissive = 1 << 7,
+  kFeatMedium = 1 << 8,   // a coating slab's medium (MFP): drives transmittance only
+};
+inline constexpr int kFeatureCount = 9;
+std::string_view featureName(int bit);  // scene/report names: "f90", "anisotropy", ...
+
+struct Slab {
+  std::string id;       // source node id (with instance suffix when instanced twice)
+  std::string pointer;  // JSON pointer of the slab node
+  std::array<ValueId, kSlabPinCount> pins{};
+  int specularProfileInput = -1;  // input index of the LUT texture, or -1
+  SssType sssType = SssType::None;
+  bool sssTypeExplicit = false;
+  std::uint16_t features = 0;     // filled by the feature pass
+  int basis = -1;                 // filled by the shared-bases pass
+
+  ValueId pin(SlabPin p) const { return pins[static_cast<int>(p)]; }
+  ValueId& pin(SlabPin p) { return pins[static_cast<int>(p)]; }
+};
+
+enum class TreeOp : std::uint8_t { Slab, Horizontal, Vertical, Add, CoverageWeight, Select };
+std::string_view treeOpName(TreeOp op);
+
+/// One node of the Substrate tree. Operands: Horizontal (left = background,
+/// right = foreground, a = mix), Vertical (left = top, right = base,
+/// a = thickness), Add (left, right), CoverageWeight (left, a = weight),
+/// Select (left = a, right = b, a = value, b = threshold).
+struct TreeNode {
+  TreeOp op = TreeOp::Slab;
+  int left = -1, right = -1;
+  ValueId a = kNoValue, b = kNoValue;
+  int slab = -1;        // index into Material::slabs (Slab nodes)
+  std::string id;       // source node id (instance-suffixed), for names and reports
+  std::string pointer;  // JSON pointer of the source node
+};
+
+struct Basis {
+  ValueId normal = kNoValue;
+  ValueId tangent = kNoValue;  // kNoValue when every slab on it is isotropic
+  std::vector<int> slabs;
+};
+
+struct CullNote {
+  std::string what;  // node id
+  std::string why;
+};
+
+struct Material {
+  std::string file;  // as given (for diagnostics)
+  std::string name;
+  Settings settings;
+  std::vector<Input> inputs;
+  ValueDag values;
+  std::vector<Slab> slabs;
+  std::vector<TreeNode> nodes;  // arena; unreachable entries are ignored after culling
+  int root = -1;
+  std::vector<Basis> bases;
+  std::vector<CullNote> culled;
+
+  int inputIndex(std::string_view name) const;
+};
+
+/// Rendering of a value for dumps: constants, input names, op trees (bounded).
+std::string renderValue(const Material& m, ValueId v, int budget = 5);
+
+/// Slab indices in tree pre-order (left before right): the BSDF order used by
+/// reports, storage and generated code.
+std::vector<int> slabsInTreeOrder(const Material& m);
+
+}  // namespace substratec

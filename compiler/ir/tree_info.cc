@@ -1,0 +1,109 @@
+#include "ir/tree_info.h"
+
+#include <algorithm>
+
+namespace substratec {
+
+TreeInfo analyzeTree(const Material& m) {
+  TreeInfo t;
+  const std::size_t n = m.nodes.size();
+  t.reportId.assign(n, -1);
+  t.parent.assign(n, -1);
+  t.distanceFromLeaves.assign(n, 0);
+  t.depth.assign(n, 0);
+  t.layerDepth.assign(n, 0);
+  t.isTop.assign(n, false);
+  t.isBottom.assign(n, false);
+  t.unitWeight.assign(n, false);
+  t.unitCoverageAbove.assign(n, false);
+  t.unitCoverage.assign(n, false);
+  t.bsdfId.assign(m.slabs.size(), -1);
+  if (m.root < 0) return t;
+
+  // Pre-order with the facts that flow down from the root.
+  struct Item {
+    int node;
+    int parent;
+    int depth;
+    int layerDepth;
+    bool onTopSide;   // some ancestor vertical has this subtree as its top
+    bool unit;        // every weight on the path so far is exactly 1
+    bool coverAbove;  // every layer above has coverage exactly 1
+  };
+  // Static coverage first (children before parents): the coverage of a subtree
+  // is 1 for a slab and stays 1 through operators whose rule keeps it there.
+  {
+    std::vector<int> order;
+    std::vector<int> st{m.root};
+    while (!st.empty()) {
+      int i = st.back();
+      st.pop_back();
+      order.push_back(i);
+      if (m.nodes[i].left >= 0) st.push_back(m.nodes[i].left);
+      if (m.nodes[i].right >= 0) st.push_back(m.nodes[i].right);
+    }
+    for (auto it = order.rbegin(); it != order.rend(); ++it) {
+      const TreeNode& node = m.nodes[*it];
+      auto c = [&](int k) { return k >= 0 && t.unitCoverage[k]; };
+      bool one = false;
+      switch (node.op) {
+        case TreeOp::Slab: one = true; break;
+        case TreeOp::CoverageWeight: one = c(node.left) && m.values.isConstEqual(node.a, 1); break;
+        case TreeOp::Horizontal:
+        case TreeOp::Select: one = c(node.left) && c(node.right); break;   // (1-w)*1 + w*1
+        case TreeOp::Add:
+        case TreeOp::Vertical: one = c(node.left) || c(node.right); break; // sat(a+1), Ct + 1*(1-Ct)
+      }
+      t.unitCoverage[*it] = one;
+    }
+  }
+  std::vector<Item> stack{{m.root, -1, 0, 0, false, true, true}};
+  while (!stack.empty()) {
+    Item it = stack.back();
+    stack.pop_back();
+    const TreeNode& node = m.nodes[it.node];
+    t.reportId[it.node] = static_cast<int>(t.preorder.size());
+    t.preorder.push_back(it.node);
+    t.parent[it.node] = it.parent;
+    t.depth[it.node] = it.depth;
+    t.layerDepth[it.node] = it.layerDepth;
+    if (node.op == TreeOp::Slab) {
+      t.isTop[it.node] = it.layerDepth == 0;
+      t.isBottom[it.node] = !it.onTopSide;
+      t.unitWeight[it.node] = it.unit;
+      t.unitCoverageAbove[it.node] = it.coverAbove;
+      t.bsdfId[node.slab] = static_cast<int>(t.slabOrder.size());
+      t.slabOrder.push_back(node.slab);
+      continue;
+    }
+    Item l{node.left, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove};
+    Item r{node.right, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove};
+    switch (node.op) {
+      case TreeOp::Vertical:
+        l.onTopSide = true;           // the top has a layer below it
+        r.layerDepth += 1;            // the base is under one more layer
+        r.coverAbove = it.coverAbove && t.unitCoverage[node.left];
+        break;
+      case TreeOp::Horizontal:
+      case TreeOp::CoverageWeight:
+      case TreeOp::Select:
+        l.unit = r.unit = false;      // weighted by a run-time value
+        break;
+      default: break;                 // Add keeps both sides at full weight
+    }
+    if (node.right >= 0) stack.push_back(r);
+    if (node.left >= 0) stack.push_back(l);
+  }
+  // Distance from leaves: reverse pre-order visits children before parents.
+  for (auto it = t.preorder.rbegin(); it != t.preorder.rend(); ++it) {
+    const TreeNode& node = m.nodes[*it];
+    int d = 0;
+    if (node.left >= 0) d = std::max(d, t.distanceFromLeaves[node.left] + 1);
+    if (node.right >= 0) d = std::max(d, t.distanceFromLeaves[node.right] + 1);
+    t.distanceFromLeaves[*it] = d;
+  }
+  t.maxDistanceFromLeaves = t.distanceFromLeaves[m.root];
+  return t;
+}
+
+}  // namespace substratec

@@ -1,0 +1,31 @@
+// Structural facts about the Substrate tree that several passes and the
+// report need: parents, pre-order ids, distance from leaves, layer depth,
+// top/bottom flags, and whether a slab's view throughput is statically 1.
+#pragma once
+#include <vector>
+
+#include "ir/material.h"
+
+namespace substratec {
+
+struct TreeInfo {
+  std::vector<int> preorder;     // reachable node indices, root first, left before right
+  std::vector<int> reportId;     // node index -> pre-order id (-1 if unreachable)
+  std::vector<int> parent;       // node index -> parent node index (-1 for root)
+  std::vector<int> distanceFromLeaves;
+  std::vector<int> depth;        // distance from the root
+  std::vector<int> layerDepth;   // number of vertical "base" edges above
+  std::vector<bool> isTop;       // slabs: nothing layered above (layerDepth == 0)
+  std::vector<bool> isBottom;    // slabs: nothing layered below (never a vertical top)
+  std::vector<bool> unitWeight;  // slabs: the mix/coverage weights on the path to the
+                                 // root are statically 1 (transmittance not included)
+  std::vector<bool> unitCoverageAbove;  // slabs: every layer above has coverage statically 1
+  std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
+  std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order)
+  std::vector<int> bsdfId;       // slab index -> position in slabOrder
+  int maxDistanceFromLeaves = 0;
+};
+
+TreeInfo analyzeTree(const Material& m);
+
+}  // namespace substratec

@@ -1,0 +1,120 @@
+#include "passes/build_tree.h"
+
+#include <unordered_set>
+
+#include <fmt/format.h>
+
+namespace substratec {
+
+namespace {
+
+class TreeBuilder {
+ public:
+  TreeBuilder(const ResolvedDoc& doc, const ValueTable& table, Material& m)
+      : doc_(doc), table_(table), m_(m) {
+    // Every user-visible id is reserved so generated instance names never clash.
+    for (const auto& s : doc.substrate) used_.insert(s.id);
+    for (const auto& v : doc.values) used_.insert(v.id);
+    for (const auto& in : doc.inputs) used_.insert(in.name);
+  }
+
+  int instance(int s) {
+    const SNode& src = doc_.substrate[s];
+    TreeNode node;
+    node.op = src.op;
+    node.pointer = src.pointer;
+    node.id = uniqueId(src.id);
+    int index = static_cast<int>(m_.nodes.size());
+    m_.nodes.push_back(node);
+    if (src.op == TreeOp::Slab) {
+      Slab slab;
+      slab.id = m_.nodes[index].id;
+      slab.pointer = src.pointer;
+      for (int p = 0; p < kSlabPinCount; ++p) {
+        const SlabPinInfo& info = slabPinInfo(static_cast<SlabPin>(p));
+        slab.pins[p] = pinToValue(src.slabPins[p], info.type, table_, m_);
+      }
+      slab.specularProfileInput = src.specularProfileInput;
+      slab.sssType = src.sssType;
+      slab.sssTypeExplicit = src.sssTypeExplicit;
+      m_.nodes[index].slab = static_cast<int>(m_.slabs.size());
+      m_.slabs.push_back(std::move(slab));
+      return index;
+    }
+    auto value = [&](const PinRef& p) { return pinToValue(p, VType::Float, table_, m_); };
+    ValueId a = src.op == TreeOp::Add ? kNoValue : value(src.a);
+    ValueId b = src.op == TreeOp::Select ? value(src.b) : kNoValue;
+    int left = src.left >= 0 ? instance(src.left) : -1;
+    int right = src.right >= 0 ? instance(src.right) : -1;
+    TreeNode& n = m_.nodes[index];
+    n.left = left;
+    n.right = right;
+    n.a = a;
+    n.b = b;
+    return index;
+  }
+
+ private:
+  std::string uniqueId(const std::string& base) {
+    auto& count = seen_[base];
+    ++count;
+    if (count == 1) {
+      generated_.insert(base);
+      return base;
+    }
+    for (int k = count;; ++k) {
+      std::string candidate = fmt::format("{}_{}", base, k);
+      if (!used_.count(candidate) && !generated_.count(candidate)) {
+        generated_.insert(candidate);
+        count = k;
+        return candidate;
+      }
+    }
+  }
+
+  const ResolvedDoc& doc_;
+  const ValueTable& table_;
+  Material& m_;
+  std::unordered_set<std::string> used_, generated_;
+  std::unordered_map<std::string, int> seen_;
+};
+
+}  // namespace
+
+bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Material& m, Diagnostics& diags,
+                        const TreeLimits& limits) {
+  if (doc.output < 0) return false;
+  // Instance count per Substrate node (iterative post-order; saturating), so a
+  // small DAG that would instance into a huge tree is rejected before any work.
+  const std::size_t cap = limits.maxTreeNodes + 1;
+  std::vector<std::size_t> size(doc.substrate.size(), 0);
+  std::vector<std::pair<int, bool>> stack{{doc.output, false}};
+  while (!stack.empty()) {
+    auto [s, expanded] = stack.back();
+    stack.pop_back();
+    if (size[s]) continue;
+    const SNode& n = doc.substrate[s];
+    if (!expanded) {
+      stack.push_back({s, true});
+      if (n.left >= 0 && !size[n.left]) stack.push_back({n.left, false});
+      if (n.right >= 0 && !size[n.right]) stack.push_back({n.right, false});
+      continue;
+    }
+    std::size_t total = 1;
+    if (n.left >= 0) total += size[n.left];
+    if (n.right >= 0) total += size[n.right];
+    size[s] = std::min(total, cap);
+  }
+  if (size[doc.output] > limits.maxTreeNodes) {
+    diags.error(doc.substrate[doc.output].pointer,
+                fmt::format("the Substrate tree would have more than {} nodes after instancing (a node "
+                            "referenced twice is instanced twice); this is the tree-size limit",
+                            limits.maxTreeNodes));
+    return false;
+  }
+  TreeBuilder builder(doc, table, m);
+  m.root = builder.instance(doc.output);
+  return true;
+}
+
+}  // namespace substratec

@@ -1,0 +1,1363 @@
+#include "passes/resolve.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <set>
+#include <unordered_map>
+#include <unordered_set>
+
+#include <fmt/format.h>
+
+namespace substratec {
+
+namespace {
+
+// ---------------------------------------------------------------------------
+// Tables: value node kinds and their pins.
+
+enum class PinKind : std::uint8_t {
+  Value,      // any value (math ops: types checked by the op's rule)
+  Float,      // a scalar value
+  Color,      // vec3, a Float broadcasts to grey
+  Vec3,       // a direction/vector, exactly vec3
+  Vec2,       // exactly vec2
+  TextureRef, // "$name" of a texture2d input
+  Attribute,  // geometry attribute name
+  Channels,   // swizzle channel string
+};
+
+struct PinSpec {
+  const char* name;
+  PinKind kind;
+  bool required;
+  double def;       // default for optional scalar/colour pins
+  int geoDefault;   // GeometryAttr default, or -1
+};
+
+struct OpSpec {
+  const char* kind;
+  Op op;
+  std::vector<PinSpec> pins;
+  std::vector<const char*> outputs;  // empty: a single unnamed output
+};
+
+constexpr int G_N = static_cast<int>(GeometryAttr::Normal);
+constexpr int G_UV0 = static_cast<int>(GeometryAttr::Uv0);
+
+const std::vector<OpSpec>& opSpecs() {
+  static const std::vector<OpSpec> specs = [] {
+    std::vector<OpSpec> v;
+    auto binary = [&](const char* k, Op op) {
+      v.push_back({k, op, {{"a", PinKind::Value, true, 0, -1}, {"b", PinKind::Value, true, 0, -1}}, {}});
+    };
+    auto unary = [&](const char* k, Op op) {
+      v.push_back({k, op, {{"x", PinKind::Value, true, 0, -1}}, {}});
+    };
+    v.push_back({"geometry", Op::Geometry, {{"attribute", PinKind::Attribute, true, 0, -1}}, {}});
+    v.push_back({"texture",
+                 Op::Sample,
+                 {{"texture", PinKind::TextureRef, true, 0, -1}, {"uv", PinKind::Vec2, false, 0, G_UV0}},
+                 {"rgb", "r", "g", "b", "a"}});
+    binary("add", Op::Add);
+    binary("subtract", Op::Subtract);
+    binary("multiply", Op::Multiply);
+    binary("divide", Op::Divide);
+    binary("min", Op::Min);
+    binary("max", Op::Max);
+    v.push_back({"lerp", Op::Lerp,
+                 {{"a", PinKind::Value, true, 0, -1}, {"b", PinKind::Value, true, 0, -1},
+                  {"t", PinKind::Value, true, 0, -1}}, {}});
+    v.push_back({"clamp", Op::Clamp,
+                 {{"x", PinKind::Value, true, 0, -1}, {"lo", PinKind::Value, true, 0, -1},
+                  {"hi", PinKind::Value, true, 0, -1}}, {}});
+    unary("saturate", Op::Saturate);
+    unary("one_minus", Op::OneMinus);
+    unary("abs", Op::Abs);
+    unary("sqrt", Op::Sqrt);
+    unary("normalize", Op::Normalize);
+    unary("length", Op::Length);
+    v.push_back({"pow", Op::Pow, {{"x", PinKind::Value, true, 0, -1}, {"y", PinKind::Value, true, 0, -1}}, {}});
+    v.push_back({"dot", Op::Dot, {{"a", PinKind::Value, true, 0, -1}, {"b", PinKind::Value, true, 0, -1}}, {}});
+    v.push_back({"swizzle", Op::Swizzle,
+                 {{"x", PinKind::Value, true, 0, -1}, {"channels", PinKind::Channels, true, 0, -1}}, {}});
+    v.push_back({"combine", Op::Combine,
+                 {{"x", PinKind::Float, true, 0, -1}, {"y", PinKind::Float, true, 0, -1},
+                  {"z", PinKind::Float, false, 0, -1}, {"w", PinKind::Float, false, 0, -1}}, {}});
+    v.push_back({"metalness_to_diffuse_f0", Op::MetalnessToDiffuseF0,
+                 {{"base_color", PinKind::Color, false, 0.18, -1}, {"metallic", PinKind::Float, false, 0, -1},
+                  {"specular", PinKind::Float, false, 0.5, -1}},
+                 {"diffuse_albedo", "f0"}});
+    v.push_back({"ior_to_f0", Op::IorToF0, {{"ior", PinKind::Float, false, 1.5, -1}}, {}});
+    v.push_back({"haziness_to_second_roughness", Op::HazinessToSecondRoughness,
+                 {{"roughness", PinKind::Float, false, 0.5, -1}, {"haziness", PinKind::Float, false, 0, -1}},
+                 {"second_roughness", "second_roughness_weight"}});
+    v.push_back({"transmittance_to_mfp", Op::TransmittanceToMfp,
+                 {{"transmittance", PinKind::Color, false, 0.5, -1},
+                  {"thickness", PinKind::Float, false, 0.0001, -1}},
+                 {"mfp", "thickness"}});
+    v.push_back({"thin_film", Op::ThinFilm,
+                 {{"normal", PinKind::Vec3, false, 0, G_N}, {"f0", PinKind::Color, false, 0.04, -1},
+                  {"f90", PinKind::Color, false, 1.0, -1}, {"thickness", PinKind::Float, false, 0, -1},
+                  {"ior", PinKind::Float, false, 1.5, -1}},
+                 {"f0", "f90"}});
+    v.push_back({"rotation_to_tangent", Op::RotationToTangent,
+                 {{"angle", PinKind::Float, false, 0, -1}, {"normal", PinKind::Vec3, false, 0, G_N}}, {}});
+    v.push_back({"view_dependent_coverage", Op::ViewDependentCoverage,
+                 {{"coverage", PinKind::Float, false, 1, -1}, {"normal", PinKind::Vec3, false, 0, G_N}}, {}});
+    return v;
+  }();
+  return specs;
+}
+
+const OpSpec* findOpSpec(const std::string& kind) {
+  for (const auto& s : opSpecs())
+    if (kind == s.kind) return &s;
+  return nullptr;
+}
+
+std::optional<TreeOp> substrateKind(const std::string& kind) {
+  if (kind == "slab") return TreeOp::Slab;
+  if (kind == "horizontal") return TreeOp::Horizontal;
+  if (kind == "vertical") return TreeOp::Vertical;
+  if (kind == "coverage_weight") return TreeOp::CoverageWeight;
+  if (kind == "select") return TreeOp::Select;
+  return std::nullopt;  // "add" is decided by its operands
+}
+
+const char* const kReserved[] = {
+    // C / C++
+    "auto", "break", "case", "char", "const", "continue", "default", "do", "double", "else", "enum",
+    "extern", "float", "for", "goto", "if", "inline", "int", "long", "register", "restrict",
+    "return", "short", "signed", "sizeof", "static", "struct", "switch", "typedef", "union",
+    "unsigned", "void", "volatile", "while", "bool", "true", "false", "class", "namespace",
+    "template", "this", "new", "delete", "main",
+    // GLSL
+    "attribute", "uniform", "varying", "layout", "centroid", "flat", "smooth", "noperspective",
+    "patch", "sample", "buffer", "shared", "coherent", "readonly", "writeonly", "precise", "in",
+    "out", "inout", "lowp", "mediump", "highp", "precision", "invariant", "discard", "subroutine",
+    "uint", "vec2", "vec3", "vec4", "ivec2", "ivec3", "ivec4", "uvec2", "uvec3", "uvec4", "bvec2",
+    "bvec3", "bvec4", "dvec2", "dvec3", "dvec4", "mat2", "mat3", "mat4", "sampler2D", "texture",
+    "image2D", "input", "output", "filter", "common", "partition", "active", "asm", "fixed",
+    "half", "hvec2", "hvec3", "hvec4", "superp", "cast", "using", "public", "static_assert",
+    "demote", "terminateInvocation",
+    // HLSL
+    "float2", "float3", "float4", "float3x3", "float4x4", "half2", "half3", "half4", "int2",
+    "int3", "int4", "uint2", "uint3", "uint4", "cbuffer", "tbuffer", "Texture2D", "SamplerState",
+    "groupshared", "nointerpolation", "linear", "centroid", "row_major", "column_major", "snorm",
+    "unorm", "technique", "pass", "string", "matrix", "vector", "register", "packoffset",
+    "globallycoherent", "export", "typename", "lerp", "saturate", "mix", "clamp", "dot", "pow",
+    "sqrt", "abs", "min", "max", "length", "normalize"};
+
+}  // namespace
+
+bool isUsableIdentifier(const std::string& s, std::size_t maxBytes) {
+  if (s.empty() || s.size() > maxBytes) return false;
+  auto alpha = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
+  if (!alpha(s[0])) return false;
+  for (char c : s)
+    if (!alpha(c) && !(c >= '0' && c <= '9')) return false;
+  if (s.find("__") != std::string::npos) return false;  // reserved in GLSL and C++
+  if (s.rfind("gl_", 0) == 0 || s.rfind("spvc_", 0) == 0) return false;
+  for (const char* r : kReserved)
+    if (s == r) return false;
+  return true;
+}
+
+namespace {
+
+std::string kindOfJson(const Json& j) {
+  switch (j.type()) {
+    case Json::value_t::null: return "null";
+    case Json::value_t::boolean: return j.get<bool>() ? "true" : "false";
+    case Json::value_t::string: return quoteForDiagnostic(j.get<std::string>());
+    case Json::value_t::array: return fmt::format("an array of {}", j.size());
+    case Json::value_t::object: return "an object";
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned:
+    case Json::value_t::number_float: return fmt::format("{:g}", j.get<double>());
+    default: return "a value";
+  }
+}
+
+std::string typeWord(VType t, bool color) {
+  if (color && t == VType::Vec3) return "color";
+  return std::string(typeName(t));
+}
+
+// ---------------------------------------------------------------------------
+
+class Resolver {
+ public:
+  Resolver(const Json& doc, Diagnostics& diags, const ResolveLimits& limits)
+      : doc_(doc), d_(diags), limits_(limits) {}
+
+  std::optional<ResolvedDoc> run();
+
+ private:
+  // --- top level
+  void readTop();
+  void readSettings(const Json& s, const std::string& ptr);
+  void readInputs(const Json& s, const std::string& ptr);
+  void classifyNodes();
+  int resolveValueNode(const std::string& id);
+  int resolveSubstrateNode(const std::string& id);
+
+  // --- values
+  PinRef readValuePin(const Json& j, const std::string& ptr, const std::string& pinName);
+  int makeInlineValueNode(const Json& j, const std::string& ptr);
+  void readValueNodeBody(int index, const Json& j, const std::string& ptr, const OpSpec& spec);
+  bool expectPinType(PinRef& pin, PinKind kind, const std::string& ptr, bool* color = nullptr);
+  PinRef defaultPin(const PinSpec& ps);
+
+  // --- substrate
+  int readSubstratePin(const Json& j, const std::string& ptr, const std::string& nameForInline);
+  void fillSubstrateNode(int index, const Json& j, const std::string& ptr, TreeOp op);
+  bool isSubstrateValue(const Json& j) const;
+  void checkRange(const PinRef& pin, const Json& j, const std::string& ptr, double lo, double hi,
+                  const char* what);
+
+  // --- typing and cycles
+  void typeValueNodes();
+  void checkSubstrateCycles();
+
+  bool isValueKindName(const std::string& id) const {
+    auto it = namedKind_.find(id);
+    return it != namedKind_.end() && it->second == 1;
+  }
+  bool isSubstrateName(const std::string& id) const {
+    auto it = namedKind_.find(id);
+    return it != namedKind_.end() && it->second == 2;
+  }
+  bool budget() {
+    if (++nodeCount_ > limits_.maxNodes) {
+      if (!nodeLimitReported_) {
+        d_.error("/nodes", fmt::format("material has more than {} nodes (the limit)", limits_.maxNodes));
+        nodeLimitReported_ = true;
+      }
+      return false;
+    }
+    return true;
+  }
+
+  const Json& doc_;
+  Diagnostics& d_;
+  ResolveLimits limits_;
+  ResolvedDoc out_;
+  const Json* nodes_ = nullptr;
+  std::unordered_map<std::string, int> inputIndex_;
+  std::unordered_map<std::string, const Json*> namedJson_;
+  std::unordered_map<std::string, int> namedKind_;   // 1 value, 2 substrate, 0 invalid
+  std::unordered_map<std::string, int> namedValue_;  // id -> VNode index (-1 while resolving)
+  std::unordered_map<std::string, int> namedSubstrate_;
+  std::size_t nodeCount_ = 0;
+  bool nodeLimitReported_ = false;
+  std::string outputId_;
+};
+
+std::optional<ResolvedDoc> Resolver::run() {
+  if (!doc_.is_object()) {
+    d_.error("", fmt::format("expected the material object at the top level, got {}", kindOfJson(doc_)));
+    return std::nullopt;
+  }
+  readTop();
+  if (d_.limitReached()) return std::nullopt;
+  typeValueNodes();
+  checkSubstrateCycles();
+  if (d_.hasErrors()) return std::nullopt;
+  return std::move(out_);
+}
+
+void Resolver::readTop() {
+  static const std::set<std::string> known = {"$schema", "format", "name", "settings",
+                                              "inputs", "nodes", "output", "description"};
+  for (auto it = doc_.begin(); it != doc_.end(); ++it)
+    if (!known.count(it.key()))
+      d_.error("/" + pointerToken(it.key()),
+               fmt::format("unknown key {} (expected one of: format, name, settings, inputs, nodes, output)",
+                           quoteForDiagnostic(it.key())));
+
+  auto fmtIt = doc_.find("format");
+  if (fmtIt == doc_.end()) {
+    d_.error("", "missing required key \"format\" (expected \"substrate-material/1\")");
+  } else if (!fmtIt->is_string() || fmtIt->get<std::string>() != "substrate-material/1") {
+    d_.error("/format", fmt::format("expected \"substrate-material/1\", got {}", kindOfJson(*fmtIt)));
+  }
+  if (auto it = doc_.find("$schema"); it != doc_.end() && !it->is_string())
+    d_.error("/$schema", "expected a string");
+  if (auto it = doc_.find("description"); it != doc_.end() && !it->is_string())
+    d_.error("/description", "expected a string");
+
+  auto nameIt = doc_.find("name");
+  if (nameIt == doc_.end()) {
+    d_.error("", "missing required key \"name\"");
+  } else if (!nameIt->is_string()) {
+    d_.error("/name", fmt::format("expected a C identifier string, got {}", kindOfJson(*nameIt)));
+  } else if (!isUsableIdentifier(nameIt->get<std::string>(), limits_.maxIdentifierBytes)) {
+    d_.error("/name", fmt::format("{} is not usable as a name: it must be a C identifier of at most {} "
+                                  "bytes, without \"__\", and not a C/GLSL/HLSL keyword",
+                                  quoteForDiagnostic(nameIt->get<std::string>()), limits_.maxIdentifierBytes));
+  } else {
+    out_.name = nameIt->get<std::string>();
+  }
+
+  if (auto it = doc_.find("settings"); it != doc_.end()) readSettings(*it, "/settings");
+  if (auto it = doc_.find("inputs"); it != doc_.end()) readInputs(*it, "/inputs");
+
+  auto nodesIt = doc_.find("nodes");
+  if (nodesIt == doc_.end()) {
+    d_.error("", "missing required key \"nodes\"");
+  } else if (!nodesIt->is_object()) {
+    d_.error("/nodes", fmt::format("expected an object of nodes keyed by id, got {}", kindOfJson(*nodesIt)));
+  } else {
+    nodes_ = &*nodesIt;
+  }
+
+  auto outIt = doc_.find("output");
+  if (outIt == doc_.end()) {
+    d_.error("", "missing required key \"output\" (the id of the root Substrate node)");
+  } else if (!outIt->is_string()) {
+    d_.error("/output", fmt::format("expected a Substrate node id, got {}", kindOfJson(*outIt)));
+  } else {
+    outputId_ = outIt->get<std::string>();
+  }
+
+  if (!nodes_) return;
+  classifyNodes();
+  // Every named node gets its index first, so that references never recurse
+  // (a chain of 100k named nodes must not deepen the stack); then each body
+  // is read, in file order, so unused nodes are checked too.
+  for (auto it = nodes_->begin(); it != nodes_->end(); ++it) {
+    const std::string& id = it.key();
+    std::string p = "/nodes/" + pointerToken(id);
+    if (isValueKindName(id)) {
+      if (!budget()) return;
+      namedValue_[id] = static_cast<int>(out_.values.size());
+      out_.values.emplace_back();
+      out_.values.back().id = id;
+      out_.values.back().pointer = p;
+    } else if (isSubstrateName(id)) {
+      if (!budget()) return;
+      namedSubstrate_[id] = static_cast<int>(out_.substrate.size());
+      out_.substrate.emplace_back();
+      out_.substrate.back().id = id;
+      out_.substrate.back().pointer = p;
+    }
+  }
+  for (auto it = nodes_->begin(); it != nodes_->end(); ++it) {
+    if (d_.limitReached()) return;
+    const std::string& id = it.key();
+    std::string p = "/nodes/" + pointerToken(id);
+    std::string kind = isValueKindName(id) || isSubstrateName(id) ? (*it)["kind"].get<std::string>() : "";
+    if (isValueKindName(id)) {
+      const OpSpec* spec = findOpSpec(kind);
+      int index = namedValue_[id];
+      out_.values[index].op = spec->op;
+      readValueNodeBody(index, *it, p, *spec);
+    } else if (isSubstrateName(id)) {
+      fillSubstrateNode(namedSubstrate_[id], *it, p, kind == "add" ? TreeOp::Add : *substrateKind(kind));
+    }
+  }
+  if (!outputId_.empty()) {
+    if (!namedKind_.count(outputId_)) {
+      if (inputIndex_.count(outputId_))
+        d_.error("/output", fmt::format("{} is an input, not a Substrate node", quoteForDiagnostic(outputId_)));
+      else
+        d_.error("/output", fmt::format("unknown node {}", quoteForDiagnostic(outputId_)));
+    } else if (isValueKindName(outputId_)) {
+      d_.error("/output", fmt::format("{} is a value node; the output must be a Substrate node "
+                                      "(slab, horizontal, vertical, add, coverage_weight, select)",
+                                      quoteForDiagnostic(outputId_)));
+    } else if (isSubstrateName(outputId_)) {
+      out_.output = namedSubstrate_[outputId_];
+    }
+  }
+}
+
+void Resolver::readSettings(const Json& s, const std::string& ptr) {
+  if (!s.is_object()) {
+    d_.error(ptr, fmt::format("expected an object, got {}", kindOfJson(s)));
+    return;
+  }
+  Settings& st = out_.settings;
+  for (auto it = s.begin(); it != s.end(); ++it) {
+    const std::string& k = it.key();
+    const Json& v = *it;
+    std::string p = ptr + "/" + pointerToken(k);
+    auto intIn = [&](int lo, int hi, int& dst) {
+      if (!v.is_number() || (v.is_number_float() && v.get<double>() != std::floor(v.get<double>()))) {
+        d_.error(p, fmt::format("expected an integer in [{},{}], got {}", lo, hi, kindOfJson(v)));
+        return;
+      }
+      double x = v.get<double>();
+      if (x < lo || x > hi) {
+        d_.error(p, fmt::format("expected an integer in [{},{}], got {}", lo, hi, kindOfJson(v)));
+        return;
+      }
+      dst = static_cast<int>(x);
+    };
+    if (k == "bytes_per_pixel") {
+      intIn(8, 1024, st.bytesPerPixel);
+    } else if (k == "max_closures") {
+      intIn(1, 8, st.maxClosures);
+    } else if (k == "thin_surface") {
+      if (!v.is_boolean()) d_.error(p, fmt::format("expected true or false, got {}", kindOfJson(v)));
+      else st.thinSurface = v.get<bool>();
+    } else if (k == "surface_thickness") {
+      if (!v.is_number() || v.get<double>() < 0)
+        d_.error(p, fmt::format("expected a thickness in meters >= 0, got {}", kindOfJson(v)));
+      else st.surfaceThickness = v.get<double>();
+    } else if (k == "blend_mode") {
+      static const std::pair<const char*, BlendMode> modes[] = {
+          {"opaque", BlendMode::Opaque},
+          {"masked", BlendMode::Masked},
+          {"translucent_grey", BlendMode::TranslucentGrey},
+          {"translucent_colored", BlendMode::TranslucentColored},
+          {"colored_transmittance_only", BlendMode::ColoredTransmittanceOnly},
+          {"alpha_holdout", BlendMode::AlphaHoldout}};
+      bool found = false;
+      if (v.is_string())
+        for (auto& [n, m] : modes)
+          if (v.get<std::string>() == n) {
+            st.blendMode = m;
+            found = true;
+          }
+      if (!found)
+        d_.error(p, fmt::format("expected one of opaque, masked, translucent_grey, translucent_colored, "
+                                "colored_transmittance_only, alpha_holdout; got {}", kindOfJson(v)));
+    } else {
+      d_.error(p, fmt::format("unknown setting {} (expected bytes_per_pixel, max_closures, thin_surface, "
+                              "surface_thickness or blend_mode)", quoteForDiagnostic(k)));
+    }
+  }
+}
+
+void Resolver::readInputs(const Json& s, const std::string& ptr) {
+  if (!s.is_object()) {
+    d_.error(ptr, fmt::format("expected an object of inputs keyed by name, got {}", kindOfJson(s)));
+    return;
+  }
+  for (auto it = s.begin(); it != s.end(); ++it) {
+    const std::string& name = it.key();
+    std::string p = ptr + "/" + pointerToken(name);
+    const Json& v = *it;
+    if (!isUsableIdentifier(name, limits_.maxIdentifierBytes)) {
+      d_.error(p, fmt::format("input name {} is not usable: it must be a C identifier of at most {} bytes, "
+                              "without \"__\", and not a C/GLSL/HLSL keyword",
+                              quoteForDiagnostic(name), limits_.maxIdentifierBytes));
+      continue;
+    }
+    if (!v.is_object()) {
+      d_.error(p, fmt::format("expected an input object like {{\"type\": \"float\", \"default\": 0.5}}, got {}",
+                              kindOfJson(v)));
+      continue;
+    }
+    Input in;
+    in.name = name;
+    in.pointer = p;
+    bool ok = true;
+    auto t = v.find("type");
+    if (t == v.end() || !t->is_string()) {
+      d_.error(p + (t == v.end() ? "" : "/type"),
+               "expected \"type\": one of float, vec2, vec3, color, texture2d");
+      continue;
+    }
+    std::string ts = t->get<std::string>();
+    if (ts == "float") in.type = VType::Float;
+    else if (ts == "vec2") in.type = VType::Vec2;
+    else if (ts == "vec3") in.type = VType::Vec3;
+    else if (ts == "color") { in.type = VType::Vec3; in.isColor = true; }
+    else if (ts == "texture2d") in.type = VType::Texture;
+    else {
+      d_.error(p + "/type", fmt::format("unknown input type {} (expected float, vec2, vec3, color or texture2d)",
+                                        quoteForDiagnostic(ts)));
+      continue;
+    }
+    for (auto k = v.begin(); k != v.end(); ++k) {
+      const std::string& key = k.key();
+      std::string kp = p + "/" + pointerToken(key);
+      if (key == "type" || key == "description") {
+        if (key == "description" && !k->is_string()) d_.error(kp, "expected a string");
+        continue;
+      }
+      if (key == "colorspace") {
+        if (in.type != VType::Texture) d_.error(kp, "\"colorspace\" applies to texture2d inputs only");
+        else if (!k->is_string() || (k->get<std::string>() != "srgb" && k->get<std::string>() != "linear"))
+          d_.error(kp, fmt::format("expected \"srgb\" or \"linear\", got {}", kindOfJson(*k)));
+        continue;
+      }
+      if (key == "min" || key == "max") {
+        // A number bounds every component; an array bounds each component.
+        auto& dst = key == "min" ? in.min : in.max;
+        int n = componentCount(in.type);
+        if (in.type == VType::Texture) {
+          d_.error(kp, fmt::format("\"{}\" does not apply to a texture2d input", key));
+          ok = false;
+        } else if (k->is_number()) {
+          double x = k->get<double>();
+          dst = std::array<double, 4>{x, x, x, x};
+        } else if (k->is_array() && static_cast<int>(k->size()) == n && n > 1 &&
+                   std::all_of(k->begin(), k->end(), [](const Json& e) { return e.is_number(); })) {
+          std::array<double, 4> a{0, 0, 0, 0};
+          for (int i = 0; i < n; ++i) a[i] = (*k)[i].get<double>();
+          dst = a;
+        } else {
+          d_.error(kp, fmt::format("expected a number{}, got {}", n > 1 ? fmt::format(" or {} numbers", n) : "",
+                                   kindOfJson(*k)));
+          ok = false;
+        }
+        continue;
+      }
+      if (key == "default") {
+        if (in.type == VType::Texture) {
+          d_.error(kp, "a texture2d input has no default (it is bound at run time)");
+          ok = false;
+          continue;
+        }
+        int n = componentCount(in.type);
+        if (k->is_number() && (n == 1 || in.isColor)) {
+          double x = k->get<double>();
+          in.defaultValue = {x, x, x, 0};
+        } else if (k->is_array() && static_cast<int>(k->size()) == n && n > 1 &&
+                   std::all_of(k->begin(), k->end(), [](const Json& e) { return e.is_number(); })) {
+          for (int i = 0; i < n; ++i) in.defaultValue[i] = (*k)[i].get<double>();
+        } else {
+          d_.error(kp, fmt::format("expected a {} default ({}), got {}", typeWord(in.type, in.isColor),
+                                   n == 1 ? "a number" : fmt::format("an array of {} numbers", n),
+                                   kindOfJson(*k)));
+          ok = false;
+        }
+        continue;
+      }
+      d_.error(kp, fmt::format("unknown input key {} (expected type, default, min, max, description)",
+                               quoteForDiagnostic(key)));
+    }
+    if (in.type != VType::Texture && !v.contains("default")) {
+      d_.error(p, fmt::format("missing \"default\" for {} input", typeWord(in.type, in.isColor)));
+      ok = false;
+    }
+    for (int i = 0; in.min && in.max && i < componentCount(in.type); ++i) {
+      if ((*in.min)[i] > (*in.max)[i]) {
+        d_.error(p + "/min", fmt::format("min {:g} is greater than max {:g}", (*in.min)[i], (*in.max)[i]));
+        ok = false;
+        break;
+      }
+    }
+    if (ok && in.type != VType::Texture && v.contains("default")) {
+      for (int i = 0; i < componentCount(in.type); ++i) {
+        double x = in.defaultValue[i];
+        if ((in.min && x < (*in.min)[i]) || (in.max && x > (*in.max)[i])) {
+          d_.error(p + "/default", fmt::format("default {:g} is outside [{}, {}]", x,
+                                               in.min ? fmt::format("{:g}", (*in.min)[i]) : "-inf",
+                                               in.max ? fmt::format("{:g}", (*in.max)[i]) : "inf"));
+          break;
+        }
+      }
+    }
+    inputIndex_[name] = static_cast<int>(out_.inputs.size());
+    out_.inputs.push_back(std::move(in));
+  }
+}
+
+/// Decides for every named node whether it is a value node or a Substrate
+/// node. "add" is both a math and a Substrate kind: an add is Substrate when
+/// an operand is (transitively) Substrate matter.
+void Resolver::classifyNodes() {
+  std::vector<std::string> adds;
+  for (auto it = nodes_->begin(); it != nodes_->end(); ++it) {
+    const std::string& id = it.key();
+    std::string p = "/nodes/" + pointerToken(id);
+    namedKind_[id] = 0;
+    if (!isUsableIdentifier(id, limits_.maxIdentifierBytes)) {
+      d_.error(p, fmt::format("node id {} is not usable: it must be a C identifier of at most {} bytes, "
+                              "without \"__\", and not a C/GLSL/HLSL keyword",
+                              quoteForDiagnostic(id), limits_.maxIdentifierBytes));
+      continue;
+    }
+    if (inputIndex_.count(id)) {
+      d_.error(p, fmt::format("node id {} is already an input name (ids and input names share one namespace)",
+                              quoteForDiagnostic(id)));
+      continue;
+    }
+    namedJson_[id] = &*it;
+    if (!it->is_object()) {
+      d_.error(p, fmt::format("expected a node object with a \"kind\", got {}", kindOfJson(*it)));
+      continue;
+    }
+    auto k = it->find("kind");
+    if (k == it->end() || !k->is_string()) {
+      d_.error(p, "missing \"kind\" (a string naming the node kind)");
+      continue;
+    }
+    std::string kind = k->get<std::string>();
+    if (kind == "add") {
+      adds.push_back(id);
+      namedKind_[id] = 1;  // decided below
+    } else if (substrateKind(kind)) {
+      namedKind_[id] = 2;
+    } else if (findOpSpec(kind)) {
+      namedKind_[id] = 1;
+    } else {
+      d_.error(p + "/kind", fmt::format("unknown node kind {}", quoteForDiagnostic(kind)));
+    }
+  }
+  // Named adds: an add is Substrate if an operand is Substrate. Inline content
+  // decides directly; references to other named adds propagate backwards.
+  std::unordered_map<std::string, std::vector<std::string>> referencedBy;
+  std::deque<std::string> queue;
+  std::function<bool(const Json&, const std::string&)> scan = [&](const Json& j,
+                                                                  const std::string& owner) -> bool {
+    if (j.is_string()) {
+      const std::string& s = j.get_ref<const std::string&>();
+      if (isSubstrateName(s)) return true;
+      auto f = namedJson_.find(s);
+      if (f != namedJson_.end() && f->second->is_object() && f->second->value("kind", "") == "add")
+        referencedBy[s].push_back(owner);
+      return false;
+    }
+    if (!j.is_object()) return false;
+    auto k = j.find("kind");
+    if (k == j.end() || !k->is_string()) return false;
+    std::string kind = k->get<std::string>();
+    if (substrateKind(kind)) return true;
+    if (kind != "add") return false;
+    bool any = false;
+    for (const char* pin : {"a", "b"})
+      if (auto p = j.find(pin); p != j.end()) any = scan(*p, owner) || any;
+    return any;
+  };
+  for (const auto& id : adds) {
+    const Json& j = *namedJson_[id];
+    bool direct = false;
+    for (const char* pin : {"a", "b"})
+      if (auto p = j.find(pin); p != j.end()) direct = scan(*p, id) || direct;
+    if (direct) {
+      namedKind_[id] = 2;
+      queue.push_back(id);
+    }
+  }
+  while (!queue.empty()) {
+    std::string id = queue.front();
+    queue.pop_front();
+    for (const auto& owner : referencedBy[id])
+      if (namedKind_[owner] != 2) {
+        namedKind_[owner] = 2;
+        queue.push_back(owner);
+      }
+  }
+}
+
+bool Resolver::isSubstrateValue(const Json& j) const {
+  if (j.is_string()) return isSubstrateName(j.get_ref<const std::string&>());
+  if (!j.is_object()) return false;
+  auto k = j.find("kind");
+  if (k == j.end() || !k->is_string()) return false;
+  std::string kind = k->get<std::string>();
+  if (substrateKind(kind)) return true;
+  if (kind == "add") {
+    for (const char* pin : {"a", "b"})
+      if (auto p = j.find(pin); p != j.end() && isSubstrateValue(*p)) return true;
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------------------
+// Values
+
+int Resolver::resolveValueNode(const std::string& id) {
+  auto it = namedValue_.find(id);
+  return it == namedValue_.end() ? -1 : it->second;
+}
+
+int Resolver::makeInlineValueNode(const Json& j, const std::string& ptr) {
+  if (!budget()) return -1;
+  const std::string kind = j["kind"].get<std::string>();
+  const OpSpec* spec = findOpSpec(kind);
+  int index = static_cast<int>(out_.values.size());
+  out_.values.emplace_back();
+  out_.values[index].op = spec->op;
+  out_.values[index].pointer = ptr;
+  readValueNodeBody(index, j, ptr, *spec);
+  return index;
+}
+
+PinRef Resolver::defaultPin(const PinSpec& ps) {
+  PinRef r;
+  r.tag = PinRef::Default;
+  if (ps.geoDefault >= 0) {
+    r.index = ps.geoDefault;
+    r.type = geometryAttrType(static_cast<GeometryAttr>(ps.geoDefault));
+  } else {
+    r.literal = {ps.def, ps.def, ps.def, ps.def};
+    r.literalCount = ps.kind == PinKind::Color ? 3 : 1;
+    r.type = ps.kind == PinKind::Color ? VType::Vec3 : VType::Float;
+  }
+  return r;
+}
+
+void Resolver::readValueNodeBody(int index, const Json& j, const std::string& ptr, const OpSpec& spec) {
+  std::vector<PinRef> pins(spec.pins.size());
+  std::uint16_t attr = 0;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();
+    if (key == "kind" || key == "comment") {
+      if (key == "comment" && !it->is_string()) d_.error(ptr + "/comment", "expected a string");
+      continue;
+    }
+    auto ps = std::find_if(spec.pins.begin(), spec.pins.end(), [&](const PinSpec& p) { return key == p.name; });
+    if (ps == spec.pins.end()) {
+      std::string list;
+      for (const auto& p : spec.pins) list += (list.empty() ? "" : ", ") + std::string(p.name);
+      d_.error(ptr + "/" + pointerToken(key), fmt::format("unknown pin {} for a {} node (pins: {})",
+                                                          quoteForDiagnostic(key), spec.kind, list));
+    }
+  }
+  for (std::size_t i = 0; i < spec.pins.size(); ++i) {
+    const PinSpec& ps = spec.pins[i];
+    std::string pp = ptr + "/" + ps.name;
+    auto it = j.find(ps.name);
+    if (it == j.end()) {
+      if (ps.required) d_.error(ptr, fmt::format("missing required pin \"{}\" of a {} node", ps.name, spec.kind));
+      pins[i] = defaultPin(ps);
+      if (ps.required) pins[i].type = VType::Invalid;
+      continue;
+    }
+    const Json& v = *it;
+    switch (ps.kind) {
+      case PinKind::Attribute: {
+        static const std::pair<const char*, GeometryAttr> attrs[] = {
+            {"normal", GeometryAttr::Normal},   {"tangent", GeometryAttr::Tangent},
+            {"uv0", GeometryAttr::Uv0},         {"uv1", GeometryAttr::Uv1},
+            {"vertex_color", GeometryAttr::VertexColor}, {"position", GeometryAttr::Position},
+            {"view", GeometryAttr::View}};
+        bool found = false;
+        if (v.is_string())
+          for (auto& [n, a] : attrs)
+            if (v.get<std::string>() == n) {
+              attr = static_cast<std::uint16_t>(a);
+              found = true;
+            }
+        if (!found)
+          d_.error(pp, fmt::format("expected one of normal, tangent, uv0, uv1, vertex_color, position, view; got {}",
+                                   kindOfJson(v)));
+        pins[i].type = found ? geometryAttrType(static_cast<GeometryAttr>(attr)) : VType::Invalid;
+        break;
+      }
+      case PinKind::TextureRef: {
+        if (v.is_string() && !v.get<std::string>().empty() && v.get<std::string>()[0] == '$') {
+          std::string n = v.get<std::string>().substr(1);
+          auto f = inputIndex_.find(n);
+          if (f == inputIndex_.end()) {
+            d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic("$" + n)));
+          } else if (out_.inputs[f->second].type != VType::Texture) {
+            d_.error(pp, fmt::format("input {} is a {}, expected a texture2d input",
+                                     quoteForDiagnostic("$" + n),
+                                     typeWord(out_.inputs[f->second].type, out_.inputs[f->second].isColor)));
+          } else {
+            attr = static_cast<std::uint16_t>(f->second);
+            pins[i].type = VType::Texture;
+          }
+        } else {
+          d_.error(pp, fmt::format("expected a texture2d input reference like \"$albedo\", got {}", kindOfJson(v)));
+        }
+        break;
+      }
+      case PinKind::Channels: {
+        bool ok = v.is_string() && !v.get<std::string>().empty() && v.get<std::string>().size() <= 4;
+        std::uint16_t packed = 0;
+        if (ok) {
+          std::string s = v.get<std::string>();
+          for (std::size_t c = 0; c < s.size(); ++c) {
+            int idx = -1;
+            switch (s[c]) {
+              case 'x': case 'r': idx = 0; break;
+              case 'y': case 'g': idx = 1; break;
+              case 'z': case 'b': idx = 2; break;
+              case 'w': case 'a': idx = 3; break;
+              default: ok = false;
+            }
+            if (idx >= 0) packed |= static_cast<std::uint16_t>(idx << (2 * c));
+          }
+          packed |= static_cast<std::uint16_t>(s.size() << 8);
+        }
+        if (!ok) d_.error(pp, fmt::format("expected 1 to 4 channels from xyzw or rgba, got {}", kindOfJson(v)));
+        attr = ok ? packed : 0;
+        pins[i].type = ok ? VType::Float : VType::Invalid;  // marker only
+        break;
+      }
+      default:
+        pins[i] = readValuePin(v, pp, ps.name);
+        break;
+    }
+  }
+  out_.values[index].pins = std::move(pins);
+  out_.values[index].attr = attr;
+}
+
+PinRef Resolver::readValuePin(const Json& j, const std::string& ptr, const std::string& pinName) {
+  PinRef r;
+  if (j.is_number()) {
+    r.tag = PinRef::Literal;
+    double x = j.get<double>();
+    r.literal = {x, x, x, x};
+    r.literalCount = 1;
+    r.type = VType::Float;
+    return r;
+  }
+  if (j.is_array()) {
+    if (j.size() < 2 || j.size() > 4 || !std::all_of(j.begin(), j.end(), [](const Json& e) { return e.is_number(); })) {
+      d_.error(ptr, fmt::format("expected a number or an array of 2, 3 or 4 numbers, got {}",
+                                j.size() >= 2 && j.size() <= 4 ? "an array with a non-number" : kindOfJson(j)));
+      return r;
+    }
+    r.tag = PinRef::Literal;
+    r.literalCount = static_cast<int>(j.size());
+    for (std::size_t i = 0; i < j.size(); ++i) r.literal[i] = j[i].get<double>();
+    r.type = vectorType(r.literalCount);
+    return r;
+  }
+  if (j.is_string()) {
+    std::string s = j.get<std::string>();
+    if (!s.empty() && s[0] == '$') {
+      std::string n = s.substr(1);
+      auto f = inputIndex_.find(n);
+      if (f == inputIndex_.end()) {
+        d_.error(ptr, fmt::format("unknown input {}", quoteForDiagnostic(s)));
+        return r;
+      }
+      if (out_.inputs[f->second].type == VType::Texture) {
+        d_.error(ptr, fmt::format("{} is a texture2d input; sample it with a \"texture\" node", quoteForDiagnostic(s)));
+        return r;
+      }
+      r.tag = PinRef::Input;
+      r.index = f->second;
+      r.type = out_.inputs[f->second].type;
+      return r;
+    }
+    std::string id = s, output;
+    if (auto dot = s.find('.'); dot != std::string::npos) {
+      id = s.substr(0, dot);
+      output = s.substr(dot + 1);
+    }
+    if (!namedKind_.count(id)) {
+      if (inputIndex_.count(id))
+        d_.error(ptr, fmt::format("unknown node {}; to use the input write {}", quoteForDiagnostic(id),
+                                  quoteForDiagnostic("$" + id)));
+      else
+        d_.error(ptr, fmt::format("unknown node {}", quoteForDiagnostic(id)));
+      return r;
+    }
+    if (isSubstrateName(id)) {
+      d_.error(ptr, fmt::format("expected a value, got Substrate node {}", quoteForDiagnostic(id)));
+      return r;
+    }
+    if (namedKind_[id] != 1) return r;  // already reported
+    int index = resolveValueNode(id);
+    if (index < 0) return r;
+    r.tag = PinRef::Node;
+    r.index = index;
+    const OpSpec* spec = findOpSpec(namedJson_[id]->value("kind", ""));
+    if (!spec) return r;
+    if (output.empty()) {
+      if (spec->outputs.size() > 1 && spec->op != Op::Sample) {
+        // An unnamed reference to a multi-output helper picks the output named
+        // like the pin (f0 -> .f0), which is what an author writing it means.
+        auto f = std::find(spec->outputs.begin(), spec->outputs.end(), pinName);
+        if (f == spec->outputs.end()) {
+          std::string list;
+          for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
+          d_.error(ptr, fmt::format("node {} has several outputs; name one ({})", quoteForDiagnostic(id), list));
+          r.tag = PinRef::Default;
+          return r;
+        }
+        r.output = static_cast<int>(f - spec->outputs.begin());
+      }
+    } else {
+      auto f = std::find(spec->outputs.begin(), spec->outputs.end(), output);
+      if (f == spec->outputs.end()) {
+        if (spec->outputs.empty())
+          d_.error(ptr, fmt::format("node {} has a single output; write {} without a suffix",
+                                    quoteForDiagnostic(id), quoteForDiagnostic(id)));
+        else {
+          std::string list;
+          for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
+          d_.error(ptr, fmt::format("node {} has no output {} (outputs: {})", quoteForDiagnostic(id),
+                                    quoteForDiagnostic("." + output), list));
+        }
+        r.tag = PinRef::Default;
+        return r;
+      }
+      r.output = static_cast<int>(f - spec->outputs.begin());
+    }
+    return r;
+  }
+  if (j.is_object()) {
+    auto k = j.find("kind");
+    if (k == j.end() || !k->is_string()) {
+      d_.error(ptr, "inline node is missing \"kind\"");
+      return r;
+    }
+    std::string kind = k->get<std::string>();
+    if (isSubstrateValue(j)) {
+      d_.error(ptr, fmt::format("expected a value, got an inline Substrate node ({})", kind));
+      return r;
+    }
+    const OpSpec* spec = findOpSpec(kind);
+    if (!spec) {
+      d_.error(ptr + "/kind", fmt::format("unknown node kind {}", quoteForDiagnostic(kind)));
+      return r;
+    }
+    int index = makeInlineValueNode(j, ptr);
+    if (index < 0) return r;
+    r.tag = PinRef::Node;
+    r.index = index;
+    if (spec->outputs.size() > 1 && spec->op != Op::Sample) {
+      auto f = std::find(spec->outputs.begin(), spec->outputs.end(), pinName);
+      if (f == spec->outputs.end()) {
+        std::string list;
+        for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
+        d_.error(ptr, fmt::format("inline {} node has several outputs ({}) and none is named \"{}\"; "
+                                  "make it a named node and reference one output",
+                                  kind, list, pinName));
+        r.tag = PinRef::Default;
+        return r;
+      }
+      r.output = static_cast<int>(f - spec->outputs.begin());
+    }
+    return r;
+  }
+  d_.error(ptr, fmt::format("expected a value (a number, an array of 2-4 numbers, a reference or an inline "
+                            "node), got {}", kindOfJson(j)));
+  return r;
+}
+
+// ---------------------------------------------------------------------------
+// Substrate
+
+int Resolver::resolveSubstrateNode(const std::string& id) {
+  auto it = namedSubstrate_.find(id);
+  return it == namedSubstrate_.end() ? -1 : it->second;
+}
+
+int Resolver::readSubstratePin(const Json& j, const std::string& ptr, const std::string& nameForInline) {
+  if (j.is_string()) {
+    const std::string& s = j.get_ref<const std::string&>();
+    if (isSubstrateName(s)) return resolveSubstrateNode(s);
+    if (!s.empty() && s[0] == '$')
+      d_.error(ptr, fmt::format("expected a Substrate node, got input {}", quoteForDiagnostic(s)));
+    else if (isValueKindName(s.substr(0, s.find('.'))))
+      d_.error(ptr, fmt::format("expected a Substrate node, got value node {}", quoteForDiagnostic(s)));
+    else if (!namedKind_.count(s))
+      d_.error(ptr, fmt::format("unknown node {}", quoteForDiagnostic(s)));
+    return -1;
+  }
+  if (j.is_object()) {
+    auto k = j.find("kind");
+    if (k == j.end() || !k->is_string()) {
+      d_.error(ptr, "inline node is missing \"kind\"");
+      return -1;
+    }
+    std::string kind = k->get<std::string>();
+    if (kind == "add" ? isSubstrateValue(j) : substrateKind(kind).has_value())
+    {
+      if (!budget()) return -1;
+      int index = static_cast<int>(out_.substrate.size());
+      out_.substrate.emplace_back();
+      out_.substrate[index].id = nameForInline;
+      out_.substrate[index].pointer = ptr;
+      fillSubstrateNode(index, j, ptr, kind == "add" ? TreeOp::Add : *substrateKind(kind));
+      return index;
+    }
+    if (findOpSpec(kind))
+      d_.error(ptr, fmt::format("expected a Substrate node, got an inline {} value node", kind));
+    else
+      d_.error(ptr + "/kind", fmt::format("unknown node kind {}", quoteForDiagnostic(kind)));
+    return -1;
+  }
+  d_.error(ptr, fmt::format("expected a Substrate node (an id or an inline slab/operator), got {}", kindOfJson(j)));
+  return -1;
+}
+
+void Resolver::checkRange(const PinRef& pin, const Json& j, const std::string& ptr, double lo, double hi,
+                          const char* what) {
+  if (pin.tag != PinRef::Literal) return;
+  for (int i = 0; i < pin.literalCount; ++i) {
+    if (pin.literal[i] < lo || pin.literal[i] > hi) {
+      std::string range = hi >= 1e300 ? fmt::format(">= {:g}", lo) : fmt::format("in [{:g},{:g}]", lo, hi);
+      d_.error(ptr, fmt::format("expected {} {}, got {}", what, range, kindOfJson(j).substr(0, 80)));
+      return;
+    }
+  }
+}
+
+bool Resolver::expectPinType(PinRef& pin, PinKind kind, const std::string& ptr, bool* color) {
+  if (pin.type == VType::Invalid) return false;
+  VType want = VType::Invalid;
+  bool broadcast = false;
+  switch (kind) {
+    case PinKind::Float: want = VType::Float; break;
+    case PinKind::Color: want = VType::Vec3; broadcast = true; break;
+    case PinKind::Vec3: want = VType::Vec3; break;
+    case PinKind::Vec2: want = VType::Vec2; break;
+    default: return true;
+  }
+  if (color) *color = broadcast;
+  if (pin.type == want || (broadcast && pin.type == VType::Float)) return true;
+  d_.error(ptr, fmt::format("expected a {}, got a {}", kind == PinKind::Color ? "color" : std::string(typeName(want)),
+                            typeName(pin.type)));
+  pin.type = VType::Invalid;
+  return false;
+}
+
+void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& ptr, TreeOp op) {
+  out_.substrate[index].op = op;
+  const std::string id = out_.substrate[index].id;
+
+  auto checkKeys = [&](std::initializer_list<const char*> keys) {
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      const std::string& k = it.key();
+      if (k == "kind" || k == "comment") continue;
+      bool known = false;
+      for (const char* kk : keys) known = known || k == kk;
+      if (!known) {
+        std::string list;
+        for (const char* kk : keys) list += (list.empty() ? "" : ", ") + std::string(kk);
+        d_.error(ptr + "/" + pointerToken(k), fmt::format("unknown pin {} for a {} node (pins: {})",
+                                                          quoteForDiagnostic(k), j["kind"].get<std::string>(), list));
+      }
+    }
+  };
+  auto sub = [&](const char* pin, bool required, int& dst) {
+    auto it = j.find(pin);
+    if (it == j.end()) {
+      if (required) d_.error(ptr, fmt::format("missing required pin \"{}\"", pin));
+      return;
+    }
+    dst = readSubstratePin(*it, ptr + "/" + pin, (id.empty() ? std::string("node") : id) + "_" + pin);
+  };
+  auto val = [&](const char* pin, bool required, double def, double lo, double hi, PinRef& dst) {
+    auto it = j.find(pin);
+    if (it == j.end()) {
+      if (required) d_.error(ptr, fmt::format("missing required pin \"{}\"", pin));
+      dst.tag = PinRef::Default;
+      dst.literal = {def, def, def, def};
+      dst.literalCount = 1;
+      dst.type = VType::Float;
+      return;
+    }
+    dst = readValuePin(*it, ptr + "/" + pin, pin);
+    if (expectPinType(dst, PinKind::Float, ptr + "/" + pin)) checkRange(dst, *it, ptr + "/" + pin, lo, hi, "a float");
+  };
+  SNode node;  // filled locally: out_.substrate may reallocate during recursion
+  constexpr double kBig = 1e300;
+  switch (op) {
+    case TreeOp::Horizontal:
+      checkKeys({"background", "foreground", "mix"});
+      sub("background", true, node.left);
+      sub("foreground", true, node.right);
+      val("mix", true, 0.5, 0, 1, node.a);
+      break;
+    case TreeOp::Vertical:
+      checkKeys({"top", "base", "thickness"});
+      sub("top", true, node.left);
+      sub("base", true, node.right);
+      val("thickness", false, 0.0001, 0, kBig, node.a);
+      break;
+    case TreeOp::Add:
+      checkKeys({"a", "b"});
+      sub("a", true, node.left);
+      sub("b", true, node.right);
+      break;
+    case TreeOp::CoverageWeight:
+      checkKeys({"a", "weight"});
+      sub("a", true, node.left);
+      val("weight", true, 1, 0, 1, node.a);
+      break;
+    case TreeOp::Select:
+      checkKeys({"a", "b", "value", "threshold"});
+      sub("a", true, node.left);
+      sub("b", true, node.right);
+      val("value", true, 0, -kBig, kBig, node.a);
+      val("threshold", false, 0.5, -kBig, kBig, node.b);
+      break;
+    case TreeOp::Slab: {
+      for (auto it = j.begin(); it != j.end(); ++it) {
+        const std::string& k = it.key();
+        if (k == "kind" || k == "comment" || k == "sss_type" || k == "specular_profile") continue;
+        if (!slabPinByName(k))
+          d_.error(ptr + "/" + pointerToken(k), fmt::format("unknown slab pin {}", quoteForDiagnostic(k)));
+      }
+      for (int p = 0; p < kSlabPinCount; ++p) {
+        const SlabPinInfo& info = slabPinInfo(static_cast<SlabPin>(p));
+        PinRef& dst = node.slabPins[p];
+        auto it = j.find(std::string(info.name));
+        if (it == j.end()) {
+          dst.tag = PinRef::Default;
+          if (info.geometryDefault >= 0) {
+            dst.index = info.geometryDefault;
+            dst.type = info.type;
+          } else {
+            dst.literal = {info.defaultValue, info.defaultValue, info.defaultValue, info.defaultValue};
+            dst.literalCount = componentCount(info.type);
+            dst.type = info.type;
+          }
+          continue;
+        }
+        std::string pp = ptr + "/" + std::string(info.name);
+        dst = readValuePin(*it, pp, std::string(info.name));
+        PinKind kind = info.color ? PinKind::Color
+                                  : info.type == VType::Float ? PinKind::Float
+                                  : info.type == VType::Vec2 ? PinKind::Vec2 : PinKind::Vec3;
+        if (expectPinType(dst, kind, pp)) {
+          const char* what = info.color ? "a color with components" : "a float";
+          if (info.type == VType::Vec3 && !info.color) what = "a vector with components";
+          if (info.type != VType::Vec2) checkRange(dst, *it, pp, info.lo, info.hi, what);
+          if (dst.tag == PinRef::Literal && info.type == VType::Vec3 && !info.color) {
+            double len2 = dst.literal[0] * dst.literal[0] + dst.literal[1] * dst.literal[1] +
+                          dst.literal[2] * dst.literal[2];
+            if (len2 < 1e-12) d_.error(pp, fmt::format("expected a non-zero direction, got {}", kindOfJson(*it)));
+          }
+        }
+      }
+      if (auto it = j.find("sss_type"); it != j.end()) {
+        static const std::pair<const char*, SssType> types[] = {{"none", SssType::None},
+                                                                {"wrap", SssType::Wrap},
+                                                                {"diffusion", SssType::Diffusion},
+                                                                {"simple_volume", SssType::SimpleVolume}};
+        bool found = false;
+        if (it->is_string())
+          for (auto& [n, t] : types)
+            if (it->get<std::string>() == n) {
+              node.sssType = t;
+              found = true;
+            }
+        if (!found)
+          d_.error(ptr + "/sss_type",
+                   fmt::format("expected one of none, wrap, diffusion, simple_volume; got {}", kindOfJson(*it)));
+        node.sssTypeExplicit = found;
+      }
+      if (auto it = j.find("specular_profile"); it != j.end()) {
+        std::string pp = ptr + "/specular_profile";
+        if (it->is_string() && !it->get<std::string>().empty() && it->get<std::string>()[0] == '$') {
+          auto f = inputIndex_.find(it->get<std::string>().substr(1));
+          if (f == inputIndex_.end())
+            d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic(it->get<std::string>())));
+          else if (out_.inputs[f->second].type != VType::Texture)
+            d_.error(pp, fmt::format("specular profile {} must be a texture2d input (a view/light LUT)",
+                                     quoteForDiagnostic(it->get<std::string>())));
+          else
+            node.specularProfileInput = f->second;
+        } else {
+          d_.error(pp, fmt::format("expected a texture2d input reference like \"$lut\", got {}", kindOfJson(*it)));
+        }
+      }
+      break;
+    }
+  }
+  SNode& dst = out_.substrate[index];
+  node.op = dst.op;
+  node.id = dst.id;
+  node.pointer = dst.pointer;
+  dst = std::move(node);
+}
+
+// ---------------------------------------------------------------------------
+// Typing (value nodes) and cycle detection (values and Substrate)
+
+void Resolver::typeValueNodes() {
+  const int n = static_cast<int>(out_.values.size());
+  std::vector<std::uint8_t> state(n, 0);  // 0 new, 1 on stack, 2 done
+  auto pinType = [&](const PinRef& p) -> VType {
+    if (p.tag != PinRef::Node) return p.type;
+    const VNode& v = out_.values[p.index];
+    if (v.outputTypes.empty()) return VType::Invalid;
+    return v.outputTypes[std::min<std::size_t>(p.output, v.outputTypes.size() - 1)];
+  };
+  auto typeOne = [&](int i) {
+    VNode& v = out_.values[i];
+    const OpSpec* spec = nullptr;
+    for (const auto& s : opSpecs())
+      if (s.op == v.op) spec = &s;
+    for (auto& p : v.pins)
+      if (p.tag == PinRef::Node) p.type = pinType(p);
+    bool bad = false;
+    for (auto& p : v.pins)
+      if (p.type == VType::Invalid) bad = true;
+    if (bad) {
+      v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
+      return;
+    }
+    auto err = [&](const std::string& pin, const std::string& msg) {
+      d_.error(v.pointer + (pin.empty() ? "" : "/" + pin), msg);
+      v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
+    };
+    auto combine2 = [&](VType a, VType b, const char* pa, const char* pb, VType& outT) -> bool {
+      if (a == b || b == VType::Float) { outT = a; return true; }
+      if (a == VType::Float) { outT = b; return true; }
+      err("", fmt::format("cannot combine {} \"{}\" with {} \"{}\" (a float broadcasts; vectors must match)",
+                          typeName(a), pa, typeName(b), pb));
+      return false;
+    };
+    VType r = VType::Invalid;
+    switch (v.op) {
+      case Op::Geometry: r = geometryAttrType(static_cast<GeometryAttr>(v.attr)); break;
+      case Op::Sample:
+        if (v.pins[1].type != VType::Vec2) return err("uv", fmt::format("expected a vec2, got a {}", typeName(v.pins[1].type)));
+        v.outputTypes = {VType::Vec3, VType::Float, VType::Float, VType::Float, VType::Float};
+        return;
+      case Op::Add: case Op::Subtract: case Op::Multiply: case Op::Divide: case Op::Min: case Op::Max:
+        if (!combine2(v.pins[0].type, v.pins[1].type, "a", "b", r)) return;
+        break;
+      case Op::Pow:
+        if (!combine2(v.pins[0].type, v.pins[1].type, "x", "y", r)) return;
+        break;
+      case Op::Lerp: {
+        if (!combine2(v.pins[0].type, v.pins[1].type, "a", "b", r)) return;
+        VType t = v.pins[2].type;
+        if (t != VType::Float && t != r) return err("t", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(t)));
+        break;
+      }
+      case Op::Clamp:
+        r = v.pins[0].type;
+        for (int k = 1; k <= 2; ++k)
+          if (v.pins[k].type != VType::Float && v.pins[k].type != r)
+            return err(k == 1 ? "lo" : "hi", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(v.pins[k].type)));
+        break;
+      case Op::Saturate: case Op::OneMinus: case Op::Abs: case Op::Sqrt: case Op::Normalize:
+        r = v.pins[0].type;
+        break;
+      case Op::Length: r = VType::Float; break;
+      case Op::Dot:
+        if (v.pins[0].type != v.pins[1].type)
+          return err("", fmt::format("dot needs two values of one type, got {} and {}", typeName(v.pins[0].type),
+                                     typeName(v.pins[1].type)));
+        r = VType::Float;
+        break;
+      case Op::Swizzle: {
+        int count = v.attr >> 8;
+        int have = componentCount(v.pins[0].type);
+        for (int c = 0; c < count; ++c)
+          if (((v.attr >> (2 * c)) & 3) >= have)
+            return err("channels", fmt::format("channel out of range for a {}", typeName(v.pins[0].type)));
+        r = vectorType(count);
+        break;
+      }
+      case Op::Combine: {
+        int count = 0;
+        for (std::size_t k = 0; k < v.pins.size(); ++k) {
+          if (v.pins[k].tag == PinRef::Default && k >= 2) break;
+          if (v.pins[k].type != VType::Float)
+            return err(spec->pins[k].name, fmt::format("expected a float, got a {}", typeName(v.pins[k].type)));
+          ++count;
+        }
+        // z without w is fine; w without z is not.
+        if (v.pins.size() == 4 && v.pins[2].tag == PinRef::Default && v.pins[3].tag != PinRef::Default)
+          return err("w", "\"w\" given without \"z\"");
+        r = vectorType(count);
+        break;
+      }
+      default: {  // helpers: pin types were fixed by their PinKind
+        for (std::size_t k = 0; k < v.pins.size(); ++k) {
+          PinRef& p = v.pins[k];
+          if (!expectPinType(p, spec->pins[k].kind, v.pointer + "/" + spec->pins[k].name)) {
+            v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
+            return;
+          }
+        }
+        switch (v.op) {
+          case Op::MetalnessToDiffuseF0: v.outputTypes = {VType::Vec3, VType::Vec3}; return;
+          case Op::IorToF0: r = VType::Float; break;
+          case Op::HazinessToSecondRoughness: v.outputTypes = {VType::Float, VType::Float}; return;
+          case Op::TransmittanceToMfp: v.outputTypes = {VType::Vec3, VType::Float}; return;
+          case Op::ThinFilm: v.outputTypes = {VType::Vec3, VType::Vec3}; return;
+          case Op::RotationToTangent: r = VType::Vec3; break;
+          case Op::ViewDependentCoverage: r = VType::Float; break;
+          default: r = VType::Invalid;
+        }
+      }
+    }
+    v.outputTypes = {r};
+  };
+  // Iterative post-order DFS; a back edge is a cycle.
+  for (int start = 0; start < n; ++start) {
+    if (state[start]) continue;
+    std::vector<std::pair<int, std::size_t>> stack{{start, 0}};
+    state[start] = 1;
+    while (!stack.empty()) {
+      auto& [i, next] = stack.back();
+      VNode& v = out_.values[i];
+      if (next < v.pins.size()) {
+        PinRef& p = v.pins[next++];
+        if (p.tag != PinRef::Node) continue;
+        if (state[p.index] == 1) {
+          std::string chain;
+          bool on = false;
+          for (auto& [si, sn] : stack) {
+            if (si == p.index) on = true;
+            if (on) chain += (out_.values[si].id.empty() ? out_.values[si].pointer : out_.values[si].id) + " -> ";
+          }
+          chain += out_.values[p.index].id.empty() ? out_.values[p.index].pointer : out_.values[p.index].id;
+          d_.error(v.pointer, fmt::format("cycle in values: {}", chain));
+          p.tag = PinRef::Default;
+          p.type = VType::Invalid;
+          continue;
+        }
+        if (state[p.index] == 0) {
+          state[p.index] = 1;
+          stack.push_back({p.index, 0});
+        }
+        continue;
+      }
+      typeOne(i);
+      state[i] = 2;
+      out_.valueOrder.push_back(i);
+      stack.pop_back();
+    }
+  }
+}
+
+void Resolver::checkSubstrateCycles() {
+  const int n = static_cast<int>(out_.substrate.size());
+  std::vector<std::uint8_t> state(n, 0);
+  for (int start = 0; start < n; ++start) {
+    if (state[start]) continue;
+    std::vector<std::pair<int, int>> stack{{start, 0}};
+    state[start] = 1;
+    while (!stack.empty()) {
+      auto& [i, next] = stack.back();
+      SNode& s = out_.substrate[i];
+      if (next < 2) {
+        int& child = next++ == 0 ? s.left : s.right;
+        if (child < 0) continue;
+        if (state[child] == 1) {
+          std::string chain;
+          bool on = false;
+          for (auto& [si, sn] : stack) {
+            if (si == child) on = true;
+            if (on) chain += out_.substrate[si].id + " -> ";
+          }
+          chain += out_.substrate[child].id;
+          d_.error(s.pointer, fmt::format("cycle in the Substrate graph: {}", chain));
+          child = -1;
+          continue;
+        }
+        if (state[child] == 0) {
+          state[child] = 1;
+          stack.push_back({child, 0});
+        }
+        continue;
+      }
+      state[i] = 2;
+      stack.pop_back();
+    }
+  }
+}
+
+}  // namespace
+
+std::optional<ResolvedDoc> resolveDocument(const Json& doc, Diagnostics& diags, const ResolveLimits& limits) {
+  Resolver r(doc, diags, limits);
+  return r.run();
+}
+
+}  // namespace substratec

@@ -1,0 +1,74 @@
+// Pass 2 — resolve: reads the parsed JSON document against the format
+// (material-format.md), checks every key, kind, type, range and reference,
+// and produces a ResolvedDoc in which every reference is an index. Errors
+// carry the JSON pointer of the offending value; all of them are reported.
+//
+// Rewrite: JSON document  ->  ResolvedDoc { settings, inputs, value nodes in
+// dependency order (typed), Substrate nodes (acyclic), output }.
+#pragma once
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "format/json_document.h"
+#include "ir/material.h"
+
+namespace substratec {
+
+struct ResolveLimits {
+  std::size_t maxNodes = 20000;        // named + inline nodes
+  std::size_t maxIdentifierBytes = 128;
+};
+
+/// A pin's value after resolution.
+struct PinRef {
+  enum Tag : std::uint8_t { Default, Literal, Input, Node } tag = Default;
+  std::array<double, 4> literal{0, 0, 0, 0};
+  int literalCount = 0;  // 1..4
+  int index = -1;        // input index (Input) or value-node index (Node)
+  int output = 0;        // output index of a multi-output node
+  VType type = VType::Invalid;  // type of the referenced value (after output selection)
+};
+
+/// A value node (named or inline), typed.
+struct VNode {
+  Op op = Op::Const;
+  std::string id;        // named nodes only
+  std::string pointer;
+  std::vector<PinRef> pins;       // in the op's pin order (see resolve.cc table)
+  std::uint16_t attr = 0;         // geometry attribute, swizzle channels, texture input
+  std::vector<VType> outputTypes; // one per output
+};
+
+/// A Substrate node (named or inline).
+struct SNode {
+  TreeOp op = TreeOp::Slab;
+  std::string id;      // named id, or a generated "<parent>_<pin>" name for inline nodes
+  std::string pointer;
+  int left = -1, right = -1;  // SNode indices
+  PinRef a, b;                // operator values (mix/thickness/weight/value, threshold)
+  std::array<PinRef, kSlabPinCount> slabPins{};
+  int specularProfileInput = -1;
+  SssType sssType = SssType::None;
+  bool sssTypeExplicit = false;
+};
+
+struct ResolvedDoc {
+  std::string name;
+  Settings settings;
+  std::vector<Input> inputs;
+  std::vector<VNode> values;
+  std::vector<int> valueOrder;  // value-node indices, dependencies first
+  std::vector<SNode> substrate;
+  int output = -1;  // SNode index
+};
+
+std::optional<ResolvedDoc> resolveDocument(const Json& doc, Diagnostics& diags,
+                                           const ResolveLimits& limits = {});
+
+/// True for C identifiers that are not reserved in C, GLSL or HLSL.
+bool isUsableIdentifier(const std::string& s, std::size_t maxBytes = 128);
+
+}  // namespace substratec

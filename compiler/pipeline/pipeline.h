@@ -1,0 +1,64 @@
+// The compiler pipeline: one straight-line function from JSON text to a
+// priced material. Each step is a pass with one job (see passes/*.h).
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "format/json_document.h"
+#include "ir/material.h"
+#include "ir/tree_info.h"
+#include "passes/build_tree.h"
+#include "passes/resolve.h"
+#include "storage/layout.h"
+
+namespace substratec {
+
+struct CompileOptions {
+  ReadLimits read;
+  ResolveLimits resolve;
+  TreeLimits tree;
+  std::optional<int> budgetOverride;       // --budget
+  std::optional<int> maxClosuresOverride;  // --max-closures
+  bool fullSimplification = false;         // --full-simplification
+  bool printAfterAll = false;              // dump the IR after every pass into debugLog
+  bool timePasses = false;                 // record per-pass wall time
+};
+
+struct PassTiming {
+  std::string pass;
+  double milliseconds = 0;
+};
+
+/// One simplification step (issue 3 fills these).
+struct SimplifyStep {
+  std::string action;     // "collapse" or "disable"
+  std::string node;       // operator id, or feature name
+  std::string kind;       // operator kind, or "feature"
+  int depth = 0;
+  int bytesBefore = 0, bytesAfter = 0;
+  int closuresBefore = 0, closuresAfter = 0;
+};
+
+struct CompileResult {
+  Material material;
+  TreeInfo tree;            // of the final material
+  StorageLayout before;     // priced before simplification
+  StorageLayout after;      // priced after simplification
+  int budgetBytes = 80;
+  int maxClosures = 8;
+  std::vector<SimplifyStep> steps;
+  std::vector<PassTiming> timings;
+  std::string debugLog;     // --print-after-all output
+};
+
+/// Compiles JSON text. `displayName` is what diagnostics call the file.
+std::optional<CompileResult> compileText(const std::string& displayName, const std::string& text,
+                                         const CompileOptions& options, Diagnostics& diags);
+
+/// Reads (within the input-size limit) and compiles a file.
+std::optional<CompileResult> compileFile(const std::string& path, const CompileOptions& options,
+                                         Diagnostics& diags);
+
+}  // namespace substratec

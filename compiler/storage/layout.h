@@ -1,0 +1,73 @@
+// The per-pixel storage layout of a material (docs/storage.md is its
+// specification): which fields are stored, in which order, with how many
+// bits and which encoding. Pricing (bytes per pixel, closures, layout class)
+// is derived from it, and code generation packs exactly these fields.
+#pragma once
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ir/material.h"
+#include "ir/tree_info.h"
+
+namespace substratec {
+
+enum class LayoutClass { Simple, Single, Complex, Special };
+std::string_view layoutClassName(LayoutClass c);  // "SIMPLE", ...
+
+/// Field widths in bits (docs/storage.md, "Field table").
+namespace bits {
+inline constexpr int kHeader = 16;          // material header
+inline constexpr int kClosureHeader = 16;   // per closure, when there are several
+inline constexpr int kColor = 20;           // 7/7/6 after a sqrt curve
+inline constexpr int kRoughness = 8;
+inline constexpr int kGreyWeight = 8;
+inline constexpr int kCoverageAbove = 8;
+inline constexpr int kSss = 28;             // 3 x 8-bit log2 MFP + 4-bit phase anisotropy
+inline constexpr int kHaze = 16;            // second roughness 8 + weight 8
+inline constexpr int kFuzz = 32;            // amount 6 + color 20 + roughness 6
+inline constexpr int kAnisotropy = 8;
+inline constexpr int kSpecularProfile = 8;
+inline constexpr int kGlint = 136;          // density 8 + uv 2 x fp32 + uv derivatives 4 x fp16
+inline constexpr int kNormal = 32;          // octahedral 2 x 16
+inline constexpr int kTangentAngle = 14;
+inline constexpr int kTopLayerBytes = 4;    // octahedral normal 2 x 12 + roughness 8
+}  // namespace bits
+
+struct LayoutField {
+  std::string name;      // e.g. "closure1.f0", "basis0.tangent_angle", "header"
+  int bits = 0;
+  std::string encoding;  // e.g. "unorm7/7/6 sqrt", "log2 unorm8 x3 + snorm4"
+  int closure = -1;      // closure index, or -1
+  int basis = -1;        // basis index, or -1
+};
+
+struct ClosureLayout {
+  int slab = -1;          // Material::slabs index
+  int basis = -1;
+  bool isTop = true;
+  bool storesWeight = false;         // grey mix/coverage weight (not statically 1)
+  bool storesCoverageAbove = false;  // below a layer whose coverage is not statically 1
+  std::uint16_t storedFeatures = 0;
+};
+
+struct StorageLayout {
+  LayoutClass layoutClass = LayoutClass::Simple;
+  std::vector<ClosureLayout> closures;
+  int basisCount = 0;
+  bool basis0NormalElided = false;
+  std::vector<LayoutField> fields;  // in stream order (the top-layer word is separate)
+  int totalBits = 0;
+
+  int words() const { return (totalBits + 31) / 32; }
+  /// Bytes per pixel, including the 4 bytes of top-layer data.
+  int bytes() const { return words() * 4 + bits::kTopLayerBytes; }
+};
+
+/// Features whose data lives in a closure (emissive and medium cost no bytes).
+inline constexpr std::uint16_t kStoredFeatureMask =
+    kFeatF90 | kFeatAnisotropy | kFeatSss | kFeatHaze | kFeatFuzz | kFeatGlint | kFeatSpecularProfile;
+
+StorageLayout computeLayout(const Material& m, const TreeInfo& info);
+
+}  // namespace substratec
