@@ -7,6 +7,7 @@
 
 #include "pipeline/pipeline.h"
 #include "report/report.h"
+#include "validate/toolchain.h"
 
 namespace substratec {
 
@@ -68,7 +69,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                "flattened shaders",
                "substratec"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "substratec 0.1.0");
+  app.set_version_flag("--version", "substratec 0.1.0 (" + toolchainVersions() + ")");
 
   ReportArgs report;
   CLI::App* rep = app.add_subcommand("report", "Print the tree, features, byte budget and layout of materials");
@@ -95,7 +96,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     out << app.help("", CLI::AppFormatMode::All);
     return kExitOk;
   } catch (const CLI::CallForVersion&) {
-    out << "substratec 0.1.0\n";
+    out << "substratec 0.1.0 (" << toolchainVersions() << ")\n";
     return kExitOk;
   } catch (const CLI::ParseError& e) {
     err << "substratec: error: " << e.what() << "\n";

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <unordered_set>
 #include <vector>
 
 #include <fmt/format.h>
@@ -135,7 +136,7 @@ class StrictDomBuilder {
     std::string ptr = pointerForNext();
     Json* slot = slotForNext();
     *slot = Json::object();
-    stack_.push_back(Frame{slot, {}, std::move(ptr)});
+    stack_.push_back(Frame{slot, {}, std::move(ptr), {}, false});
     return true;
   }
   bool key(std::string& k) {
@@ -145,7 +146,9 @@ class StrictDomBuilder {
       diags_.error(f.pointer, fmt::format("key of {} bytes is longer than the limit of {}", k.size(),
                                           limits_.maxStringBytes));
       failed = true;
-    } else if (f.node->contains(k)) {
+    }
+    f.duplicate = !f.keys.insert(k).second;
+    if (f.duplicate) {
       diags_.error(ptr, fmt::format("duplicate key {}", quoteForDiagnostic(k)));
       failed = true;
     }
@@ -160,7 +163,7 @@ class StrictDomBuilder {
     std::string ptr = pointerForNext();
     Json* slot = slotForNext();
     *slot = Json::array();
-    stack_.push_back(Frame{slot, {}, std::move(ptr)});
+    stack_.push_back(Frame{slot, {}, std::move(ptr), {}, false});
     return true;
   }
   bool end_array() {
@@ -184,6 +187,8 @@ class StrictDomBuilder {
     Json* node;
     std::string key;
     std::string pointer;
+    std::unordered_set<std::string> keys;  // objects: keys seen (ordered_json lookups are linear)
+    bool duplicate = false;                 // the current key repeats an earlier one
   };
 
   static std::string describe(const std::string& what, const std::string& lastToken) {
@@ -192,6 +197,7 @@ class StrictDomBuilder {
     std::string msg = what;
     auto p = msg.find("syntax error while parsing");
     if (p != std::string::npos) msg = msg.substr(p);
+    else if (auto q = msg.find("] "); q != std::string::npos) msg = msg.substr(q + 2);  // drop "[json.exception...]" 
     auto lr = msg.find("; last read:");
     if (lr != std::string::npos) msg = msg.substr(0, lr);
     if (lastToken.empty()) return "JSON " + msg;
@@ -212,8 +218,16 @@ class StrictDomBuilder {
       f.node->push_back(Json());
       return &f.node->back();
     }
-    // A duplicate key overwrites (already reported); keep the first position.
-    return &(*f.node)[f.key];
+    // Append directly to the ordered map's vector: its operator[] searches
+    // linearly, which would make an object of n keys cost O(n^2). A duplicate
+    // (already reported) goes to a scratch slot so the first value is kept.
+    if (f.duplicate) {
+      scratch_ = Json();
+      return &scratch_;
+    }
+    auto& items = static_cast<std::vector<std::pair<const std::string, Json>>&>(f.node->get_ref<Json::object_t&>());
+    items.emplace_back(f.key, Json());
+    return &items.back().second;
   }
   bool put(Json v) {
     Json* slot = slotForNext();
@@ -225,6 +239,7 @@ class StrictDomBuilder {
   const ReadLimits& limits_;
   Diagnostics& diags_;
   std::vector<Frame> stack_;
+  Json scratch_;
 };
 
 }  // namespace

@@ -35,7 +35,7 @@ constexpr double kHazeExtent = 3.0;  // alpha_h = (1 + L) alpha_c
 // ---------------------------------------------------------------------------
 // Transmittance to MFP.
 
-constexpr double kMfpTransparent = 1e9;          // metres; "no extinction"
+constexpr double kMfpTransparent = 1e9;            // metres; "no extinction"
 constexpr double kDefaultSurfaceThickness = 1e-4;  // metres; format default
 
 // ---------------------------------------------------------------------------
@@ -68,8 +68,7 @@ Vec3 xyzSensitivity(double opd, double shift) {
     return l.val * std::sqrt(2.0 * kPi * l.var) * std::cos(l.pos * phase + shift) * g;
   };
   constexpr double kNorm = 1.0685e-7;
-  return {(lobe(kLobes[0]) + lobe(kLobes[3])) / kNorm, lobe(kLobes[1]) / kNorm,
-          lobe(kLobes[2]) / kNorm};
+  return {(lobe(kLobes[0]) + lobe(kLobes[3])) / kNorm, lobe(kLobes[1]) / kNorm, lobe(kLobes[2]) / kNorm};
 }
 
 /// CIE XYZ to linear Rec.709 (D65), one row per RGB channel.
@@ -121,8 +120,8 @@ double airyReflectance(const FilmInterface& film, double baseF0, double baseF90,
   // Film -> base interface: exact dielectric Fresnel, its grazing value moved
   // from 1 to the base's F90 with Schlick's weight (F90 = 1 leaves it exact).
   const double x = 1.0 - film.cosTheta2, x5 = x * x * x * x * x;
-  const double R23 = clampSafe(fresnelDielectric(eta3 / film.eta2, film.cosTheta2) + (baseF90 - 1.0) * x5,
-                               0.0, 1.0);
+  const double R23 =
+      clampSafe(fresnelDielectric(eta3 / film.eta2, film.cosTheta2) + (baseF90 - 1.0) * x5, 0.0, 1.0);
   // Phase: air -> film reflects with no shift (eta2 >= 1), so film -> air
   // (phi21) shifts by pi; film -> base shifts by pi if the base is less dense.
   const double phi = kPi + (eta3 < film.eta2 ? kPi : 0.0);

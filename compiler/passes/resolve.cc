@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <cstdlib>
 #include <set>
 #include <unordered_map>
 #include <unordered_set>
@@ -151,14 +152,18 @@ const char* const kReserved[] = {
 
 }  // namespace
 
-bool isUsableIdentifier(const std::string& s, std::size_t maxBytes) {
+bool isIdentifier(const std::string& s, std::size_t maxBytes) {
   if (s.empty() || s.size() > maxBytes) return false;
   auto alpha = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
   if (!alpha(s[0])) return false;
   for (char c : s)
     if (!alpha(c) && !(c >= '0' && c <= '9')) return false;
-  if (s.find("__") != std::string::npos) return false;  // reserved in GLSL and C++
-  if (s.rfind("gl_", 0) == 0 || s.rfind("spvc_", 0) == 0) return false;
+  return s.find("__") == std::string::npos;  // reserved in GLSL and C++
+}
+
+bool isUsableIdentifier(const std::string& s, std::size_t maxBytes) {
+  if (!isIdentifier(s, maxBytes)) return false;
+  if (s.rfind("gl_", 0) == 0) return false;
   for (const char* r : kReserved)
     if (s == r) return false;
   return true;
@@ -246,6 +251,7 @@ class Resolver {
   ResolvedDoc out_;
   const Json* nodes_ = nullptr;
   std::unordered_map<std::string, int> inputIndex_;
+  std::unordered_set<std::string> badInputs_;  // reported once; references stay silent
   std::unordered_map<std::string, const Json*> namedJson_;
   std::unordered_map<std::string, int> namedKind_;   // 1 value, 2 substrate, 0 invalid
   std::unordered_map<std::string, int> namedValue_;  // id -> VNode index (-1 while resolving)
@@ -441,15 +447,17 @@ void Resolver::readInputs(const Json& s, const std::string& ptr) {
     const std::string& name = it.key();
     std::string p = ptr + "/" + pointerToken(name);
     const Json& v = *it;
-    if (!isUsableIdentifier(name, limits_.maxIdentifierBytes)) {
-      d_.error(p, fmt::format("input name {} is not usable: it must be a C identifier of at most {} bytes, "
-                              "without \"__\", and not a C/GLSL/HLSL keyword",
+    if (!isIdentifier(name, limits_.maxIdentifierBytes)) {
+      d_.error(p, fmt::format("input name {} is not a C identifier of at most {} bytes (letters, digits, '_'; "
+                              "no leading digit, no \"__\")",
                               quoteForDiagnostic(name), limits_.maxIdentifierBytes));
+      badInputs_.insert(name);
       continue;
     }
     if (!v.is_object()) {
       d_.error(p, fmt::format("expected an input object like {{\"type\": \"float\", \"default\": 0.5}}, got {}",
                               kindOfJson(v)));
+      badInputs_.insert(name);
       continue;
     }
     Input in;
@@ -460,6 +468,7 @@ void Resolver::readInputs(const Json& s, const std::string& ptr) {
     if (t == v.end() || !t->is_string()) {
       d_.error(p + (t == v.end() ? "" : "/type"),
                "expected \"type\": one of float, vec2, vec3, color, texture2d");
+      badInputs_.insert(name);
       continue;
     }
     std::string ts = t->get<std::string>();
@@ -471,6 +480,7 @@ void Resolver::readInputs(const Json& s, const std::string& ptr) {
     else {
       d_.error(p + "/type", fmt::format("unknown input type {} (expected float, vec2, vec3, color or texture2d)",
                                         quoteForDiagnostic(ts)));
+      badInputs_.insert(name);
       continue;
     }
     for (auto k = v.begin(); k != v.end(); ++k) {
@@ -568,9 +578,9 @@ void Resolver::classifyNodes() {
     const std::string& id = it.key();
     std::string p = "/nodes/" + pointerToken(id);
     namedKind_[id] = 0;
-    if (!isUsableIdentifier(id, limits_.maxIdentifierBytes)) {
-      d_.error(p, fmt::format("node id {} is not usable: it must be a C identifier of at most {} bytes, "
-                              "without \"__\", and not a C/GLSL/HLSL keyword",
+    if (!isIdentifier(id, limits_.maxIdentifierBytes)) {
+      d_.error(p, fmt::format("node id {} is not a C identifier of at most {} bytes (letters, digits, '_'; "
+                              "no leading digit, no \"__\")",
                               quoteForDiagnostic(id), limits_.maxIdentifierBytes));
       continue;
     }
@@ -748,7 +758,7 @@ void Resolver::readValueNodeBody(int index, const Json& j, const std::string& pt
           std::string n = v.get<std::string>().substr(1);
           auto f = inputIndex_.find(n);
           if (f == inputIndex_.end()) {
-            d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic("$" + n)));
+            if (!badInputs_.count(n)) d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic("$" + n)));
           } else if (out_.inputs[f->second].type != VType::Texture) {
             d_.error(pp, fmt::format("input {} is a {}, expected a texture2d input",
                                      quoteForDiagnostic("$" + n),
@@ -822,7 +832,7 @@ PinRef Resolver::readValuePin(const Json& j, const std::string& ptr, const std::
       std::string n = s.substr(1);
       auto f = inputIndex_.find(n);
       if (f == inputIndex_.end()) {
-        d_.error(ptr, fmt::format("unknown input {}", quoteForDiagnostic(s)));
+        if (!badInputs_.count(n)) d_.error(ptr, fmt::format("unknown input {}", quoteForDiagnostic(s)));
         return r;
       }
       if (out_.inputs[f->second].type == VType::Texture) {
@@ -833,6 +843,14 @@ PinRef Resolver::readValuePin(const Json& j, const std::string& ptr, const std::
       r.index = f->second;
       r.type = out_.inputs[f->second].type;
       return r;
+    }
+    {
+      char* end = nullptr;
+      std::strtod(s.c_str(), &end);
+      if (!s.empty() && end && *end == '\0') {
+        d_.error(ptr, fmt::format("expected a number, got the string {} (remove the quotes)", quoteForDiagnostic(s)));
+        return r;
+      }
     }
     std::string id = s, output;
     if (auto dot = s.find('.'); dot != std::string::npos) {

@@ -68,7 +68,11 @@ struct ResolvedDoc {
 std::optional<ResolvedDoc> resolveDocument(const Json& doc, Diagnostics& diags,
                                            const ResolveLimits& limits = {});
 
-/// True for C identifiers that are not reserved in C, GLSL or HLSL.
+/// True for C identifiers (letters, digits, '_', no leading digit, no "__").
+/// Node ids and input names must be identifiers; generated code prefixes them.
+bool isIdentifier(const std::string& s, std::size_t maxBytes = 128);
+/// Identifiers that are also not reserved in C, GLSL or HLSL (the material
+/// name, which names generated symbols).
 bool isUsableIdentifier(const std::string& s, std::size_t maxBytes = 128);
 
 }  // namespace substratec

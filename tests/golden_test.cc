@@ -1,0 +1,122 @@
+// Golden files: the report (text and JSON) of every example, and the
+// diagnostics of every bad input, compared with files committed beside them.
+// Run with --update-golden to regenerate them (then review the diff).
+// Output is normalized (no absolute paths; '\n' line endings).
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "pipeline/pipeline.h"
+#include "report/report.h"
+
+namespace fs = std::filesystem;
+using namespace substratec;
+
+namespace {
+
+bool gUpdate = false;
+const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::vector<fs::path> filesIn(const fs::path& dir, const std::string& ext) {
+  std::vector<fs::path> out;
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.is_regular_file() && e.path().extension() == ext) out.push_back(e.path());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// A short line diff: the first differing lines with context.
+std::string lineDiff(const std::string& expected, const std::string& got) {
+  std::istringstream a(expected), b(got);
+  std::string la, lb, out;
+  int line = 1, shown = 0;
+  while (shown < 10) {
+    bool ea = !std::getline(a, la), eb = !std::getline(b, lb);
+    if (ea && eb) break;
+    if (ea || eb || la != lb) {
+      out += "@@ line " + std::to_string(line) + "\n- " + (ea ? "<eof>" : la) + "\n+ " + (eb ? "<eof>" : lb) + "\n";
+      ++shown;
+    }
+    ++line;
+  }
+  return out;
+}
+
+void checkGolden(const fs::path& golden, const std::string& got) {
+  if (gUpdate) {
+    std::ofstream(golden, std::ios::binary) << got;
+    return;
+  }
+  ASSERT_TRUE(fs::exists(golden)) << "missing golden file " << golden.lexically_relative(kSource)
+                                  << " (run golden_tests --update-golden)";
+  std::string expected = readFile(golden);
+  EXPECT_EQ(expected, got) << "golden mismatch: " << golden.lexically_relative(kSource) << "\nExpected:\n"
+                           << expected << "\nGot:\n" << got << "\nDiff:\n" << lineDiff(expected, got);
+}
+
+/// Compiles `path`, naming it `display` in diagnostics (so goldens carry no paths).
+std::pair<std::optional<CompileResult>, std::string> compileAs(const fs::path& path, const std::string& display,
+                                                                const CompileOptions& o = {}) {
+  Diagnostics diags(display);
+  std::optional<CompileResult> r;
+  if (auto text = readSourceFile(path.string(), o.read, diags)) r = compileText(display, *text, o, diags);
+  return {std::move(r), diags.formatAll()};
+}
+
+}  // namespace
+
+TEST(Golden, EveryExampleReport) {
+  auto examples = filesIn(kSource / "examples", ".json");
+  ASSERT_GE(examples.size(), 16u);
+  for (const auto& e : examples) {
+    SCOPED_TRACE(e.filename().string());
+    auto [r, diags] = compileAs(e, "examples/" + e.filename().string());
+    ASSERT_TRUE(r.has_value()) << diags;
+    EXPECT_EQ(diags, "");
+    const std::string stem = e.stem().string();
+    checkGolden(kSource / "tests/golden" / (stem + ".report.txt"), formatReportText(*r));
+    checkGolden(kSource / "tests/golden" / (stem + ".report.json"), reportJson(*r).dump(2) + "\n");
+  }
+}
+
+TEST(Golden, EveryBadInputDiagnostic) {
+  auto bad = filesIn(kSource / "tests/bad", ".json");
+  ASSERT_GE(bad.size(), 50u);
+  for (const auto& b : bad) {
+    SCOPED_TRACE(b.filename().string());
+    auto [r, diags] = compileAs(b, b.filename().string());
+    EXPECT_FALSE(r.has_value()) << "a bad input compiled";
+    EXPECT_NE(diags.find(": error: "), std::string::npos);
+    checkGolden(kSource / "tests/bad" / (b.stem().string() + ".expected.txt"), diags);
+  }
+}
+
+TEST(Golden, SameInputTwiceGivesIdenticalOutput) {
+  for (const auto& e : filesIn(kSource / "examples", ".json")) {
+    SCOPED_TRACE(e.filename().string());
+    auto [a, da] = compileAs(e, e.filename().string());
+    auto [b, db] = compileAs(e, e.filename().string());
+    ASSERT_TRUE(a && b);
+    EXPECT_EQ(formatReportText(*a), formatReportText(*b));
+    EXPECT_EQ(reportJson(*a).dump(), reportJson(*b).dump());
+  }
+}
+
+int main(int argc, char** argv) {
+  ::testing::InitGoogleTest(&argc, argv);
+  for (int i = 1; i < argc; ++i)
+    if (std::string(argv[i]) == "--update-golden") gUpdate = true;
+  return RUN_ALL_TESTS();
+}
