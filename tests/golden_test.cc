@@ -103,6 +103,42 @@ TEST(Golden, EveryBadInputDiagnostic) {
   }
 }
 
+// Every example at the budgets of issue 3: it fits (bytes, closures, class,
+// the steps taken) or fails with the clear error; one golden table.
+TEST(Golden, EveryExampleAtEveryBudget) {
+  std::string table;
+  for (const auto& e : filesIn(kSource / "examples", ".json")) {
+    for (const char* b : {"80", "48", "32", "20", "full"}) {
+      CompileOptions o;
+      if (std::string(b) == "full") o.fullSimplification = true;
+      else o.budgetOverride = std::stoi(b);
+      auto [r, diags] = compileAs(e, e.filename().string(), o);
+      table += e.stem().string() + " budget=" + b + ": ";
+      if (!r) {
+        table += diags;
+        continue;
+      }
+      EXPECT_TRUE(o.fullSimplification ? r->after.bytes() <= kFullSimplificationBytes && r->after.closures.size() == 1
+                                       : r->after.bytes() <= *o.budgetOverride)
+          << e.filename() << " at " << b;
+      table += std::to_string(r->after.bytes()) + " B, " + std::to_string(r->after.closures.size()) + " closure(s), " +
+               std::string(layoutClassName(r->after.layoutClass));
+      for (const auto& s : r->steps) table += "; " + s.action + " " + s.node;
+      table += "\n";
+    }
+  }
+  checkGolden(kSource / "tests/golden/budgets.expected.txt", table);
+}
+
+// The course's worked example, simplified to one closure, step by step.
+TEST(Golden, WorkedExampleToOneClosure) {
+  CompileOptions o;
+  o.maxClosuresOverride = 1;
+  auto [r, diags] = compileAs(kSource / "examples/worked_example_72.json", "examples/worked_example_72.json", o);
+  ASSERT_TRUE(r) << diags;
+  checkGolden(kSource / "tests/golden/worked_example_72.max_closures_1.report.txt", formatReportText(*r));
+}
+
 TEST(Golden, SameInputTwiceGivesIdenticalOutput) {
   for (const auto& e : filesIn(kSource / "examples", ".json")) {
     SCOPED_TRACE(e.filename().string());

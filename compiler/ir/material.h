@@ -82,6 +82,10 @@ struct Slab {
   bool sssTypeExplicit = false;
   std::uint16_t features = 0;     // filled by the feature pass
   int basis = -1;                 // filled by the shared-bases pass
+  // Set only on slabs made by simplification (parameter blending):
+  ValueId coverage = kNoValue;    // the slab's own coverage (kNoValue: 1)
+  ValueId thickness = kNoValue;   // accumulated layer thickness (kNoValue: none)
+  std::string collapsedFrom;      // the operator it replaces ("" for authored slabs)
 
   ValueId pin(SlabPin p) const { return pins[static_cast<int>(p)]; }
   ValueId& pin(SlabPin p) { return pins[static_cast<int>(p)]; }

@@ -47,7 +47,11 @@ TreeInfo analyzeTree(const Material& m) {
       auto c = [&](int k) { return k >= 0 && t.unitCoverage[k]; };
       bool one = false;
       switch (node.op) {
-        case TreeOp::Slab: one = true; break;
+        case TreeOp::Slab: {
+          ValueId c = m.slabs[node.slab].coverage;
+          one = c == kNoValue || m.values.isConstEqual(c, 1);
+          break;
+        }
         case TreeOp::CoverageWeight: one = c(node.left) && m.values.isConstEqual(node.a, 1); break;
         case TreeOp::Horizontal:
         case TreeOp::Select: one = c(node.left) && c(node.right); break;   // (1-w)*1 + w*1
@@ -70,7 +74,7 @@ TreeInfo analyzeTree(const Material& m) {
     if (node.op == TreeOp::Slab) {
       t.isTop[it.node] = it.layerDepth == 0;
       t.isBottom[it.node] = !it.onTopSide;
-      t.unitWeight[it.node] = it.unit;
+      t.unitWeight[it.node] = it.unit && t.unitCoverage[it.node];  // a blended slab may carry a coverage
       t.unitCoverageAbove[it.node] = it.coverAbove;
       t.bsdfId[node.slab] = static_cast<int>(t.slabOrder.size());
       t.slabOrder.push_back(node.slab);

@@ -26,7 +26,7 @@ std::string_view opName(Op op) {
   static constexpr std::string_view names[] = {
       "const", "input", "geometry", "texture", "add", "subtract", "multiply", "divide", "min",
       "max", "lerp", "clamp", "saturate", "one_minus", "abs", "sqrt", "normalize", "length", "pow",
-      "dot", "swizzle", "combine", "step", "metalness_to_diffuse_f0", "ior_to_f0",
+      "dot", "swizzle", "combine", "step", "exp", "metalness_to_diffuse_f0", "ior_to_f0",
       "haziness_to_second_roughness", "transmittance_to_mfp", "thin_film", "rotation_to_tangent",
       "view_dependent_coverage"};
   static_assert(sizeof(names) / sizeof(names[0]) == static_cast<std::size_t>(Op::Count_));
@@ -224,6 +224,7 @@ bool evalConstOp(Op op, std::uint16_t attr, VType rt, const std::array<double, 4
       for (int i = 0; i < n; ++i) out[i] = a[i][0];
       return true;
     case Op::Step: out[0] = a[1][0] >= a[0][0] ? 1.0 : 0.0; return true;
+    case Op::Exp: return unary([](double x) { return std::exp(std::min(x, 700.0)); });
     case Op::MetalnessToDiffuseF0: {
       auto r = helpers::metalnessToDiffuseF0(vec3(0), a[1][0], a[2][0]);
       const auto& v = attr == 0 ? r.diffuse_albedo : r.f0;

@@ -33,6 +33,7 @@ enum class Op : std::uint8_t {
   Swizzle,   // attr = packed channel indices (2 bits each) | count << 8
   Combine,   // 2..4 scalar args
   Step,      // internal (not a format kind): step(edge, x) = x >= edge ? 1 : 0
+  Exp,       // internal: exp(x), for transmittance exp(-d/mfp)
   // helpers (attr = output index for multi-output helpers)
   MetalnessToDiffuseF0,      // base_color, metallic, specular -> 0: diffuse_albedo, 1: f0
   IorToF0,                   // ior

@@ -69,11 +69,15 @@ std::optional<CompileResult> compileText(const std::string& displayName, const s
   result.budgetBytes = options.budgetOverride.value_or(m.settings.bytesPerPixel);
   result.maxClosures = options.maxClosuresOverride.value_or(m.settings.maxClosures);
   pass.run("price", [&] {
-    result.tree = analyzeTree(m);
-    result.before = computeLayout(m, result.tree);
-    result.after = result.before;
+    result.before = computeLayout(m, analyzeTree(m));
     return true;
   });
+  // 9. simplify to the budget (re-runs 6-8 after each step, so it comes last).
+  result.after = result.before;
+  SimplifyBudget budget{result.budgetBytes, result.maxClosures, options.fullSimplification};
+  if (!pass.run("simplify", [&] { return simplifyToBudget(m, budget, result.after, result.steps, diags); }))
+    return std::nullopt;
+  result.tree = analyzeTree(m);
   return result;
 }
 

@@ -11,6 +11,7 @@
 #include "ir/tree_info.h"
 #include "passes/build_tree.h"
 #include "passes/resolve.h"
+#include "passes/simplify.h"
 #include "storage/layout.h"
 
 namespace substratec {
@@ -29,16 +30,6 @@ struct CompileOptions {
 struct PassTiming {
   std::string pass;
   double milliseconds = 0;
-};
-
-/// One simplification step (issue 3 fills these).
-struct SimplifyStep {
-  std::string action;     // "collapse" or "disable"
-  std::string node;       // operator id, or feature name
-  std::string kind;       // operator kind, or "feature"
-  int depth = 0;
-  int bytesBefore = 0, bytesAfter = 0;
-  int closuresBefore = 0, closuresAfter = 0;
 };
 
 struct CompileResult {

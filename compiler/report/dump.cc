@@ -46,6 +46,8 @@ std::string dumpMaterial(const Material& m) {
     if (s.specularProfileInput >= 0) out += fmt::format("{}specular_profile = ${}\n", pad, m.inputs[s.specularProfileInput].name);
     if (s.sssType != SssType::None) out += fmt::format("{}sss_type = {}\n", pad, sssTypeName(s.sssType));
     if (s.features) out += fmt::format("{}features = {}\n", pad, featureList(s.features));
+    if (s.coverage != kNoValue) out += fmt::format("{}coverage = {}\n", pad, renderValue(m, s.coverage));
+    if (s.thickness != kNoValue) out += fmt::format("{}thickness = {}\n", pad, renderValue(m, s.thickness));
     if (s.basis >= 0) out += fmt::format("{}basis = {}\n", pad, s.basis);
   }
   for (std::size_t b = 0; b < m.bases.size(); ++b) {

@@ -1,0 +1,244 @@
+#include "passes/blend.h"
+
+#include "ir/value_eval.h"
+
+namespace substratec {
+
+namespace {
+
+constexpr double kEps = 1e-6;
+
+/// Small expression builder over the DAG: broadcasting binary ops and guards.
+class Ex {
+ public:
+  explicit Ex(ValueDag& d) : d_(d) {}
+  ValueId k(double v) { return d_.scalar(v); }
+  VType type(ValueId a) const { return d_.node(a).type; }
+  VType join(ValueId a, ValueId b) const { return type(a) == VType::Float ? type(b) : type(a); }
+  ValueId bc(ValueId a, VType t) { return d_.broadcast(a, t); }
+  ValueId bin(Op op, ValueId a, ValueId b) {
+    VType r = join(a, b);
+    return d_.make(op, r, {bc(a, r), bc(b, r)});
+  }
+  ValueId add(ValueId a, ValueId b) { return bin(Op::Add, a, b); }
+  ValueId sub(ValueId a, ValueId b) { return bin(Op::Subtract, a, b); }
+  ValueId mul(ValueId a, ValueId b) { return bin(Op::Multiply, a, b); }
+  ValueId max(ValueId a, ValueId b) { return bin(Op::Max, a, b); }
+  /// a / max(b, eps): finite for b = 0.
+  ValueId safeDiv(ValueId a, ValueId b) { return bin(Op::Divide, a, max(b, k(kEps))); }
+  ValueId lerp(ValueId a, ValueId b, ValueId t) {
+    VType r = join(a, b);
+    return d_.make(Op::Lerp, r, {bc(a, r), bc(b, r), bc(t, r)});
+  }
+  ValueId sat(ValueId a) { return d_.make(Op::Saturate, type(a), {a}); }
+  ValueId oneMinus(ValueId a) { return d_.make(Op::OneMinus, type(a), {a}); }
+  ValueId exp(ValueId a) { return d_.make(Op::Exp, type(a), {a}); }
+  ValueId normalize(ValueId a) { return d_.make(Op::Normalize, type(a), {a}); }
+  /// Mean of a colour's channels.
+  ValueId mean(ValueId a) {
+    if (type(a) == VType::Float) return a;
+    return d_.make(Op::Dot, VType::Float, {a, d_.splat(VType::Vec3, 1.0 / 3.0)});
+  }
+
+ private:
+  ValueDag& d_;
+};
+
+/// Evaluates a (scalar) weight at the inputs' defaults: used only for the
+/// discrete choices a blend cannot express as an expression.
+double typicalValue(const Material& m, ValueId v) { return evaluateValue(m, v)[0]; }
+
+ValueId pin(const Slab& s, SlabPin p) { return s.pin(p); }
+
+ValueId thicknessOf(Material& m, const Slab& s) { return s.thickness == kNoValue ? m.values.scalar(0) : s.thickness; }
+
+/// Hemispherical average of the Schlick Fresnel: F0 + (F90 - F0)/21.
+ValueId fresnelAverage(Material& m, const Slab& s) {
+  Ex e(m.values);
+  return e.add(pin(s, SlabPin::F0), e.mul(e.sub(pin(s, SlabPin::F90), pin(s, SlabPin::F0)), e.k(1.0 / 21.0)));
+}
+
+/// The slab's diffuse with its fuzz folded in: lerp(d, fuzz colour, k·amount).
+ValueId foldedDiffuse(Material& m, const Slab& s) {
+  Ex e(m.values);
+  return e.lerp(pin(s, SlabPin::DiffuseAlbedo), pin(s, SlabPin::FuzzColor),
+                e.mul(pin(s, SlabPin::FuzzAmount), e.k(kFuzzAlbedo)));
+}
+
+/// The part of the directional albedo that is not specular: (1 - F)·folded diffuse.
+ValueId diffuseEnergy(Material& m, const Slab& s) {
+  Ex e(m.values);
+  return e.mul(e.oneMinus(fresnelAverage(m, s)), foldedDiffuse(m, s));
+}
+
+/// Sets r's diffuse albedo so that (1 - F_r)·folded diffuse equals `target`:
+/// the blended slab returns exactly the blended energy (a plain lerp of the
+/// diffuse would not, since (1-F)·d is bilinear in the blended parameters).
+void setDiffuseEnergy(Material& m, Slab& r, ValueId target) {
+  Ex e(m.values);
+  ValueId folded = e.safeDiv(target, e.oneMinus(fresnelAverage(m, r)));
+  ValueId fuzz = e.mul(pin(r, SlabPin::FuzzAmount), e.k(kFuzzAlbedo));
+  ValueId d = e.safeDiv(e.sub(folded, e.mul(fuzz, pin(r, SlabPin::FuzzColor))), e.oneMinus(fuzz));
+  r.pin(SlabPin::DiffuseAlbedo) = e.sat(d);
+}
+
+/// Lerps every blendable pin of two slabs by t (normals/tangents renormalized).
+Slab lerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
+  Ex e(m.values);
+  Slab r = a;
+  for (int p = 0; p < kSlabPinCount; ++p) {
+    SlabPin sp = static_cast<SlabPin>(p);
+    ValueId v = e.lerp(pin(a, sp), pin(b, sp), t);
+    if (sp == SlabPin::Normal || sp == SlabPin::Tangent) v = e.normalize(v);
+    r.pin(sp) = v;
+  }
+  if (a.thickness != kNoValue || b.thickness != kNoValue)
+    r.thickness = e.lerp(thicknessOf(m, a), thicknessOf(m, b), t);
+  else
+    r.thickness = kNoValue;
+  // Fuzz colour premultiplied by the amount, so amount·colour blends linearly.
+  r.pin(SlabPin::FuzzColor) = e.safeDiv(
+      e.lerp(e.mul(pin(a, SlabPin::FuzzAmount), pin(a, SlabPin::FuzzColor)),
+             e.mul(pin(b, SlabPin::FuzzAmount), pin(b, SlabPin::FuzzColor)), t),
+      pin(r, SlabPin::FuzzAmount));
+  setDiffuseEnergy(m, r, e.lerp(diffuseEnergy(m, a), diffuseEnergy(m, b), t));
+  return r;
+}
+
+/// Discrete properties (specular profile, SSS type, glint uv) from the side
+/// that dominates: `bWins` picks b when both sides have the property.
+void takeDiscrete(Slab& r, const Slab& a, const Slab& b, bool bWins) {
+  auto pick = [&](bool aHas, bool bHas) { return aHas == bHas ? bWins : bHas; };
+  r.specularProfileInput =
+      pick(a.specularProfileInput >= 0, b.specularProfileInput >= 0) ? b.specularProfileInput : a.specularProfileInput;
+  bool aSss = a.features & kFeatSss, bSss = b.features & kFeatSss;
+  const Slab& sss = pick(aSss, bSss) ? b : a;
+  r.sssType = sss.sssType;
+  r.sssTypeExplicit = sss.sssTypeExplicit;
+  bool aGlint = a.features & kFeatGlint, bGlint = b.features & kFeatGlint;
+  r.pin(SlabPin::GlintUv) = pick(aGlint, bGlint) ? b.pin(SlabPin::GlintUv) : a.pin(SlabPin::GlintUv);
+}
+
+}  // namespace
+
+ValueId coverageOf(Material& m, const Slab& s) { return s.coverage == kNoValue ? m.values.scalar(1) : s.coverage; }
+
+Slab foldToSingleInterface(Material& m, const Slab& s) {
+  Ex e(m.values);
+  Slab r = s;
+  r.pin(SlabPin::Roughness) =
+      e.lerp(pin(s, SlabPin::Roughness), pin(s, SlabPin::SecondRoughness), pin(s, SlabPin::SecondRoughnessWeight));
+  r.pin(SlabPin::SecondRoughnessWeight) = m.values.scalar(0);
+  r.pin(SlabPin::DiffuseAlbedo) = e.lerp(pin(s, SlabPin::DiffuseAlbedo), pin(s, SlabPin::FuzzColor),
+                                         e.mul(pin(s, SlabPin::FuzzAmount), e.k(kFuzzAlbedo)));
+  r.pin(SlabPin::FuzzAmount) = m.values.scalar(0);
+  return r;
+}
+
+Slab blendHorizontal(Material& m, const Slab& bg, const Slab& fg, ValueId w) {
+  Ex e(m.values);
+  ValueId cb = coverageOf(m, bg), cf = coverageOf(m, fg);
+  ValueId num = e.mul(cf, w);
+  ValueId mix = e.safeDiv(num, e.add(num, e.mul(cb, e.oneMinus(w))));
+  Slab r = lerpSlabs(m, bg, fg, mix);
+  takeDiscrete(r, bg, fg, typicalValue(m, w) > 0.5);
+  r.coverage = e.lerp(cb, cf, w);
+  r.features = bg.features | fg.features;
+  return r;
+}
+
+Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, ValueId threshold) {
+  // a when value <= threshold: the weight of b is 1 - step(value, threshold).
+  ValueId pickA = m.values.make(Op::Step, VType::Float, {value, threshold});
+  return blendHorizontal(m, a, b, m.values.make(Op::OneMinus, VType::Float, {pickA}));
+}
+
+Slab blendCoverageWeight(Material& m, const Slab& a, ValueId weight) {
+  Ex e(m.values);
+  Slab r = a;
+  r.coverage = e.mul(coverageOf(m, a), weight);
+  return r;
+}
+
+Slab blendAdd(Material& m, const Slab& a, const Slab& b) {
+  Ex e(m.values);
+  ValueId ca = coverageOf(m, a), cb = coverageOf(m, b);
+  ValueId c = e.sat(e.add(ca, cb));
+  ValueId t = e.safeDiv(cb, e.add(ca, cb));
+  Slab r = lerpSlabs(m, a, b, t);
+  // Colours add: the summed contribution Ca·Xa + Cb·Xb, re-expressed per unit
+  // of the new coverage and saturated.
+  auto added = [&](ValueId xa, ValueId xb) { return e.sat(e.safeDiv(e.add(e.mul(ca, xa), e.mul(cb, xb)), c)); };
+  r.pin(SlabPin::F0) = added(pin(a, SlabPin::F0), pin(b, SlabPin::F0));
+  // The diffuse part adds too: the energy of both, per unit of the new
+  // coverage, minus what the (added) specular now takes.
+  ValueId albedoA = e.add(fresnelAverage(m, a), diffuseEnergy(m, a));
+  ValueId albedoB = e.add(fresnelAverage(m, b), diffuseEnergy(m, b));
+  setDiffuseEnergy(m, r, e.max(e.sub(added(albedoA, albedoB), fresnelAverage(m, r)), e.k(0)));
+  r.pin(SlabPin::Emissive) = e.safeDiv(e.add(e.mul(ca, pin(a, SlabPin::Emissive)), e.mul(cb, pin(b, SlabPin::Emissive))), c);
+  takeDiscrete(r, a, b, typicalValue(m, t) > 0.5);
+  r.coverage = c;
+  r.features = a.features | b.features;
+  return r;
+}
+
+Slab blendVertical(Material& m, const Slab& topIn, const Slab& baseIn, ValueId d) {
+  Ex e(m.values);
+  const Slab top = foldToSingleInterface(m, topIn);
+  const Slab base1 = foldToSingleInterface(m, baseIn);  // the base as seen under the top
+  ValueId ct = coverageOf(m, topIn), cb = coverageOf(m, baseIn);
+
+  // Transmittance of the top's medium along the normal, and both ways.
+  ValueId mfp = e.mul(pin(top, SlabPin::SssMfp), pin(top, SlabPin::SssMfpScale));
+  ValueId tn = e.exp(e.sub(e.k(0), e.bin(Op::Divide, e.bc(d, VType::Vec3), e.max(mfp, e.k(1e-30)))));
+  ValueId tn2 = e.mul(tn, tn);
+  ValueId tn2cb = e.mul(tn2, cb);
+
+  // Region "top present": one interface (the top's) over the base seen through the medium.
+  auto over = [&](SlabPin p) {  // R = Rt + (1-Rt)^2 T^2 Rb / (1 - Rt Rb), the smooth two-interface sum
+    ValueId rt = pin(top, p), rb = pin(base1, p);
+    ValueId omr = e.oneMinus(rt);
+    return e.add(rt, e.safeDiv(e.mul(e.mul(omr, omr), e.mul(tn2cb, rb)), e.oneMinus(e.mul(rt, rb))));
+  };
+  Slab t = base1;
+  t.pin(SlabPin::F0) = over(SlabPin::F0);
+  t.pin(SlabPin::F90) = over(SlabPin::F90);
+  // Energy of the stack: the top's interface reflects F_T; what it transmits
+  // meets the medium, which returns its volumetric albedo a_T(1 - T^2) and lets
+  // T^2 reach the base and come back. The diffuse makes the single interface
+  // return exactly that.
+  ValueId ft = fresnelAverage(m, top);
+  ValueId albedoBase = e.add(fresnelAverage(m, base1), diffuseEnergy(m, base1));
+  ValueId stack = e.add(ft, e.mul(e.oneMinus(ft), e.add(e.mul(pin(top, SlabPin::DiffuseAlbedo), e.oneMinus(tn2)),
+                                                         e.mul(tn2cb, albedoBase))));
+  setDiffuseEnergy(m, t, e.max(e.sub(stack, fresnelAverage(m, t)), e.k(0)));
+  t.pin(SlabPin::Emissive) = e.add(pin(top, SlabPin::Emissive), e.mul(e.mul(tn, cb), pin(base1, SlabPin::Emissive)));
+  // Which layer dominates what is seen: the top, unless its medium and
+  // interface let the base through.
+  ValueId baseSeen = e.mul(e.mean(tn2cb), e.oneMinus(e.mean(pin(top, SlabPin::F0))));
+  ValueId k = e.oneMinus(baseSeen);
+  t.pin(SlabPin::Roughness) = e.lerp(pin(base1, SlabPin::Roughness), pin(top, SlabPin::Roughness), k);
+  t.pin(SlabPin::Normal) = e.normalize(e.lerp(pin(base1, SlabPin::Normal), pin(top, SlabPin::Normal), k));
+  t.pin(SlabPin::Anisotropy) = e.k(0);
+  t.pin(SlabPin::GlintValue) = e.lerp(pin(base1, SlabPin::GlintValue), pin(top, SlabPin::GlintValue), k);
+
+  // Coverage-weighted: C = Ct + Cb(1-Ct); the top region weighs Ct/C.
+  ValueId c = e.sub(e.add(ct, cb), e.mul(ct, cb));
+  ValueId wt = e.safeDiv(ct, c);
+  Slab r = lerpSlabs(m, baseIn, t, wt);
+  // The medium below is the base's; the top's was consumed into the colours.
+  for (SlabPin p : {SlabPin::SssMfp, SlabPin::SssMfpScale, SlabPin::SssPhaseAnisotropy, SlabPin::Tangent,
+                    SlabPin::SecondRoughness, SlabPin::FuzzColor, SlabPin::FuzzRoughness})
+    r.pin(p) = pin(baseIn, p);
+  r.sssType = baseIn.sssType;
+  r.sssTypeExplicit = baseIn.sssTypeExplicit;
+  bool topGlint = topIn.features & kFeatGlint;
+  r.pin(SlabPin::GlintUv) = topGlint ? pin(topIn, SlabPin::GlintUv) : pin(baseIn, SlabPin::GlintUv);
+  r.specularProfileInput = topIn.specularProfileInput >= 0 ? topIn.specularProfileInput : baseIn.specularProfileInput;
+  r.thickness = e.add(d, thicknessOf(m, baseIn));
+  r.coverage = c;
+  r.features = (topIn.features | baseIn.features) & ~kFeatAnisotropy;
+  return r;
+}
+
+}  // namespace substratec

@@ -1,0 +1,45 @@
+// Parameter blending: one function per operator, each turning an operator
+// over two (or one) slabs into one equivalent slab. The results are value-DAG
+// expressions (folded where constant), so the same blend runs at compile time
+// and in the generated shader. Formulas and reasoning: docs/simplification.md.
+#pragma once
+#include "ir/material.h"
+
+namespace substratec {
+
+/// Horizontal mix (w toward the foreground): every parameter is lerped by the
+/// coverage-weighted m = Cf·w / (Cf·w + Cb·(1−w)); normals and tangents are
+/// lerped then normalized; coverage is lerp(Cb, Cf, w); what cannot be blended
+/// (specular profile, SSS type, glint uv) goes to the side with the larger weight.
+Slab blendHorizontal(Material& m, const Slab& background, const Slab& foreground, ValueId mix);
+
+/// Vertical layering: where the top is present (probability Ct/C) the pair is
+/// one interface over the base seen through the top's medium (T = exp(−d/MFP)
+/// along the normal, twice); where it is absent, the base as it is.
+Slab blendVertical(Material& m, const Slab& top, const Slab& base, ValueId thickness);
+
+/// Add: colours add (saturated), everything else is coverage-weighted;
+/// coverage sat(Ca + Cb).
+Slab blendAdd(Material& m, const Slab& a, const Slab& b);
+
+/// Coverage weight: the slab with its coverage scaled by w.
+Slab blendCoverageWeight(Material& m, const Slab& a, ValueId weight);
+
+/// Select (a when value <= threshold): a horizontal mix toward b by the
+/// run-time condition step(threshold < value).
+Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, ValueId threshold);
+
+/// The slab's single-interface form: haze folded into the roughness
+/// (lerp(r, r2, w)) and fuzz into the diffuse albedo (lerp(d, fuzz colour,
+/// kFuzzAlbedo·amount)). Vertical blending uses it under the top.
+Slab foldToSingleInterface(Material& m, const Slab& s);
+
+/// Fraction of the fuzz colour a fully fuzzy slab adds to its diffuse albedo
+/// when fuzz is folded (the mean directional albedo of a Charlie sheen lobe
+/// over roughness, rounded).
+inline constexpr double kFuzzAlbedo = 0.25;
+
+/// The slab's coverage as a value (1 when not set).
+ValueId coverageOf(Material& m, const Slab& s);
+
+}  // namespace substratec
