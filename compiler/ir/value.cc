@@ -180,7 +180,13 @@ bool evalConstOp(Op op, std::uint16_t attr, VType rt, const std::array<double, 4
     case Op::Min: return binary([](double x, double y) { return std::min(x, y); });
     case Op::Max: return binary([](double x, double y) { return std::max(x, y); });
     case Op::Pow:
-      return binary([](double x, double y) { return std::pow(std::max(x, 0.0), y); });
+      // Guarded: a negative base is clamped to 0, and 0 to a negative power is
+      // 0 rather than infinity (the runtime's substrate_pow does the same).
+      return binary([](double x, double y) {
+        double b = std::max(x, 0.0);
+        if (b == 0.0) return y == 0.0 ? 1.0 : 0.0;
+        return std::pow(b, y);
+      });
     case Op::Lerp:
       for (int i = 0; i < k; ++i) {
         double x = componentOf(a[0], at[0], i), y = componentOf(a[1], at[1], i),

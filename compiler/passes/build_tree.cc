@@ -10,10 +10,11 @@ namespace {
 
 class TreeBuilder {
  public:
-  TreeBuilder(const ResolvedDoc& doc, const ValueTable& table, Material& m)
-      : doc_(doc), table_(table), m_(m) {
+  TreeBuilder(const ResolvedDoc& doc, const ValueTable& table, Material& m, Diagnostics& diags)
+      : doc_(doc), table_(table), m_(m), diags_(diags) {
     // Every user-visible id is reserved so generated instance names never clash.
-    for (const auto& s : doc.substrate) used_.insert(s.id);
+    for (const auto& s : doc.substrate)
+      if (s.pointer == "/nodes/" + s.id) used_.insert(s.id);  // author ids (inline names are generated)
     for (const auto& v : doc.values) used_.insert(v.id);
     for (const auto& in : doc.inputs) used_.insert(in.name);
   }
@@ -23,7 +24,7 @@ class TreeBuilder {
     TreeNode node;
     node.op = src.op;
     node.pointer = src.pointer;
-    node.id = uniqueId(src.id);
+    node.id = uniqueId(src.id, src.pointer == "/nodes/" + src.id);
     int index = static_cast<int>(m_.nodes.size());
     m_.nodes.push_back(node);
     if (src.op == TreeOp::Slab) {
@@ -33,6 +34,7 @@ class TreeBuilder {
       for (int p = 0; p < kSlabPinCount; ++p) {
         const SlabPinInfo& info = slabPinInfo(static_cast<SlabPin>(p));
         slab.pins[p] = pinToValue(src.slabPins[p], info.type, table_, m_);
+        if (src.slabPins[p].tag == PinRef::Node) checkConstantRange(slab.pins[p], info, src.pointer);
       }
       slab.specularProfileInput = src.specularProfileInput;
       slab.sssType = src.sssType;
@@ -55,14 +57,17 @@ class TreeBuilder {
   }
 
  private:
-  std::string uniqueId(const std::string& base) {
+  /// The first instance of an author node keeps its id; every other name
+  /// (later instances, inline nodes) takes the first free `base`, `base_2`, ...
+  /// that is neither an author id nor already generated.
+  std::string uniqueId(const std::string& base, bool authorNode) {
     auto& count = seen_[base];
     ++count;
-    if (count == 1) {
+    if (!generated_.count(base) && (authorNode || !used_.count(base))) {
       generated_.insert(base);
       return base;
     }
-    for (int k = count;; ++k) {
+    for (int k = std::max(count, 2);; ++k) {
       std::string candidate = fmt::format("{}_{}", base, k);
       if (!used_.count(candidate) && !generated_.count(candidate)) {
         generated_.insert(candidate);
@@ -72,9 +77,33 @@ class TreeBuilder {
     }
   }
 
+  /// An expression that folds to a constant must obey the pin's range, like a
+  /// literal (literals were checked by resolve).
+  void checkConstantRange(ValueId v, const SlabPinInfo& info, const std::string& ptr) {
+    const ValueNode& n = m_.values.node(v);
+    if (n.op != Op::Const || info.type == VType::Vec2) return;
+    std::string where = ptr + "/" + std::string(info.name);
+    if (!reported_.insert(where).second) return;  // a node instanced twice reports once
+    if (info.type == VType::Vec3 && !info.color) {
+      if (n.c[0] * n.c[0] + n.c[1] * n.c[1] + n.c[2] * n.c[2] < 1e-12)
+        diags_.error(where, "expected a non-zero direction, but the expression is the constant zero vector");
+      return;
+    }
+    for (int i = 0; i < componentCount(n.type); ++i) {
+      if (n.c[i] < info.lo || n.c[i] > info.hi) {
+        std::string range = info.hi >= 1e300 ? fmt::format(">= {:g}", info.lo) : fmt::format("in [{:g},{:g}]", info.lo, info.hi);
+        diags_.error(where, fmt::format("expected {} {}, but the expression is the constant {}",
+                                        info.color ? "a color with components" : "a float", range, m_.values.render(v)));
+        return;
+      }
+    }
+  }
+
   const ResolvedDoc& doc_;
   const ValueTable& table_;
   Material& m_;
+  Diagnostics& diags_;
+  std::unordered_set<std::string> reported_;
   std::unordered_set<std::string> used_, generated_;
   std::unordered_map<std::string, int> seen_;
 };
@@ -112,9 +141,9 @@ bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Materia
                             limits.maxTreeNodes));
     return false;
   }
-  TreeBuilder builder(doc, table, m);
+  TreeBuilder builder(doc, table, m, diags);
   m.root = builder.instance(doc.output);
-  return true;
+  return !diags.hasErrors();
 }
 
 }  // namespace substratec

@@ -57,7 +57,10 @@ class Culler {
     int l = n.left >= 0 ? visit(n.left) : -1;
     int r = n.right >= 0 ? visit(n.right) : -1;
     if (n.op == TreeOp::CoverageWeight) {
-      if (l < 0) return -1;
+      if (l < 0) {
+        note(n.id, fmt::format("coverage_weight '{}' removed: its subtree is empty", n.id));
+        return -1;
+      }
       m_.nodes[i].left = l;
       return i;
     }

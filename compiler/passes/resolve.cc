@@ -256,6 +256,14 @@ class Resolver {
   std::unordered_map<std::string, int> namedKind_;   // 1 value, 2 substrate, 0 invalid
   std::unordered_map<std::string, int> namedValue_;  // id -> VNode index (-1 while resolving)
   std::unordered_map<std::string, int> namedSubstrate_;
+  struct DeferredPinCheck {
+    int snode;
+    int pin;  // slab pin index, or -1 (a) / -2 (b) for operator values
+    PinKind kind;
+    std::string pointer;
+  };
+  std::vector<DeferredPinCheck> deferred_;  // pins referencing value nodes: typed after typeValueNodes
+  void checkDeferredPins();
   std::size_t nodeCount_ = 0;
   bool nodeLimitReported_ = false;
   std::string outputId_;
@@ -269,6 +277,7 @@ std::optional<ResolvedDoc> Resolver::run() {
   readTop();
   if (d_.limitReached()) return std::nullopt;
   typeValueNodes();
+  checkDeferredPins();
   checkSubstrateCycles();
   if (d_.hasErrors()) return std::nullopt;
   return std::move(out_);
@@ -1031,6 +1040,7 @@ void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& pt
   out_.substrate[index].op = op;
   const std::string id = out_.substrate[index].id;
 
+  SNode node;  // filled locally: out_.substrate may reallocate during recursion
   auto checkKeys = [&](std::initializer_list<const char*> keys) {
     for (auto it = j.begin(); it != j.end(); ++it) {
       const std::string& k = it.key();
@@ -1064,9 +1074,9 @@ void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& pt
       return;
     }
     dst = readValuePin(*it, ptr + "/" + pin, pin);
+    if (dst.tag == PinRef::Node) deferred_.push_back({index, &dst == &node.a ? -1 : -2, PinKind::Float, ptr + "/" + pin});
     if (expectPinType(dst, PinKind::Float, ptr + "/" + pin)) checkRange(dst, *it, ptr + "/" + pin, lo, hi, "a float");
   };
-  SNode node;  // filled locally: out_.substrate may reallocate during recursion
   constexpr double kBig = 1e300;
   switch (op) {
     case TreeOp::Horizontal:
@@ -1126,6 +1136,7 @@ void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& pt
         PinKind kind = info.color ? PinKind::Color
                                   : info.type == VType::Float ? PinKind::Float
                                   : info.type == VType::Vec2 ? PinKind::Vec2 : PinKind::Vec3;
+        if (dst.tag == PinRef::Node) deferred_.push_back({index, p, kind, pp});
         if (expectPinType(dst, kind, pp)) {
           const char* what = info.color ? "a color with components" : "a float";
           if (info.type == VType::Vec3 && !info.color) what = "a vector with components";
@@ -1331,6 +1342,21 @@ void Resolver::typeValueNodes() {
       out_.valueOrder.push_back(i);
       stack.pop_back();
     }
+  }
+}
+
+/// Pins of Substrate nodes that reference value nodes can only be typed once
+/// every value node is typed; checked here with the same rule as literals.
+void Resolver::checkDeferredPins() {
+  for (const auto& c : deferred_) {
+    SNode& s = out_.substrate[c.snode];
+    PinRef& pin = c.pin >= 0 ? s.slabPins[c.pin] : c.pin == -1 ? s.a : s.b;
+    if (pin.tag != PinRef::Node) continue;
+    const VNode& v = out_.values[pin.index];
+    if (v.outputTypes.empty()) continue;
+    pin.type = v.outputTypes[std::min<std::size_t>(pin.output, v.outputTypes.size() - 1)];
+    if (pin.type == VType::Invalid) continue;  // already reported
+    expectPinType(pin, c.kind, c.pointer);
   }
 }
 

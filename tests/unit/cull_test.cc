@@ -1,0 +1,571 @@
+// Tests for pass 5, static culling (compiler/passes/cull.h), in the Tint
+// style: the IR dump of a small material before the pass, the pass, the dump
+// after it. Each rule of cull.h has its test; the NoModify_ tests show what
+// the pass must leave alone (anything whose weight is not a constant 0 or 1).
+#include "passes/cull.h"
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+
+namespace substratec {
+namespace {
+
+using test::buildMaterial;
+using test::diagnosticsOf;
+using test::material;
+using test::Stage;
+
+constexpr const char* kInputs = R"({
+  "m": {"type": "float", "default": 0.5, "min": 0, "max": 1},
+  "v": {"type": "float", "default": 0},
+  "w": {"type": "float", "default": 0.5, "min": 0, "max": 1}
+})";
+
+class CullTest : public ::testing::Test {
+ protected:
+  /// Builds the tree of `nodes` (output "root"), checks its dump is `before`,
+  /// culls it and returns the dump after.
+  std::string cull(const std::string& nodes, const std::string& before) {
+    m = buildMaterial(material(nodes, kInputs), Stage::Tree);
+    EXPECT_EQ(dumpMaterial(m), before) << "(input dump)";
+    Diagnostics d("test.json");
+    ok = cullStaticMatter(m, d);
+    diags = d.formatAll();
+    return dumpMaterial(m);
+  }
+  /// For NoModify_ tests: the dump must be the same before and after.
+  void expectUnchanged(const std::string& nodes, const std::string& dump) {
+    EXPECT_EQ(cull(nodes, dump), dump);
+    EXPECT_TRUE(ok);
+    EXPECT_EQ(diags, "");
+    EXPECT_TRUE(m.culled.empty());
+  }
+
+  Material m;
+  bool ok = false;
+  std::string diags;
+};
+
+// ---------------------------------------------------------------------------
+// horizontal with a constant mix
+
+TEST_F(CullTest, HorizontalMixConstantZeroKeepsTheBackground) {
+  auto after = cull(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "foreground": "fg", "mix": 0})",
+                    R"(HORIZONTAL root mix=0
+  SLAB bg
+      roughness = 0.2
+  SLAB fg
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB bg
+    roughness = 0.2
+culled fg: foreground of horizontal 'root': mix is constant 0
+culled root: horizontal with constant mix 0 replaced by its background
+)");
+  EXPECT_TRUE(ok);
+}
+
+TEST_F(CullTest, HorizontalMixConstantOneKeepsTheForeground) {
+  auto after = cull(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "foreground": "fg", "mix": 1})",
+                    R"(HORIZONTAL root mix=1
+  SLAB bg
+      roughness = 0.2
+  SLAB fg
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB fg
+    roughness = 0.8
+culled bg: background of horizontal 'root': mix is constant 1
+culled root: horizontal with constant mix 1 replaced by its foreground
+)");
+}
+
+TEST_F(CullTest, HorizontalMixThatFoldsToAConstantIsConstant) {
+  // one_minus(1) is folded to 0 when the value DAG is built.
+  auto after = cull(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "foreground": "fg",
+             "mix": {"kind": "one_minus", "x": 1}})",
+                    R"(HORIZONTAL root mix=0
+  SLAB bg
+      roughness = 0.2
+  SLAB fg
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB bg
+    roughness = 0.2
+culled fg: foreground of horizontal 'root': mix is constant 0
+culled root: horizontal with constant mix 0 replaced by its background
+)");
+}
+
+TEST_F(CullTest, KeptSideIsCulledToo) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "kept": {"kind": "coverage_weight", "a": "b", "weight": 1},
+    "root": {"kind": "horizontal", "background": "a", "foreground": "kept", "mix": 1})",
+                    R"(HORIZONTAL root mix=1
+  SLAB a
+      roughness = 0.2
+  WEIGHT kept weight=1
+    SLAB b
+        roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB b
+    roughness = 0.8
+culled a: background of horizontal 'root': mix is constant 1
+culled root: horizontal with constant mix 1 replaced by its foreground
+culled kept: coverage_weight with constant weight 1 removed (no effect)
+)");
+}
+
+TEST_F(CullTest, NoModify_HorizontalWithARunTimeMix) {
+  expectUnchanged(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "foreground": "fg", "mix": "$m"})",
+                  R"(HORIZONTAL root mix=$m
+  SLAB bg
+      roughness = 0.2
+  SLAB fg
+      roughness = 0.8
+)");
+}
+
+TEST_F(CullTest, NoModify_HorizontalWithAConstantMixStrictlyBetweenZeroAndOne) {
+  expectUnchanged(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "foreground": "fg", "mix": 0.001})",
+                  R"(HORIZONTAL root mix=0.001
+  SLAB bg
+      roughness = 0.2
+  SLAB fg
+      roughness = 0.8
+)");
+}
+
+// ---------------------------------------------------------------------------
+// coverage_weight with a constant weight
+
+TEST_F(CullTest, CoverageWeightZeroRemovesItsSubtree) {
+  auto after = cull(R"(
+    "coat": {"kind": "slab", "roughness": 0.1},
+    "base": {"kind": "slab", "roughness": 0.6},
+    "worn": {"kind": "coverage_weight", "a": "coat", "weight": 0},
+    "root": {"kind": "vertical", "top": "worn", "base": "base"})",
+                    R"(VERTICAL root thickness=0.0001
+  WEIGHT worn weight=0
+    SLAB coat
+        roughness = 0.1
+  SLAB base
+      roughness = 0.6
+)");
+  EXPECT_EQ(after, R"(SLAB base
+    roughness = 0.6
+culled coat: under coverage_weight 'worn': weight is constant 0
+culled worn: coverage_weight with constant weight 0 removed with its subtree
+culled root: VERTICAL 'root' removed: one side is empty
+)");
+}
+
+TEST_F(CullTest, CoverageWeightOneDisappears) {
+  auto after = cull(R"(
+    "s": {"kind": "slab", "roughness": 0.3},
+    "root": {"kind": "coverage_weight", "a": "s", "weight": 1})",
+                    R"(WEIGHT root weight=1
+  SLAB s
+      roughness = 0.3
+)");
+  EXPECT_EQ(after, R"(SLAB s
+    roughness = 0.3
+culled root: coverage_weight with constant weight 1 removed (no effect)
+)");
+}
+
+TEST_F(CullTest, NoModify_CoverageWeightOneHalf) {
+  expectUnchanged(R"(
+    "s": {"kind": "slab", "roughness": 0.3},
+    "root": {"kind": "coverage_weight", "a": "s", "weight": 0.5})",
+                  R"(WEIGHT root weight=0.5
+  SLAB s
+      roughness = 0.3
+)");
+}
+
+TEST_F(CullTest, NoModify_CoverageWeightOfAnInput) {
+  // The input's default is 0.5, but it is a run-time value: nothing is constant.
+  expectUnchanged(R"(
+    "s": {"kind": "slab", "roughness": 0.3},
+    "root": {"kind": "coverage_weight", "a": "s", "weight": "$w"})",
+                  R"(WEIGHT root weight=$w
+  SLAB s
+      roughness = 0.3
+)");
+}
+
+// ---------------------------------------------------------------------------
+// select with a constant value
+
+TEST_F(CullTest, SelectWithAConstantValueAtMostTheThresholdKeepsA) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "a": "a", "b": "b", "value": 0.2})",
+                    R"(SELECT root value=0.2 threshold=0.5
+  SLAB a
+      roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB a
+    roughness = 0.2
+culled b: side b of select 'root': the constant value always picks a
+culled root: select with a constant value replaced by side a
+)");
+}
+
+TEST_F(CullTest, SelectWithAConstantValueAboveTheThresholdKeepsB) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "a": "a", "b": "b", "value": 0.3, "threshold": 0.25})",
+                    R"(SELECT root value=0.3 threshold=0.25
+  SLAB a
+      roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB b
+    roughness = 0.8
+culled a: side a of select 'root': the constant value always picks b
+culled root: select with a constant value replaced by side b
+)");
+}
+
+TEST_F(CullTest, SelectValueEqualToTheThresholdKeepsA) {
+  // "a when value <= threshold".
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "a": "a", "b": "b", "value": 0.5})",
+                    R"(SELECT root value=0.5 threshold=0.5
+  SLAB a
+      roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB a
+    roughness = 0.2
+culled b: side b of select 'root': the constant value always picks a
+culled root: select with a constant value replaced by side a
+)");
+}
+
+TEST_F(CullTest, NoModify_SelectOnAnInput) {
+  expectUnchanged(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "a": "a", "b": "b", "value": "$v"})",
+                  R"(SELECT root value=$v threshold=0.5
+  SLAB a
+      roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+}
+
+TEST_F(CullTest, NoModify_SelectWithAConstantValueAndARunTimeThreshold) {
+  expectUnchanged(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "a": "a", "b": "b", "value": 0.2, "threshold": "$v"})",
+                  R"(SELECT root value=0.2 threshold=$v
+  SLAB a
+      roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+}
+
+// ---------------------------------------------------------------------------
+// Operators left with one empty side
+
+TEST_F(CullTest, VerticalWithAnEmptyBaseKeepsItsTop) {
+  auto after = cull(R"(
+    "coat": {"kind": "slab", "roughness": 0.1},
+    "base": {"kind": "slab", "roughness": 0.6},
+    "gone": {"kind": "coverage_weight", "a": "base", "weight": 0},
+    "root": {"kind": "vertical", "top": "coat", "base": "gone"})",
+                    R"(VERTICAL root thickness=0.0001
+  SLAB coat
+      roughness = 0.1
+  WEIGHT gone weight=0
+    SLAB base
+        roughness = 0.6
+)");
+  EXPECT_EQ(after, R"(SLAB coat
+    roughness = 0.1
+culled base: under coverage_weight 'gone': weight is constant 0
+culled gone: coverage_weight with constant weight 0 removed with its subtree
+culled root: VERTICAL 'root' removed: one side is empty
+)");
+}
+
+TEST_F(CullTest, AddWithAnEmptySideKeepsTheOtherSide) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "add", "a": {"kind": "coverage_weight", "a": "a", "weight": 0}, "b": "b"})",
+                    R"(ADD root
+  WEIGHT root_a weight=0
+    SLAB a
+        roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(SLAB b
+    roughness = 0.8
+culled a: under coverage_weight 'root_a': weight is constant 0
+culled root_a: coverage_weight with constant weight 0 removed with its subtree
+culled root: ADD 'root' removed: one side is empty
+)");
+}
+
+TEST_F(CullTest, HorizontalWithAnEmptyForegroundWeighsTheBackgroundByOneMinusMix) {
+  auto after = cull(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "mix": "$m",
+             "foreground": {"kind": "coverage_weight", "a": "fg", "weight": 0}})",
+                    R"(HORIZONTAL root mix=$m
+  SLAB bg
+      roughness = 0.2
+  WEIGHT root_foreground weight=0
+    SLAB fg
+        roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(WEIGHT root weight=one_minus($m)
+  SLAB bg
+      roughness = 0.2
+culled fg: under coverage_weight 'root_foreground': weight is constant 0
+culled root_foreground: coverage_weight with constant weight 0 removed with its subtree
+culled root: horizontal 'root' with an empty side is a coverage_weight
+)");
+}
+
+TEST_F(CullTest, HorizontalWithAnEmptyBackgroundWeighsTheForegroundByMix) {
+  auto after = cull(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "foreground": "fg", "mix": "$m",
+             "background": {"kind": "coverage_weight", "a": "bg", "weight": 0}})",
+                    R"(HORIZONTAL root mix=$m
+  WEIGHT root_background weight=0
+    SLAB bg
+        roughness = 0.2
+  SLAB fg
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(WEIGHT root weight=$m
+  SLAB fg
+      roughness = 0.8
+culled bg: under coverage_weight 'root_background': weight is constant 0
+culled root_background: coverage_weight with constant weight 0 removed with its subtree
+culled root: horizontal 'root' with an empty side is a coverage_weight
+)");
+}
+
+TEST_F(CullTest, HorizontalWithAnEmptySideAndAConstantMixFoldsTheWeight) {
+  auto after = cull(R"(
+    "bg": {"kind": "slab", "roughness": 0.2},
+    "fg": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "horizontal", "background": "bg", "mix": 0.25,
+             "foreground": {"kind": "coverage_weight", "a": "fg", "weight": 0}})",
+                    R"(HORIZONTAL root mix=0.25
+  SLAB bg
+      roughness = 0.2
+  WEIGHT root_foreground weight=0
+    SLAB fg
+        roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(WEIGHT root weight=0.75
+  SLAB bg
+      roughness = 0.2
+culled fg: under coverage_weight 'root_foreground': weight is constant 0
+culled root_foreground: coverage_weight with constant weight 0 removed with its subtree
+culled root: horizontal 'root' with an empty side is a coverage_weight
+)");
+}
+
+TEST_F(CullTest, SelectWithAnEmptyBKeepsAWeightedByTheCondition) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "a": "a", "value": "$v", "threshold": 0.25,
+             "b": {"kind": "coverage_weight", "a": "b", "weight": 0}})",
+                    R"(SELECT root value=$v threshold=0.25
+  SLAB a
+      roughness = 0.2
+  WEIGHT root_b weight=0
+    SLAB b
+        roughness = 0.8
+)");
+  // step(value, threshold) = threshold >= value: 1 exactly when a is picked.
+  EXPECT_EQ(after, R"(WEIGHT root weight=step($v, 0.25)
+  SLAB a
+      roughness = 0.2
+culled b: under coverage_weight 'root_b': weight is constant 0
+culled root_b: coverage_weight with constant weight 0 removed with its subtree
+culled root: select 'root' with an empty side is a coverage_weight
+)");
+}
+
+TEST_F(CullTest, SelectWithAnEmptyAKeepsBWeightedByTheOppositeCondition) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "root": {"kind": "select", "b": "b", "value": "$v",
+             "a": {"kind": "coverage_weight", "a": "a", "weight": 0}})",
+                    R"(SELECT root value=$v threshold=0.5
+  WEIGHT root_a weight=0
+    SLAB a
+        roughness = 0.2
+  SLAB b
+      roughness = 0.8
+)");
+  EXPECT_EQ(after, R"(WEIGHT root weight=one_minus(step($v, 0.5))
+  SLAB b
+      roughness = 0.8
+culled a: under coverage_weight 'root_a': weight is constant 0
+culled root_a: coverage_weight with constant weight 0 removed with its subtree
+culled root: select 'root' with an empty side is a coverage_weight
+)");
+}
+
+TEST_F(CullTest, EmptinessPropagatesUpwards) {
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "keep": {"kind": "slab", "roughness": 0.4},
+    "both": {"kind": "add", "a": {"kind": "coverage_weight", "a": "a", "weight": 0},
+                            "b": {"kind": "coverage_weight", "a": "b", "weight": 0}},
+    "root": {"kind": "vertical", "top": "both", "base": "keep"})",
+                    R"(VERTICAL root thickness=0.0001
+  ADD both
+    WEIGHT both_a weight=0
+      SLAB a
+          roughness = 0.2
+    WEIGHT both_b weight=0
+      SLAB b
+          roughness = 0.8
+  SLAB keep
+      roughness = 0.4
+)");
+  EXPECT_EQ(after, R"(SLAB keep
+    roughness = 0.4
+culled a: under coverage_weight 'both_a': weight is constant 0
+culled both_a: coverage_weight with constant weight 0 removed with its subtree
+culled b: under coverage_weight 'both_b': weight is constant 0
+culled both_b: coverage_weight with constant weight 0 removed with its subtree
+culled both: ADD 'both' removed: both sides are empty
+culled root: VERTICAL 'root' removed: one side is empty
+)");
+}
+
+TEST_F(CullTest, NoModify_RunTimeWeightsAllTheWayDown) {
+  expectUnchanged(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "c": {"kind": "slab", "roughness": 0.4},
+    "root": {"kind": "vertical", "top": {"kind": "coverage_weight", "a": "a", "weight": "$w"},
+             "base": {"kind": "add", "a": "b",
+                      "b": {"kind": "select", "a": "c", "b": "a", "value": "$v"}}})",
+                  R"(VERTICAL root thickness=0.0001
+  WEIGHT root_top weight=$w
+    SLAB a
+        roughness = 0.2
+  ADD root_base
+    SLAB b
+        roughness = 0.8
+    SELECT root_base_b value=$v threshold=0.5
+      SLAB c
+          roughness = 0.4
+      SLAB a_2
+          roughness = 0.2
+)");
+}
+
+// "Every removal is recorded in Material::culled with the reason." BUG: a
+// coverage_weight with a run-time weight whose subtree becomes empty is
+// removed silently: `outer` is gone from the tree but has no CullNote.
+TEST_F(CullTest, CoverageWeightWithAnEmptiedSubtreeIsRecorded) {
+  cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "outer": {"kind": "coverage_weight", "weight": "$w",
+              "a": {"kind": "coverage_weight", "a": "b", "weight": 0}},
+    "root": {"kind": "add", "a": "a", "b": "outer"})",
+       R"(ADD root
+  SLAB a
+      roughness = 0.2
+  WEIGHT outer weight=$w
+    WEIGHT outer_a weight=0
+      SLAB b
+          roughness = 0.8
+)");
+  std::vector<std::string> what;
+  for (const CullNote& n : m.culled) what.push_back(n.what);
+  EXPECT_EQ(what, (std::vector<std::string>{"b", "outer_a", "outer", "root"}));
+}
+
+// ---------------------------------------------------------------------------
+// Nothing left
+
+TEST_F(CullTest, NothingLeftIsAnError) {
+  cull(R"(
+    "s": {"kind": "slab", "roughness": 0.3},
+    "root": {"kind": "coverage_weight", "a": "s", "weight": 0})",
+       R"(WEIGHT root weight=0
+  SLAB s
+      roughness = 0.3
+)");
+  EXPECT_FALSE(ok);
+  EXPECT_EQ(diags,
+            "test.json: /output: error: no matter is left after static culling (every slab is under a constant zero "
+            "weight)\n");
+}
+
+TEST_F(CullTest, NothingLeftThroughOperatorsIsAnError) {
+  EXPECT_EQ(diagnosticsOf(material(R"(
+    "a": {"kind": "slab"},
+    "b": {"kind": "slab"},
+    "root": {"kind": "horizontal", "mix": "$m",
+             "background": {"kind": "coverage_weight", "a": "a", "weight": 0},
+             "foreground": {"kind": "select", "a": "b", "b": "a", "value": 0.25,
+                            "threshold": {"kind": "multiply", "a": 0.5, "b": 0}}})",
+                                   kInputs)),
+            "");  // the select keeps its side b (0.25 > 0), so the foreground stays
+  EXPECT_EQ(diagnosticsOf(material(R"(
+    "a": {"kind": "slab"},
+    "b": {"kind": "slab"},
+    "root": {"kind": "horizontal", "mix": "$m",
+             "background": {"kind": "coverage_weight", "a": "a", "weight": 0},
+             "foreground": {"kind": "select", "a": "b", "b": {"kind": "coverage_weight", "a": "a", "weight": 0},
+                            "value": 0.25, "threshold": 0}})",
+                                   kInputs)),
+            "test.json: /output: error: no matter is left after static culling (every slab is under a constant zero "
+            "weight)\n");
+}
+
+}  // namespace
+}  // namespace substratec
