@@ -3,6 +3,7 @@
 // Run with --update-golden to regenerate them (then review the diff).
 // Output is normalized (no absolute paths; '\n' line endings).
 #include <algorithm>
+#include <map>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/pipeline.h"
+#include "emit/generate.h"
 #include "report/report.h"
 
 namespace fs = std::filesystem;
@@ -139,6 +141,63 @@ TEST(Golden, WorkedExampleToOneClosure) {
   checkGolden(kSource / "tests/golden/worked_example_72.max_closures_1.report.txt", formatReportText(*r));
 }
 
+/// The generated files of an example, by name.
+std::map<std::string, std::string> generatedFor(const fs::path& e) {
+  auto [r, diags] = compileAs(e, e.filename().string());
+  EXPECT_TRUE(r.has_value()) << diags;
+  std::map<std::string, std::string> files;
+  if (!r) return files;
+  GenerateOptions o;
+  o.emit.sourceName = e.filename().string();
+  for (auto& f : generateFiles(*r, o).files) files[f.name] = f.contents;
+  return files;
+}
+
+// Code generation goldens: tests/golden/<name>.expected.{material.glsl,material.hlsl,layout.json}.
+TEST(Golden, EveryExampleGeneratedCode) {
+  for (const auto& e : filesIn(kSource / "examples", ".json")) {
+    SCOPED_TRACE(e.filename().string());
+    const std::string stem = e.stem().string();
+    auto files = generatedFor(e);
+    for (const char* ext : {".material.glsl", ".material.hlsl", ".layout.json"})
+      checkGolden(kSource / "tests/golden" / (stem + ".expected" + ext), files[stem + ext]);
+  }
+}
+
+// Pay for what you use: no output of a material mentions a feature no slab uses.
+TEST(Golden, GeneratedCodeContainsOnlyTheFeaturesUsed) {
+  const std::pair<const char*, const char*> features[] = {
+      {"fuzz", "fuzz"}, {"anisotropy", "anisotropy"}, {"glint", "glint"}, {"haze", "secondRoughness"},
+      {"specular_profile", "specularProfile"}, {"sss", "sssMfp"}};
+  for (const auto& e : filesIn(kSource / "examples", ".json")) {
+    SCOPED_TRACE(e.filename().string());
+    auto [r, diags] = compileAs(e, e.filename().string());
+    ASSERT_TRUE(r);
+    std::uint16_t used = 0;
+    for (int s : r->tree.slabOrder) used |= r->material.slabs[s].features;
+    auto files = generatedFor(e);
+    for (const auto& [feature, word] : features) {
+      bool uses = false;
+      for (int b = 0; b < kFeatureCount; ++b)
+        if ((used & (1u << b)) && featureName(b) == feature) uses = true;
+      if (uses) continue;
+      for (const auto& [name, text] : files) {
+        if (name.ends_with(".layout.json")) continue;
+        auto start = text.find("#include \"substrate_tree.h\"");  // materials: after the USE switches
+        std::string code = start == std::string::npos ? text : text.substr(start);
+        EXPECT_EQ(code.find(word), std::string::npos) << name << " mentions " << word << " but no slab uses " << feature;
+      }
+    }
+    // A one-closure material's forward shader evaluates its closure without a loop.
+    if (r->after.closures.size() == 1)
+      for (const auto& [name, text] : files)
+        if (name.find(".forward.") != std::string::npos) {
+          EXPECT_EQ(text.find("for ("), std::string::npos) << name;
+          EXPECT_EQ(text.find("substrate_light_closures("), std::string::npos) << name;
+        }
+  }
+}
+
 TEST(Golden, SameInputTwiceGivesIdenticalOutput) {
   for (const auto& e : filesIn(kSource / "examples", ".json")) {
     SCOPED_TRACE(e.filename().string());
@@ -147,6 +206,7 @@ TEST(Golden, SameInputTwiceGivesIdenticalOutput) {
     ASSERT_TRUE(a && b);
     EXPECT_EQ(formatReportText(*a), formatReportText(*b));
     EXPECT_EQ(reportJson(*a).dump(), reportJson(*b).dump());
+    EXPECT_EQ(generatedFor(e), generatedFor(e));
   }
 }
 

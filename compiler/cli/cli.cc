@@ -8,6 +8,10 @@
 #include "pipeline/pipeline.h"
 #include "report/report.h"
 #include "validate/toolchain.h"
+#include "emit/generate.h"
+#include "output/atomic_write.h"
+
+#include <filesystem>
 
 namespace substratec {
 
@@ -62,6 +66,53 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
   return status;
 }
 
+struct CompileArgs {
+  std::string file;
+  std::string outDir;
+  std::string target = "all";
+  std::string diffuse = "chan2024";
+  int budget = 0;
+  int maxClosures = 0;
+  bool fullSimplification = false;
+  bool skipValidation = false;
+  std::size_t maxInputSize = 16u << 20;
+};
+
+int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
+  Diagnostics diags(a.file);
+  CompileOptions o;
+  if (a.budget > 0) o.budgetOverride = a.budget;
+  if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
+  o.fullSimplification = a.fullSimplification;
+  o.read.maxInputBytes = a.maxInputSize;
+  auto result = compileFile(a.file, o, diags);
+  err << diags.formatAll();
+  if (!result) return kExitBadInput;
+  GenerateOptions go;
+  go.glsl = a.target != "hlsl";
+  go.hlsl = a.target != "glsl";
+  go.emit.sourceName = std::filesystem::path(a.file).filename().string();
+  static const char* const kModels[] = {"lambert", "chan2018", "chan2024", "eon"};
+  for (int i = 0; i < 4; ++i)
+    if (a.diffuse == kModels[i]) go.emit.diffuseModel = i;
+  Generated gen = generateFiles(*result, go);
+  // Validate in-process before anything is written: a shader that does not
+  // compile is the compiler's bug (exit 3), and the output folder stays as it was.
+  if (!a.skipValidation) validateGenerated(gen);
+  if (!gen.valid) {
+    err << "substratec: internal compiler error: generated code does not validate\n" << gen.failure << "\n";
+    return kExitInternal;
+  }
+  const std::vector<OutputFile>& files = gen.files;
+  std::string error = writeFilesAtomically(a.outDir, files);
+  if (!error.empty()) {
+    err << "substratec: error: " << error << "\n";
+    return kExitBadInput;
+  }
+  for (const auto& f : files) out << (std::filesystem::path(a.outDir) / f.name).string() << "\n";
+  return kExitOk;
+}
+
 }  // namespace
 
 int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -85,6 +136,21 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   rep->add_flag("--print-after-all", report.printAfterAll, "Dump the IR after every pass (stderr)");
   rep->add_flag("--time-passes", report.timePasses, "Print the time of every pass (stderr)");
 
+  CompileArgs compile;
+  CLI::App* comp = app.add_subcommand("compile", "Generate flattened GLSL/HLSL, the packing layout and entry shaders");
+  comp->add_option("file", compile.file, "Material file (substrate-material/1 JSON)")->required();
+  comp->add_option("-o,--output", compile.outDir, "Output directory")->required();
+  comp->add_option("--target", compile.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}));
+  comp->add_option("--diffuse", compile.diffuse, "Diffuse model")
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
+  comp->add_option("--budget", compile.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
+  comp->add_option("--max-closures", compile.maxClosures, "Closure budget")->check(CLI::Range(1, 8));
+  comp->add_flag("--full-simplification", compile.fullSimplification, "Collapse everything into one closure");
+  comp->add_flag("--skip-validation", compile.skipValidation,
+                 "Write the outputs without compiling them with glslang (debugging the generator)");
+  comp->add_option("--max-input-size", compile.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
   try {
@@ -105,6 +171,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   }
   try {
     if (rep->parsed()) return runReport(report, out, err);
+    if (comp->parsed()) return runCompile(compile, out, err);
   } catch (const std::exception& e) {
     err << "substratec: internal compiler error: " << e.what() << "\n";
     return kExitInternal;

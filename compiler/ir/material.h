@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 #include "ir/value.h"
@@ -129,6 +130,9 @@ struct Material {
   int root = -1;
   std::vector<Basis> bases;
   std::vector<CullNote> culled;
+  /// Readable names for DAG nodes that are named value nodes (or their
+  /// outputs) in the source: generated code uses them as variable names.
+  std::unordered_map<ValueId, std::string> valueNames;
 
   int inputIndex(std::string_view name) const;
 };

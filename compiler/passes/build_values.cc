@@ -108,6 +108,25 @@ ValueTable buildValueDag(const ResolvedDoc& doc, Material& m) {
       default:
         out = {dag.scalar(0)};
     }
+    if (!v.id.empty()) {
+      static const char* const kTextureOutputs[] = {"rgb", "r", "g", "b", "a"};
+      static const char* const kHelperOutputs[][2] = {{"diffuse_albedo", "f0"}, {"second_roughness", "second_roughness_weight"},
+                                                      {"mfp", "thickness"}, {"f0", "f90"}};
+      for (std::size_t o = 0; o < out.size(); ++o) {
+        const ValueNode& node = dag.node(out[o]);
+        if (node.op == Op::Const || node.op == Op::Input || node.op == Op::Geometry) continue;
+        std::string name = v.id;
+        if (out.size() > 1) {
+          const char* suffix = v.op == Op::Sample ? kTextureOutputs[o]
+                               : v.op == Op::MetalnessToDiffuseF0 ? kHelperOutputs[0][o]
+                               : v.op == Op::HazinessToSecondRoughness ? kHelperOutputs[1][o]
+                               : v.op == Op::TransmittanceToMfp ? kHelperOutputs[2][o]
+                                                                : kHelperOutputs[3][o];
+          name += std::string("_") + suffix;
+        }
+        m.valueNames.emplace(out[o], name);  // the first name given to a node wins
+      }
+    }
   }
   return table;
 }

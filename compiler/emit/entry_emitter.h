@@ -1,0 +1,25 @@
+// Self-contained entry shaders (a stock glslangValidator compiles them with
+// -I DIR -I runtime_shaders): the forward pass (closures evaluated inline and
+// lit, no packing; unrolled per closure, so a one-closure material has no
+// loop) and the base pass (closures packed into the material buffer: the
+// first 3 words to render targets, the rest to a storage image array; the
+// top-layer word to its own target). GLSL and HLSL through one Syntax table.
+#pragma once
+#include <string>
+
+#include "emit/material_emitter.h"
+
+namespace substratec {
+
+std::string emitForwardEntry(const Material& m, const StorageLayout& layout, const Syntax& syn);
+std::string emitBasePassEntry(const Material& m, const StorageLayout& layout, const Syntax& syn);
+
+/// The packing function `<name>_pack(closures, dither, words, topLayer)`,
+/// static bit offsets following `layout` (appended to the material file).
+std::string emitPackFunction(const Material& m, const StorageLayout& layout, const Syntax& syn);
+
+/// File names: `<name>.forward.frag` / `<name>.forward.ps.hlsl`, ...
+std::string forwardFileName(const Material& m, const Syntax& syn);
+std::string basePassFileName(const Material& m, const Syntax& syn);
+
+}  // namespace substratec

@@ -1,0 +1,495 @@
+#include "emit/material_emitter.h"
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "report/dump.h"
+
+namespace substratec {
+
+std::string materialUpper(const Material& m) {
+  std::string s = m.name;
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+namespace {
+
+// Closure feature bits (runtime_shaders/substrate_closure.h, docs/storage.md).
+constexpr unsigned kBitF90 = 1, kBitAniso = 2, kBitHaze = 4, kBitFuzz = 8, kBitGlint = 16, kBitProfile = 32,
+                   kBitWeight = 64, kBitCoverageAbove = 128;
+
+class Emitter {
+ public:
+  Emitter(const Material& m, const TreeInfo& t, const StorageLayout& L, const Syntax& s, const EmitOptions& o)
+      : m_(m), t_(t), L_(L), syn_(s), opt_(o) {}
+
+  std::string run();
+
+ private:
+  // --- values
+  std::string expr(ValueId v);                 // an expression for v (inline or a variable)
+  std::string varName(ValueId v) const;
+  std::string opExpr(const ValueNode& n);
+  void need(ValueId v);                        // marks v and its arguments as used
+  void emitValues();
+  std::string vec3(double x, double y, double z) const {
+    return syn_.construct(VType::Vec3, fmt::format("{}, {}, {}", Syntax::literal(x), Syntax::literal(y), Syntax::literal(z)));
+  }
+
+  // --- tree
+  void collectNeeded();
+  void emitResources();
+  void emitTree();
+  void emitClosures();
+  std::string nodeName(int n) const { return m_.nodes[n].id; }
+  int verticalOfTop(int node) const;  // the vertical whose top is `node`, or -1
+
+  void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
+  /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
+  std::string mfpOf(const Slab& s) {
+    ValueId scale = s.pin(SlabPin::SssMfpScale);
+    if (m_.values.isConstEqual(scale, 1.0)) return expr(s.pin(SlabPin::SssMfp));
+    return fmt::format("{} * {}", expr(s.pin(SlabPin::SssMfp)), expr(scale));
+  }
+
+  const Material& m_;
+  const TreeInfo& t_;
+  const StorageLayout& L_;
+  const Syntax& syn_;
+  const EmitOptions& opt_;
+  std::string out_, indent_;
+  std::vector<bool> needed_;
+  std::set<int> textures_;  // texture input indices sampled
+  std::map<int, int> profileIndex_;  // input index -> profile index
+};
+
+std::string Emitter::varName(ValueId v) const {
+  auto it = m_.valueNames.find(v);
+  if (it != m_.valueNames.end()) return "n_" + it->second;
+  return fmt::format("v{}", v);
+}
+
+void Emitter::need(ValueId root) {
+  std::vector<ValueId> stack{root};
+  while (!stack.empty()) {
+    ValueId v = stack.back();
+    stack.pop_back();
+    if (needed_[v]) continue;
+    needed_[v] = true;
+    const ValueNode& n = m_.values.node(v);
+    for (int i = 0; i < n.argCount; ++i) stack.push_back(n.args[i]);
+  }
+}
+
+std::string Emitter::expr(ValueId v) {
+  const ValueNode& n = m_.values.node(v);
+  switch (n.op) {
+    case Op::Const: {
+      int k = componentCount(n.type);
+      if (k == 1) return Syntax::literal(n.c[0]);
+      std::string args;
+      for (int i = 0; i < k; ++i) args += (i ? ", " : "") + Syntax::literal(n.c[i]);
+      return syn_.construct(n.type, args);
+    }
+    case Op::Input: return syn_.inputAccess(m_.name, m_.inputs[n.attr].name);
+    case Op::Geometry:
+      switch (static_cast<GeometryAttr>(n.attr)) {
+        case GeometryAttr::Normal: return vec3(0, 0, 1);   // tangent space (the format's convention)
+        case GeometryAttr::Tangent: return vec3(1, 0, 0);
+        case GeometryAttr::View: return "ts_view";
+        case GeometryAttr::Uv0: return "g.uv0";
+        case GeometryAttr::Uv1: return "g.uv1";
+        case GeometryAttr::VertexColor: return "g.vertexColor";
+        case GeometryAttr::Position: return "g.position";
+      }
+      return "g.N";
+    default: return varName(v);
+  }
+}
+
+std::string Emitter::opExpr(const ValueNode& n) {
+  auto a = [&](int i) { return expr(n.args[i]); };
+  auto call = [&](const char* f) {
+    std::string s = std::string(f) + "(";
+    for (int i = 0; i < n.argCount; ++i) s += (i ? ", " : "") + a(i);
+    return s + ")";
+  };
+  switch (n.op) {
+    case Op::Add: return fmt::format("({} + {})", a(0), a(1));
+    case Op::Subtract: return fmt::format("({} - {})", a(0), a(1));
+    case Op::Multiply: return fmt::format("({} * {})", a(0), a(1));
+    case Op::Divide: return call("substrate_safe_div");
+    case Op::Min: return call("min");
+    case Op::Max: return call("max");
+    case Op::Lerp: return syn_.lerp(a(0), a(1), a(2));
+    case Op::Clamp: return call("clamp");
+    case Op::Saturate: return syn_.saturate(a(0));
+    case Op::OneMinus: return fmt::format("(1.0 - {})", a(0));
+    case Op::Abs: return call("abs");
+    case Op::Sqrt: return call("substrate_value_sqrt");
+    case Op::Normalize: return call("substrate_value_normalize");
+    case Op::Length: return call("length");
+    case Op::Pow: return call("substrate_value_pow");
+    case Op::Dot: return call("dot");
+    case Op::Step: return call("step");
+    case Op::Exp: return call("exp");
+    case Op::Swizzle: {
+      std::string sw;
+      for (int i = 0; i < componentCount(n.type); ++i) sw += "xyzw"[(n.attr >> (2 * i)) & 3];
+      return a(0) + "." + sw;
+    }
+    case Op::Combine: {
+      std::string args;
+      for (int i = 0; i < n.argCount; ++i) args += (i ? ", " : "") + a(i);
+      return syn_.construct(n.type, args);
+    }
+    case Op::Sample: return syn_.sample(m_.inputs[n.attr].name, a(0));
+    case Op::MetalnessToDiffuseF0:
+      return n.attr == 0 ? call("substrate_metalness_to_diffuse") : call("substrate_metalness_to_f0");
+    case Op::IorToF0: return call("substrate_ior_to_f0");
+    case Op::HazinessToSecondRoughness:
+      return n.attr == 0 ? call("substrate_haziness_second_roughness") : call("substrate_haziness_weight");
+    case Op::TransmittanceToMfp:
+      return n.attr == 0 ? call("substrate_transmittance_to_mfp") : call("substrate_transmittance_to_mfp_thickness");
+    case Op::ThinFilm: {
+      std::string s = call(n.attr == 0 ? "substrate_thin_film_f0" : "substrate_thin_film_f90");
+      return s.substr(0, s.size() - 1) + ", ts_view)";
+    }
+    case Op::RotationToTangent: return call("substrate_rotation_to_tangent");
+    case Op::ViewDependentCoverage: {
+      std::string s = call("substrate_view_dependent_coverage");
+      return s.substr(0, s.size() - 1) + ", ts_view)";
+    }
+    default: return "0.0";
+  }
+}
+
+int Emitter::verticalOfTop(int node) const {
+  int p = t_.parent[node];
+  if (p >= 0 && m_.nodes[p].op == TreeOp::Vertical && m_.nodes[p].left == node) return p;
+  return -1;
+}
+
+/// Marks every value the generated function computes: operator values, the
+/// slabs' media, and for each closure only the pins its features use.
+void Emitter::collectNeeded() {
+  needed_.assign(m_.values.size(), false);
+  for (int n : t_.preorder) {
+    const TreeNode& node = m_.nodes[n];
+    if (node.a != kNoValue) need(node.a);
+    if (node.b != kNoValue) need(node.b);
+  }
+  for (const ClosureLayout& c : L_.closures) {
+    const Slab& s = m_.slabs[c.slab];
+    for (SlabPin p : {SlabPin::DiffuseAlbedo, SlabPin::F0, SlabPin::Roughness, SlabPin::Normal, SlabPin::SssMfp,
+                      SlabPin::SssMfpScale})
+      need(s.pin(p));
+    if (s.coverage != kNoValue) need(s.coverage);
+    const std::uint16_t f = s.features;
+    if (f & kFeatF90) need(s.pin(SlabPin::F90));
+    if (f & kFeatAnisotropy) {
+      need(s.pin(SlabPin::Anisotropy));
+      need(s.pin(SlabPin::Tangent));
+    }
+    if (f & kFeatSss) need(s.pin(SlabPin::SssPhaseAnisotropy));
+    if (f & kFeatHaze) {
+      need(s.pin(SlabPin::SecondRoughness));
+      need(s.pin(SlabPin::SecondRoughnessWeight));
+    }
+    if (f & kFeatFuzz) {
+      need(s.pin(SlabPin::FuzzAmount));
+      need(s.pin(SlabPin::FuzzColor));
+      need(s.pin(SlabPin::FuzzRoughness));
+    }
+    if (f & kFeatGlint) {
+      need(s.pin(SlabPin::GlintValue));
+      need(s.pin(SlabPin::GlintUv));
+    }
+    if (f & kFeatEmissive) need(s.pin(SlabPin::Emissive));
+    if (s.specularProfileInput >= 0 && !profileIndex_.count(s.specularProfileInput)) {
+      int k = static_cast<int>(profileIndex_.size());
+      profileIndex_[s.specularProfileInput] = k;
+    }
+  }
+  for (ValueId v = 0; v < m_.values.size(); ++v)
+    if (needed_[v] && m_.values.node(v).op == Op::Sample) textures_.insert(m_.values.node(v).attr);
+}
+
+void Emitter::emitResources() {
+  const bool glsl = syn_.target == Target::Glsl;
+  std::vector<const Input*> uniforms;
+  for (const auto& in : m_.inputs)
+    if (in.type != VType::Texture) uniforms.push_back(&in);
+  line("// Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.");
+  if (!uniforms.empty()) {
+    if (glsl) {
+      line(fmt::format("layout(set = 1, binding = 0, std140) uniform {}_Inputs {{", m_.name));
+      for (const Input* in : uniforms) line(fmt::format("  {} i_{};", syn_.type(in->type), in->name));
+      line(fmt::format("}} {}_inputs;", m_.name));
+    } else {
+      line(fmt::format("[[vk::binding(0, 1)]] cbuffer {}_Inputs {{", m_.name));
+      for (const Input* in : uniforms) line(fmt::format("  {} {}_i_{};", syn_.type(in->type), m_.name, in->name));
+      line("};");
+    }
+  }
+  int binding = 1;
+  for (std::size_t i = 0; i < m_.inputs.size(); ++i) {
+    if (m_.inputs[i].type != VType::Texture || !textures_.count(static_cast<int>(i))) continue;
+    const std::string& n = m_.inputs[i].name;
+    if (glsl) {
+      line(fmt::format("layout(set = 1, binding = {}) uniform sampler2D t_{};", binding, n));
+    } else {
+      line(fmt::format("[[vk::binding({}, 1)]] Texture2D<float4> t_{};", binding, n));
+      line(fmt::format("[[vk::binding({}, 1)]] SamplerState s_{};", binding + 16, n));
+    }
+    ++binding;
+  }
+  if (!textures_.empty()) {
+    line("#ifndef SUBSTRATE_SAMPLE");
+    line("#ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives");
+    line(glsl ? "#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)"
+              : "#define SUBSTRATE_SAMPLE(t, s, uv) t.SampleLevel(s, uv, 0.0)");
+    line("#else");
+    line(glsl ? "#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)" : "#define SUBSTRATE_SAMPLE(t, s, uv) t.Sample(s, uv)");
+    line("#endif");
+    line("#endif");
+  }
+}
+
+void Emitter::emitValues() {
+  bool any = false;
+  for (ValueId v = 0; v < m_.values.size(); ++v) {
+    if (!needed_[v]) continue;
+    const ValueNode& n = m_.values.node(v);
+    if (n.op == Op::Const || n.op == Op::Input || n.op == Op::Geometry) continue;
+    if (!any) line("// Values (the value DAG, in dependency order)");
+    any = true;
+    line(fmt::format("{} {} = {};", syn_.type(n.type), varName(v), opExpr(n)));
+  }
+}
+
+void Emitter::emitTree() {
+  const std::string v3 = syn_.type(VType::Vec3);
+  line("// Tree: coverage C and transmittance T (along the normal) of every node.");
+  for (int n : t_.preorder) {
+    const TreeNode& node = m_.nodes[n];
+    if (node.op != TreeOp::Slab) continue;
+    const Slab& s = m_.slabs[node.slab];
+    std::string c = s.coverage == kNoValue ? "1.0" : expr(s.coverage);
+    int v = verticalOfTop(n);
+    ValueId mfp = s.pin(SlabPin::SssMfp);
+    std::string t;
+    double d = m_.settings.surfaceThickness;
+    if (m_.values.isConstEqual(mfp, 0.0) && (v < 0 ? d > 0 : m_.values.isConst(m_.nodes[v].a) &&
+                                                                  m_.values.node(m_.nodes[v].a).c[0] > 0))
+      t = vec3(0, 0, 0);  // no medium: opaque matter
+    else
+      t = fmt::format("substrate_transmittance({}, {})", mfpOf(s), v >= 0 ? expr(m_.nodes[v].a) : Syntax::literal(d));
+    line(fmt::format("// slab '{}' (Id={}, BSDF {}){}", node.id, t_.reportId[n], t_.bsdfId[node.slab],
+                     v >= 0 ? fmt::format(", the top of vertical '{}'", m_.nodes[v].id) : ""));
+    line(fmt::format("float C_{} = {};", node.id, c));
+    line(fmt::format("{} T_{} = {};", v3, node.id, t));
+  }
+  // Operators bottom-up: by distance from leaves, then tree id.
+  std::vector<int> ops;
+  for (int n : t_.preorder)
+    if (m_.nodes[n].op != TreeOp::Slab) ops.push_back(n);
+  std::stable_sort(ops.begin(), ops.end(),
+                   [&](int a, int b) { return t_.distanceFromLeaves[a] < t_.distanceFromLeaves[b]; });
+  for (int n : ops) {
+    const TreeNode& node = m_.nodes[n];
+    const std::string id = node.id, l = nodeName(node.left), r = node.right >= 0 ? nodeName(node.right) : "";
+    line(fmt::format("// {} '{}' (Id={}, DistanceFromLeaves={})", treeOpName(node.op), id, t_.reportId[n],
+                     t_.distanceFromLeaves[n]));
+    line(fmt::format("float C_{}; {} T_{};", id, v3, id));
+    switch (node.op) {
+      case TreeOp::Horizontal:
+        line(fmt::format("substrate_op_horizontal(C_{0}, T_{0}, C_{1}, T_{1}, {2}, C_{3}, T_{3});", l, r, expr(node.a), id));
+        break;
+      case TreeOp::Select:
+        line(fmt::format("substrate_op_horizontal(C_{0}, T_{0}, C_{1}, T_{1}, 1.0 - step({2}, {3}), C_{4}, T_{4});", l, r,
+                         expr(node.a), expr(node.b), id));
+        break;
+      case TreeOp::Vertical:
+        line(fmt::format("substrate_op_vertical(C_{0}, T_{0}, C_{1}, T_{1}, C_{2}, T_{2});", l, r, id));
+        break;
+      case TreeOp::Add: line(fmt::format("substrate_op_add(C_{0}, T_{0}, C_{1}, T_{1}, C_{2}, T_{2});", l, r, id)); break;
+      case TreeOp::CoverageWeight:
+        line(fmt::format("C_{0} = {1} * C_{2}; T_{0} = T_{2};", id, expr(node.a), l));
+        break;
+      case TreeOp::Slab: break;
+    }
+  }
+}
+
+void Emitter::emitClosures() {
+  const std::string v3 = syn_.type(VType::Vec3);
+  for (std::size_t i = 0; i < L_.closures.size(); ++i) {
+    const ClosureLayout& cl = L_.closures[i];
+    const Slab& s = m_.slabs[cl.slab];
+    int node = -1;
+    for (int n : t_.preorder)
+      if (m_.nodes[n].op == TreeOp::Slab && m_.nodes[n].slab == cl.slab) node = n;
+    const std::string c = fmt::format("closures[{}]", i), id = m_.nodes[node].id;
+    line("");
+    line(fmt::format("// Closure {}: slab '{}' (BSDF {}, LayerDepth {}, {}){}", i, id, i, t_.layerDepth[node],
+                     cl.isTop ? "top layer" : "under a layer",
+                     s.collapsedFrom.empty() ? "" : fmt::format(" (a blended {})", s.collapsedFrom)));
+    // The walk up to the root: mix/coverage weights, and the layers above.
+    std::string weight = s.coverage == kNoValue ? "" : fmt::format("C_{}", id);
+    std::vector<std::string> layerLines;
+    for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
+      const TreeNode& op = m_.nodes[p];
+      std::string f;
+      switch (op.op) {
+        case TreeOp::Horizontal: f = op.right == x ? expr(op.a) : fmt::format("(1.0 - {})", expr(op.a)); break;
+        case TreeOp::CoverageWeight: f = expr(op.a); break;
+        case TreeOp::Select:
+          f = op.right == x ? fmt::format("(1.0 - step({}, {}))", expr(op.a), expr(op.b))
+                            : fmt::format("step({}, {})", expr(op.a), expr(op.b));
+          break;
+        case TreeOp::Vertical:
+          if (op.right == x) {
+            const TreeNode& top = m_.nodes[op.left];
+            std::string tTop = fmt::format("T_{}", top.id);
+            if (top.op == TreeOp::Slab)  // the top's interface transmits 1 - F0 at normal incidence
+              tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
+            layerLines.push_back(fmt::format("substrate_layer_above(ca_{0}, ta_{0}, C_{1}, {2});  // under '{1}' (vertical '{3}')",
+                                             id, top.id, tTop, op.id));
+            if (top.op == TreeOp::Slab)
+              layerLines.push_back(fmt::format("va_{0} += C_{1} * substrate_roughness_to_variance({2});", id, top.id,
+                                               expr(m_.slabs[top.slab].pin(SlabPin::Roughness))));
+          }
+          break;
+        default: break;
+      }
+      if (!f.empty()) weight += (weight.empty() ? "" : " * ") + f;
+    }
+    if (!cl.isTop) {
+      line(fmt::format("float ca_{0} = 0.0; {1} ta_{0} = {2}; float va_{0} = 0.0;", id, v3, vec3(1, 1, 1)));
+      for (auto it = layerLines.rbegin(); it != layerLines.rend(); ++it) line(*it);  // from the root down
+    }
+    line(fmt::format("substrate_closure_init({});", c));
+    line(fmt::format("{}.diffuseAlbedo = {};", c, expr(s.pin(SlabPin::DiffuseAlbedo))));
+    line(fmt::format("{}.f0 = {};", c, expr(s.pin(SlabPin::F0))));
+    std::string rough = expr(s.pin(SlabPin::Roughness));
+    if (!cl.isTop)  // a rough layer above widens the lobes below (Belcour 2018)
+      rough = fmt::format("substrate_variance_to_roughness(substrate_roughness_to_variance({}) + va_{})", rough, id);
+    line(fmt::format("{}.roughness = {};", c, rough));
+    line(fmt::format("{}.N = substrate_tangent_to_world({}, g.N, g.T);", c, expr(s.pin(SlabPin::Normal))));
+    unsigned bits = 0;
+    const std::uint16_t f = s.features;
+    if (f & kFeatF90) {
+      bits |= kBitF90;
+      line(fmt::format("{}.f90 = {};", c, expr(s.pin(SlabPin::F90))));
+    }
+    if (f & kFeatAnisotropy) {
+      bits |= kBitAniso;
+      line(fmt::format("{}.anisotropy = {};", c, expr(s.pin(SlabPin::Anisotropy))));
+      line(fmt::format("{0}.T = substrate_orthogonal_tangent({0}.N, substrate_tangent_to_world({1}, g.N, g.T));", c,
+                       expr(s.pin(SlabPin::Tangent))));
+    }
+    if (f & kFeatSss) {
+      line(fmt::format("{}.sssMfp = {};", c, mfpOf(s)));
+      line(fmt::format("{}.sssPhaseAnisotropy = {};", c, expr(s.pin(SlabPin::SssPhaseAnisotropy))));
+      line(fmt::format("{}.sssType = {}u;", c, static_cast<unsigned>(s.sssType)));
+    }
+    if (f & kFeatHaze) {
+      bits |= kBitHaze;
+      line(fmt::format("{}.secondRoughness = {};", c, expr(s.pin(SlabPin::SecondRoughness))));
+      line(fmt::format("{}.secondRoughnessWeight = {};", c, expr(s.pin(SlabPin::SecondRoughnessWeight))));
+    }
+    if (f & kFeatFuzz) {
+      bits |= kBitFuzz;
+      line(fmt::format("{}.fuzzAmount = {};", c, expr(s.pin(SlabPin::FuzzAmount))));
+      line(fmt::format("{}.fuzzColor = {};", c, expr(s.pin(SlabPin::FuzzColor))));
+      line(fmt::format("{}.fuzzRoughness = {};", c, expr(s.pin(SlabPin::FuzzRoughness))));
+    }
+    if (f & kFeatGlint) {
+      bits |= kBitGlint;
+      line(fmt::format("{}.glintValue = {};", c, expr(s.pin(SlabPin::GlintValue))));
+      line(fmt::format("{}.glintUv = {};", c, expr(s.pin(SlabPin::GlintUv))));
+      line(fmt::format("{}.glintUvDerivatives = g.uvDerivatives;", c));
+    }
+    if (f & kFeatSpecularProfile) {
+      bits |= kBitProfile;
+      line(fmt::format("{}.specularProfile = {}u;  // ${}", c, profileIndex_[s.specularProfileInput] + 1,
+                       m_.inputs[s.specularProfileInput].name));
+    }
+    if (f & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
+    if (cl.storesWeight) bits |= kBitWeight;
+    if (cl.storesCoverageAbove) bits |= kBitCoverageAbove;
+    if (!weight.empty()) line(fmt::format("{}.weight = {};", c, weight));
+    if (!cl.isTop) {
+      line(fmt::format("{}.topTransmittance = ta_{};", c, id));
+      line(fmt::format("{}.coverageAbove = ca_{};", c, id));
+      line(fmt::format("{}.isTop = false;", c));
+    }
+    line(fmt::format("{}.features = {}u;", c, bits));
+  }
+}
+
+std::string Emitter::run() {
+  const std::string upper = materialUpper(m_);
+  collectNeeded();
+  std::uint16_t all = 0;
+  for (int s : t_.slabOrder) all |= m_.slabs[s].features;
+  out_ += fmt::format("// Generated by substratec from {}: do not edit.\n", opt_.sourceName);
+  out_ += fmt::format("// Material '{}': {} closure(s), {} layout, {} bytes per pixel ({} words + 4 top-layer bytes).\n",
+                      m_.name, L_.closures.size(), layoutClassName(L_.layoutClass), L_.bytes(), L_.words());
+  out_ += fmt::format("// Features: {}.\n", all ? featureList(all) : "none");
+  out_ += fmt::format("#ifndef SUBSTRATE_MATERIAL_{0}\n#define SUBSTRATE_MATERIAL_{0} 1\n\n", upper);
+  line("// What this material uses: the runtime compiles nothing else.");
+  auto use = [&](const char* macro, bool on) { line(fmt::format("#define {} {}", macro, on ? 1 : 0)); };
+  use("SUBSTRATE_USE_F90", all & kFeatF90);
+  use("SUBSTRATE_USE_ANISOTROPY", all & kFeatAnisotropy);
+  use("SUBSTRATE_USE_HAZE", all & kFeatHaze);
+  use("SUBSTRATE_USE_FUZZ", all & kFeatFuzz);
+  use("SUBSTRATE_USE_SSS", all & kFeatSss);
+  use("SUBSTRATE_USE_GLINT", all & kFeatGlint);
+  use("SUBSTRATE_USE_SPECULAR_PROFILE", all & kFeatSpecularProfile);
+  use("SUBSTRATE_USE_EMISSIVE", all & kFeatEmissive);
+  line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", opt_.diffuseModel));
+  line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));
+  line(fmt::format("#define {}_WORD_COUNT {}", upper, L_.words()));
+  line("#include \"substrate_closure.h\"");
+  line("#include \"substrate_common.h\"");
+  line("#include \"substrate_values.h\"");
+  line("#include \"substrate_tree.h\"");
+  line("#include \"substrate_pack.h\"");
+  line("");
+  emitResources();
+  line("");
+  line(fmt::format("// Evaluates the material at one shading point into its closures (fully unrolled)."));
+  line(fmt::format("void {0}_evaluate(SubstrateGeometry g, out SubstrateClosure closures[{1}_CLOSURE_COUNT], "
+                   "out float coverage, out {2} transmittance) {{",
+                   m_.name, upper, syn_.type(VType::Vec3)));
+  indent_ = "  ";
+  line(fmt::format("{} ts_view = {};  // the view direction in tangent space", syn_.type(VType::Vec3),
+                   syn_.construct(VType::Vec3, "dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N)")));
+  emitValues();
+  emitTree();
+  emitClosures();
+  line("");
+  line(fmt::format("coverage = C_{};", m_.nodes[m_.root].id));
+  line(fmt::format("transmittance = T_{};", m_.nodes[m_.root].id));
+  indent_ = "";
+  line("}");
+  line("");
+  out_ += fmt::format("#endif  // SUBSTRATE_MATERIAL_{}\n", upper);
+  return out_;
+}
+
+}  // namespace
+
+std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayout& layout, const Syntax& syn,
+                         const EmitOptions& options) {
+  return Emitter(m, t, layout, syn, options).run();
+}
+
+}  // namespace substratec

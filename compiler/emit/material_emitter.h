@@ -1,0 +1,34 @@
+// Code generation: the flattened material function. One language-neutral
+// emitter; everything lexical goes through the target's Syntax table.
+//
+// Output (docs/codegen.md): resources (the inputs' uniform block / constant
+// buffer and the textures), then `<name>_evaluate(g, closures, coverage,
+// transmittance)`: the value DAG as locals, each slab's coverage and
+// transmittance, the operators bottom-up by distance from leaves, and each
+// slab's walk up to the root producing its closure — all unrolled for this
+// static topology (no loops, no recursion). Then `<name>_pack`, the packing
+// of the closures into the uint stream of docs/storage.md with static bit
+// offsets.
+#pragma once
+#include <string>
+
+#include "emit/syntax.h"
+#include "ir/material.h"
+#include "ir/tree_info.h"
+#include "storage/layout.h"
+
+namespace substratec {
+
+struct EmitOptions {
+  int diffuseModel = 2;          // 0 lambert, 1 chan2018, 2 chan2024, 3 eon
+  std::string sourceName;        // file name (no directory) for the header comment
+};
+
+/// `<name>.material.glsl` / `.hlsl`.
+std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayout& layout, const Syntax& syn,
+                         const EmitOptions& options);
+
+/// Names used across emitted files.
+std::string materialUpper(const Material& m);  // NAME in macros
+
+}  // namespace substratec

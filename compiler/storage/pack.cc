@@ -1,0 +1,535 @@
+#include "storage/pack.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include <fmt/format.h>
+
+namespace substratec {
+
+namespace {
+
+constexpr double kTwoPi = 6.283185307179586476925286766559;
+
+double clampDither(double u) {
+  if (!(u >= 0)) return 0;  // also NaN
+  return std::min(u, std::nextafter(1.0, 0.0));
+}
+
+double saturate(double x) {
+  if (!(x > 0)) return 0;  // also NaN
+  return std::min(x, 1.0);
+}
+
+double signNotZero(double x) { return x >= 0 ? 1.0 : -1.0; }
+
+double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+Vec3d normalized(const Vec3d& v) {
+  double l = std::sqrt(dot(v, v));
+  if (!(l > 0)) return {0, 0, 1};
+  return {v[0] / l, v[1] / l, v[2] / l};
+}
+
+std::uint32_t mask(int bits) { return bits >= 32 ? 0xffffffffu : ((1u << bits) - 1u); }
+
+}  // namespace
+
+// ---- Scalars -----------------------------------------------------------------
+
+std::uint32_t quantizeUnorm(double x, int bits, double dither) {
+  const double n = static_cast<double>(mask(bits));
+  const double f = std::floor(saturate(x) * n + clampDither(dither));
+  return static_cast<std::uint32_t>(std::clamp(f, 0.0, n));
+}
+
+double dequantizeUnorm(std::uint32_t code, int bits) {
+  return static_cast<double>(code & mask(bits)) / static_cast<double>(mask(bits));
+}
+
+std::uint32_t quantizeSnorm(double x, int bits, double dither) {
+  const double s = static_cast<double>(mask(bits - 1));
+  const double v = x >= -1 ? std::min(x, 1.0) : (x < -1 ? -1.0 : 0.0);  // NaN -> 0
+  const double f = std::floor(v * s + s + clampDither(dither));
+  return static_cast<std::uint32_t>(std::clamp(f, 0.0, 2 * s));
+}
+
+double dequantizeSnorm(std::uint32_t code, int bits) {
+  const double s = static_cast<double>(mask(bits - 1));
+  return std::clamp(static_cast<double>(code & mask(bits)) / s - 1.0, -1.0, 1.0);
+}
+
+std::uint32_t quantizeColor(const Vec3d& c, double dither) {
+  const std::uint32_t r = quantizeUnorm(std::sqrt(saturate(c[0])), 7, dither);
+  const std::uint32_t g = quantizeUnorm(std::sqrt(saturate(c[1])), 7, dither);
+  const std::uint32_t b = quantizeUnorm(std::sqrt(saturate(c[2])), 6, dither);
+  return r | (g << 7) | (b << 14);
+}
+
+Vec3d dequantizeColor(std::uint32_t code) {
+  const double r = dequantizeUnorm(code & 0x7fu, 7);
+  const double g = dequantizeUnorm((code >> 7) & 0x7fu, 7);
+  const double b = dequantizeUnorm((code >> 14) & 0x3fu, 6);
+  return {r * r, g * g, b * b};
+}
+
+std::uint32_t quantizeMfp(double mfp, double dither) {
+  if (!(mfp > 0)) return 0;  // no medium (also NaN)
+  const double t = std::clamp((std::log2(mfp) - packfmt::kMfpLog2Min) / packfmt::kMfpLog2Range, 0.0, 1.0);
+  const double f = std::floor(t * 255.0 + clampDither(dither));
+  return static_cast<std::uint32_t>(std::clamp(f, 1.0, 255.0));
+}
+
+double dequantizeMfp(std::uint32_t code) {
+  code &= 0xffu;
+  if (code == 0) return 0;
+  return std::exp2(static_cast<double>(code) * packfmt::kMfpLog2Range / 255.0 + packfmt::kMfpLog2Min);
+}
+
+std::uint32_t quantizeSss(const Vec3d& mfp, double phaseAnisotropy, double dither) {
+  return quantizeMfp(mfp[0], dither) | (quantizeMfp(mfp[1], dither) << 8) | (quantizeMfp(mfp[2], dither) << 16) |
+         (quantizeSnorm(phaseAnisotropy, 4, dither) << 24);
+}
+
+void dequantizeSss(std::uint32_t code, Vec3d& mfp, double& phaseAnisotropy) {
+  mfp = {dequantizeMfp(code & 0xffu), dequantizeMfp((code >> 8) & 0xffu), dequantizeMfp((code >> 16) & 0xffu)};
+  phaseAnisotropy = dequantizeSnorm((code >> 24) & 0xfu, 4);
+}
+
+std::uint16_t floatToHalf(double x) {
+  if (std::isnan(x)) x = 0;
+  x = std::clamp(x, -packfmt::kHalfMax, packfmt::kHalfMax);
+  const std::uint32_t f = std::bit_cast<std::uint32_t>(static_cast<float>(x));
+  const std::uint32_t sign = (f >> 16) & 0x8000u;
+  const std::uint32_t a = f & 0x7fffffffu;
+  if (a < 0x38800000u) {  // below 2^-14: a half subnormal (or zero), in units of 2^-24
+    const double m = std::nearbyint(static_cast<double>(std::bit_cast<float>(a)) * 16777216.0);
+    return static_cast<std::uint16_t>(sign | static_cast<std::uint32_t>(m));  // 1024 is the smallest normal
+  }
+  const std::uint32_t exponent = (a >> 23) - 127u + 15u;
+  const std::uint32_t mantissa = a & 0x7fffffu;
+  std::uint32_t h = (exponent << 10) | (mantissa >> 13);
+  const std::uint32_t rest = mantissa & 0x1fffu;
+  if (rest > 0x1000u || (rest == 0x1000u && (h & 1u))) ++h;  // a carry moves into the exponent
+  return static_cast<std::uint16_t>(sign | h);
+}
+
+double halfToFloat(std::uint16_t h) {
+  const double sign = (h & 0x8000u) ? -1.0 : 1.0;
+  const int exponent = (h >> 10) & 0x1f;
+  const int mantissa = h & 0x3ff;
+  if (exponent == 0) return sign * std::ldexp(mantissa, -24);
+  if (exponent == 31) return mantissa ? std::nan("") : sign * INFINITY;
+  return sign * std::ldexp(1024 + mantissa, exponent - 25);
+}
+
+// ---- Directions --------------------------------------------------------------
+
+std::array<double, 2> octProject(const Vec3d& n) {
+  const double l1 = std::abs(n[0]) + std::abs(n[1]) + std::abs(n[2]);
+  if (!(l1 > 0) || !std::isfinite(l1)) return {0, 0};
+  double px = n[0] / l1, py = n[1] / l1;
+  if (n[2] < 0) {
+    const double ox = (1 - std::abs(py)) * signNotZero(px);
+    const double oy = (1 - std::abs(px)) * signNotZero(py);
+    px = ox;
+    py = oy;
+  }
+  return {px, py};
+}
+
+Vec3d octUnproject(const std::array<double, 2>& p) {
+  Vec3d n{p[0], p[1], 1 - std::abs(p[0]) - std::abs(p[1])};
+  if (n[2] < 0) {
+    const double ox = (1 - std::abs(n[1])) * signNotZero(n[0]);
+    const double oy = (1 - std::abs(n[0])) * signNotZero(n[1]);
+    n[0] = ox;
+    n[1] = oy;
+  }
+  return normalized(n);
+}
+
+std::array<std::uint32_t, 2> octEncodeSnorm(const Vec3d& n, int bits, double dither) {
+  const auto p = octProject(n);
+  return {quantizeSnorm(p[0], bits, dither), quantizeSnorm(p[1], bits, dither)};
+}
+
+Vec3d octDecodeSnorm(const std::array<std::uint32_t, 2>& code, int bits) {
+  return octUnproject({dequantizeSnorm(code[0], bits), dequantizeSnorm(code[1], bits)});
+}
+
+std::array<std::uint32_t, 2> octEncodeUnorm(const Vec3d& n, int bits, double dither) {
+  const auto p = octProject(n);
+  return {quantizeUnorm(p[0] * 0.5 + 0.5, bits, dither), quantizeUnorm(p[1] * 0.5 + 0.5, bits, dither)};
+}
+
+Vec3d octDecodeUnorm(const std::array<std::uint32_t, 2>& code, int bits) {
+  return octUnproject({dequantizeUnorm(code[0], bits) * 2 - 1, dequantizeUnorm(code[1], bits) * 2 - 1});
+}
+
+std::uint32_t quantizeNormal(const Vec3d& n, double dither) {
+  const auto c = octEncodeSnorm(n, 16, dither);
+  return c[0] | (c[1] << 16);
+}
+
+Vec3d dequantizeNormal(std::uint32_t code) { return octDecodeSnorm({code & 0xffffu, code >> 16}, 16); }
+
+void orthonormalBasis(const Vec3d& n, Vec3d& t0, Vec3d& b0) {
+  const double s = std::copysign(1.0, n[2]);  // -0 counts as negative, like rotationToTangent
+  const double a = -1.0 / (s + n[2]);
+  const double b = n[0] * n[1] * a;
+  t0 = {1 + s * n[0] * n[0] * a, s * b, -s * n[0]};
+  b0 = {b, s + n[1] * n[1] * a, -n[1]};
+}
+
+std::uint32_t encodeTangentAngle(const Vec3d& tangent, const Vec3d& n, double dither) {
+  Vec3d t0, b0;
+  orthonormalBasis(n, t0, b0);
+  const double y = dot(tangent, b0), x = dot(tangent, t0);
+  double angle = (std::isfinite(x) && std::isfinite(y)) ? std::atan2(y, x) : 0.0;
+  if (angle < 0) angle += kTwoPi;
+  return quantizeUnorm(angle / kTwoPi, bits::kTangentAngle, dither);
+}
+
+Vec3d decodeTangentAngle(std::uint32_t code, const Vec3d& n) {
+  Vec3d t0, b0;
+  orthonormalBasis(n, t0, b0);
+  const double angle = dequantizeUnorm(code, bits::kTangentAngle) * kTwoPi;
+  const double c = std::cos(angle), s = std::sin(angle);
+  return normalized({c * t0[0] + s * b0[0], c * t0[1] + s * b0[1], c * t0[2] + s * b0[2]});
+}
+
+std::uint32_t packTopLayer(const TopLayerValues& top, double dither) {
+  const auto c = octEncodeUnorm(top.normal, 12, dither);
+  return c[0] | (c[1] << 12) | (quantizeUnorm(top.roughness, 8, dither) << 24);
+}
+
+TopLayerValues unpackTopLayer(std::uint32_t word) {
+  TopLayerValues t;
+  t.normal = octDecodeUnorm({word & 0xfffu, (word >> 12) & 0xfffu}, 12);
+  t.roughness = dequantizeUnorm(word >> 24, 8);
+  return t;
+}
+
+// ---- Bit stream --------------------------------------------------------------
+
+std::uint32_t readBits(const std::uint32_t* words, std::size_t count, std::size_t offset, int bits) {
+  if (bits < 0 || bits > 32) throw std::out_of_range("readBits: width must be 0..32");
+  if (bits == 0) return 0;
+  if (offset + static_cast<std::size_t>(bits) > count * 32) throw std::out_of_range("readBits: past the stream");
+  const std::size_t w = offset / 32;
+  const unsigned s = static_cast<unsigned>(offset % 32);
+  std::uint64_t v = words[w] >> s;
+  if (s + static_cast<unsigned>(bits) > 32) v |= static_cast<std::uint64_t>(words[w + 1]) << (32 - s);
+  return static_cast<std::uint32_t>(v) & mask(bits);
+}
+
+void writeBits(std::vector<std::uint32_t>& words, std::size_t offset, int bits, std::uint32_t value) {
+  if (bits < 0 || bits > 32) throw std::out_of_range("writeBits: width must be 0..32");
+  if (bits == 0) return;
+  if (offset + static_cast<std::size_t>(bits) > words.size() * 32) throw std::out_of_range("writeBits: past the stream");
+  const std::uint64_t v = static_cast<std::uint64_t>(value & mask(bits)) << (offset % 32);
+  const std::size_t w = offset / 32;
+  words[w] |= static_cast<std::uint32_t>(v);
+  if ((offset % 32) + static_cast<std::size_t>(bits) > 32) words[w + 1] |= static_cast<std::uint32_t>(v >> 32);
+}
+
+// ---- Materials ---------------------------------------------------------------
+
+std::uint32_t closureHeaderFeatures(const ClosureLayout& c) {
+  std::uint32_t f = 0;
+  if (c.storedFeatures & kFeatF90) f |= kClosureF90;
+  if (c.storedFeatures & kFeatAnisotropy) f |= kClosureAnisotropy;
+  if (c.storedFeatures & kFeatHaze) f |= kClosureHaze;
+  if (c.storedFeatures & kFeatFuzz) f |= kClosureFuzz;
+  if (c.storedFeatures & kFeatGlint) f |= kClosureGlint;
+  if (c.storedFeatures & kFeatSpecularProfile) f |= kClosureSpecularProfile;
+  if (c.storesWeight) f |= kClosureWeight;
+  if (c.storesCoverageAbove) f |= kClosureCoverageAbove;
+  return f;
+}
+
+namespace {
+
+std::uint16_t featuresFromHeader(std::uint32_t f, std::uint32_t sssType) {
+  std::uint16_t s = 0;
+  if (f & kClosureF90) s |= kFeatF90;
+  if (f & kClosureAnisotropy) s |= kFeatAnisotropy;
+  if (f & kClosureHaze) s |= kFeatHaze;
+  if (f & kClosureFuzz) s |= kFeatFuzz;
+  if (f & kClosureGlint) s |= kFeatGlint;
+  if (f & kClosureSpecularProfile) s |= kFeatSpecularProfile;
+  if (sssType != kSssTypeNone) s |= kFeatSss;
+  return s;
+}
+
+std::uint32_t headerSssType(const ClosureLayout& c, const ClosureValues& v) {
+  if (!(c.storedFeatures & kFeatSss)) return kSssTypeNone;
+  return (v.sssType >= 1 && v.sssType <= 3) ? v.sssType : kSssTypeDiffusion;
+}
+
+std::uint32_t classBits(LayoutClass c) { return static_cast<std::uint32_t>(c); }
+
+std::string_view fieldSuffix(const std::string& name) {
+  const auto dot = name.find('.');
+  return dot == std::string::npos ? std::string_view(name) : std::string_view(name).substr(dot + 1);
+}
+
+void expectBits(const LayoutField& f, int bits) {
+  if (f.bits != bits)
+    throw std::invalid_argument(fmt::format("packMaterial: field '{}' has {} bits, the format says {}", f.name, f.bits, bits));
+}
+
+/// The glint field (136 bits) as five parts: density (8), uv.x, uv.y, then two
+/// words of two halves (d(u)/dx | d(v)/dx << 16, d(u)/dy | d(v)/dy << 16).
+void writeGlint(std::vector<std::uint32_t>& w, std::size_t& pos, const ClosureValues& v, double dither) {
+  auto put = [&](int n, std::uint32_t x) { writeBits(w, pos, n, x); pos += static_cast<std::size_t>(n); };
+  put(8, quantizeUnorm(v.glintValue, 8, dither));
+  put(32, std::bit_cast<std::uint32_t>(static_cast<float>(v.glintUv[0])));
+  put(32, std::bit_cast<std::uint32_t>(static_cast<float>(v.glintUv[1])));
+  const auto& d = v.glintUvDerivatives;
+  put(32, floatToHalf(d[0]) | (static_cast<std::uint32_t>(floatToHalf(d[1])) << 16));
+  put(32, floatToHalf(d[2]) | (static_cast<std::uint32_t>(floatToHalf(d[3])) << 16));
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::vector<ClosureValues>& closures,
+                                        const std::vector<BasisValues>& bases, double dither) {
+  const int count = static_cast<int>(layout.closures.size());
+  if (count < 1 || count > packfmt::kMaxClosures)
+    throw std::invalid_argument(fmt::format("packMaterial: {} closures (the format holds 1 to 8)", count));
+  if (static_cast<int>(closures.size()) != count)
+    throw std::invalid_argument("packMaterial: one ClosureValues per layout closure");
+  const bool multi = count > 1;
+  if (layout.basisCount < 1 || layout.basisCount > packfmt::kMaxBases)
+    throw std::invalid_argument(fmt::format("packMaterial: {} bases (the format holds 1 to 8)", layout.basisCount));
+  if (!multi && (layout.basisCount != 1 || layout.closures[0].basis != 0))
+    throw std::invalid_argument("packMaterial: a single closure must use basis 0, the only basis");
+  if (static_cast<int>(bases.size()) < layout.basisCount)
+    throw std::invalid_argument("packMaterial: fewer BasisValues than layout bases");
+  for (const auto& c : layout.closures)
+    if (c.basis < 0 || c.basis >= layout.basisCount) throw std::invalid_argument("packMaterial: closure basis out of range");
+
+  // The normal of each basis as the unpacker will see it (tangent angles are
+  // measured in its frame).
+  auto decodedNormal = [&](int b) -> Vec3d {
+    const bool elided = !multi || (b == 0 && layout.basis0NormalElided);
+    if (elided) return unpackTopLayer(packTopLayer({bases[0].normal, 0.0}, dither)).normal;
+    return dequantizeNormal(quantizeNormal(bases[b].normal, dither));
+  };
+
+  std::vector<std::uint32_t> words(static_cast<std::size_t>(layout.words()), 0u);
+  std::size_t pos = 0;
+  auto put = [&](int n, std::uint32_t x) { writeBits(words, pos, n, x); pos += static_cast<std::size_t>(n); };
+
+  for (const LayoutField& f : layout.fields) {
+    const std::string_view what = fieldSuffix(f.name);
+    if (f.closure < 0 && f.basis < 0) {
+      if (what != "header") throw std::invalid_argument(fmt::format("packMaterial: unknown field '{}'", f.name));
+      expectBits(f, bits::kHeader);
+      std::uint32_t h = classBits(layout.layoutClass);
+      if (multi) {
+        h |= static_cast<std::uint32_t>(count - 1) << 2;
+        h |= static_cast<std::uint32_t>(layout.basisCount) << 5;
+        h |= packfmt::kMultiClosureHeaderBit;
+      } else {
+        h |= (closureHeaderFeatures(layout.closures[0]) & 0x7fu) << 2;
+        h |= headerSssType(layout.closures[0], closures[0]) << 10;
+      }
+      put(16, h);
+      continue;
+    }
+    if (f.closure >= 0) {
+      if (f.closure >= count) throw std::invalid_argument(fmt::format("packMaterial: field '{}' names no closure", f.name));
+      const ClosureLayout& c = layout.closures[f.closure];
+      const ClosureValues& v = closures[f.closure];
+      if (what == "header") {
+        expectBits(f, bits::kClosureHeader);
+        std::uint32_t h = static_cast<std::uint32_t>(c.basis) | (c.isTop ? 8u : 0u);
+        h |= closureHeaderFeatures(c) << 4;
+        h |= headerSssType(c, v) << 12;
+        put(16, h);
+      } else if (what == "diffuse_albedo") {
+        expectBits(f, bits::kColor);
+        put(20, quantizeColor(v.diffuseAlbedo, dither));
+      } else if (what == "f0") {
+        expectBits(f, bits::kColor);
+        put(20, quantizeColor(v.f0, dither));
+      } else if (what == "roughness") {
+        expectBits(f, bits::kRoughness);
+        put(8, quantizeUnorm(v.roughness, 8, dither));
+      } else if (what == "weight") {
+        expectBits(f, bits::kGreyWeight);
+        put(8, quantizeUnorm(v.weight, 8, dither));
+      } else if (what == "top_transmittance") {
+        expectBits(f, bits::kColor);
+        put(20, quantizeColor(v.topTransmittance, dither));
+      } else if (what == "coverage_above") {
+        expectBits(f, bits::kCoverageAbove);
+        put(8, quantizeUnorm(v.coverageAbove, 8, dither));
+      } else if (what == "f90") {
+        expectBits(f, bits::kColor);
+        put(20, quantizeColor(v.f90, dither));
+      } else if (what == "sss") {
+        expectBits(f, bits::kSss);
+        put(28, quantizeSss(v.sssMfp, v.sssPhaseAnisotropy, dither));
+      } else if (what == "haze") {
+        expectBits(f, bits::kHaze);
+        put(16, quantizeUnorm(v.secondRoughness, 8, dither) | (quantizeUnorm(v.secondRoughnessWeight, 8, dither) << 8));
+      } else if (what == "fuzz") {
+        expectBits(f, bits::kFuzz);
+        put(32, quantizeUnorm(v.fuzzAmount, 6, dither) | (quantizeColor(v.fuzzColor, dither) << 6) |
+                    (quantizeUnorm(v.fuzzRoughness, 6, dither) << 26));
+      } else if (what == "anisotropy") {
+        expectBits(f, bits::kAnisotropy);
+        put(8, quantizeSnorm(v.anisotropy, 8, dither));
+      } else if (what == "specular_profile") {
+        expectBits(f, bits::kSpecularProfile);
+        put(8, v.specularProfile == 0 ? 0u : std::min<std::uint32_t>(v.specularProfile - 1, 255u));
+      } else if (what == "glint") {
+        expectBits(f, bits::kGlint);
+        writeGlint(words, pos, v, dither);
+      } else {
+        throw std::invalid_argument(fmt::format("packMaterial: unknown field '{}'", f.name));
+      }
+      continue;
+    }
+    if (f.basis >= layout.basisCount) throw std::invalid_argument(fmt::format("packMaterial: field '{}' names no basis", f.name));
+    if (what == "normal") {
+      expectBits(f, bits::kNormal);
+      put(32, quantizeNormal(bases[f.basis].normal, dither));
+    } else if (what == "tangent_angle") {
+      expectBits(f, bits::kTangentAngle);
+      put(14, encodeTangentAngle(bases[f.basis].tangent, decodedNormal(f.basis), dither));
+    } else {
+      throw std::invalid_argument(fmt::format("packMaterial: unknown field '{}'", f.name));
+    }
+  }
+  if (static_cast<int>(pos) != layout.totalBits)
+    throw std::invalid_argument(fmt::format("packMaterial: wrote {} bits, the layout totals {}", pos, layout.totalBits));
+  return words;
+}
+
+UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, std::uint32_t topLayer) {
+  UnpackedMaterial out;
+  StorageLayout& L = out.layout;
+  std::size_t pos = 0;
+  // Records a field of `n` bits at the cursor and returns its start.
+  auto take = [&](std::string name, int n, int closure = -1, int basis = -1) -> std::size_t {
+    if (pos + static_cast<std::size_t>(n) > count * 32)
+      throw std::runtime_error(fmt::format("unpackMaterial: field '{}' runs past the {} words of the stream", name, count));
+    const std::size_t start = pos;
+    pos += static_cast<std::size_t>(n);
+    L.fields.push_back({std::move(name), n, std::string(), closure, basis});
+    L.totalBits += n;
+    return start;
+  };
+  auto field = [&](std::string name, int n, int closure = -1, int basis = -1) -> std::uint32_t {
+    return readBits(words, count, take(std::move(name), n, closure, basis), n);
+  };
+
+  out.topLayer = unpackTopLayer(topLayer);
+  const std::uint32_t header = field("header", bits::kHeader);
+  out.cls = static_cast<LayoutClass>(header & 3u);
+  L.layoutClass = out.cls;
+  const bool multi = (header & packfmt::kMultiClosureHeaderBit) != 0;
+  int closureCount = 1;
+  int basisCount = 1;
+  if (multi) {
+    closureCount = static_cast<int>((header >> 2) & 7u) + 1;
+    basisCount = static_cast<int>((header >> 5) & 15u);
+    if (basisCount < 1 || basisCount > packfmt::kMaxBases)
+      throw std::runtime_error(fmt::format("unpackMaterial: basis count {} (1 to 8)", basisCount));
+  }
+  L.basisCount = basisCount;
+
+  for (int i = 0; i < closureCount; ++i) {
+    const std::string p = fmt::format("closure{}.", i);
+    ClosureValues v;
+    ClosureLayout c;
+    std::uint32_t feats = 0, sss = 0;
+    if (multi) {
+      const std::uint32_t h = field(p + "header", bits::kClosureHeader, i);
+      c.basis = static_cast<int>(h & 7u);
+      c.isTop = (h >> 3) & 1u;
+      feats = (h >> 4) & 0xffu;
+      sss = (h >> 12) & 3u;
+      if (c.basis >= basisCount)
+        throw std::runtime_error(fmt::format("unpackMaterial: closure {} uses basis {} of {}", i, c.basis, basisCount));
+    } else {
+      c.basis = 0;
+      c.isTop = true;
+      feats = (header >> 2) & 0x7fu;
+      sss = (header >> 10) & 3u;
+    }
+    c.storesWeight = feats & kClosureWeight;
+    c.storesCoverageAbove = feats & kClosureCoverageAbove;
+    c.storedFeatures = featuresFromHeader(feats, sss);
+    v.features = feats;
+    v.isTop = c.isTop;
+    v.basis = c.basis;
+    v.sssType = sss;
+    if (!c.isTop) v.coverageAbove = 1;  // below layers of static coverage 1 unless stored
+
+    v.diffuseAlbedo = dequantizeColor(field(p + "diffuse_albedo", bits::kColor, i));
+    v.f0 = dequantizeColor(field(p + "f0", bits::kColor, i));
+    v.roughness = dequantizeUnorm(field(p + "roughness", bits::kRoughness, i), 8);
+    if (c.storesWeight) v.weight = dequantizeUnorm(field(p + "weight", bits::kGreyWeight, i), 8);
+    if (!c.isTop) v.topTransmittance = dequantizeColor(field(p + "top_transmittance", bits::kColor, i));
+    if (c.storesCoverageAbove) v.coverageAbove = dequantizeUnorm(field(p + "coverage_above", bits::kCoverageAbove, i), 8);
+    if (feats & kClosureF90) v.f90 = dequantizeColor(field(p + "f90", bits::kColor, i));
+    if (sss != kSssTypeNone) dequantizeSss(field(p + "sss", bits::kSss, i), v.sssMfp, v.sssPhaseAnisotropy);
+    if (feats & kClosureHaze) {
+      const std::uint32_t h = field(p + "haze", bits::kHaze, i);
+      v.secondRoughness = dequantizeUnorm(h & 0xffu, 8);
+      v.secondRoughnessWeight = dequantizeUnorm(h >> 8, 8);
+    }
+    if (feats & kClosureFuzz) {
+      const std::uint32_t z = field(p + "fuzz", bits::kFuzz, i);
+      v.fuzzAmount = dequantizeUnorm(z & 0x3fu, 6);
+      v.fuzzColor = dequantizeColor((z >> 6) & 0xfffffu);
+      v.fuzzRoughness = dequantizeUnorm(z >> 26, 6);
+    }
+    if (feats & kClosureAnisotropy) v.anisotropy = dequantizeSnorm(field(p + "anisotropy", bits::kAnisotropy, i), 8);
+    if (feats & kClosureSpecularProfile)
+      v.specularProfile = field(p + "specular_profile", bits::kSpecularProfile, i) + 1;
+    if (feats & kClosureGlint) {
+      const std::size_t start = take(p + "glint", bits::kGlint, i);
+      auto part = [&](std::size_t off, int n) { return readBits(words, count, start + off, n); };
+      v.glintValue = dequantizeUnorm(part(0, 8), 8);
+      v.glintUv = {std::bit_cast<float>(part(8, 32)), std::bit_cast<float>(part(40, 32))};
+      const std::uint32_t dx = part(72, 32), dy = part(104, 32);
+      v.glintUvDerivatives = {halfToFloat(static_cast<std::uint16_t>(dx & 0xffffu)),
+                              halfToFloat(static_cast<std::uint16_t>(dx >> 16)),
+                              halfToFloat(static_cast<std::uint16_t>(dy & 0xffffu)),
+                              halfToFloat(static_cast<std::uint16_t>(dy >> 16))};
+    }
+    L.closures.push_back(c);
+    out.closures.push_back(v);
+  }
+
+  bool topShare = true;
+  for (const auto& c : L.closures)
+    if (c.isTop && c.basis != 0) topShare = false;
+  L.basis0NormalElided = topShare;
+  for (int b = 0; b < basisCount; ++b) {
+    const std::string p = fmt::format("basis{}.", b);
+    bool anisotropic = false;
+    for (const auto& c : L.closures)
+      if (c.basis == b && (c.storedFeatures & kFeatAnisotropy)) anisotropic = true;
+    const bool elided = !multi || (b == 0 && topShare);
+    BasisValues bv;
+    bv.normal = elided ? out.topLayer.normal : dequantizeNormal(field(p + "normal", bits::kNormal, -1, b));
+    Vec3d b0;
+    orthonormalBasis(bv.normal, bv.tangent, b0);
+    if (anisotropic) bv.tangent = decodeTangentAngle(field(p + "tangent_angle", bits::kTangentAngle, -1, b), bv.normal);
+    out.bases.push_back(bv);
+  }
+  return out;
+}
+
+}  // namespace substratec

@@ -1,0 +1,297 @@
+#include "validate/shader_validate.h"
+
+#include <fmt/format.h>
+#include <glslang/Public/ResourceLimits.h>
+#include <glslang/Public/ShaderLang.h>
+#include <glslang/SPIRV/GlslangToSpv.h>
+#include <spirv-tools/libspirv.hpp>
+#include <spirv-tools/optimizer.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <mutex>
+#include <sstream>
+#include <system_error>
+
+namespace substratec {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr std::size_t kMaxIncludeDepth = 64;
+constexpr uint32_t kOpEntryPoint = 15;
+
+// glslang::InitializeProcess() builds the built-in symbol tables shared by all
+// threads; it is called once and never finalized (the tables live as long as
+// the process).
+void initializeGlslangOnce() {
+  static std::once_flag once;
+  std::call_once(once, [] { glslang::InitializeProcess(); });
+}
+
+EShLanguage toGlslangStage(ShaderStage stage) {
+  switch (stage) {
+    case ShaderStage::Vertex: return EShLangVertex;
+    case ShaderStage::Fragment: return EShLangFragment;
+    case ShaderStage::Compute: return EShLangCompute;
+  }
+  return EShLangFragment;
+}
+
+bool readWholeFile(const fs::path& path, std::string& out) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::ostringstream s;
+  s << in.rdbuf();
+  out = s.str();
+  return true;
+}
+
+// Resolves `#include "x"` relative to the including file (glslang passes the
+// resolved name of the including file, or the top-level source name), then
+// through the include directories; `#include <x>` only through the include
+// directories. glslang calls includeLocal first for "" includes and falls back
+// to includeSystem when it returns nullptr.
+class FileIncluder final : public glslang::TShader::Includer {
+ public:
+  explicit FileIncluder(const std::vector<std::string>& dirs) : dirs_(dirs) {}
+
+  IncludeResult* includeLocal(const char* headerName, const char* includerName, std::size_t depth) override {
+    if (depth > kMaxIncludeDepth) return depthError(headerName);
+    fs::path header(headerName);
+    if (header.is_absolute()) return tryOpen(header);
+    // A top-level source given by bare name has no location: don't resolve
+    // against the working directory.
+    fs::path dir = fs::path(includerName ? includerName : "").parent_path();
+    if (dir.empty()) return nullptr;
+    return tryOpen(dir / header);
+  }
+
+  IncludeResult* includeSystem(const char* headerName, const char* /*includerName*/, std::size_t depth) override {
+    if (depth > kMaxIncludeDepth) return depthError(headerName);
+    fs::path header(headerName);
+    if (header.is_absolute()) return tryOpen(header);
+    for (const std::string& d : dirs_) {
+      if (IncludeResult* r = tryOpen(fs::path(d) / header)) return r;
+    }
+    return nullptr;
+  }
+
+  void releaseInclude(IncludeResult* result) override {
+    if (!result) return;
+    delete static_cast<std::string*>(result->userData);
+    delete result;
+  }
+
+ private:
+  IncludeResult* tryOpen(const fs::path& path) {
+    std::string text;
+    if (!readWholeFile(path, text)) return nullptr;
+    auto* content = new std::string(std::move(text));
+    return new IncludeResult(path.lexically_normal().string(), content->data(), content->size(), content);
+  }
+
+  IncludeResult* depthError(const char* headerName) {
+    auto* msg = new std::string(fmt::format("include depth exceeds {} (recursive include of \"{}\"?)",
+                                            kMaxIncludeDepth, headerName));
+    return new IncludeResult("", msg->data(), msg->size(), msg);
+  }
+
+  const std::vector<std::string>& dirs_;
+};
+
+void appendLog(std::string& log, const std::string& text) {
+  if (text.empty()) return;
+  log += text;
+  if (log.back() != '\n') log += '\n';
+}
+
+bool containsLine(const std::string& log, const char* prefix) {
+  std::istringstream in(log);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
+spvtools::MessageConsumer collectInto(std::string& log, const std::string& name, const char* tool) {
+  return [&log, name, tool](spv_message_level_t level, const char* /*source*/, const spv_position_t& pos,
+                            const char* message) {
+    const char* kind = level <= SPV_MSG_ERROR ? "error" : level == SPV_MSG_WARNING ? "warning" : "info";
+    log += fmt::format("{}: {}: {}: {} (instruction word {})\n", name, tool, kind, message, pos.index);
+  };
+}
+
+// Names of the module's OpEntryPoint instructions.
+std::vector<std::string> entryPointNames(const std::vector<uint32_t>& words) {
+  std::vector<std::string> names;
+  if (words.size() < 5) return names;
+  for (std::size_t i = 5; i < words.size();) {
+    uint32_t count = words[i] >> 16;
+    if (count == 0 || i + count > words.size()) break;
+    if ((words[i] & 0xffffu) == kOpEntryPoint && count > 3) {
+      std::string name;
+      for (std::size_t w = i + 3; w < i + count; ++w) {
+        bool end = false;
+        for (int b = 0; b < 4; ++b) {
+          char c = static_cast<char>((words[w] >> (8 * b)) & 0xffu);
+          if (c == '\0') {
+            end = true;
+            break;
+          }
+          name += c;
+        }
+        if (end) break;
+      }
+      names.push_back(std::move(name));
+    }
+    i += count;
+  }
+  return names;
+}
+
+}  // namespace
+
+std::size_t spirvInstructionCount(const std::vector<uint32_t>& words) {
+  if (words.size() < 5) return 0;
+  std::size_t n = 0;
+  for (std::size_t i = 5; i < words.size();) {
+    uint32_t count = words[i] >> 16;
+    if (count == 0 || i + count > words.size()) return 0;
+    ++n;
+    i += count;
+  }
+  return n;
+}
+
+ShaderValidation compileAndValidate(const ShaderSource& src) {
+  initializeGlslangOnce();
+  ShaderValidation result;
+  const bool hlsl = src.language == ShaderLanguage::Hlsl;
+  const EShLanguage stage = toGlslangStage(src.stage);
+
+  std::string preamble;
+  if (!hlsl) preamble += "#extension GL_GOOGLE_include_directive : enable\n";
+  for (const auto& [name, value] : src.defines) preamble += fmt::format("#define {} {}\n", name, value);
+
+  // TShader must outlive TProgram (the program refers to the shader's tree).
+  glslang::TShader shader(stage);
+  const char* text = src.text.c_str();
+  const int length = static_cast<int>(src.text.size());
+  const char* name = src.name.c_str();
+  shader.setStringsWithLengthsAndNames(&text, &length, &name, 1);
+  shader.setPreamble(preamble.c_str());
+  shader.setEntryPoint(src.entryPoint.c_str());
+  if (hlsl || src.entryPoint != "main") shader.setSourceEntryPoint(src.entryPoint.c_str());
+  shader.setEnvInput(hlsl ? glslang::EShSourceHlsl : glslang::EShSourceGlsl, stage, glslang::EShClientVulkan, 100);
+  shader.setEnvClient(glslang::EShClientVulkan, glslang::EShTargetVulkan_1_2);
+  shader.setEnvTarget(glslang::EShTargetSpv, glslang::EShTargetSpv_1_5);
+
+  int messages = EShMsgSpvRules | EShMsgVulkanRules;
+  if (hlsl) messages |= EShMsgReadHlsl | EShMsgHlslOffsets;
+  const auto msgs = static_cast<EShMessages>(messages);
+
+  FileIncluder includer(src.includeDirs);
+  const bool parsed = shader.parse(GetDefaultResources(), /*defaultVersion=*/hlsl ? 100 : 450,
+                                   /*forwardCompatible=*/false, msgs, includer);
+  appendLog(result.log, shader.getInfoLog());
+  appendLog(result.log, shader.getInfoDebugLog());
+  if (!parsed) return result;
+
+  glslang::TProgram program;
+  program.addShader(&shader);
+  const bool linked = program.link(msgs);
+  const std::string linkLog = program.getInfoLog();
+  appendLog(result.log, linkLog);
+  appendLog(result.log, program.getInfoDebugLog());
+  // A missing HLSL entry point is only a link *warning*: every link warning fails.
+  if (!linked || containsLine(linkLog, "WARNING:") || containsLine(linkLog, "ERROR:")) {
+    if (linked) {
+      if (linkLog.find("Entry point not found") != std::string::npos)
+        appendLog(result.log, fmt::format("{}: entry point \"{}\" not found", src.name, src.entryPoint));
+      appendLog(result.log, fmt::format("{}: link warnings are treated as errors", src.name));
+    }
+    return result;
+  }
+
+  glslang::SpvOptions spvOptions;
+  spvOptions.generateDebugInfo = false;
+  spvOptions.validate = false;
+  spvOptions.disableOptimizer = true;
+  spv::SpvBuildLogger logger;
+  glslang::GlslangToSpv(*program.getIntermediate(stage), result.spirv, &logger, &spvOptions);
+  const std::string spvLog = logger.getAllMessages();
+  appendLog(result.log, spvLog);
+  if (containsLine(spvLog, "error") || result.spirv.empty()) return result;
+  // "Before optimization" is the module as the front end emits it, for both
+  // languages, so GLSL and HLSL counts compare.
+  const std::size_t rawInstructionCount = spirvInstructionCount(result.spirv);
+  if (hlsl) {
+    // glslang's HLSL output needs its legalization passes (they run only with
+    // the optimizer enabled), e.g. for structs holding textures and samplers.
+    std::vector<uint32_t> legalized;
+    spv::SpvBuildLogger legalizeLogger;
+    spvOptions.disableOptimizer = false;
+    glslang::GlslangToSpv(*program.getIntermediate(stage), legalized, &legalizeLogger, &spvOptions);
+    const std::string legalizeLog = legalizeLogger.getAllMessages();
+    if (legalizeLog != spvLog) appendLog(result.log, legalizeLog);
+    if (containsLine(legalizeLog, "error") || legalized.empty()) return result;
+    result.spirv = std::move(legalized);
+  }
+
+  const std::vector<std::string> entries = entryPointNames(result.spirv);
+  if (entries.size() != 1 || entries.front() != src.entryPoint) {
+    appendLog(result.log, fmt::format("{}: expected exactly one entry point \"{}\", the module has {}", src.name,
+                                      src.entryPoint, entries.size()));
+    return result;
+  }
+
+  spvtools::SpirvTools tools(SPV_ENV_VULKAN_1_2);
+  tools.SetMessageConsumer(collectInto(result.log, src.name, "spirv-val"));
+  if (!tools.Validate(result.spirv)) return result;
+  result.instructionCount = rawInstructionCount;
+
+  std::vector<uint32_t> optimized;
+  spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
+  optimizer.SetMessageConsumer(collectInto(result.log, src.name, "spirv-opt"));
+  optimizer.RegisterPerformancePasses();
+  if (!optimizer.Run(result.spirv.data(), result.spirv.size(), &optimized, spvtools::ValidatorOptions(),
+                     /*skip_validation=*/true)) {
+    appendLog(result.log, fmt::format("{}: spirv-opt performance passes failed", src.name));
+    return result;
+  }
+  spvtools::SpirvTools optimizedTools(SPV_ENV_VULKAN_1_2);
+  optimizedTools.SetMessageConsumer(collectInto(result.log, src.name, "spirv-val (optimized)"));
+  if (!optimizedTools.Validate(optimized)) return result;
+  result.optimizedInstructionCount = spirvInstructionCount(optimized);
+
+  result.ok = true;
+  return result;
+}
+
+std::string numberLines(const std::string& text) {
+  std::size_t lines = 1;
+  for (char c : text) lines += c == '\n';
+  if (!text.empty() && text.back() == '\n') --lines;
+  const std::size_t width = std::max<std::size_t>(4, std::to_string(lines).size());
+  std::string out;
+  std::size_t number = 1;
+  std::size_t start = 0;
+  while (start < text.size() || (start == 0 && text.empty())) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    out += fmt::format("{:>{}} | ", number++, width);
+    out.append(text, start, end - start);
+    out += '\n';
+    start = end + 1;
+    if (text.empty()) break;
+  }
+  return out;
+}
+
+}  // namespace substratec

@@ -1,0 +1,481 @@
+// substratec runtime shaders: evaluation of one closure for one light.
+// Common dialect; include order: prelude -> substrate_closure.h ->
+// substrate_common.h -> substrate_energy_lut.h -> this file.
+//
+//   float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L)
+//
+// returns BSDF * NoL (no weight, no throughput of the layers above): GGX
+// specular (+ haze lobe) with Schlick/F90 Fresnel and Turquin 2019 energy
+// compensation, the diffuse model SUBSTRATE_DIFFUSE_MODEL scaled by
+// (1 - E_spec), SSS wrap, Charlie fuzz on top, glints and specular profiles.
+// Formulas and references: README.md.
+#ifndef SUBSTRATE_BSDF_H
+#define SUBSTRATE_BSDF_H 1
+
+// The including shader may define this before including the runtime to tint
+// the specular with its profile atlas: index = profile index (uint), uv =
+// float2(NoV, NoL). Default: no tint.
+#ifndef SUBSTRATE_SPECULAR_PROFILE_SAMPLE
+#define SUBSTRATE_SPECULAR_PROFILE_SAMPLE(index, uv) SUBSTRATE_SPLAT3(1.0)
+#endif
+
+// Shading normals that face away from the eye by less than this (in NoV) are
+// shaded as grazing (NoV = 1e-4); beyond it the closure returns 0.
+#ifndef SUBSTRATE_NOV_BIAS
+#define SUBSTRATE_NOV_BIAS 1e-3
+#endif
+
+// SSS wrap: per-channel wrap amount w = mfp / (mfp + SCALE) (meters).
+#ifndef SUBSTRATE_SSS_WRAP_MFP_SCALE
+#define SUBSTRATE_SSS_WRAP_MFP_SCALE 0.005
+#endif
+
+// Glints: microfacet density per unit uv area is 2^lerp(MIN, MAX, glintValue);
+// the reflection cone half-angle (radians) is CONE_ANGLE.
+#ifndef SUBSTRATE_GLINT_LOG2_DENSITY_MIN
+#define SUBSTRATE_GLINT_LOG2_DENSITY_MIN 8.0
+#endif
+#ifndef SUBSTRATE_GLINT_LOG2_DENSITY_MAX
+#define SUBSTRATE_GLINT_LOG2_DENSITY_MAX 40.0
+#endif
+#ifndef SUBSTRATE_GLINT_CONE_ANGLE
+#define SUBSTRATE_GLINT_CONE_ANGLE 0.05
+#endif
+
+// Smallest GGX alpha (Kulla-Conty clamp; scripts/gen_energy_lut.py uses the same).
+SUBSTRATE_CONST float SUBSTRATE_MIN_ALPHA = 1e-3;
+// Smallest Charlie sheen alpha (the table generator uses the same).
+SUBSTRATE_CONST float SUBSTRATE_FUZZ_MIN_ALPHA = 1e-3;
+
+// ---------------------------------------------------------------------------
+// Frames.
+
+// Unit shading normal of a closure (falls back to +Z for a zero normal).
+float3 substrate_closure_normal(SubstrateClosure c) {
+  return substrate_safe_normalize(c.N, float3(0.0, 0.0, 1.0));
+}
+
+// Tangent frame around the unit normal N: c.T made orthogonal to N (one
+// Gram-Schmidt step); the Duff et al. basis when c.T is (nearly) parallel to N.
+void substrate_closure_frame(SubstrateClosure c, float3 N, out float3 T, out float3 B) {
+  float3 t0;
+  float3 b0;
+  substrate_orthonormal_basis(N, t0, b0);
+  T = substrate_safe_normalize(c.T - N * dot(N, c.T), t0);
+  B = cross(N, T);
+}
+
+// ---------------------------------------------------------------------------
+// GGX.
+
+// (ax, ay) from perceptual roughness r and anisotropy A (Kulla & Conty 2017):
+// a = r^2, ax = a (1 + A), ay = a (1 - A), each clamped to [1e-3, 1].
+float2 substrate_ggx_alpha(float roughness, float anisotropy) {
+  float r = saturate(roughness);
+  float a = r * r;
+  float A = clamp(anisotropy, -1.0, 1.0);
+  return clamp(float2(a * (1.0 + A), a * (1.0 - A)), SUBSTRATE_SPLAT2(SUBSTRATE_MIN_ALPHA), SUBSTRATE_SPLAT2(1.0));
+}
+
+// Isotropic GGX NDF: a^2 / (pi ((a^2 - 1) NoH^2 + 1)^2). With NoH in [0, 1]
+// the bracket is >= a^2, so D <= 1 / (pi a^2).
+float substrate_ggx_d(float a, float NoH) {
+  float a2 = a * a;
+  float n = saturate(NoH);
+  float d = (n * a2 - n) * n + 1.0;
+  return a2 / (SUBSTRATE_PI * max(d * d, 1e-30));
+}
+
+// Anisotropic GGX NDF (Burley 2012), written as a2 w^2 / pi with
+// w = a2 / |(ay ToH, ax BoH, a2 NoH)|^2 and a2 = ax ay (finite for ax, ay in
+// [1e-3, 1] and unit H).
+float substrate_ggx_d_aniso(float2 alpha, float ToH, float BoH, float NoH) {
+  float a2 = alpha.x * alpha.y;
+  float3 v = float3(alpha.y * ToH, alpha.x * BoH, a2 * NoH);
+  float w = a2 / max(dot(v, v), 1e-30);
+  return a2 * w * w * SUBSTRATE_INV_PI;
+}
+
+// Height-correlated Smith visibility G2 / (4 NoV NoL) (Heitz 2014):
+// 0.5 / (NoL sqrt(NoV^2 (1 - a^2) + a^2) + NoV sqrt(NoL^2 (1 - a^2) + a^2)).
+float substrate_ggx_vis(float a, float NoV, float NoL) {
+  float a2 = a * a;
+  float gv = NoL * sqrt(NoV * NoV * (1.0 - a2) + a2);
+  float gl = NoV * sqrt(NoL * NoL * (1.0 - a2) + a2);
+  return 0.5 / max(gv + gl, 1e-30);
+}
+
+// Anisotropic height-correlated visibility:
+// 0.5 / (NoL |(ax ToV, ay BoV, NoV)| + NoV |(ax ToL, ay BoL, NoL)|).
+float substrate_ggx_vis_aniso(float2 alpha, float ToV, float BoV, float NoV, float ToL, float BoL, float NoL) {
+  float gv = NoL * length(float3(alpha.x * ToV, alpha.y * BoV, NoV));
+  float gl = NoV * length(float3(alpha.x * ToL, alpha.y * BoL, NoL));
+  return 0.5 / max(gv + gl, 1e-30);
+}
+
+// Schlick's Fresnel with an F90: F0 + (F90 - F0) (1 - VoH)^5.
+float3 substrate_fresnel(float3 f0, float3 f90, float VoH) {
+  return f0 + (f90 - f0) * substrate_pow5(1.0 - VoH);
+}
+
+// Turquin 2019 multiple-scattering compensation W = 1 + F0 (1 - E) / E and the
+// compensated lobe's directional albedo E_spec = (F0 (E - B) + F90 B) W, from
+// the tables at (NoV, r). Returns W; E_spec in `albedo`.
+float3 substrate_specular_energy(float3 f0, float3 f90, float NoV, float roughness, out float3 albedo) {
+  float2 dfg = substrate_energy_dfg(NoV, roughness);
+  float e = max(dfg.x + dfg.y, 1e-3);
+  float3 w = SUBSTRATE_SPLAT3(1.0) + f0 * ((1.0 - e) / e);
+  albedo = saturate((f0 * dfg.x + f90 * dfg.y) * w);
+  return w;
+}
+
+// ---------------------------------------------------------------------------
+// Diffuse models (each returns BRDF * NoL for albedo `albedo`).
+
+float3 substrate_diffuse_lambert(float3 albedo, float NoL) {
+  return albedo * (SUBSTRATE_INV_PI * saturate(NoL));
+}
+
+// Chan 2018, "Material Advances in Call of Duty: WWII": GGX-rough diffuse with
+// g = sat(log2(2 / a^2 - 1) / 18) (a = r^2), a rough term VoH + (1 - VoH)^5,
+// a smooth term (1 - 0.75 (1 - NoV)^5)(1 - 0.75 (1 - NoL)^5) blended by
+// sat(2.2 g - 0.5), and a retro-reflection term
+// ((34.5 g - 59) g + 24.5) VoH 2^(-max(73.2 g - 21.2, 8.9) sqrt(NoH)).
+// As in UE, the lobe (f * pi) / pi is capped at 1.
+float3 substrate_diffuse_chan2018(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
+  float r = saturate(roughness);
+  float a2 = max(r * r * r * r, 1e-7);
+  float g = saturate((1.0 / 18.0) * log2(2.0 / a2 - 1.0));
+  float rough = VoH + substrate_pow5(1.0 - VoH);
+  float smoothTerm = (1.0 - 0.75 * substrate_pow5(1.0 - NoV)) * (1.0 - 0.75 * substrate_pow5(1.0 - NoL));
+  float fd = lerp(rough, smoothTerm, saturate(2.2 * g - 0.5));
+  float fb = ((34.5 * g - 59.0) * g + 24.5) * VoH * exp2(-max(73.2 * g - 21.2, 8.9) * sqrt(saturate(NoH)));
+  float lobe = min(1.0, SUBSTRATE_INV_PI * (fd + fb));
+  return albedo * (lobe * saturate(NoL));
+}
+
+// Chan 2024, "Multiscattering Diffuse and Specular BRDFs" (as UE ships it, with
+// a Lambertian smooth limit): Scale = max(0.55 - 0.2 r, 1.25 - 1.6 r),
+// Bias = sat(4 a), FRough = Scale (NoH + Bias) / (NoH + 0.025) VoH^2,
+// f = albedo / pi (lerp(1, FRough, r) + 0.38 a).
+float3 substrate_diffuse_chan2024(float3 albedo, float roughness, float NoL, float NoH, float VoH) {
+  float r = saturate(roughness);
+  float a = r * r;
+  float scale = max(0.55 - 0.2 * r, 1.25 - 1.6 * r);
+  float bias = saturate(4.0 * a);
+  float n = saturate(NoH);
+  float fRough = scale * (n + bias) / (n + 0.025) * VoH * VoH;
+  float f = lerp(1.0, fRough, r) + 0.38 * a;
+  return albedo * (SUBSTRATE_INV_PI * f * saturate(NoL));
+}
+
+// E_FON(mu, r): the directional albedo of the Fujii Oren-Nayar lobe, the
+// quartic fit of Portsmouth et al. 2025 (max error 5e-4).
+float substrate_eon_albedo(float mu, float r) {
+  float m = 1.0 - saturate(mu);
+  float gOverPi = m * (0.0571085289 + m * (0.491881867 + m * (-0.332181442 + m * 0.0714429953)));
+  return (1.0 + r * gOverPi) / (1.0 + 0.287793409 * r);
+}
+
+// EON, Portsmouth, Kutz & Hill 2025, "EON: A Practical Energy-Preserving Rough
+// Diffuse BRDF": f = rho/pi AF (1 + r s/t) + rho_ms/pi (1 - E(mu_o))(1 - E(mu_i)) /
+// (1 - E_avg), AF = 1 / (1 + c1 r), c1 = 1/2 - 2/(3 pi), E_avg = AF (1 + c2 r),
+// c2 = 2/3 - 28/(15 pi), rho_ms = rho^2 E_avg / (1 - rho (1 - E_avg)).
+// The EON roughness is 0.4 r (UE's match to GGX-distributed Lambertian facets).
+// The albedo is inverted exactly for the model's hemispherical mean: with
+// A = rho E_avg / (1 - rho (1 - E_avg)), rho = A / (E_avg + A (1 - E_avg)), so the
+// mean albedo equals the closure's diffuseAlbedo (post multiple scattering).
+float3 substrate_diffuse_eon(float3 albedo, float roughness, float NoV, float NoL, float VoL) {
+  float r = 0.4 * saturate(roughness);
+  float mo = saturate(NoV);
+  float mi = saturate(NoL);
+  float s = VoL - mo * mi;
+  float sOverT = s > 0.0 ? s / max(max(mo, mi), 1e-6) : s;
+  float af = 1.0 / (1.0 + 0.287793409 * r);
+  float eAvg = af * (1.0 + 0.0724882125 * r);
+  float3 rho = albedo / (SUBSTRATE_SPLAT3(eAvg) + albedo * (1.0 - eAvg));
+  float3 rhoMs = rho * rho * eAvg / (SUBSTRATE_SPLAT3(1.0) - rho * (1.0 - eAvg));
+  float fss = af * (1.0 + r * sOverT);
+  float ms = max(1e-7, 1.0 - substrate_eon_albedo(mo, r)) * max(1e-7, 1.0 - substrate_eon_albedo(mi, r)) /
+             max(1e-7, 1.0 - eAvg);
+  return (rho * fss + rhoMs * ms) * (SUBSTRATE_INV_PI * mi);
+}
+
+// The diffuse model selected by SUBSTRATE_DIFFUSE_MODEL.
+float3 substrate_diffuse(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL) {
+#if SUBSTRATE_DIFFUSE_MODEL == 1
+  return substrate_diffuse_chan2018(albedo, roughness, NoV, NoL, NoH, VoH);
+#elif SUBSTRATE_DIFFUSE_MODEL == 2
+  return substrate_diffuse_chan2024(albedo, roughness, NoL, NoH, VoH);
+#elif SUBSTRATE_DIFFUSE_MODEL == 3
+  return substrate_diffuse_eon(albedo, roughness, NoV, NoL, VoL);
+#else
+  return substrate_diffuse_lambert(albedo, NoL);
+#endif
+}
+
+// ---------------------------------------------------------------------------
+// SSS wrap.
+
+// Per-channel wrap amount from the mean free path (meters):
+// w = mfp / (mfp + SUBSTRATE_SSS_WRAP_MFP_SCALE), in [0, 1): 0 for no medium,
+// 0.5 at mfp = 5 mm, -> 1 for very long paths.
+float3 substrate_sss_wrap_amount(float3 mfp) {
+  float3 m = max(mfp, SUBSTRATE_SPLAT3(0.0));
+  return m / (m + SUBSTRATE_SPLAT3(SUBSTRATE_SSS_WRAP_MFP_SCALE));
+}
+
+// Energy-conserving wrap lighting: albedo / pi * max(NoL + w, 0) / (1 + w)^2
+// (its integral over the sphere equals Lambert's over the hemisphere).
+float3 substrate_diffuse_wrap(float3 albedo, float3 wrap, float NoL) {
+  float3 w = saturate(wrap);
+  float3 onePlus = SUBSTRATE_SPLAT3(1.0) + w;
+  return albedo * SUBSTRATE_INV_PI * max(SUBSTRATE_SPLAT3(NoL) + w, SUBSTRATE_SPLAT3(0.0)) / (onePlus * onePlus);
+}
+
+// ---------------------------------------------------------------------------
+// Fuzz: Charlie sheen (Estevez & Kulla 2017).
+
+// D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi), a = max(r^2, 1e-3).
+float substrate_charlie_d(float a, float NoH) {
+  float inv = 1.0 / a;
+  float sin2 = max(1.0 - NoH * NoH, 0.0);
+  return (2.0 + inv) * substrate_pow(sin2, 0.5 * inv) * (0.5 * SUBSTRATE_INV_PI);
+}
+
+// The fitted exponent L(x) of Estevez & Kulla's shadowing, parameters
+// interpolated between a = 1 and a = 0 by (1 - a)^2.
+float substrate_charlie_l(float x, float a) {
+  float t = (1.0 - a) * (1.0 - a);
+  float pa = lerp(21.5473, 25.3245, t);
+  float pb = lerp(3.82987, 3.32435, t);
+  float pc = lerp(0.19823, 0.16801, t);
+  float pd = lerp(-1.97760, -1.27393, t);
+  float pe = lerp(-4.32054, -4.85967, t);
+  return pa / (1.0 + pb * substrate_pow(x, pc)) + pd * x + pe;
+}
+
+// Lambda(mu) = exp(L(mu)) for mu < 0.5, exp(2 L(0.5) - L(1 - mu)) otherwise.
+float substrate_charlie_lambda(float mu, float a) {
+  float m = saturate(mu);
+  float l = m < 0.5 ? substrate_charlie_l(m, a) : 2.0 * substrate_charlie_l(0.5, a) - substrate_charlie_l(1.0 - m, a);
+  return exp(min(l, 80.0));
+}
+
+// Charlie sheen f * NoL = D G / (4 NoV), G = 1 / (1 + Lambda(NoV) + Lambda(NoL)).
+float substrate_charlie_sheen(float fuzzRoughness, float NoV, float NoL, float NoH) {
+  float r = saturate(fuzzRoughness);
+  float a = max(r * r, SUBSTRATE_FUZZ_MIN_ALPHA);
+  float g = 1.0 / (1.0 + substrate_charlie_lambda(NoV, a) + substrate_charlie_lambda(NoL, a));
+  return substrate_charlie_d(a, NoH) * g / (4.0 * max(NoV, SUBSTRATE_MIN_COS));
+}
+
+// ---------------------------------------------------------------------------
+// Glints: a cheap stand-in for Chermain et al. 2021 ("Procedural Physically
+// based BRDF for Real-Time Rendering of Glints"). The pixel footprint in uv
+// (area A = |det(duv/dx, duv/dy)|) holds N = rho A microfacets
+// (rho = 2^lerp(8, 40, glintValue) per uv unit^2); a fraction
+// p = min(1, D(H) NoH Omega) of them (Omega = pi gamma^2, gamma the reflection
+// cone) reflect toward H, an expected lambda = N p. The lobe is multiplied by
+// X / lambda with X a random count of mean lambda: a log-normal of mean 1 and
+// variance 1 / lambda, M = exp(sigma z - sigma^2 / 2), sigma^2 = ln(1 + 1/lambda),
+// z a Gaussian from a hash of (uv cell at the footprint's scale, H's slope bin).
+// Two grid levels around the footprint size are blended (no popping).
+// E[M] = 1 (energy-neutral on average); as the footprint or the density grows,
+// lambda -> inf and M -> 1 (the smooth lobe). glintValue >= 1: no glint.
+float substrate_glint_level_sample(float2 uv, float level, int2 slopeBin, float expected) {
+  float size = exp2(level);
+  float2 cell = clamp(floor(uv / size), SUBSTRATE_SPLAT2(-8388608.0), SUBSTRATE_SPLAT2(8388607.0));
+  uint3 key = uint3(uint(int(cell.x)), uint(int(cell.y)),
+                    (uint(slopeBin.x) & 0xffffu) | (uint(slopeBin.y) << 16u));
+  key.z ^= uint(int(level) + 128) * 0x9E3779B9u;
+  uint3 h = substrate_pcg3d(key);
+  float u1 = substrate_hash_to_unit(h.x);
+  float u2 = substrate_hash_to_unit(h.y);
+  float z = sqrt(-2.0 * log(u1)) * cos(SUBSTRATE_TWO_PI * u2);
+  float sigma2 = log(1.0 + 1.0 / expected);
+  return exp(sqrt(sigma2) * z - 0.5 * sigma2);
+}
+
+// The glint multiplier of the specular lobe. d = D(H) of the primary lobe;
+// ToH, BoH, NoH: H in the closure's tangent frame.
+float substrate_glint_factor(SubstrateClosure c, float d, float ToH, float BoH, float NoH) {
+  float density = saturate(c.glintValue);
+  if (density >= 1.0) {
+    return 1.0;
+  }
+  float2 dx = c.glintUvDerivatives.xy;
+  float2 dy = c.glintUvDerivatives.zw;
+  // Footprint: area (anisotropy capped at 64:1), at least 1e-6 uv units wide.
+  float lx = length(dx);
+  float ly = length(dy);
+  float wide = clamp(max(lx, ly), 1e-6, 1e6);
+  float area = max(abs(dx.x * dy.y - dx.y * dy.x), wide * wide * (1.0 / 64.0));
+  float rho = exp2(lerp(SUBSTRATE_GLINT_LOG2_DENSITY_MIN, SUBSTRATE_GLINT_LOG2_DENSITY_MAX, density));
+  float gamma = SUBSTRATE_GLINT_CONE_ANGLE;
+  float p = min(1.0, d * saturate(NoH) * (SUBSTRATE_PI * gamma * gamma));
+  float expected = clamp(rho * area * p, 1e-3, 1e30);
+  // H's slope, binned at the cone's scale (a new light direction meets new facets).
+  float2 slope = float2(ToH, BoH) / max(NoH, 0.05);
+  int2 bin = int2(floor(slope / (2.0 * gamma)));
+  float level = clamp(0.5 * log2(area), -40.0, 20.0);
+  float l0 = floor(level);
+  float t = level - l0;
+  float m0 = substrate_glint_level_sample(c.glintUv, l0, bin, expected);
+  float m1 = substrate_glint_level_sample(c.glintUv, l0 + 1.0, bin, expected);
+  return lerp(m0, m1, t);
+}
+
+// ---------------------------------------------------------------------------
+// The closure.
+
+float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
+  float3 N = substrate_closure_normal(c);
+  float NoVraw = dot(N, V);
+  // Back-facing beyond the bias (or NaN): nothing. Otherwise NoV >= 1e-4.
+  if (!(NoVraw > -SUBSTRATE_NOV_BIAS)) {
+    return SUBSTRATE_SPLAT3(0.0);
+  }
+  float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
+  float NoL = clamp(dot(N, L), -1.0, 1.0);
+
+  bool isWrap = false;
+  float3 wrap = SUBSTRATE_SPLAT3(0.0);
+#if SUBSTRATE_USE_SSS
+  if (c.sssType == SUBSTRATE_SSS_WRAP) {
+    isWrap = true;
+    wrap = substrate_sss_wrap_amount(c.sssMfp);
+  }
+#endif
+  bool lightFacing = NoL > 0.0;
+  // Wrap lighting reaches below the horizon, down to NoL = -w.
+  if (!lightFacing && !(isWrap && NoL > -substrate_max3(wrap))) {
+    return SUBSTRATE_SPLAT3(0.0);
+  }
+  float NoLc = max(NoL, 0.0);
+  float3 H = substrate_safe_normalize(V + L, N);
+  float NoH = saturate(dot(N, H));
+  float VoH = saturate(dot(V, H));
+  float VoL = clamp(dot(V, L), -1.0, 1.0);
+
+  float3 f0 = saturate(c.f0);
+  float3 f90 = SUBSTRATE_SPLAT3(1.0);
+#if SUBSTRATE_USE_F90
+  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
+    f90 = saturate(c.f90);
+  }
+#endif
+  float roughness = saturate(c.roughness);
+
+  // Specular: energy terms (needed by the diffuse even when NoL <= 0).
+  float3 specAlbedo;
+  float3 w1 = substrate_specular_energy(f0, f90, NoV, roughness, specAlbedo);
+  float hazeWeight = 0.0;
+  float hazeRoughness = roughness;
+#if SUBSTRATE_USE_HAZE
+  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u) {
+    hazeWeight = saturate(c.secondRoughnessWeight);
+    hazeRoughness = saturate(c.secondRoughness);
+  }
+#endif
+  float3 w2 = w1;
+  if (hazeWeight > 0.0) {
+    float3 specAlbedo2;
+    w2 = substrate_specular_energy(f0, f90, NoV, hazeRoughness, specAlbedo2);
+    specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
+  }
+
+  float3 spec = SUBSTRATE_SPLAT3(0.0);
+  if (lightFacing) {
+    float anisotropy = 0.0;
+#if SUBSTRATE_USE_ANISOTROPY
+    if ((c.features & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
+      anisotropy = clamp(c.anisotropy, -1.0, 1.0);
+    }
+#endif
+    bool needFrame = anisotropy != 0.0;
+#if SUBSTRATE_USE_GLINT
+    needFrame = needFrame || ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u && c.glintValue < 1.0);
+#endif
+    float ToV = 0.0;
+    float BoV = 0.0;
+    float ToL = 0.0;
+    float BoL = 0.0;
+    float ToH = 0.0;
+    float BoH = 0.0;
+    if (needFrame) {
+      float3 T;
+      float3 B;
+      substrate_closure_frame(c, N, T, B);
+      ToV = dot(T, V);
+      BoV = dot(B, V);
+      ToL = dot(T, L);
+      BoL = dot(B, L);
+      ToH = dot(T, H);
+      BoH = dot(B, H);
+    }
+    float2 alpha1 = substrate_ggx_alpha(roughness, anisotropy);
+    float d1;
+    float vis1;
+    if (anisotropy != 0.0) {
+      d1 = substrate_ggx_d_aniso(alpha1, ToH, BoH, NoH);
+      vis1 = substrate_ggx_vis_aniso(alpha1, ToV, BoV, NoV, ToL, BoL, NoLc);
+    } else {
+      d1 = substrate_ggx_d(alpha1.x, NoH);
+      vis1 = substrate_ggx_vis(alpha1.x, NoV, NoLc);
+    }
+    float3 lobe = w1 * (d1 * vis1 * NoLc);
+    if (hazeWeight > 0.0) {
+      float2 alpha2 = substrate_ggx_alpha(hazeRoughness, anisotropy);
+      float d2;
+      float vis2;
+      if (anisotropy != 0.0) {
+        d2 = substrate_ggx_d_aniso(alpha2, ToH, BoH, NoH);
+        vis2 = substrate_ggx_vis_aniso(alpha2, ToV, BoV, NoV, ToL, BoL, NoLc);
+      } else {
+        d2 = substrate_ggx_d(alpha2.x, NoH);
+        vis2 = substrate_ggx_vis(alpha2.x, NoV, NoLc);
+      }
+      lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
+    }
+    spec = substrate_fresnel(f0, f90, VoH) * lobe;
+#if SUBSTRATE_USE_GLINT
+    if ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u) {
+      spec *= substrate_glint_factor(c, d1, ToH, BoH, NoH);
+    }
+#endif
+#if SUBSTRATE_USE_SPECULAR_PROFILE
+    if ((c.features & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u && c.specularProfile > 0u) {
+      spec *= SUBSTRATE_SPECULAR_PROFILE_SAMPLE(c.specularProfile - 1u, float2(NoV, NoLc));
+    }
+#endif
+  }
+
+  // Diffuse, below the specular interface.
+  float3 albedo = saturate(c.diffuseAlbedo);
+  float3 diffuse;
+  if (isWrap) {
+    diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
+  } else {
+    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
+  }
+  float3 result = spec + diffuse * (SUBSTRATE_SPLAT3(1.0) - specAlbedo);
+
+#if SUBSTRATE_USE_FUZZ
+  if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
+    float amount = saturate(c.fuzzAmount);
+    float eFuzz = substrate_fuzz_albedo(NoV, c.fuzzRoughness);
+    // The lobe is normalized where the model's albedo exceeds 1 (grazing,
+    // smooth fuzz); what it reflects no longer reaches the layers below.
+    float3 fuzz = SUBSTRATE_SPLAT3(0.0);
+    if (lightFacing) {
+      fuzz = saturate(c.fuzzColor) * (amount * substrate_charlie_sheen(c.fuzzRoughness, NoV, NoLc, NoH) /
+                                      max(1.0, eFuzz));
+    }
+    result = result * (1.0 - amount * min(eFuzz, 1.0)) + fuzz;
+  }
+#endif
+  return result;
+}
+
+#endif

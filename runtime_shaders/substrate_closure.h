@@ -1,0 +1,140 @@
+// substratec runtime shaders: the closure — what one slab contributes after
+// the tree walk, and what the lighting evaluates. Written in the common
+// dialect (include substrate_prelude.glsl or .hlsl first).
+//
+// The generated material function fills closures inline (forward) or packs
+// them (base pass); the deferred lighting unpacks them (substrate_pack.h).
+// Field meanings and ranges follow docs/storage.md.
+#ifndef SUBSTRATE_CLOSURE_H
+#define SUBSTRATE_CLOSURE_H 1
+
+// Feature bits of a closure, the same bits as the closure header's feature
+// field in docs/storage.md.
+#define SUBSTRATE_FEATURE_F90 1u
+#define SUBSTRATE_FEATURE_ANISOTROPY 2u
+#define SUBSTRATE_FEATURE_HAZE 4u
+#define SUBSTRATE_FEATURE_FUZZ 8u
+#define SUBSTRATE_FEATURE_GLINT 16u
+#define SUBSTRATE_FEATURE_SPECULAR_PROFILE 32u
+#define SUBSTRATE_FEATURE_WEIGHT 64u
+#define SUBSTRATE_FEATURE_COVERAGE_ABOVE 128u
+
+#define SUBSTRATE_SSS_NONE 0u
+#define SUBSTRATE_SSS_WRAP 1u
+#define SUBSTRATE_SSS_DIFFUSION 2u
+#define SUBSTRATE_SSS_SIMPLE_VOLUME 3u
+
+// Layout classes (material header bits 0-1).
+#define SUBSTRATE_LAYOUT_SIMPLE 0u
+#define SUBSTRATE_LAYOUT_SINGLE 1u
+#define SUBSTRATE_LAYOUT_COMPLEX 2u
+#define SUBSTRATE_LAYOUT_SPECIAL 3u
+
+#ifndef SUBSTRATE_MAX_CLOSURES
+#define SUBSTRATE_MAX_CLOSURES 8
+#endif
+
+struct SubstrateClosure {
+  float3 diffuseAlbedo;   // post multiple scattering, [0,1]
+  float3 f0;              // reflectance at normal incidence, [0,1]
+  float3 f90;             // reflectance at grazing (hue only), [0,1]
+  float roughness;        // perceptual, shared by diffuse and primary specular, [0,1]
+  float anisotropy;       // [-1,1], Kulla-Conty
+  float3 N;               // unit normal (world or view space, the caller's choice)
+  float3 T;               // unit tangent, orthogonal to N (used when anisotropic)
+  float3 sssMfp;          // mean free path in meters (after sss_mfp_scale); 0 = none
+  float sssPhaseAnisotropy;
+  uint sssType;           // SUBSTRATE_SSS_*
+  float secondRoughness;  // haze lobe
+  float secondRoughnessWeight;
+  float fuzzAmount;
+  float3 fuzzColor;
+  float fuzzRoughness;
+  float glintValue;       // 1 = no glint
+  float2 glintUv;
+  float4 glintUvDerivatives;  // d(uv)/dx in xy, d(uv)/dy in zw
+  uint specularProfile;       // profile index + 1; 0 = none
+  float3 emissive;            // forward only (deferred adds it in the base pass)
+  float weight;               // mix and coverage weights on the path to the root
+  float3 topTransmittance;    // transmittance of the layers above along the normal (1 on top)
+  float coverageAbove;        // coverage of the layers above (0 on top)
+  uint features;              // SUBSTRATE_FEATURE_* bits
+  bool isTop;                 // nothing layered above
+};
+
+// The shading point as the generated material function sees it.
+struct SubstrateGeometry {
+  float3 N;            // unit geometric/vertex normal
+  float3 T;            // unit tangent (orthogonal to N)
+  float3 V;            // unit direction to the eye
+  float3 position;     // world space, meters
+  float2 uv0;
+  float2 uv1;
+  float4 vertexColor;
+  float4 uvDerivatives;  // d(uv0)/dx in xy, d(uv0)/dy in zw (glints)
+  float dither;          // per-pixel value in [0,1) for the centred quantization dither
+};
+
+// Which optional parts of the runtime a shader compiles. The generated code
+// defines these (0 for features no slab of the material uses: a material pays
+// only for what it uses); when undefined, everything is compiled (the generic
+// deferred lighting).
+#ifndef SUBSTRATE_USE_F90
+#define SUBSTRATE_USE_F90 1
+#endif
+#ifndef SUBSTRATE_USE_ANISOTROPY
+#define SUBSTRATE_USE_ANISOTROPY 1
+#endif
+#ifndef SUBSTRATE_USE_HAZE
+#define SUBSTRATE_USE_HAZE 1
+#endif
+#ifndef SUBSTRATE_USE_FUZZ
+#define SUBSTRATE_USE_FUZZ 1
+#endif
+#ifndef SUBSTRATE_USE_SSS
+#define SUBSTRATE_USE_SSS 1
+#endif
+#ifndef SUBSTRATE_USE_GLINT
+#define SUBSTRATE_USE_GLINT 1
+#endif
+#ifndef SUBSTRATE_USE_SPECULAR_PROFILE
+#define SUBSTRATE_USE_SPECULAR_PROFILE 1
+#endif
+#ifndef SUBSTRATE_USE_EMISSIVE
+#define SUBSTRATE_USE_EMISSIVE 1
+#endif
+// Diffuse model: 0 Lambert, 1 Chan 2018, 2 Chan 2024, 3 EON (Portsmouth 2025).
+#ifndef SUBSTRATE_DIFFUSE_MODEL
+#define SUBSTRATE_DIFFUSE_MODEL 2
+#endif
+
+// Every field set to its neutral value (no feature, weight 1, on top).
+void substrate_closure_init(out SubstrateClosure c) {
+  c.diffuseAlbedo = SUBSTRATE_SPLAT3(0.18);
+  c.f0 = SUBSTRATE_SPLAT3(0.04);
+  c.f90 = SUBSTRATE_SPLAT3(1.0);
+  c.roughness = 0.5;
+  c.anisotropy = 0.0;
+  c.N = float3(0.0, 0.0, 1.0);
+  c.T = float3(1.0, 0.0, 0.0);
+  c.sssMfp = SUBSTRATE_SPLAT3(0.0);
+  c.sssPhaseAnisotropy = 0.0;
+  c.sssType = SUBSTRATE_SSS_NONE;
+  c.secondRoughness = 0.5;
+  c.secondRoughnessWeight = 0.0;
+  c.fuzzAmount = 0.0;
+  c.fuzzColor = SUBSTRATE_SPLAT3(0.0);
+  c.fuzzRoughness = 0.5;
+  c.glintValue = 1.0;
+  c.glintUv = SUBSTRATE_SPLAT2(0.0);
+  c.glintUvDerivatives = SUBSTRATE_SPLAT4(0.0);
+  c.specularProfile = 0u;
+  c.emissive = SUBSTRATE_SPLAT3(0.0);
+  c.weight = 1.0;
+  c.topTransmittance = SUBSTRATE_SPLAT3(1.0);
+  c.coverageAbove = 0.0;
+  c.features = 0u;
+  c.isTop = true;
+}
+
+#endif

@@ -1,0 +1,212 @@
+// substratec runtime shaders: lighting of closures — throughputs of the layers
+// above, the deferred light loop, split-sum environment lighting and
+// translucency. Common dialect; include order: prelude -> substrate_closure.h
+// -> substrate_common.h -> substrate_energy_lut.h -> substrate_bsdf.h -> this.
+// Formulas and references: README.md.
+#ifndef SUBSTRATE_LIGHTING_H
+#define SUBSTRATE_LIGHTING_H 1
+
+// The cosine at which the transmittance of the layers above is evaluated for
+// light arriving from the whole hemisphere (irradiance): the mean of 1/mu under
+// the cosine-weighted hemisphere is 2, so T^(1/0.5) is exact to first order in
+// the optical depth.
+#ifndef SUBSTRATE_DIFFUSE_MEAN_COS
+#define SUBSTRATE_DIFFUSE_MEAN_COS 0.5
+#endif
+
+// lerp(1, T_N^(1/max(mu, 1e-4)), coverageAbove): the transmittance of the
+// layers above along a direction at cosine mu, blended by their coverage. No
+// transcendental when nothing covers the closure (top layers).
+float3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
+  float cover = saturate(c.coverageAbove);
+  if (cover > 0.0) {
+    return lerp(SUBSTRATE_SPLAT3(1.0), substrate_transmittance_at_cosine(c.topTransmittance, mu), cover);
+  }
+  return SUBSTRATE_SPLAT3(1.0);
+}
+
+// Along the view: c.weight * lerp(1, T_N^(1/max(NoV, 1e-4)), c.coverageAbove).
+float3 substrate_closure_view_throughput(SubstrateClosure c, float NoV) {
+  return max(c.weight, 0.0) * substrate_closure_above_throughput(c, NoV);
+}
+
+// Along the light: lerp(1, T_N^(1/max(NoL, 1e-4)), c.coverageAbove). The
+// closure's weight is counted once, in the view throughput.
+float3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
+  return substrate_closure_above_throughput(c, NoL);
+}
+
+// One closure lit by one light of radiance `radiance` (the light's radiance
+// times its solid angle / attenuation, i.e. what multiplies BSDF * NoL):
+// view throughput * light throughput * BSDF * NoL * radiance. Emissive is not
+// added here (the base pass adds it once).
+float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 radiance) {
+  float3 N = substrate_closure_normal(c);
+  float3 f = substrate_eval_closure(c, V, L);
+  float3 throughput = substrate_closure_view_throughput(c, dot(N, V)) * substrate_closure_light_throughput(c, dot(N, L));
+  return throughput * f * radiance;
+}
+
+// The deferred light loop over the unpacked closures of a pixel. The optional
+// lobes branch on each closure's feature bits inside substrate_eval_closure,
+// so pixels without a feature never run its code.
+float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES], uint count, float3 V, float3 L,
+                                float3 radiance) {
+  float3 sum = SUBSTRATE_SPLAT3(0.0);
+  uint n = min(count, uint(SUBSTRATE_MAX_CLOSURES));
+  for (uint i = 0u; i < n; ++i) {
+    sum += substrate_light_closure(closures[i], V, L, radiance);
+  }
+  return sum;
+}
+
+// ---------------------------------------------------------------------------
+// Environment lighting (split sum, Karis 2013).
+
+// Roughness of the prefiltered fetch: the primary roughness, lerped toward the
+// haze roughness by the haze weight when the closure has haze.
+float substrate_env_roughness(SubstrateClosure c) {
+  float r = saturate(c.roughness);
+#if SUBSTRATE_USE_HAZE
+  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u) {
+    r = lerp(r, saturate(c.secondRoughness), saturate(c.secondRoughnessWeight));
+  }
+#endif
+  return r;
+}
+
+// Direction to fetch the prefiltered environment at: the mirror direction
+// R = 2 (N.V) N - V moved toward N for rough lobes (dominant direction,
+// Lagarde & de Rousiers 2014: lerp(N, R, (1 - a)(sqrt(1 - a) + a)), a = r^2).
+// Anisotropic closures first bend N toward V within the plane orthogonal to
+// the axis the facets tilt about (B for A > 0, T for A < 0), by |A| sat(5 r)
+// (the bent-normal approximation of the stretched lobe).
+float3 substrate_reflection_dir(SubstrateClosure c, float3 V) {
+  float3 N = substrate_closure_normal(c);
+  float r = substrate_env_roughness(c);
+#if SUBSTRATE_USE_ANISOTROPY
+  if ((c.features & SUBSTRATE_FEATURE_ANISOTROPY) != 0u && c.anisotropy != 0.0) {
+    float3 T;
+    float3 B;
+    substrate_closure_frame(c, N, T, B);
+    float A = clamp(c.anisotropy, -1.0, 1.0);
+    // A > 0 (ax > ay): the facets tilt mostly along T, i.e. about B, so the
+    // normal is bent toward V within the plane orthogonal to B (and vice versa).
+    float3 axis = B;
+    if (A < 0.0) {
+      axis = T;
+    }
+    float3 side = cross(axis, V);
+    float3 bentN = substrate_safe_normalize(cross(side, axis), N);
+    N = substrate_safe_normalize(lerp(N, bentN, abs(A) * saturate(5.0 * r)), N);
+  }
+#endif
+  float NoV = dot(N, V);
+  float3 R = 2.0 * NoV * N - V;
+  float a = r * r;
+  float k = (1.0 - a) * (sqrt(1.0 - a) + a);
+  return substrate_safe_normalize(lerp(N, R, k), N);
+}
+
+// Mip of a prefiltered cube of `mipCount` levels prefiltered with perceptual
+// roughness r_i = i / (mipCount - 1) at mip i: r (mipCount - 1).
+float substrate_env_mip(float roughness, float mipCount) {
+  return saturate(roughness) * max(mipCount - 1.0, 0.0);
+}
+
+// Split-sum environment lighting of one closure, throughputs included.
+//   prefilteredRadiance: the prefiltered cube at substrate_reflection_dir(c, V)
+//                        and mip substrate_env_mip(substrate_env_roughness(c), n);
+//   irradiance:          the cosine-weighted integral of radiance around N,
+//                        E = integral L cos (Lambert gives albedo E / pi).
+// Specular: E_spec = (F0 (E - B) + F90 B) W from the same tables as the direct
+// lighting (haze: lerped by weight); diffuse: albedo (1 - E_spec) E / pi (every
+// diffuse model, wrap included, uses its hemispherical albedo = albedo);
+// fuzz: amount colour min(E_fuzz, 1) E / pi on top, the rest attenuated by
+// (1 - amount min(E_fuzz, 1)). The specular sees the layers above at NoV (its
+// light comes from the mirror direction), the diffuse and fuzz at
+// SUBSTRATE_DIFFUSE_MEAN_COS.
+float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredRadiance, float3 irradiance) {
+  float3 N = substrate_closure_normal(c);
+  float NoVraw = dot(N, V);
+  if (!(NoVraw > -SUBSTRATE_NOV_BIAS)) {
+    return SUBSTRATE_SPLAT3(0.0);
+  }
+  float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
+  float3 f0 = saturate(c.f0);
+  float3 f90 = SUBSTRATE_SPLAT3(1.0);
+#if SUBSTRATE_USE_F90
+  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
+    f90 = saturate(c.f90);
+  }
+#endif
+  float3 specAlbedo;
+  substrate_specular_energy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
+#if SUBSTRATE_USE_HAZE
+  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
+    float3 specAlbedo2;
+    substrate_specular_energy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
+    specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
+  }
+#endif
+  float3 spec = specAlbedo * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
+#if SUBSTRATE_USE_SPECULAR_PROFILE
+  if ((c.features & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u && c.specularProfile > 0u) {
+    spec *= SUBSTRATE_SPECULAR_PROFILE_SAMPLE(c.specularProfile - 1u, float2(NoV, NoV));
+  }
+#endif
+  float3 irr = max(irradiance, SUBSTRATE_SPLAT3(0.0)) * SUBSTRATE_INV_PI;
+  float3 diffuse = saturate(c.diffuseAlbedo) * (SUBSTRATE_SPLAT3(1.0) - specAlbedo) * irr;
+  float3 specLight = substrate_closure_light_throughput(c, NoV);
+  float3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
+  float3 result = spec * specLight + diffuse * diffuseLight;
+#if SUBSTRATE_USE_FUZZ
+  if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
+    float amount = saturate(c.fuzzAmount);
+    float eFuzz = min(substrate_fuzz_albedo(NoV, c.fuzzRoughness), 1.0);
+    result = result * (1.0 - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
+  }
+#endif
+  return substrate_closure_view_throughput(c, NoV) * result;
+}
+
+// ---------------------------------------------------------------------------
+// Translucency (dual-source blending).
+
+// coverage:      saturate(c.weight), the share of the pixel this closure covers;
+// transmittance: what the covered part lets through from behind, per channel:
+//                lerp(1, T_N^(1/NoV), coverageAbove) (the layers above, along V)
+//                * (1 - E_spec(NoV)) (reflected by the interface)
+//                * (1 - fuzzAmount min(E_fuzz, 1)) (caught by the fuzz).
+// The caller blends dst = colour + dst * ((1 - coverage) + coverage * transmittance)
+// (dual-source: src1 = that factor) and multiplies `transmittance` by the
+// slab's own medium, substrate_transmittance(mfp, thickness / max(NoV, 1e-4)),
+// which the closure does not carry.
+void substrate_translucency(SubstrateClosure c, float NoV, out float coverage, out float3 transmittance) {
+  coverage = saturate(c.weight);
+  float mu = clamp(NoV, SUBSTRATE_MIN_COS, 1.0);
+  float3 f0 = saturate(c.f0);
+  float3 f90 = SUBSTRATE_SPLAT3(1.0);
+#if SUBSTRATE_USE_F90
+  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
+    f90 = saturate(c.f90);
+  }
+#endif
+  float3 specAlbedo;
+  substrate_specular_energy(f0, f90, mu, saturate(c.roughness), specAlbedo);
+#if SUBSTRATE_USE_HAZE
+  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
+    float3 specAlbedo2;
+    substrate_specular_energy(f0, f90, mu, saturate(c.secondRoughness), specAlbedo2);
+    specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
+  }
+#endif
+  transmittance = substrate_closure_above_throughput(c, mu) * (SUBSTRATE_SPLAT3(1.0) - specAlbedo);
+#if SUBSTRATE_USE_FUZZ
+  if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
+    transmittance *= 1.0 - saturate(c.fuzzAmount) * min(substrate_fuzz_albedo(mu, c.fuzzRoughness), 1.0);
+  }
+#endif
+}
+
+#endif

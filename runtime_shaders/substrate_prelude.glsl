@@ -1,0 +1,44 @@
+// substratec runtime shaders: GLSL prelude of the common dialect.
+// The runtime library (substrate_*.h) is written once in a small dialect with
+// HLSL spellings; this file maps it to GLSL 4.50 (Vulkan). Include it first.
+#ifndef SUBSTRATE_PRELUDE
+#define SUBSTRATE_PRELUDE 1
+#define SUBSTRATE_GLSL 1
+
+#define float2 vec2
+#define float3 vec3
+#define float4 vec4
+#define int2 ivec2
+#define int3 ivec3
+#define int4 ivec4
+#define uint2 uvec2
+#define uint3 uvec3
+#define uint4 uvec4
+#define bool2 bvec2
+#define bool3 bvec3
+#define float3x3 mat3
+
+#define lerp mix
+#define frac fract
+#define rsqrt inversesqrt
+#define atan2 atan
+#define ddx dFdx
+#define ddy dFdy
+#define asuint floatBitsToUint
+#define asfloat uintBitsToFloat
+#define saturate(x) clamp((x), 0.0, 1.0)
+#define rcp(x) (1.0 / (x))
+
+// Constants at file scope, and splats of a scalar to a vector.
+#define SUBSTRATE_CONST const
+#define SUBSTRATE_SPLAT2(x) vec2(x)
+#define SUBSTRATE_SPLAT3(x) vec3(x)
+#define SUBSTRATE_SPLAT4(x) vec4(x)
+// float <-> half bits (low 16 bits).
+#define substrate_f32tof16(x) (packHalf2x16(vec2((x), 0.0)) & 0xffffu)
+#define substrate_f16tof32(x) (unpackHalf2x16(uint(x)).x)
+// A constant array: SUBSTRATE_CONST float NAME[4] = SUBSTRATE_ARRAY_BEGIN(float, 4) a, b, c, d SUBSTRATE_ARRAY_END;
+#define SUBSTRATE_ARRAY_BEGIN(T, N) T[N](
+#define SUBSTRATE_ARRAY_END )
+
+#endif

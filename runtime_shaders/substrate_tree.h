@@ -1,0 +1,42 @@
+// substratec runtime shaders: the statistical operators of the Substrate tree
+// walk (SIGGRAPH 2023 course, bonus slides), used by the generated material
+// functions, which call them in a fully unrolled order. Common dialect.
+//
+// Each subtree carries a coverage C (probability of presence) and a
+// transmittance T (along the normal), assuming uncorrelated coverage.
+#ifndef SUBSTRATE_TREE_H
+#define SUBSTRATE_TREE_H 1
+
+#define SUBSTRATE_TREE_EPSILON 1e-6
+
+// Horizontal mix toward the foreground by w:
+//   C = (1-w)Cb + w Cf,  T = ((1-w)Cb Tb + w Cf Tf) / max(eps, C).
+void substrate_op_horizontal(float cb, float3 tb, float cf, float3 tf, float w, out float c, out float3 t) {
+  c = (1.0 - w) * cb + w * cf;
+  t = ((1.0 - w) * cb * tb + w * cf * tf) / max(SUBSTRATE_TREE_EPSILON, c);
+}
+
+// Vertical layering:
+//   C = Ct + Cb(1-Ct),  T = Tt Ct(1-Cb) + Tb Cb(1-Ct) + Tt Tb Ct Cb.
+void substrate_op_vertical(float ct, float3 tt, float cb, float3 tb, out float c, out float3 t) {
+  c = ct + cb * (1.0 - ct);
+  t = tt * (ct * (1.0 - cb)) + tb * (cb * (1.0 - ct)) + tt * tb * (ct * cb);
+}
+
+// Add: C = sat(Ca + Cb), T coverage-weighted.
+void substrate_op_add(float ca, float3 ta, float cb, float3 tb, out float c, out float3 t) {
+  c = saturate(ca + cb);
+  t = (ca * ta + cb * tb) / max(SUBSTRATE_TREE_EPSILON, ca + cb);
+}
+
+// One more layer above a slab on its walk to the root: the layers above are
+// kept as one (coverage, transmittance) pair whose throughput at normal
+// incidence, 1 - C + C T, is the product of the layers' throughputs.
+void substrate_layer_above(inout float c, inout float3 t, float cLayer, float3 tLayer) {
+  float3 through = (SUBSTRATE_SPLAT3(1.0 - c) + c * t) * (SUBSTRATE_SPLAT3(1.0 - cLayer) + cLayer * tLayer);
+  float cNew = 1.0 - (1.0 - c) * (1.0 - cLayer);
+  t = saturate((through - SUBSTRATE_SPLAT3(1.0 - cNew)) / max(SUBSTRATE_TREE_EPSILON, cNew));
+  c = cNew;
+}
+
+#endif

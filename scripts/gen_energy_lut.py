@@ -1,0 +1,286 @@
+#!/usr/bin/env python3
+"""Generate runtime_shaders/substrate_energy_lut.h: the directional-albedo
+tables the runtime shaders use for energy compensation and split-sum lighting.
+
+Tables (32 x 32 each, row-major: index = j * 32 + i, i = NoV cell, j = roughness
+cell; NoV = (i + 0.5) / 32 and perceptual roughness r = (j + 0.5) / 32 at cell
+centres):
+
+  SUBSTRATE_ENERGY_LUT         E(mu, r): directional albedo of the single-scattering
+                               GGX lobe with F = 1 (F0 = F90 = 1), height-correlated
+                               Smith G2, alpha = max(r^2, 1e-3) (the runtime clamp).
+  SUBSTRATE_ENERGY_LUT_SCHLICK B(mu, r): the part of E weighted by (1 - VoH)^5, so
+                               that with Schlick's Fresnel the albedo of the lobe is
+                               E_ss(F0, F90) = F0 * (E - B) + F90 * B
+                               (the split-sum "DFG" pair is (E - B, B)).
+  SUBSTRATE_FUZZ_LUT           E_fuzz(mu, r): directional albedo of the Charlie sheen
+                               lobe (Estevez & Kulla 2017) with its fitted Lambda
+                               shadowing, alpha = max(r^2, SHEEN_MIN_ALPHA).
+
+Integration is deterministic: GGX by visible-normal importance sampling
+(Heitz 2018) and the sheen by sampling its NDF, both over a Hammersley set.
+Pure Python 3 (no numpy). Writes the header (default path, or argv[1]) and prints
+nothing; two runs give identical files.
+"""
+
+import math
+import os
+import sys
+
+N = 32                 # table resolution per axis
+GGX_SAMPLES = 4096     # Hammersley points per GGX cell
+FUZZ_SAMPLES = 8192    # Hammersley points per sheen cell
+GGX_MIN_ALPHA = 1e-3   # must match SUBSTRATE_MIN_ALPHA in substrate_bsdf.h
+SHEEN_MIN_ALPHA = 1e-3 # must match SUBSTRATE_FUZZ_MIN_ALPHA in substrate_bsdf.h
+
+
+def radical_inverse2(i):
+    i = ((i << 16) | (i >> 16)) & 0xFFFFFFFF
+    i = ((i & 0x55555555) << 1) | ((i & 0xAAAAAAAA) >> 1)
+    i = ((i & 0x33333333) << 2) | ((i & 0xCCCCCCCC) >> 2)
+    i = ((i & 0x0F0F0F0F) << 4) | ((i & 0xF0F0F0F0) >> 4)
+    i = ((i & 0x00FF00FF) << 8) | ((i & 0xFF00FF00) >> 8)
+    return i * (1.0 / 4294967296.0)
+
+
+def hammersley(n):
+    # (i + 0.5) / n in the first coordinate keeps the points off the poles.
+    return [((i + 0.5) / n, radical_inverse2(i)) for i in range(n)]
+
+
+def ggx_lambda(mu, a2):
+    # Smith Lambda for GGX: (-1 + sqrt(1 + a^2 tan^2)) / 2.
+    mu2 = mu * mu
+    return 0.5 * (-1.0 + math.sqrt(1.0 + a2 * (1.0 - mu2) / mu2))
+
+
+def ggx_cell(mu, r, pts):
+    """E and B for view cosine mu and perceptual roughness r."""
+    a = max(r * r, GGX_MIN_ALPHA)
+    a2 = a * a
+    vx = math.sqrt(max(0.0, 1.0 - mu * mu))
+    vz = mu
+    lam_v = ggx_lambda(vz, a2)
+    g1v = 1.0 / (1.0 + lam_v)
+    # Heitz 2018 VNDF sampling; V lies in the xz plane (vy = 0).
+    hx, hz = a * vx, vz
+    hl = math.sqrt(hx * hx + hz * hz)
+    hx /= hl
+    hz /= hl
+    # T1 = (-Vh.y, Vh.x, 0) / |.| = (0, 1, 0) since Vh.y = 0 and Vh.x >= 0
+    # (for Vh.x = 0 the fallback (1, 0, 0) gives the same distribution).
+    # T2 = cross(Vh, T1) = (-hz, 0, hx).
+    s = 0.5 * (1.0 + hz)
+    e_sum = 0.0
+    b_sum = 0.0
+    two_pi = 2.0 * math.pi
+    for u1, u2 in pts:
+        rr = math.sqrt(u1)
+        phi = two_pi * u2
+        t1 = rr * math.cos(phi)
+        t2 = rr * math.sin(phi)
+        t2 = (1.0 - s) * math.sqrt(max(0.0, 1.0 - t1 * t1)) + s * t2
+        tn = math.sqrt(max(0.0, 1.0 - t1 * t1 - t2 * t2))
+        # Nh = t1 * T1 + t2 * T2 + tn * Vh
+        nx = -t2 * hz + tn * hx
+        ny = t1
+        nz = t2 * hx + tn * hz
+        # back to the ellipsoid configuration
+        mx, my, mz = a * nx, a * ny, max(0.0, nz)
+        ml = math.sqrt(mx * mx + my * my + mz * mz)
+        if ml <= 0.0:
+            continue
+        mx /= ml
+        my /= ml
+        mz /= ml
+        voh = vx * mx + vz * mz
+        if voh <= 0.0:
+            continue
+        lz = 2.0 * voh * mz - vz
+        if lz <= 0.0:
+            continue
+        lam_l = ggx_lambda(min(lz, 1.0), a2)
+        w = (1.0 + lam_v) / (1.0 + lam_v + lam_l)  # G2 / G1(V)
+        fc = 1.0 - voh
+        fc2 = fc * fc
+        e_sum += w
+        b_sum += w * fc2 * fc2 * fc
+    del g1v
+    n = float(len(pts))
+    return e_sum / n, b_sum / n
+
+
+def sheen_l(x, a):
+    t = (1.0 - a) * (1.0 - a)
+    pa = 21.5473 + (25.3245 - 21.5473) * t
+    pb = 3.82987 + (3.32435 - 3.82987) * t
+    pc = 0.19823 + (0.16801 - 0.19823) * t
+    pd = -1.97760 + (-1.27393 + 1.97760) * t
+    pe = -4.32054 + (-4.85967 + 4.32054) * t
+    return pa / (1.0 + pb * (x ** pc if x > 0.0 else 0.0)) + pd * x + pe
+
+
+def sheen_lambda(mu, a):
+    if mu < 0.5:
+        return math.exp(sheen_l(mu, a))
+    return math.exp(2.0 * sheen_l(0.5, a) - sheen_l(1.0 - mu, a))
+
+
+def fuzz_cell(mu, r, pts):
+    """Directional albedo of the Charlie sheen lobe: f = D G / (4 NoV NoL),
+    D = (2 + 1/a) sin^(1/a)(theta_h) / (2 pi), G = 1 / (1 + Lv + Ll).
+    H is sampled with pdf D(h) NoH: sin(theta_h) = u^(1 / (2 + 1/a))."""
+    a = max(r * r, SHEEN_MIN_ALPHA)
+    vx = math.sqrt(max(0.0, 1.0 - mu * mu))
+    vz = mu
+    lam_v = sheen_lambda(vz, a)
+    k = 1.0 / (2.0 + 1.0 / a)
+    total = 0.0
+    two_pi = 2.0 * math.pi
+    for u1, u2 in pts:
+        st = u1 ** k
+        ct = math.sqrt(max(0.0, 1.0 - st * st))
+        phi = two_pi * u2
+        hx = st * math.cos(phi)
+        hz = ct
+        voh = vx * hx + vz * hz
+        if voh <= 0.0 or hz <= 0.0:
+            continue
+        lz = 2.0 * voh * hz - vz
+        if lz <= 0.0:
+            continue
+        g = 1.0 / (1.0 + lam_v + sheen_lambda(min(lz, 1.0), a))
+        # f NoL / pdf_L with pdf_L = D NoH / (4 VoH): G VoH / (NoV NoH)
+        total += g * voh / (vz * hz)
+    return total / float(len(pts))
+
+
+def fmt(v):
+    return "%.5e" % v
+
+
+def emit_table(out, name, values, comment):
+    out.append("// " + comment)
+    out.append("SUBSTRATE_CONST float %s[%d] = SUBSTRATE_ARRAY_BEGIN(float, %d)" % (name, N * N, N * N))
+    for j in range(N):
+        row = values[j * N:(j + 1) * N]
+        line = ", ".join(fmt(v) for v in row)
+        sep = "," if j + 1 < N else ""
+        out.append("  " + line + sep + "  // r = %.5f" % ((j + 0.5) / N))
+    out.append("SUBSTRATE_ARRAY_END;")
+    out.append("")
+
+
+HEADER_TOP = """\
+// substratec runtime shaders: directional-albedo tables (GENERATED by
+// scripts/gen_energy_lut.py -- do not edit; rerun the script instead).
+// Common dialect: include substrate_prelude.{glsl,hlsl}, substrate_closure.h and
+// substrate_common.h first.
+//
+// Three 32 x 32 tables, row-major: index = j * 32 + i with i the NoV cell and j the
+// perceptual-roughness cell; NoV = (i + 0.5) / 32 and r = (j + 0.5) / 32 at cell
+// centres. Lookups are clamped bilinear (outside the centres the edge value holds).
+//
+//   SUBSTRATE_ENERGY_LUT          E(NoV, r): albedo of the single-scattering GGX lobe
+//                                 with F = 1 (height-correlated Smith G2,
+//                                 alpha = max(r^2, 1e-3)). Turquin 2019 uses it for
+//                                 W = 1 + F0 (1 - E) / E.
+//   SUBSTRATE_ENERGY_LUT_SCHLICK  B(NoV, r): the part of E weighted by (1 - VoH)^5;
+//                                 with Schlick's Fresnel the lobe's albedo is
+//                                 F0 (E - B) + F90 B (the split-sum DFG pair).
+//   SUBSTRATE_FUZZ_LUT            E_fuzz(NoV, r): albedo of the Charlie sheen lobe
+//                                 (Estevez & Kulla 2017, fitted Lambda shadowing,
+//                                 alpha = max(r^2, 1e-3)). Not clamped: the model
+//                                 exceeds 1 at grazing view for small roughness
+//                                 (up to ~3.2 at NoV = 1/64, r = 1/64); the BSDF
+//                                 divides the lobe by max(1, E_fuzz).
+//
+// Integration: %d (GGX, visible-normal sampling, Heitz 2018) and %d (sheen, NDF
+// sampling) Hammersley points per cell.
+#ifndef SUBSTRATE_ENERGY_LUT_H
+#define SUBSTRATE_ENERGY_LUT_H 1
+
+#define SUBSTRATE_LUT_SIZE 32
+"""
+
+HEADER_BOTTOM = """\
+// Clamped bilinear coordinates into a 32 x 32 table: the four indices
+// (x0y0, x1y0, x0y1, x1y1) and the fractional weights. x = NoV, y = roughness,
+// both clamped to [0, 1] first (NaN maps to 0 with most GPUs' clamp).
+void substrate_lut_coords(float x, float y, out int4 idx, out float2 f) {
+  float2 p = float2(saturate(x), saturate(y)) * 32.0 - SUBSTRATE_SPLAT2(0.5);
+  p = clamp(p, SUBSTRATE_SPLAT2(0.0), SUBSTRATE_SPLAT2(31.0));
+  float2 p0 = floor(p);
+  f = p - p0;
+  int x0 = int(p0.x);
+  int y0 = int(p0.y);
+  int x1 = min(x0 + 1, 31);
+  int y1 = min(y0 + 1, 31);
+  idx = int4(y0 * 32 + x0, y0 * 32 + x1, y1 * 32 + x0, y1 * 32 + x1);
+}
+
+float substrate_lut_blend(float v00, float v10, float v01, float v11, float2 f) {
+  return lerp(lerp(v00, v10, f.x), lerp(v01, v11, f.x), f.y);
+}
+
+// E(NoV, r): directional albedo of the GGX lobe with F = 1.
+float substrate_energy_albedo(float NoV, float roughness) {
+  int4 i;
+  float2 f;
+  substrate_lut_coords(NoV, roughness, i, f);
+  return substrate_lut_blend(SUBSTRATE_ENERGY_LUT[i.x], SUBSTRATE_ENERGY_LUT[i.y],
+                             SUBSTRATE_ENERGY_LUT[i.z], SUBSTRATE_ENERGY_LUT[i.w], f);
+}
+
+// The split-sum DFG pair (E - B, B): the lobe's albedo is F0 * x + F90 * y.
+float2 substrate_energy_dfg(float NoV, float roughness) {
+  int4 i;
+  float2 f;
+  substrate_lut_coords(NoV, roughness, i, f);
+  float e = substrate_lut_blend(SUBSTRATE_ENERGY_LUT[i.x], SUBSTRATE_ENERGY_LUT[i.y],
+                                SUBSTRATE_ENERGY_LUT[i.z], SUBSTRATE_ENERGY_LUT[i.w], f);
+  float b = substrate_lut_blend(SUBSTRATE_ENERGY_LUT_SCHLICK[i.x], SUBSTRATE_ENERGY_LUT_SCHLICK[i.y],
+                                SUBSTRATE_ENERGY_LUT_SCHLICK[i.z], SUBSTRATE_ENERGY_LUT_SCHLICK[i.w], f);
+  return float2(max(e - b, 0.0), b);
+}
+
+// E_fuzz(NoV, r): directional albedo of the Charlie sheen lobe (colour 1, amount 1).
+float substrate_fuzz_albedo(float NoV, float fuzzRoughness) {
+  int4 i;
+  float2 f;
+  substrate_lut_coords(NoV, fuzzRoughness, i, f);
+  return substrate_lut_blend(SUBSTRATE_FUZZ_LUT[i.x], SUBSTRATE_FUZZ_LUT[i.y],
+                             SUBSTRATE_FUZZ_LUT[i.z], SUBSTRATE_FUZZ_LUT[i.w], f);
+}
+
+#endif
+"""
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
+        here, "..", "runtime_shaders", "substrate_energy_lut.h")
+    pts_ggx = hammersley(GGX_SAMPLES)
+    pts_fuzz = hammersley(FUZZ_SAMPLES)
+    e_tab, b_tab, f_tab = [], [], []
+    for j in range(N):
+        r = (j + 0.5) / N
+        for i in range(N):
+            mu = (i + 0.5) / N
+            e, b = ggx_cell(mu, r, pts_ggx)
+            e_tab.append(min(e, 1.0))
+            b_tab.append(min(b, e))
+            f_tab.append(fuzz_cell(mu, r, pts_fuzz))  # may exceed 1 (see header)
+    out = [HEADER_TOP % (GGX_SAMPLES, FUZZ_SAMPLES)]
+    emit_table(out, "SUBSTRATE_ENERGY_LUT", e_tab, "E(NoV, r), F = 1")
+    emit_table(out, "SUBSTRATE_ENERGY_LUT_SCHLICK", b_tab, "B(NoV, r), the (1 - VoH)^5 part of E")
+    emit_table(out, "SUBSTRATE_FUZZ_LUT", f_tab, "E_fuzz(NoV, r), Charlie sheen")
+    out.append(HEADER_BOTTOM)
+    text = "\n".join(out)
+    with open(path, "w", newline="\n") as fh:
+        fh.write(text)
+
+
+if __name__ == "__main__":
+    main()
