@@ -49,7 +49,7 @@
 #define SUBSTRATE_BITS_TANGENT_ANGLE 14u
 
 // log2 of the mean free path is stored over [-24, 8] (meters).
-#define SUBSTRATE_MFP_LOG2_MIN -24.0
+#define SUBSTRATE_MFP_LOG2_MIN (-24.0)
 #define SUBSTRATE_MFP_LOG2_RANGE 32.0
 #define SUBSTRATE_HALF_MAX 65504.0
 #define SUBSTRATE_PACK_TWO_PI 6.28318530717959
@@ -355,14 +355,23 @@ uint substrate_layout_class(uint word0) {
 
 // ---- Bit stream -----------------------------------------------------------------
 
-// `width` (0..32) bits at stream bit `pos`; the field may straddle two words.
+// The `width` (0..32) bits at bit `shift` (0..31) of the 64-bit pair lo | hi << 32.
+uint substrate_bits_from_pair(uint lo, uint hi, uint shift, uint width) {
+  uint v = (lo >> shift) | (shift != 0u ? (hi << (32u - shift)) : 0u);
+  return v & (width >= 32u ? 0xffffffffu : ((1u << width) - 1u));
+}
+
+// The `width` (0..32) bits at stream bit `pos` of the word array W (a
+// variable: the macro indexes it in place, where a function call would copy
+// the whole array); the field may straddle two words.
+#define SUBSTRATE_READ_BITS(W, pos, width)                                                         \
+  substrate_bits_from_pair((W)[min((pos) >> 5u, uint(SUBSTRATE_MAX_WORDS - 1))],                   \
+                           (W)[min(((pos) >> 5u) + 1u, uint(SUBSTRATE_MAX_WORDS - 1))], (pos) & 31u, \
+                           (width))
+
+// The same as a function (the array is passed by value).
 uint substrate_read_bits(uint words[SUBSTRATE_MAX_WORDS], uint pos, uint width) {
-  uint w = pos >> 5u;
-  uint s = pos & 31u;
-  uint lo = words[min(w, uint(SUBSTRATE_MAX_WORDS - 1))] >> s;
-  uint hi = s != 0u ? (words[min(w + 1u, uint(SUBSTRATE_MAX_WORDS - 1))] << (32u - s)) : 0u;
-  uint m = width >= 32u ? 0xffffffffu : ((1u << width) - 1u);
-  return (lo | hi) & m;
+  return SUBSTRATE_READ_BITS(words, pos, width);
 }
 
 // ORs `value` (masked to `width` bits, 0..32) into the stream at bit `pos`
@@ -420,7 +429,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       uint feats = (header >> 2u) & 0x7fu;
       uint sss = (header >> 10u) & 3u;
       if (multi) {
-        uint h = substrate_read_bits(words, pos, SUBSTRATE_BITS_CLOSURE_HEADER);
+        uint h = SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_CLOSURE_HEADER);
         pos += SUBSTRATE_BITS_CLOSURE_HEADER;
         basis = min(h & 7u, basisCount - 1u);
         isTop = ((h >> 3u) & 1u) != 0u;
@@ -439,33 +448,33 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       closures[i].sssType = sss;
       closures[i].coverageAbove = isTop ? 0.0 : 1.0;
 
-      closures[i].diffuseAlbedo = substrate_dq_color20(substrate_read_bits(words, pos, SUBSTRATE_BITS_COLOR));
+      closures[i].diffuseAlbedo = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
       pos += SUBSTRATE_BITS_COLOR;
-      closures[i].f0 = substrate_dq_color20(substrate_read_bits(words, pos, SUBSTRATE_BITS_COLOR));
+      closures[i].f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
       pos += SUBSTRATE_BITS_COLOR;
-      closures[i].roughness = substrate_dq_unorm(substrate_read_bits(words, pos, SUBSTRATE_BITS_ROUGHNESS), 8u);
+      closures[i].roughness = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ROUGHNESS), 8u);
       pos += SUBSTRATE_BITS_ROUGHNESS;
       if ((feats & SUBSTRATE_FEATURE_WEIGHT) != 0u) {
-        closures[i].weight = substrate_dq_unorm(substrate_read_bits(words, pos, SUBSTRATE_BITS_WEIGHT), 8u);
+        closures[i].weight = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_WEIGHT), 8u);
         pos += SUBSTRATE_BITS_WEIGHT;
       }
       if (!isTop) {
-        closures[i].topTransmittance = substrate_dq_color20(substrate_read_bits(words, pos, SUBSTRATE_BITS_COLOR));
+        closures[i].topTransmittance = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
         pos += SUBSTRATE_BITS_COLOR;
       }
       if ((feats & SUBSTRATE_FEATURE_COVERAGE_ABOVE) != 0u) {
         closures[i].coverageAbove =
-            substrate_dq_unorm(substrate_read_bits(words, pos, SUBSTRATE_BITS_COVERAGE_ABOVE), 8u);
+            substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COVERAGE_ABOVE), 8u);
         pos += SUBSTRATE_BITS_COVERAGE_ABOVE;
       }
       if ((feats & SUBSTRATE_FEATURE_F90) != 0u) {
-        closures[i].f90 = substrate_dq_color20(substrate_read_bits(words, pos, SUBSTRATE_BITS_COLOR));
+        closures[i].f90 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
         pos += SUBSTRATE_BITS_COLOR;
       }
       if (sss != SUBSTRATE_SSS_NONE) {
         float3 mfp;
         float phase;
-        substrate_dq_sss(substrate_read_bits(words, pos, SUBSTRATE_BITS_SSS), mfp, phase);
+        substrate_dq_sss(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_SSS), mfp, phase);
         closures[i].sssMfp = mfp;
         closures[i].sssPhaseAnisotropy = phase;
         pos += SUBSTRATE_BITS_SSS;
@@ -473,7 +482,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       if ((feats & SUBSTRATE_FEATURE_HAZE) != 0u) {
         float r2;
         float w2;
-        substrate_dq_haze(substrate_read_bits(words, pos, SUBSTRATE_BITS_HAZE), r2, w2);
+        substrate_dq_haze(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_HAZE), r2, w2);
         closures[i].secondRoughness = r2;
         closures[i].secondRoughnessWeight = w2;
         pos += SUBSTRATE_BITS_HAZE;
@@ -482,25 +491,25 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
         float fa;
         float3 fc;
         float fr;
-        substrate_dq_fuzz(substrate_read_bits(words, pos, SUBSTRATE_BITS_FUZZ), fa, fc, fr);
+        substrate_dq_fuzz(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_FUZZ), fa, fc, fr);
         closures[i].fuzzAmount = fa;
         closures[i].fuzzColor = fc;
         closures[i].fuzzRoughness = fr;
         pos += SUBSTRATE_BITS_FUZZ;
       }
       if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
-        closures[i].anisotropy = substrate_dq_anisotropy(substrate_read_bits(words, pos, SUBSTRATE_BITS_ANISOTROPY));
+        closures[i].anisotropy = substrate_dq_anisotropy(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ANISOTROPY));
         pos += SUBSTRATE_BITS_ANISOTROPY;
       }
       if ((feats & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u) {
         closures[i].specularProfile =
-            substrate_dq_specular_profile(substrate_read_bits(words, pos, SUBSTRATE_BITS_SPECULAR_PROFILE));
+            substrate_dq_specular_profile(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_SPECULAR_PROFILE));
         pos += SUBSTRATE_BITS_SPECULAR_PROFILE;
       }
       if ((feats & SUBSTRATE_FEATURE_GLINT) != 0u) {
-        uint density = substrate_read_bits(words, pos, 8u);
-        uint4 rest = uint4(substrate_read_bits(words, pos + 8u, 32u), substrate_read_bits(words, pos + 40u, 32u),
-                           substrate_read_bits(words, pos + 72u, 32u), substrate_read_bits(words, pos + 104u, 32u));
+        uint density = SUBSTRATE_READ_BITS(words, pos, 8u);
+        uint4 rest = uint4(SUBSTRATE_READ_BITS(words, pos + 8u, 32u), SUBSTRATE_READ_BITS(words, pos + 40u, 32u),
+                           SUBSTRATE_READ_BITS(words, pos + 72u, 32u), SUBSTRATE_READ_BITS(words, pos + 104u, 32u));
         float gv;
         float2 guv;
         float4 gd;
@@ -523,7 +532,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
     if (uint(b) < basisCount) {
       bool elided = !multi || (b == 0 && topShare);
       if (!elided) {
-        n = substrate_dq_normal(substrate_read_bits(words, pos, SUBSTRATE_BITS_NORMAL));
+        n = substrate_dq_normal(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_NORMAL));
         pos += SUBSTRATE_BITS_NORMAL;
       }
     }
@@ -531,7 +540,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
     float3 b0;
     substrate_pack_frame(n, t0, b0);
     if (uint(b) < basisCount && basisAniso[b]) {
-      t0 = substrate_tangent_angle_decode(substrate_read_bits(words, pos, SUBSTRATE_BITS_TANGENT_ANGLE), n);
+      t0 = substrate_tangent_angle_decode(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_TANGENT_ANGLE), n);
       pos += SUBSTRATE_BITS_TANGENT_ANGLE;
     }
     basisN[b] = n;

@@ -35,8 +35,8 @@
 #define SUBSTRATE_SPLAT3(x) vec3(x)
 #define SUBSTRATE_SPLAT4(x) vec4(x)
 // float <-> half bits (low 16 bits).
-#define substrate_f32tof16(x) (packHalf2x16(vec2((x), 0.0)) & 0xffffu)
-#define substrate_f16tof32(x) (unpackHalf2x16(uint(x)).x)
+#define substrate_f32tof16(v_) (packHalf2x16(vec2((v_), 0.0)) & 0xffffu)
+#define substrate_f16tof32(h_) (unpackHalf2x16(uint(h_)).x)
 // A constant array: SUBSTRATE_CONST float NAME[4] = SUBSTRATE_ARRAY_BEGIN(float, 4) a, b, c, d SUBSTRATE_ARRAY_END;
 #define SUBSTRATE_ARRAY_BEGIN(T, N) T[N](
 #define SUBSTRATE_ARRAY_END )

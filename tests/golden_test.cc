@@ -188,7 +188,8 @@ TEST(Golden, GeneratedCodeContainsOnlyTheFeaturesUsed) {
         EXPECT_EQ(code.find(word), std::string::npos) << name << " mentions " << word << " but no slab uses " << feature;
       }
     }
-    // A one-closure material's forward shader evaluates its closure without a loop.
+    // A one-closure material's forward shader evaluates its closure without a loop
+    // (several closures share one loop, so the lighting code exists once).
     if (r->after.closures.size() == 1)
       for (const auto& [name, text] : files)
         if (name.find(".forward.") != std::string::npos) {

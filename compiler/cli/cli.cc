@@ -26,6 +26,7 @@ struct ReportArgs {
   std::size_t maxInputSize = 16u << 20;
   bool printAfterAll = false;
   bool timePasses = false;
+  bool spirv = false;
 };
 
 CompileOptions optionsFrom(const ReportArgs& a) {
@@ -54,11 +55,34 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
     if (a.printAfterAll) err << result->debugLog;
     if (a.timePasses)
       for (const auto& t : result->timings) err << fmt::format("{}: pass {:<14} {:8.3f} ms\n", file, t.pass, t.milliseconds);
+    std::vector<EntryReport> entries;
+    if (a.spirv) {  // compile every entry shader to count its SPIR-V instructions
+      Generated gen = generateFiles(*result, GenerateOptions{});
+      validateGenerated(gen);
+      if (!gen.valid) {
+        err << "substratec: internal compiler error: generated code does not validate\n" << gen.failure << "\n";
+        return kExitInternal;
+      }
+      entries = gen.entries;
+    }
     if (a.json) {
-      all.push_back(reportJson(*result));
+      auto j = reportJson(*result);
+      if (a.spirv) {
+        nlohmann::ordered_json list = nlohmann::ordered_json::array();
+        for (const auto& e : entries)
+          list.push_back({{"file", e.file}, {"instructions", e.instructions}, {"optimized_instructions", e.optimizedInstructions}});
+        j["spirv"] = list;
+      }
+      all.push_back(j);
     } else {
       if (!first) out << "\n";
       out << formatReportText(*result);
+      if (a.spirv) {
+        out << fmt::format("----- SPIR-V - {} -----\n", result->material.name);
+        for (const auto& e : entries)
+          out << fmt::format("{:<40} {:>6} instructions, {:>6} after SPIRV-Tools' performance passes\n", e.file,
+                             e.instructions, e.optimizedInstructions);
+      }
     }
     first = false;
   }
@@ -135,6 +159,9 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
   rep->add_flag("--print-after-all", report.printAfterAll, "Dump the IR after every pass (stderr)");
   rep->add_flag("--time-passes", report.timePasses, "Print the time of every pass (stderr)");
+  rep->add_flag("--spirv", report.spirv,
+                "Also compile every entry shader and print its SPIR-V instruction count (before and after "
+                "SPIRV-Tools' performance passes)");
 
   CompileArgs compile;
   CLI::App* comp = app.add_subcommand("compile", "Generate flattened GLSL/HLSL, the packing layout and entry shaders");

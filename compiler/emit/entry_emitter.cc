@@ -138,21 +138,25 @@ std::string emitForwardEntry(const Material& m, const StorageLayout& L, const Sy
   s += fmt::format("  SubstrateClosure closures[{}_CLOSURE_COUNT];\n  float coverage;\n  {} transmittance;\n", upper, v3);
   s += fmt::format("  {}_evaluate(g, closures, coverage, transmittance);\n", m.name);
   s += fmt::format("  {} L = frame.lightDirection.xyz;\n  {} color = SUBSTRATE_SPLAT3(0.0);\n", v3, v3);
-  for (int c = 0; c < n; ++c) {
-    const std::string cl = fmt::format("closures[{}]", c);
-    s += fmt::format("  // closure {} ('{}')\n", c, m.slabs[L.closures[c].slab].id);
-    s += fmt::format("  color += substrate_light_closure({}, g.V, L, frame.lightRadiance.rgb);\n", cl);
-    std::string pre = glsl ? fmt::format("textureLod(envPrefiltered, substrate_reflection_dir({0}, g.V), "
-                                         "substrate_env_mip({0}.roughness, frame.envParams.x)).rgb", cl)
-                           : fmt::format("envPrefiltered.SampleLevel(envSampler, substrate_reflection_dir({0}, g.V), "
-                                         "substrate_env_mip({0}.roughness, frame.envParams.x)).rgb", cl);
-    std::string irr = glsl ? fmt::format("textureLod(envIrradiance, {}.N, 0.0).rgb", cl)
-                           : fmt::format("envIrradiance.SampleLevel(envSampler, {}.N, 0.0).rgb", cl);
-    s += fmt::format("  color += substrate_closure_view_throughput({0}, dot({0}.N, g.V)) * "
-                     "substrate_env_split_sum({0}, g.V, {1}, {2});\n", cl, pre, irr);
-    if (m.slabs[L.closures[c].slab].features & kFeatEmissive)
-      s += fmt::format("  color += substrate_closure_view_throughput({0}, dot({0}.N, g.V)) * {0}.emissive;\n", cl);
-  }
+  // One closure: lit inline (no loop). Several: one loop over them, so the
+  // lighting code exists once in the shader instead of once per closure.
+  const bool loop = n > 1;
+  const std::string cl = loop ? "closures[k]" : "closures[0]";
+  if (loop) s += fmt::format("  for (uint k = 0u; k < uint({}_CLOSURE_COUNT); ++k) {{\n", upper);
+  else s += fmt::format("  // closure 0 ('{}')\n", m.slabs[L.closures[0].slab].id);
+  const std::string in = loop ? "    " : "  ";
+  s += fmt::format("{}color += substrate_light_closure({}, g.V, L, frame.lightRadiance.rgb);\n", in, cl);
+  std::string pre = glsl ? fmt::format("textureLod(envPrefiltered, substrate_reflection_dir({0}, g.V), "
+                                       "substrate_env_mip({0}.roughness, frame.envParams.x)).rgb", cl)
+                         : fmt::format("envPrefiltered.SampleLevel(envSampler, substrate_reflection_dir({0}, g.V), "
+                                       "substrate_env_mip({0}.roughness, frame.envParams.x)).rgb", cl);
+  std::string irr = glsl ? fmt::format("textureLod(envIrradiance, {}.N, 0.0).rgb", cl)
+                         : fmt::format("envIrradiance.SampleLevel(envSampler, {}.N, 0.0).rgb", cl);
+  s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * "
+                   "substrate_env_split_sum({1}, g.V, {2}, {3});\n", in, cl, pre, irr);
+  if (usesEmissive(m, L))
+    s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * {1}.emissive;\n", in, cl);
+  if (loop) s += "  }\n";
   std::string color = "color", alpha = "coverage";
   if (m.settings.blendMode == BlendMode::AlphaHoldout) color = "SUBSTRATE_SPLAT3(0.0)";
   if (m.settings.blendMode == BlendMode::Masked)
@@ -275,6 +279,10 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
     if (c.storesCoverageAbove) b |= 128;
     return b;
   };
+  // The SSS type tells the unpacker an SSS field follows: non-zero only when one is stored.
+  auto sssCode = [&](const ClosureLayout& c) {
+    return (c.storedFeatures & kFeatSss) ? static_cast<unsigned>(m.slabs[c.slab].sssType) : 0u;
+  };
   const int cls = static_cast<int>(L.layoutClass);
   for (const LayoutField& f : L.fields) {
     const std::string c = f.closure >= 0 ? fmt::format("closures[{}]", f.closure) : "";
@@ -283,13 +291,12 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
     if (f.name == "header") {
       const ClosureLayout& c0 = L.closures[0];
       put(multi ? fmt::format("substrate_material_header_multi({}u, {}u, {}u)", cls, L.closures.size(), L.basisCount)
-                : fmt::format("substrate_material_header_single({}u, {}u, {}u)", cls, featureBits(c0),
-                              static_cast<unsigned>(m.slabs[c0.slab].sssType)),
+                : fmt::format("substrate_material_header_single({}u, {}u, {}u)", cls, featureBits(c0), sssCode(c0)),
           f.bits);
     } else if (field == "header") {
       const ClosureLayout& cl = L.closures[f.closure];
       put(fmt::format("substrate_closure_header({}u, {}, {}u, {}u)", cl.basis, cl.isTop ? "true" : "false",
-                      featureBits(cl), static_cast<unsigned>(m.slabs[cl.slab].sssType)),
+                      featureBits(cl), sssCode(cl)),
           f.bits);
     } else if (field == "diffuse_albedo" || field == "f0" || field == "f90" || field == "top_transmittance") {
       const char* member = field == "diffuse_albedo" ? "diffuseAlbedo" : field == "f0" ? "f0"

@@ -4,14 +4,20 @@
 // the way a deferred lighting pass does (runtime_shaders/substrate_pack.h is
 // the shader twin). Values are doubles; bits are manipulated exactly.
 //
-// Choices the field table leaves open (see the notes at the end of this
-// header and docs/storage.md):
+// Choices the field table of docs/storage.md leaves open:
 //  - bit 15 of the material header is 1 for the multi-closure header and 0 for
 //    the single-closure header (a COMPLEX/SPECIAL layout with one closure uses
 //    the single-closure header, so the class bits cannot tell them apart);
+//  - a header's SSS type is non-zero exactly when the closure stores SSS data
+//    (the unpacker reads the SSS field from it);
 //  - sub-fields are packed in the order the table lists them, each from its
-//    least significant bit (e.g. colour: r bits 0-6, g 7-13, b 14-19);
+//    least significant bit (e.g. colour: r bits 0-6, g 7-13, b 14-19; SSS:
+//    MFP r, g, b then phase; glint: density, uv.x, uv.y, d(u)/dx, d(v)/dx,
+//    d(u)/dy, d(v)/dy);
 //  - snorm n bits: code = floor(s·x + s + u), s = 2^(n-1) - 1, decode code/s - 1;
+//  - the specular profile field holds the atlas index, SubstrateClosure's
+//    specularProfile - 1;
+//  - every field, normals included, uses the same per-pixel dither u;
 //  - the tangent angle is measured in the frame of the normal *as decoded*
 //    (the stored normal, or the top-layer normal when elided), so a normal
 //    whose quantization crosses z = 0 cannot flip the Duff frame.

@@ -552,7 +552,9 @@ void roundTrip(const StorageLayout& L, const Pixel& px, double u, const std::str
   SCOPED_TRACE(name + " u=" + std::to_string(u));
   const std::vector<std::uint32_t> words = packMaterial(L, px.closures, px.bases, u);
   ASSERT_EQ(static_cast<int>(words.size()), L.words());
-  if (L.totalBits % 32) EXPECT_EQ(words.back() >> (L.totalBits % 32), 0u) << "padding bits are zero";
+  if (L.totalBits % 32) {
+    EXPECT_EQ(words.back() >> (L.totalBits % 32), 0u) << "padding bits are zero";
+  }
   const std::uint32_t top = packTopLayer(px.top, u);
   const UnpackedMaterial m = unpackMaterial(words.data(), words.size(), top);
 
@@ -562,7 +564,9 @@ void roundTrip(const StorageLayout& L, const Pixel& px, double u, const std::str
   EXPECT_EQ(m.layout.totalBits, L.totalBits);
   EXPECT_EQ(m.layout.words(), L.words());
   EXPECT_EQ(m.layout.basisCount, L.basisCount);
-  if (L.closures.size() > 1) EXPECT_EQ(m.layout.basis0NormalElided, L.basis0NormalElided);
+  if (L.closures.size() > 1) {
+    EXPECT_EQ(m.layout.basis0NormalElided, L.basis0NormalElided);
+  }
   ASSERT_EQ(m.layout.fields.size(), L.fields.size());
   for (std::size_t i = 0; i < L.fields.size(); ++i) {
     EXPECT_EQ(m.layout.fields[i].name, L.fields[i].name);
