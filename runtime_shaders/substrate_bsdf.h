@@ -276,13 +276,18 @@ float substrate_charlie_sheen(float fuzzRoughness, float NoV, float NoL, float N
 // (area A = |det(duv/dx, duv/dy)|) holds N = rho A microfacets
 // (rho = 2^lerp(8, 40, glintValue) per uv unit^2); a fraction
 // p = min(1, D(H) NoH Omega) of them (Omega = pi gamma^2, gamma the reflection
-// cone) reflect toward H, an expected lambda = N p. The lobe is multiplied by
-// X / lambda with X a random count of mean lambda: a log-normal of mean 1 and
-// variance 1 / lambda, M = exp(sigma z - sigma^2 / 2), sigma^2 = ln(1 + 1/lambda),
-// z a Gaussian from a hash of (uv cell at the footprint's scale, H's slope bin).
-// Two grid levels around the footprint size are blended (no popping).
-// E[M] = 1 (energy-neutral on average); as the footprint or the density grows,
-// lambda -> inf and M -> 1 (the smooth lobe). glintValue >= 1: no glint.
+// cone) reflect toward H: an expected count lambda = N p. The lobe is
+// multiplied by M, a random variable of mean 1 and variance ~1/lambda (the
+// relative variance of a Poisson count), drawn from a hash of (the uv cell at
+// the footprint's scale, H's slope bin at the cone's scale):
+//   q = min(lambda, 1): the probability that the cell holds a reflecting facet;
+//   M = (u < q) ? Y / q : 0, with Y log-normal of mean 1 and variance
+//   v = q (1 + 1/lambda) - 1 (so Var M = 1/lambda): exp(sigma z - sigma^2/2),
+//   sigma^2 = ln(1 + v), z a Gaussian (Box-Muller).
+// Sparse (lambda << 1): dark cells with rare bright sparkles; dense: M -> 1,
+// the smooth lobe. Two grid levels around the footprint size are blended (no
+// popping). E[M] = 1 exactly (energy-neutral on average). glintValue >= 1:
+// no glint.
 float substrate_glint_level_sample(float2 uv, float level, int2 slopeBin, float expected) {
   float size = exp2(level);
   float2 cell = clamp(floor(uv / size), SUBSTRATE_SPLAT2(-8388608.0), SUBSTRATE_SPLAT2(8388607.0));
@@ -290,11 +295,12 @@ float substrate_glint_level_sample(float2 uv, float level, int2 slopeBin, float 
                     (uint(slopeBin.x) & 0xffffu) | (uint(slopeBin.y) << 16u));
   key.z ^= uint(int(level) + 128) * 0x9E3779B9u;
   uint3 h = substrate_pcg3d(key);
-  float u1 = substrate_hash_to_unit(h.x);
-  float u2 = substrate_hash_to_unit(h.y);
-  float z = sqrt(-2.0 * log(u1)) * cos(SUBSTRATE_TWO_PI * u2);
-  float sigma2 = log(1.0 + 1.0 / expected);
-  return exp(sqrt(sigma2) * z - 0.5 * sigma2);
+  float q = min(expected, 1.0);
+  float v = q * (1.0 + 1.0 / expected) - 1.0;
+  float sigma2 = log(1.0 + max(v, 0.0));
+  float z = sqrt(-2.0 * log(substrate_hash_to_unit(h.x))) * cos(SUBSTRATE_TWO_PI * substrate_hash_to_unit(h.y));
+  float y = exp(sqrt(sigma2) * z - 0.5 * sigma2);
+  return substrate_hash_to_unit(h.z) <= q ? y / q : 0.0;
 }
 
 // The glint multiplier of the specular lobe. d = D(H) of the primary lobe;
@@ -314,7 +320,7 @@ float substrate_glint_factor(SubstrateClosure c, float d, float ToH, float BoH, 
   float rho = exp2(lerp(SUBSTRATE_GLINT_LOG2_DENSITY_MIN, SUBSTRATE_GLINT_LOG2_DENSITY_MAX, density));
   float gamma = SUBSTRATE_GLINT_CONE_ANGLE;
   float p = min(1.0, d * saturate(NoH) * (SUBSTRATE_PI * gamma * gamma));
-  float expected = clamp(rho * area * p, 1e-3, 1e30);
+  float expected = clamp(rho * area * p, 1e-4, 1e30);
   // H's slope, binned at the cone's scale (a new light direction meets new facets).
   float2 slope = float2(ToH, BoH) / max(NoH, 0.05);
   int2 bin = int2(floor(slope / (2.0 * gamma)));

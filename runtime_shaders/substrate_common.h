@@ -22,11 +22,12 @@ SUBSTRATE_CONST float SUBSTRATE_FLT_MAX = 3.0e38;
 // pow with the compiler's constant-folding semantics (compiler/ir/value.cc,
 // Op::Pow): the base is clamped at 0; 0^y = 0 for y != 0 and 0^0 = 1. The pow()
 // intrinsic is never called with a zero base (undefined for y <= 0 on GPUs).
+// A result beyond the float range (e.g. (1e-30)^-2) is clamped to 3e38.
 float substrate_pow(float x, float y) {
   float b = max(x, 0.0);
   float r = pow(b > 0.0 ? b : 1.0, y);
   if (b > 0.0) {
-    return r;
+    return min(r, SUBSTRATE_FLT_MAX);
   }
   return y == 0.0 ? 1.0 : 0.0;
 }

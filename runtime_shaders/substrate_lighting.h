@@ -114,18 +114,22 @@ float substrate_env_mip(float roughness, float mipCount) {
   return saturate(roughness) * max(mipCount - 1.0, 0.0);
 }
 
-// Split-sum environment lighting of one closure, throughputs included.
+// Split-sum environment lighting of one closure (Karis 2013), the light-side
+// throughput of the layers above included, the view-side one NOT: the caller
+// multiplies by substrate_closure_view_throughput(c, NoV), as for emissive.
 //   prefilteredRadiance: the prefiltered cube at substrate_reflection_dir(c, V)
-//                        and mip substrate_env_mip(substrate_env_roughness(c), n);
-//   irradiance:          the cosine-weighted integral of radiance around N,
-//                        E = integral L cos (Lambert gives albedo E / pi).
+//                        and mip substrate_env_mip(roughness, mipCount) (the
+//                        closure's roughness, or substrate_env_roughness(c) to
+//                        account for haze);
+//   irradiance:          E = integral of L cos over the hemisphere around N
+//                        (W/m^2; a Lambertian albedo a reflects a E / pi).
 // Specular: E_spec = (F0 (E - B) + F90 B) W from the same tables as the direct
-// lighting (haze: lerped by weight); diffuse: albedo (1 - E_spec) E / pi (every
-// diffuse model, wrap included, uses its hemispherical albedo = albedo);
-// fuzz: amount colour min(E_fuzz, 1) E / pi on top, the rest attenuated by
-// (1 - amount min(E_fuzz, 1)). The specular sees the layers above at NoV (its
-// light comes from the mirror direction), the diffuse and fuzz at
-// SUBSTRATE_DIFFUSE_MEAN_COS.
+// lighting (haze: lerped by weight), tinted by the specular profile at
+// (NoV, NoV); diffuse: albedo (1 - E_spec) E / pi (every diffuse model, wrap
+// included, uses albedo as its hemispherical albedo); fuzz: amount colour
+// min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1)).
+// The layers above are crossed at NoV by the specular (its light comes from
+// the mirror direction) and at SUBSTRATE_DIFFUSE_MEAN_COS by the diffuse and fuzz.
 float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredRadiance, float3 irradiance) {
   float3 N = substrate_closure_normal(c);
   float NoVraw = dot(N, V);
@@ -167,7 +171,7 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
     result = result * (1.0 - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
   }
 #endif
-  return substrate_closure_view_throughput(c, NoV) * result;
+  return result;
 }
 
 // ---------------------------------------------------------------------------

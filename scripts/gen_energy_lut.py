@@ -15,7 +15,9 @@ centres):
                                (the split-sum "DFG" pair is (E - B, B)).
   SUBSTRATE_FUZZ_LUT           E_fuzz(mu, r): directional albedo of the Charlie sheen
                                lobe (Estevez & Kulla 2017) with its fitted Lambda
-                               shadowing, alpha = max(r^2, SHEEN_MIN_ALPHA).
+                               shadowing, alpha = max(r^2, SHEEN_MIN_ALPHA). Not
+                               clamped: it exceeds 1 at grazing view for smooth
+                               fuzz (the runtime normalizes the lobe there).
 
 Integration is deterministic: GGX by visible-normal importance sampling
 (Heitz 2018) and the sheen by sampling its NDF, both over a Hammersley set.
@@ -61,7 +63,6 @@ def ggx_cell(mu, r, pts):
     vx = math.sqrt(max(0.0, 1.0 - mu * mu))
     vz = mu
     lam_v = ggx_lambda(vz, a2)
-    g1v = 1.0 / (1.0 + lam_v)
     # Heitz 2018 VNDF sampling; V lies in the xz plane (vy = 0).
     hx, hz = a * vx, vz
     hl = math.sqrt(hx * hx + hz * hz)
@@ -105,7 +106,6 @@ def ggx_cell(mu, r, pts):
         fc2 = fc * fc
         e_sum += w
         b_sum += w * fc2 * fc2 * fc
-    del g1v
     n = float(len(pts))
     return e_sum / n, b_sum / n
 
@@ -179,7 +179,8 @@ HEADER_TOP = """\
 //
 // Three 32 x 32 tables, row-major: index = j * 32 + i with i the NoV cell and j the
 // perceptual-roughness cell; NoV = (i + 0.5) / 32 and r = (j + 0.5) / 32 at cell
-// centres. Lookups are clamped bilinear (outside the centres the edge value holds).
+// centres. Lookups are bilinear on [0, 1]^2 (inputs clamped); the outer half cell is
+// extrapolated linearly from the last two centres, and results are clamped to range.
 //
 //   SUBSTRATE_ENERGY_LUT          E(NoV, r): albedo of the single-scattering GGX lobe
 //                                 with F = 1 (height-correlated Smith G2,
@@ -204,19 +205,28 @@ HEADER_TOP = """\
 """
 
 HEADER_BOTTOM = """\
-// Clamped bilinear coordinates into a 32 x 32 table: the four indices
-// (x0y0, x1y0, x0y1, x1y1) and the fractional weights. x = NoV, y = roughness,
-// both clamped to [0, 1] first (NaN maps to 0 with most GPUs' clamp).
+// One table entry. The including shader may define SUBSTRATE_LUT_FETCH(table,
+// index) before including this file to read the tables from its own storage
+// (a buffer or texture holding the same values, e.g. `myLuts.table[index]`):
+// some toolchains copy a constant array for every dynamic index (glslang's
+// unoptimized SPIR-V does; spirv-opt -O and most drivers remove the copies).
+#ifndef SUBSTRATE_LUT_FETCH
+#define SUBSTRATE_LUT_FETCH(table, index) table[index]
+#endif
+
+// Bilinear coordinates into a 32 x 32 table: the four indices (x0y0, x1y0,
+// x0y1, x1y1) and the weights. x = NoV and y = roughness are clamped to [0, 1];
+// the outer half cell (between the last cell centre and the border) is
+// linearly extrapolated from the last two centres (weights in [-0.5, 1.5]),
+// which keeps E exact to ~1e-3 at r = 1 and NoV = 0 or 1 instead of holding the
+// edge value; the lookups clamp the result to the quantity's range.
 void substrate_lut_coords(float x, float y, out int4 idx, out float2 f) {
   float2 p = float2(saturate(x), saturate(y)) * 32.0 - SUBSTRATE_SPLAT2(0.5);
-  p = clamp(p, SUBSTRATE_SPLAT2(0.0), SUBSTRATE_SPLAT2(31.0));
-  float2 p0 = floor(p);
+  float2 p0 = clamp(floor(p), SUBSTRATE_SPLAT2(0.0), SUBSTRATE_SPLAT2(30.0));
   f = p - p0;
   int x0 = int(p0.x);
   int y0 = int(p0.y);
-  int x1 = min(x0 + 1, 31);
-  int y1 = min(y0 + 1, 31);
-  idx = int4(y0 * 32 + x0, y0 * 32 + x1, y1 * 32 + x0, y1 * 32 + x1);
+  idx = int4(y0 * 32 + x0, y0 * 32 + x0 + 1, y0 * 32 + x0 + 32, y0 * 32 + x0 + 33);
 }
 
 float substrate_lut_blend(float v00, float v10, float v01, float v11, float2 f) {
@@ -228,8 +238,9 @@ float substrate_energy_albedo(float NoV, float roughness) {
   int4 i;
   float2 f;
   substrate_lut_coords(NoV, roughness, i, f);
-  return substrate_lut_blend(SUBSTRATE_ENERGY_LUT[i.x], SUBSTRATE_ENERGY_LUT[i.y],
-                             SUBSTRATE_ENERGY_LUT[i.z], SUBSTRATE_ENERGY_LUT[i.w], f);
+  return clamp(substrate_lut_blend(SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.y),
+                                   SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.w), f),
+               1e-3, 1.0);
 }
 
 // The split-sum DFG pair (E - B, B): the lobe's albedo is F0 * x + F90 * y.
@@ -237,20 +248,25 @@ float2 substrate_energy_dfg(float NoV, float roughness) {
   int4 i;
   float2 f;
   substrate_lut_coords(NoV, roughness, i, f);
-  float e = substrate_lut_blend(SUBSTRATE_ENERGY_LUT[i.x], SUBSTRATE_ENERGY_LUT[i.y],
-                                SUBSTRATE_ENERGY_LUT[i.z], SUBSTRATE_ENERGY_LUT[i.w], f);
-  float b = substrate_lut_blend(SUBSTRATE_ENERGY_LUT_SCHLICK[i.x], SUBSTRATE_ENERGY_LUT_SCHLICK[i.y],
-                                SUBSTRATE_ENERGY_LUT_SCHLICK[i.z], SUBSTRATE_ENERGY_LUT_SCHLICK[i.w], f);
-  return float2(max(e - b, 0.0), b);
+  float e = substrate_lut_blend(SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.y),
+                                SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT, i.w), f);
+  float b = substrate_lut_blend(
+      SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT_SCHLICK, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT_SCHLICK, i.y),
+      SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT_SCHLICK, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_ENERGY_LUT_SCHLICK, i.w), f);
+  e = clamp(e, 1e-3, 1.0);
+  b = clamp(b, 0.0, e);
+  return float2(e - b, b);
 }
 
-// E_fuzz(NoV, r): directional albedo of the Charlie sheen lobe (colour 1, amount 1).
+// E_fuzz(NoV, r): directional albedo of the Charlie sheen lobe (colour 1,
+// amount 1); may exceed 1 at grazing view for smooth fuzz (see above).
 float substrate_fuzz_albedo(float NoV, float fuzzRoughness) {
   int4 i;
   float2 f;
   substrate_lut_coords(NoV, fuzzRoughness, i, f);
-  return substrate_lut_blend(SUBSTRATE_FUZZ_LUT[i.x], SUBSTRATE_FUZZ_LUT[i.y],
-                             SUBSTRATE_FUZZ_LUT[i.z], SUBSTRATE_FUZZ_LUT[i.w], f);
+  return max(substrate_lut_blend(SUBSTRATE_LUT_FETCH(SUBSTRATE_FUZZ_LUT, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_FUZZ_LUT, i.y),
+                                 SUBSTRATE_LUT_FETCH(SUBSTRATE_FUZZ_LUT, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_FUZZ_LUT, i.w), f),
+             0.0);
 }
 
 #endif
