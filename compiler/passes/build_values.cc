@@ -84,10 +84,7 @@ ValueTable buildValueDag(const ResolvedDoc& doc, Material& m) {
       case Op::TransmittanceToMfp:
       case Op::ThinFilm: {
         std::vector<ValueId> args;
-        for (std::size_t k = 0; k < v.pins.size(); ++k) {
-          VType want = v.pins[k].type == VType::Float && v.op != Op::ThinFilm ? VType::Invalid : VType::Invalid;
-          args.push_back(arg(static_cast<int>(k), want));
-        }
+        for (std::size_t k = 0; k < v.pins.size(); ++k) args.push_back(arg(static_cast<int>(k), VType::Invalid));
         // Colour pins broadcast a scalar to grey.
         auto grey = [&](int k) { args[k] = dag.broadcast(args[k], VType::Vec3); };
         if (v.op == Op::MetalnessToDiffuseF0) grey(0);
