@@ -332,9 +332,7 @@ void Emitter::emitClosures() {
   for (std::size_t i = 0; i < L_.closures.size(); ++i) {
     const ClosureLayout& cl = L_.closures[i];
     const Slab& s = m_.slabs[cl.slab];
-    int node = -1;
-    for (int n : t_.preorder)
-      if (m_.nodes[n].op == TreeOp::Slab && m_.nodes[n].slab == cl.slab) node = n;
+    const int node = t_.slabNode[cl.slab];
     const std::string c = fmt::format("closures[{}]", i), id = m_.nodes[node].id;
     line("");
     line(fmt::format("// Closure {}: slab '{}' (BSDF {}, LayerDepth {}, {}){}", i, id, i, t_.layerDepth[node],

@@ -18,6 +18,7 @@ TreeInfo analyzeTree(const Material& m) {
   t.unitCoverageAbove.assign(n, false);
   t.unitCoverage.assign(n, false);
   t.bsdfId.assign(m.slabs.size(), -1);
+  t.slabNode.assign(m.slabs.size(), -1);
   if (m.root < 0) return t;
 
   // Pre-order with the facts that flow down from the root.
@@ -77,6 +78,7 @@ TreeInfo analyzeTree(const Material& m) {
       t.unitWeight[it.node] = it.unit && t.unitCoverage[it.node];  // a blended slab may carry a coverage
       t.unitCoverageAbove[it.node] = it.coverAbove;
       t.bsdfId[node.slab] = static_cast<int>(t.slabOrder.size());
+      t.slabNode[node.slab] = it.node;
       t.slabOrder.push_back(node.slab);
       continue;
     }

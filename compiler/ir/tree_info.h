@@ -23,6 +23,7 @@ struct TreeInfo {
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
   std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order)
   std::vector<int> bsdfId;       // slab index -> position in slabOrder
+  std::vector<int> slabNode;     // slab index -> its tree node (-1 if not in the tree)
   int maxDistanceFromLeaves = 0;
 };
 

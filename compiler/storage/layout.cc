@@ -22,10 +22,7 @@ StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
     ClosureLayout c;
     c.slab = s;
     c.basis = slab.basis;
-    int node = -1;
-    for (int n : info.preorder)
-      if (m.nodes[n].op == TreeOp::Slab && m.nodes[n].slab == s) node = n;
-    c.isTop = info.isTop[node];
+    c.isTop = info.isTop[info.slabNode[s]];
     c.storedFeatures = slab.features & kStoredFeatureMask;
     all |= c.storedFeatures;
     L.closures.push_back(c);
@@ -33,9 +30,7 @@ StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
   const int count = static_cast<int>(L.closures.size());
   const bool multi = count > 1;
   for (auto& c : L.closures) {
-    int node = -1;
-    for (int n : info.preorder)
-      if (m.nodes[n].op == TreeOp::Slab && m.nodes[n].slab == c.slab) node = n;
+    const int node = info.slabNode[c.slab];
     c.storesWeight = !info.unitWeight[node];
     c.storesCoverageAbove = !c.isTop && !info.unitCoverageAbove[node];
   }
