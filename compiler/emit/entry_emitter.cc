@@ -17,11 +17,14 @@ bool usesEmissive(const Material& m, const StorageLayout& L) {
   return false;
 }
 
-/// Shared prologue: includes. The material file includes the runtime it needs.
+/// Shared prologue: includes. The material file includes the runtime it needs;
+/// the base pass includes substrate_pack.h before it, which compiles the
+/// material's pack function in (the forward pass does not pack).
 std::string includes(const Material& m, const Syntax& syn, bool lighting) {
   std::string s;
   if (syn.target == Target::Glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
   s += fmt::format("#include \"{}\"\n", syn.prelude);
+  if (!lighting) s += "#include \"substrate_pack.h\"\n";
   s += fmt::format("#include \"{}{}\"\n", m.name, syn.materialExtension);
   if (lighting) s += "#include \"substrate_energy_lut.h\"\n#include \"substrate_bsdf.h\"\n#include \"substrate_lighting.h\"\n";
   return s;
@@ -67,7 +70,8 @@ std::string frameResources(const Syntax& syn, bool environment) {
 )";
     if (environment)
       s += "layout(set = 0, binding = 1) uniform samplerCube envPrefiltered;\n"
-           "layout(set = 0, binding = 2) uniform samplerCube envIrradiance;\n";
+           "layout(set = 0, binding = 2) uniform samplerCube envIrradiance;\n"
+           "// set 0, binding 5: the energy tables (a uniform buffer, declared by substrate_energy_lut.h).\n";
     s += R"(
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
@@ -89,7 +93,8 @@ layout(location = 5) in vec4 inColor;
   if (environment)
     s += "[[vk::binding(1, 0)]] TextureCube<float4> envPrefiltered;\n"
          "[[vk::binding(2, 0)]] TextureCube<float4> envIrradiance;\n"
-         "[[vk::binding(3, 0)]] SamplerState envSampler;\n";
+         "[[vk::binding(3, 0)]] SamplerState envSampler;\n"
+         "// set 0, binding 5: the energy tables (a uniform buffer, declared by substrate_energy_lut.h).\n";
   s += R"(
 struct PSInput {
   float4 position : SV_Position;
@@ -242,6 +247,8 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
   const bool multi = L.closures.size() > 1;
   std::string s;
   s += "// Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).\n";
+  s += "// Compiled when substrate_pack.h is included before this file (the base pass does).\n";
+  s += "#ifdef SUBSTRATE_PACK_H\n";
   s += fmt::format("void {0}_pack(SubstrateClosure closures[{1}_CLOSURE_COUNT], float dither, out uint words[{1}_WORD_COUNT], "
                    "out uint topLayer) {{\n",
                    m.name, upper);
@@ -344,7 +351,7 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
       }
     }
   }
-  s += "}\n";
+  s += "}\n#endif\n";
   (void)syn;
   return s;
 }

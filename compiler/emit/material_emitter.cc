@@ -459,7 +459,6 @@ std::string Emitter::run() {
   line("#include \"substrate_common.h\"");
   line("#include \"substrate_values.h\"");
   line("#include \"substrate_tree.h\"");
-  line("#include \"substrate_pack.h\"");
   line("");
   emitResources();
   line("");

@@ -1,5 +1,6 @@
 // The runtime shader library (runtime_shaders/), embedded at build time.
 #pragma once
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -11,5 +12,12 @@ struct RuntimeFile {
 };
 
 const std::vector<RuntimeFile>& runtimeFiles();
+
+/// The runtime's directional-albedo tables (substrate_energy_lut_data.h): 3 x 32 x 32
+/// floats, E then B then E_fuzz, each row-major (index = roughness cell * 32 + NoV cell).
+/// A host binds them as the uniform buffer substrate_energy_lut.h reads (768 float4).
+std::span<const float> energyLutTables();
+
+inline constexpr int kEnergyLutSize = 32;  // cells per axis
 
 }  // namespace substratec

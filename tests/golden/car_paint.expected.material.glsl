@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform car_paint_Inputs {
@@ -88,6 +87,8 @@ void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_P
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void car_paint_pack(SubstrateClosure closures[CAR_PAINT_CLOSURE_COUNT], float dither, out uint words[CAR_PAINT_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -155,5 +156,6 @@ void car_paint_pack(SubstrateClosure closures[CAR_PAINT_CLOSURE_COUNT], float di
     words[8] |= q << 28u;
     words[9] |= q >> 4u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_CAR_PAINT

@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform coated_carbon_fiber_Inputs {
@@ -126,6 +125,8 @@ void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure clos
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void coated_carbon_fiber_pack(SubstrateClosure closures[COATED_CARBON_FIBER_CLOSURE_COUNT], float dither, out uint words[COATED_CARBON_FIBER_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -208,5 +209,6 @@ void coated_carbon_fiber_pack(SubstrateClosure closures[COATED_CARBON_FIBER_CLOS
   { uint q = substrate_tangent_angle_encode(closures[1].T, substrate_normal_as_stored(closures[1].N, dither), dither);
     words[9] |= q << 16u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_COATED_CARBON_FIBER

@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer dielectric_over_aniso_fiber_Inputs {
@@ -78,6 +77,8 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void dielectric_over_aniso_fiber_pack(SubstrateClosure closures[DIELECTRIC_OVER_ANISO_FIBER_CLOSURE_COUNT], float dither, out uint words[DIELECTRIC_OVER_ANISO_FIBER_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -128,5 +129,6 @@ void dielectric_over_aniso_fiber_pack(SubstrateClosure closures[DIELECTRIC_OVER_
   { uint q = substrate_tangent_angle_encode(closures[1].T, substrate_top_layer_normal_as_stored(topN, dither), dither);
     words[5] |= q << 12u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_DIELECTRIC_OVER_ANISO_FIBER

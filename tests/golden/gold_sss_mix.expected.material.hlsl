@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer gold_sss_mix_Inputs {
@@ -85,6 +84,8 @@ void gold_sss_mix_evaluate(SubstrateGeometry g, out SubstrateClosure closures[GO
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void gold_sss_mix_pack(SubstrateClosure closures[GOLD_SSS_MIX_CLOSURE_COUNT], float dither, out uint words[GOLD_SSS_MIX_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -136,5 +137,6 @@ void gold_sss_mix_pack(SubstrateClosure closures[GOLD_SSS_MIX_CLOSURE_COUNT], fl
   { uint q = substrate_q_unorm(closures[1].weight, 8u, dither);
     words[5] |= q << 20u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_GOLD_SSS_MIX

@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row12_simple_Inputs {
@@ -50,6 +49,8 @@ void row12_simple_evaluate(SubstrateGeometry g, out SubstrateClosure closures[RO
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row12_simple_pack(SubstrateClosure closures[ROW12_SIMPLE_CLOSURE_COUNT], float dither, out uint words[ROW12_SIMPLE_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -70,5 +71,6 @@ void row12_simple_pack(SubstrateClosure closures[ROW12_SIMPLE_CLOSURE_COUNT], fl
   { uint q = substrate_q_unorm(closures[0].roughness, 8u, dither);
     words[1] |= q << 24u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW12_SIMPLE

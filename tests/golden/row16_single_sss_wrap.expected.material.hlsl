@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer row16_single_sss_wrap_Inputs {
@@ -54,6 +53,8 @@ void row16_single_sss_wrap_evaluate(SubstrateGeometry g, out SubstrateClosure cl
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row16_single_sss_wrap_pack(SubstrateClosure closures[ROW16_SINGLE_SSS_WRAP_CLOSURE_COUNT], float dither, out uint words[ROW16_SINGLE_SSS_WRAP_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -78,5 +79,6 @@ void row16_single_sss_wrap_pack(SubstrateClosure closures[ROW16_SINGLE_SSS_WRAP_
   { uint q = substrate_q_sss(closures[0].sssMfp, closures[0].sssPhaseAnisotropy, dither);
     words[2] |= q << 0u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW16_SINGLE_SSS_WRAP

@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row20_haze_f90_Inputs {
@@ -60,6 +59,8 @@ void row20_haze_f90_evaluate(SubstrateGeometry g, out SubstrateClosure closures[
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row20_haze_f90_pack(SubstrateClosure closures[ROW20_HAZE_F90_CLOSURE_COUNT], float dither, out uint words[ROW20_HAZE_F90_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -92,5 +93,6 @@ void row20_haze_f90_pack(SubstrateClosure closures[ROW20_HAZE_F90_CLOSURE_COUNT]
   { uint q = substrate_q_haze(closures[0].secondRoughness, closures[0].secondRoughnessWeight, dither);
     words[3] |= q << 16u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW20_HAZE_F90

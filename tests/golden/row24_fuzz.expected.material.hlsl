@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer row24_fuzz_Inputs {
@@ -66,6 +65,8 @@ void row24_fuzz_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW2
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row24_fuzz_pack(SubstrateClosure closures[ROW24_FUZZ_CLOSURE_COUNT], float dither, out uint words[ROW24_FUZZ_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -102,5 +103,6 @@ void row24_fuzz_pack(SubstrateClosure closures[ROW24_FUZZ_CLOSURE_COUNT], float 
   { uint q = substrate_q_fuzz(closures[0].fuzzAmount, closures[0].fuzzColor, closures[0].fuzzRoughness, dither);
     words[4] |= q << 0u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW24_FUZZ

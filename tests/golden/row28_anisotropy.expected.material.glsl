@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row28_anisotropy_Inputs {
@@ -69,6 +68,8 @@ void row28_anisotropy_evaluate(SubstrateGeometry g, out SubstrateClosure closure
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row28_anisotropy_pack(SubstrateClosure closures[ROW28_ANISOTROPY_CLOSURE_COUNT], float dither, out uint words[ROW28_ANISOTROPY_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -112,5 +113,6 @@ void row28_anisotropy_pack(SubstrateClosure closures[ROW28_ANISOTROPY_CLOSURE_CO
   { uint q = substrate_tangent_angle_encode(closures[0].T, substrate_top_layer_normal_as_stored(topN, dither), dither);
     words[5] |= q << 8u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW28_ANISOTROPY

@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row40_coating_Inputs {
@@ -91,6 +90,8 @@ void row40_coating_evaluate(SubstrateGeometry g, out SubstrateClosure closures[R
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row40_coating_pack(SubstrateClosure closures[ROW40_COATING_CLOSURE_COUNT], float dither, out uint words[ROW40_COATING_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -159,5 +160,6 @@ void row40_coating_pack(SubstrateClosure closures[ROW40_COATING_CLOSURE_COUNT], 
   { uint q = substrate_tangent_angle_encode(closures[1].T, substrate_top_layer_normal_as_stored(topN, dither), dither);
     words[8] |= q << 12u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW40_COATING

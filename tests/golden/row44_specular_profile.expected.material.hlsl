@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer row44_specular_profile_Inputs {
@@ -92,6 +91,8 @@ void row44_specular_profile_evaluate(SubstrateGeometry g, out SubstrateClosure c
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row44_specular_profile_pack(SubstrateClosure closures[ROW44_SPECULAR_PROFILE_CLOSURE_COUNT], float dither, out uint words[ROW44_SPECULAR_PROFILE_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -165,5 +166,6 @@ void row44_specular_profile_pack(SubstrateClosure closures[ROW44_SPECULAR_PROFIL
     words[8] |= q << 20u;
     words[9] |= q >> 12u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW44_SPECULAR_PROFILE

@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer row60_glint_Inputs {
@@ -100,6 +99,8 @@ void row60_glint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void row60_glint_pack(SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], float dither, out uint words[ROW60_GLINT_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -193,5 +194,6 @@ void row60_glint_pack(SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], floa
     words[12] |= q << 28u;
     words[13] |= q >> 4u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_ROW60_GLINT

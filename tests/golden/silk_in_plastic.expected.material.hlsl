@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer silk_in_plastic_Inputs {
@@ -124,6 +123,8 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUNT], float dither, out uint words[SILK_IN_PLASTIC_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -224,5 +225,6 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
   { uint q = substrate_tangent_angle_encode(closures[2].T, substrate_normal_as_stored(closures[2].N, dither), dither);
     words[12] |= q << 6u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_SILK_IN_PLASTIC

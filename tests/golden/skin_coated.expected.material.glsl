@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform skin_coated_Inputs {
@@ -91,6 +90,8 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void skin_coated_pack(SubstrateClosure closures[SKIN_COATED_CLOSURE_COUNT], float dither, out uint words[SKIN_COATED_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -147,5 +148,6 @@ void skin_coated_pack(SubstrateClosure closures[SKIN_COATED_CLOSURE_COUNT], floa
     words[5] |= q << 20u;
     words[6] |= q >> 12u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_SKIN_COATED

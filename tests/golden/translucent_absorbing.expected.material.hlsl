@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 [[vk::binding(0, 1)]] cbuffer translucent_absorbing_Inputs {
@@ -56,6 +55,8 @@ void translucent_absorbing_evaluate(SubstrateGeometry g, out SubstrateClosure cl
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void translucent_absorbing_pack(SubstrateClosure closures[TRANSLUCENT_ABSORBING_CLOSURE_COUNT], float dither, out uint words[TRANSLUCENT_ABSORBING_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -80,5 +81,6 @@ void translucent_absorbing_pack(SubstrateClosure closures[TRANSLUCENT_ABSORBING_
   { uint q = substrate_q_unorm(closures[0].weight, 8u, dither);
     words[2] |= q << 0u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_TRANSLUCENT_ABSORBING

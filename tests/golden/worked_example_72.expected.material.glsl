@@ -20,7 +20,6 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
-#include "substrate_pack.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform worked_example_72_Inputs {
@@ -144,6 +143,8 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
 }
 
 // Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).
+// Compiled when substrate_pack.h is included before this file (the base pass does).
+#ifdef SUBSTRATE_PACK_H
 void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_COUNT], float dither, out uint words[WORKED_EXAMPLE_72_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
@@ -270,5 +271,6 @@ void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_
   { uint q = substrate_tangent_angle_encode(closures[2].T, substrate_normal_as_stored(closures[2].N, dither), dither);
     words[16] |= q << 12u; }
 }
+#endif
 
 #endif  // SUBSTRATE_MATERIAL_WORKED_EXAMPLE_72

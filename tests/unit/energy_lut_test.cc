@@ -1,0 +1,49 @@
+// The runtime's directional-albedo tables as host data (validate/runtime_files.h,
+// runtime_shaders/substrate_energy_lut_data.h): what a host uploads to the uniform
+// buffer substrate_energy_lut.h reads. Layout: 3 tables x 32 x 32, row-major,
+// index = roughness cell * 32 + NoV cell; E then B then E_fuzz.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "validate/runtime_files.h"
+
+namespace substratec {
+namespace {
+
+constexpr int kCells = kEnergyLutSize * kEnergyLutSize;
+
+float E(int noV, int r) { return energyLutTables()[r * kEnergyLutSize + noV]; }
+float B(int noV, int r) { return energyLutTables()[kCells + r * kEnergyLutSize + noV]; }
+float Fuzz(int noV, int r) { return energyLutTables()[2 * kCells + r * kEnergyLutSize + noV]; }
+
+TEST(EnergyLut, ThreeTablesOf32By32FitAUniformBuffer) {
+  EXPECT_EQ(energyLutTables().size(), 3u * kCells);
+  EXPECT_LE(energyLutTables().size_bytes(), 16384u);  // Vulkan's minimum maxUniformBufferRange
+  EXPECT_EQ(energyLutTables().size() % 4, 0u);        // whole float4 elements
+}
+
+TEST(EnergyLut, EntriesAreInRange) {
+  for (int r = 0; r < kEnergyLutSize; ++r)
+    for (int i = 0; i < kEnergyLutSize; ++i) {
+      SCOPED_TRACE(testing::Message() << "NoV cell " << i << ", roughness cell " << r);
+      EXPECT_GE(E(i, r), 0.0f);
+      EXPECT_LE(E(i, r), 1.0f);
+      EXPECT_GE(B(i, r), 0.0f);
+      EXPECT_LE(B(i, r), E(i, r));
+      EXPECT_GE(Fuzz(i, r), 0.0f);
+      EXPECT_TRUE(std::isfinite(Fuzz(i, r)));
+    }
+}
+
+TEST(EnergyLut, KnownValues) {
+  // A smooth lobe seen head-on loses nothing; a rough one loses two thirds
+  // (brute-force quadrature gives E(0.984, 0.984) = 0.32579).
+  EXPECT_NEAR(E(31, 0), 1.0f, 1e-5f);
+  EXPECT_NEAR(E(31, 31), 0.32579f, 1e-5f);
+  // Row order: E falls with roughness at normal incidence.
+  for (int r = 1; r < kEnergyLutSize; ++r) EXPECT_LT(E(31, r), E(31, r - 1) + 1e-6f) << r;
+}
+
+}  // namespace
+}  // namespace substratec
