@@ -58,7 +58,7 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
     std::vector<EntryReport> entries;
     if (a.spirv) {  // compile every entry shader to count its SPIR-V instructions
       Generated gen = generateFiles(*result, GenerateOptions{});
-      validateGenerated(gen);
+      validateGenerated(gen, {.optimize = true});
       if (!gen.valid) {
         err << "substratec: internal compiler error: generated code does not validate\n" << gen.failure << "\n";
         return kExitInternal;

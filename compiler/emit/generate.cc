@@ -1,9 +1,10 @@
 #include "emit/generate.h"
 
-#include <stdlib.h>
-
-#include <filesystem>
-#include <fstream>
+#include <algorithm>
+#include <atomic>
+#include <map>
+#include <string_view>
+#include <thread>
 
 #include <fmt/format.h>
 
@@ -13,8 +14,6 @@
 #include "validate/shader_validate.h"
 
 namespace substratec {
-
-namespace fs = std::filesystem;
 
 Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
   Generated g;
@@ -34,39 +33,50 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
   return g;
 }
 
-void validateGenerated(Generated& g) {
-  std::string pattern = (fs::temp_directory_path() / "substratec-XXXXXX").string();
-  if (!::mkdtemp(pattern.data())) {
-    g.valid = false;
-    g.failure = "cannot create a temporary directory for validation";
-    return;
-  }
-  const fs::path dir = pattern;
-  for (const RuntimeFile& f : runtimeFiles()) std::ofstream(dir / std::string(f.name), std::ios::binary) << f.text;
-  for (const OutputFile& f : g.files) std::ofstream(dir / f.name, std::ios::binary) << f.contents;
-  for (const OutputFile& f : g.files) {
-    bool glsl = f.name.ends_with(".frag");
-    bool hlsl = f.name.ends_with(".ps.hlsl");
-    if (!glsl && !hlsl) continue;
-    ShaderSource src;
-    src.name = (dir / f.name).string();
-    src.text = f.contents;
-    src.language = glsl ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
-    src.stage = ShaderStage::Fragment;
-    src.includeDirs = {dir.string()};
-    ShaderValidation v = compileAndValidate(src);
+void validateGenerated(Generated& g, const ValidateOptions& options) {
+  // The entries include the material files and the runtime by name: both are
+  // served from memory, so nothing touches the disk.
+  std::map<std::string, std::string_view> files;
+  for (const RuntimeFile& f : runtimeFiles()) files.emplace(std::string(f.name), f.text);
+  for (const OutputFile& f : g.files) files.emplace(f.name, f.contents);
+
+  std::vector<const OutputFile*> entries;
+  for (const OutputFile& f : g.files)
+    if (f.name.ends_with(".frag") || f.name.ends_with(".ps.hlsl")) entries.push_back(&f);
+
+  // Entries are independent: compile them on up to hardware_concurrency
+  // threads (glslang and SPIRV-Tools are thread-safe per compilation). Results
+  // are kept by index, so the outcome does not depend on scheduling.
+  std::vector<ShaderValidation> results(entries.size());
+  std::atomic<std::size_t> next{0};
+  auto work = [&] {
+    for (std::size_t i; (i = next.fetch_add(1)) < entries.size();) {
+      const OutputFile& f = *entries[i];
+      ShaderSource src;
+      src.name = f.name;
+      src.text = f.contents;
+      src.language = f.name.ends_with(".frag") ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
+      src.stage = ShaderStage::Fragment;
+      src.memoryFiles = files;
+      results[i] = compileAndValidate(src, options);
+    }
+  };
+  const std::size_t threads =
+      std::min<std::size_t>(entries.size(), std::max(1u, std::thread::hardware_concurrency()));
+  std::vector<std::thread> pool;
+  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    ShaderValidation& v = results[i];
     if (!v.ok) {
       g.valid = false;
-      std::string log = v.log;
-      // Name files without the private directory.
-      for (std::size_t p; (p = log.find(dir.string() + "/")) != std::string::npos;) log.erase(p, dir.string().size() + 1);
-      g.failure = fmt::format("{}\n{}\n{}", f.name, numberLines(f.contents), log);
-      break;
+      g.failure = fmt::format("{}\n{}\n{}", entries[i]->name, numberLines(entries[i]->contents), v.log);
+      return;
     }
-    g.entries.push_back({f.name, v.instructionCount, v.optimizedInstructionCount});
+    g.entries.push_back({entries[i]->name, v.instructionCount, v.optimizedInstructionCount, std::move(v.optimized)});
   }
-  std::error_code ec;
-  fs::remove_all(dir, ec);
 }
 
 }  // namespace substratec

@@ -1,12 +1,14 @@
 // Code generation driver: every output file of `substratec compile` for one
 // compiled material, and their in-process validation (glslang + spirv-val).
 #pragma once
+#include <cstdint>
 #include <string>
 #include <vector>
 
 #include "emit/material_emitter.h"
 #include "output/atomic_write.h"
 #include "pipeline/pipeline.h"
+#include "validate/shader_validate.h"
 
 namespace substratec {
 
@@ -18,8 +20,9 @@ struct GenerateOptions {
 
 struct EntryReport {
   std::string file;
-  std::size_t instructions = 0;           // SPIR-V instructions
-  std::size_t optimizedInstructions = 0;  // after SPIRV-Tools' performance passes
+  std::size_t instructions = 0;           // SPIR-V instructions, as validated
+  std::size_t optimizedInstructions = 0;  // after SPIRV-Tools' performance passes (0 unless requested)
+  std::vector<uint32_t> optimizedSpirv;   // that module (empty unless requested)
 };
 
 struct Generated {
@@ -32,9 +35,11 @@ struct Generated {
 /// Emits every file (no validation).
 Generated generateFiles(const CompileResult& r, const GenerateOptions& o);
 
-/// Compiles every entry shader in-process (files written to a private
-/// temporary directory together with the embedded runtime), runs spirv-val
-/// and counts instructions. Fills `entries`, `valid`, `failure`.
-void validateGenerated(Generated& g);
+/// Compiles every entry shader in-process against the generated files and the
+/// embedded runtime (all in memory), runs spirv-val and counts instructions;
+/// with `options.optimize` also after SPIRV-Tools' performance passes.
+/// Entries compile in parallel. Fills `entries`, `valid`, `failure` (the first
+/// failing entry in file order).
+void validateGenerated(Generated& g, const ValidateOptions& options = {});
 
 }  // namespace substratec

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <glslang/Public/ResourceLimits.h>
+#include <glslang/MachineIndependent/localintermediate.h>
 #include <glslang/Public/ShaderLang.h>
 #include <glslang/SPIRV/GlslangToSpv.h>
 #include <spirv-tools/libspirv.hpp>
@@ -10,6 +11,8 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <string_view>
 #include <memory>
 #include <mutex>
 #include <sstream>
@@ -58,15 +61,17 @@ bool readWholeFile(const fs::path& path, std::string& out) {
 // to includeSystem when it returns nullptr.
 class FileIncluder final : public glslang::TShader::Includer {
  public:
-  explicit FileIncluder(const std::vector<std::string>& dirs) : dirs_(dirs) {}
+  FileIncluder(const std::vector<std::string>& dirs, const std::map<std::string, std::string_view>& memory)
+      : dirs_(dirs), memory_(memory) {}
 
   IncludeResult* includeLocal(const char* headerName, const char* includerName, std::size_t depth) override {
     if (depth > kMaxIncludeDepth) return depthError(headerName);
     fs::path header(headerName);
     if (header.is_absolute()) return tryOpen(header);
     // A top-level source given by bare name has no location: don't resolve
-    // against the working directory.
+    // against the working directory (but a memory file of that name is found).
     fs::path dir = fs::path(includerName ? includerName : "").parent_path();
+    if (IncludeResult* r = tryMemory((dir / header).lexically_normal().string())) return r;
     if (dir.empty()) return nullptr;
     return tryOpen(dir / header);
   }
@@ -75,6 +80,7 @@ class FileIncluder final : public glslang::TShader::Includer {
     if (depth > kMaxIncludeDepth) return depthError(headerName);
     fs::path header(headerName);
     if (header.is_absolute()) return tryOpen(header);
+    if (IncludeResult* r = tryMemory(header.lexically_normal().string())) return r;
     for (const std::string& d : dirs_) {
       if (IncludeResult* r = tryOpen(fs::path(d) / header)) return r;
     }
@@ -83,11 +89,17 @@ class FileIncluder final : public glslang::TShader::Includer {
 
   void releaseInclude(IncludeResult* result) override {
     if (!result) return;
-    delete static_cast<std::string*>(result->userData);
+    delete static_cast<std::string*>(result->userData);  // null for memory files
     delete result;
   }
 
  private:
+  IncludeResult* tryMemory(const std::string& name) {
+    auto it = memory_.find(name);
+    if (it == memory_.end()) return nullptr;
+    return new IncludeResult(it->first, it->second.data(), it->second.size(), nullptr);
+  }
+
   IncludeResult* tryOpen(const fs::path& path) {
     std::string text;
     if (!readWholeFile(path, text)) return nullptr;
@@ -102,6 +114,7 @@ class FileIncluder final : public glslang::TShader::Includer {
   }
 
   const std::vector<std::string>& dirs_;
+  const std::map<std::string, std::string_view>& memory_;
 };
 
 void appendLog(std::string& log, const std::string& text) {
@@ -155,6 +168,22 @@ std::vector<std::string> entryPointNames(const std::vector<uint32_t>& words) {
   return names;
 }
 
+// spirv-val. Friendly names in its messages cost more than the validation
+// itself (SPIRV-Tools builds a name for every id up front), so a module is
+// validated without them, and only a rejected one again with them, for the log.
+bool spirvValid(const std::vector<uint32_t>& words, std::string* log, const std::string& name, const char* tool) {
+  spvtools::SpirvTools tools(SPV_ENV_VULKAN_1_2);
+  spvtools::ValidatorOptions quick;
+  quick.SetFriendlyNames(false);
+  if (tools.Validate(words.data(), words.size(), quick)) return true;
+  if (!log) return false;
+  tools.SetMessageConsumer(collectInto(*log, name, tool));
+  spvtools::ValidatorOptions named;
+  named.SetFriendlyNames(true);
+  tools.Validate(words.data(), words.size(), named);
+  return false;
+}
+
 }  // namespace
 
 std::size_t spirvInstructionCount(const std::vector<uint32_t>& words) {
@@ -169,7 +198,7 @@ std::size_t spirvInstructionCount(const std::vector<uint32_t>& words) {
   return n;
 }
 
-ShaderValidation compileAndValidate(const ShaderSource& src) {
+ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptions& options) {
   initializeGlslangOnce();
   ShaderValidation result;
   const bool hlsl = src.language == ShaderLanguage::Hlsl;
@@ -196,7 +225,7 @@ ShaderValidation compileAndValidate(const ShaderSource& src) {
   if (hlsl) messages |= EShMsgReadHlsl | EShMsgHlslOffsets;
   const auto msgs = static_cast<EShMessages>(messages);
 
-  FileIncluder includer(src.includeDirs);
+  FileIncluder includer(src.includeDirs, src.memoryFiles);
   const bool parsed = shader.parse(GetDefaultResources(), /*defaultVersion=*/hlsl ? 100 : 450,
                                    /*forwardCompatible=*/false, msgs, includer);
   appendLog(result.log, shader.getInfoLog());
@@ -219,6 +248,12 @@ ShaderValidation compileAndValidate(const ShaderSource& src) {
     return result;
   }
 
+  // glslang's GLSL front end declares storage buffers in the StorageBuffer
+  // class for SPIR-V >= 1.3, but its HLSL front end (12.0) keeps the
+  // Uniform + BufferBlock form that SPIR-V 1.4 removed, which spirv-val rejects
+  // for (RW)StructuredBuffer and ByteAddressBuffer. Ask for the 1.3 form.
+  program.getIntermediate(stage)->setUseStorageBuffer();
+
   glslang::SpvOptions spvOptions;
   spvOptions.generateDebugInfo = false;
   spvOptions.validate = false;
@@ -228,15 +263,15 @@ ShaderValidation compileAndValidate(const ShaderSource& src) {
   const std::string spvLog = logger.getAllMessages();
   appendLog(result.log, spvLog);
   if (containsLine(spvLog, "error") || result.spirv.empty()) return result;
-  // "Before optimization" is the module as the front end emits it, for both
-  // languages, so GLSL and HLSL counts compare.
-  const std::size_t rawInstructionCount = spirvInstructionCount(result.spirv);
-  if (hlsl) {
-    // glslang's HLSL output needs its legalization passes (they run only with
-    // the optimizer enabled), e.g. for structs holding textures and samplers.
+
+  // HLSL: glslang's raw output is often not valid Vulkan SPIR-V (e.g. structs
+  // holding textures and samplers) until its legalization passes run; they
+  // cost more than everything else here, so they run only when spirv-val
+  // rejects the raw module. Either way the module kept is one spirv-val accepts.
+  if (hlsl && !spirvValid(result.spirv, nullptr, src.name, "spirv-val")) {
     std::vector<uint32_t> legalized;
     spv::SpvBuildLogger legalizeLogger;
-    spvOptions.disableOptimizer = false;
+    spvOptions.disableOptimizer = false;  // glslang runs legalization only with its optimizer on
     glslang::GlslangToSpv(*program.getIntermediate(stage), legalized, &legalizeLogger, &spvOptions);
     const std::string legalizeLog = legalizeLogger.getAllMessages();
     if (legalizeLog != spvLog) appendLog(result.log, legalizeLog);
@@ -251,24 +286,23 @@ ShaderValidation compileAndValidate(const ShaderSource& src) {
     return result;
   }
 
-  spvtools::SpirvTools tools(SPV_ENV_VULKAN_1_2);
-  tools.SetMessageConsumer(collectInto(result.log, src.name, "spirv-val"));
-  if (!tools.Validate(result.spirv)) return result;
-  result.instructionCount = rawInstructionCount;
+  if (!spirvValid(result.spirv, &result.log, src.name, "spirv-val")) return result;
+  result.instructionCount = spirvInstructionCount(result.spirv);
 
-  std::vector<uint32_t> optimized;
-  spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
-  optimizer.SetMessageConsumer(collectInto(result.log, src.name, "spirv-opt"));
-  optimizer.RegisterPerformancePasses();
-  if (!optimizer.Run(result.spirv.data(), result.spirv.size(), &optimized, spvtools::ValidatorOptions(),
-                     /*skip_validation=*/true)) {
-    appendLog(result.log, fmt::format("{}: spirv-opt performance passes failed", src.name));
-    return result;
+  if (options.optimize) {
+    std::vector<uint32_t> optimized;
+    spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
+    optimizer.SetMessageConsumer(collectInto(result.log, src.name, "spirv-opt"));
+    optimizer.RegisterPerformancePasses();
+    if (!optimizer.Run(result.spirv.data(), result.spirv.size(), &optimized, spvtools::ValidatorOptions(),
+                       /*skip_validation=*/true)) {
+      appendLog(result.log, fmt::format("{}: spirv-opt performance passes failed", src.name));
+      return result;
+    }
+    if (!spirvValid(optimized, &result.log, src.name, "spirv-val (optimized)")) return result;
+    result.optimizedInstructionCount = spirvInstructionCount(optimized);
+    result.optimized = std::move(optimized);
   }
-  spvtools::SpirvTools optimizedTools(SPV_ENV_VULKAN_1_2);
-  optimizedTools.SetMessageConsumer(collectInto(result.log, src.name, "spirv-val (optimized)"));
-  if (!optimizedTools.Validate(optimized)) return result;
-  result.optimizedInstructionCount = spirvInstructionCount(optimized);
 
   result.ok = true;
   return result;

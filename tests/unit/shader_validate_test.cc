@@ -80,7 +80,7 @@ class TempDir {
 };
 
 TEST(ShaderValidate, TrivialGlslFragmentShaderValidates) {
-  ShaderValidation v = compileAndValidate(glsl("trivial.frag", kTrivialFrag));
+  ShaderValidation v = compileAndValidate(glsl("trivial.frag", kTrivialFrag), {.optimize = true});
   ASSERT_TRUE(v.ok) << v.log;
   EXPECT_EQ(v.log, "");
   ASSERT_GE(v.spirv.size(), 5u);
@@ -89,6 +89,15 @@ TEST(ShaderValidate, TrivialGlslFragmentShaderValidates) {
   EXPECT_GT(v.instructionCount, 0u);
   EXPECT_GT(v.optimizedInstructionCount, 0u);
   EXPECT_EQ(v.instructionCount, spirvInstructionCount(v.spirv));
+  EXPECT_EQ(v.optimizedInstructionCount, spirvInstructionCount(v.optimized));
+}
+
+TEST(ShaderValidate, OptimizedCopyOnlyOnRequest) {
+  ShaderValidation v = compileAndValidate(glsl("trivial.frag", kTrivialFrag));
+  ASSERT_TRUE(v.ok) << v.log;
+  EXPECT_GT(v.instructionCount, 0u);
+  EXPECT_TRUE(v.optimized.empty());
+  EXPECT_EQ(v.optimizedInstructionCount, 0u);
 }
 
 TEST(ShaderValidate, VertexAndComputeStagesValidate) {
@@ -128,7 +137,7 @@ void main() { outColor = vec4(1.0); }
 }
 
 TEST(ShaderValidate, HlslPixelShaderWithMainValidates) {
-  ShaderValidation v = compileAndValidate(hlsl("m.forward.ps.hlsl", kHlslPixel));
+  ShaderValidation v = compileAndValidate(hlsl("m.forward.ps.hlsl", kHlslPixel), {.optimize = true});
   ASSERT_TRUE(v.ok) << v.log;
   EXPECT_GT(v.instructionCount, 0u);
   EXPECT_LE(v.optimizedInstructionCount, v.instructionCount);
@@ -151,10 +160,24 @@ float4 main(float2 uv : TEXCOORD0) : SV_Target0 {
   return fetch(m, uv);
 }
 )"));
+  // Valid only because legalization ran: the raw module is rejected.
   ASSERT_TRUE(v.ok) << v.log;
-  // instructionCount is the pre-legalization module; `spirv` is the legalized one.
-  EXPECT_GT(v.instructionCount, spirvInstructionCount(v.spirv));
-  EXPECT_LE(v.optimizedInstructionCount, v.instructionCount);
+  EXPECT_EQ(v.instructionCount, spirvInstructionCount(v.spirv));
+}
+
+TEST(ShaderValidate, HlslStorageBuffersUseTheStorageBufferClass) {
+  // glslang 12's HLSL front end would emit Uniform + BufferBlock, which
+  // SPIR-V 1.4+ (and spirv-val for Vulkan 1.2) rejects.
+  ShaderSource s = hlsl("buffers.hlsl", R"(
+[[vk::binding(0, 0)]] StructuredBuffer<float> input;
+[[vk::binding(1, 0)]] RWStructuredBuffer<float> output;
+[[vk::binding(2, 0)]] ByteAddressBuffer raw;
+[numthreads(64, 1, 1)]
+void main(uint3 id : SV_DispatchThreadID) { output[id.x] = input[id.x] * asfloat(raw.Load(id.x * 4)); }
+)");
+  s.stage = ShaderStage::Compute;
+  ShaderValidation v = compileAndValidate(s);
+  EXPECT_TRUE(v.ok) << v.log;
 }
 
 TEST(ShaderValidate, HlslNamedEntryPointValidates) {
@@ -242,6 +265,29 @@ float4 main(float3 color : COLOR0) : SV_Target0 { return float4(scale(color), 1.
   EXPECT_TRUE(v.ok) << v.log;
 }
 
+TEST(ShaderValidate, MemoryFilesAreFoundBeforeDirectories) {
+  TempDir dir;
+  dir.write("common.glsl", "#error the directory copy must not be read\n");
+  const std::string common = "#include \"detail.glsl\"\nvec4 shade(vec3 c) { return vec4(scale(c), 1.0); }\n";
+  const std::string detail = "vec3 scale(vec3 c) { return c * 0.5; }\n";
+  ShaderSource s = glsl("m.frag", R"(#version 450
+#include "common.glsl"
+layout(location = 0) in vec3 vColor;
+layout(location = 0) out vec4 outColor;
+void main() { outColor = shade(vColor); }
+)");
+  s.includeDirs = {dir.path().string()};
+  s.memoryFiles = {{"common.glsl", common}, {"detail.glsl", detail}};
+  ShaderValidation v = compileAndValidate(s);
+  EXPECT_TRUE(v.ok) << v.log;
+  // An error inside a memory file names it.
+  const std::string broken = "vec4 shade(vec3 c) { return c; }\n";
+  s.memoryFiles = {{"common.glsl", broken}};
+  ShaderValidation bad = compileAndValidate(s);
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.log.find("common.glsl:1"), std::string::npos) << bad.log;
+}
+
 TEST(ShaderValidate, LinkErrorFails) {
   ShaderValidation v = compileAndValidate(glsl("link.frag", R"(#version 450
 layout(location = 0) out vec4 outColor;
@@ -267,17 +313,18 @@ void main() {
   if (false) { outColor = vec4(alsoDead, dead); return; }
   outColor = vec4(vColor, 1.0);
 }
-)"));
+)"),
+                                          {.optimize = true});
   ASSERT_TRUE(v.ok) << v.log;
   EXPECT_LT(v.optimizedInstructionCount, v.instructionCount);
 }
 
 TEST(ShaderValidate, Deterministic) {
-  ShaderValidation a = compileAndValidate(glsl("trivial.frag", kTrivialFrag));
-  ShaderValidation b = compileAndValidate(glsl("trivial.frag", kTrivialFrag));
+  ShaderValidation a = compileAndValidate(glsl("trivial.frag", kTrivialFrag), {.optimize = true});
+  ShaderValidation b = compileAndValidate(glsl("trivial.frag", kTrivialFrag), {.optimize = true});
   ASSERT_TRUE(a.ok && b.ok);
   EXPECT_EQ(a.spirv, b.spirv);
-  EXPECT_EQ(a.optimizedInstructionCount, b.optimizedInstructionCount);
+  EXPECT_EQ(a.optimized, b.optimized);
   ShaderValidation c = compileAndValidate(hlsl("ps.hlsl", kHlslPixel));
   ShaderValidation d = compileAndValidate(hlsl("ps.hlsl", kHlslPixel));
   ASSERT_TRUE(c.ok && d.ok);
