@@ -47,7 +47,7 @@ class Emitter {
   void emitTree();
   void emitClosures();
   std::string nodeName(int n) const { return m_.nodes[n].id; }
-  int verticalOfTop(int node) const;  // the vertical whose top is `node`, or -1
+  int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
 
   void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
   /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
@@ -169,11 +169,7 @@ std::string Emitter::opExpr(const ValueNode& n) {
   }
 }
 
-int Emitter::verticalOfTop(int node) const {
-  int p = t_.parent[node];
-  if (p >= 0 && m_.nodes[p].op == TreeOp::Vertical && m_.nodes[p].left == node) return p;
-  return -1;
-}
+int Emitter::verticalOfTop(int node) const { return t_.layerVertical[node]; }
 
 /// Marks every value the generated function computes: operator values, the
 /// slabs' media, and for each closure only the pins its features use.
@@ -291,7 +287,7 @@ void Emitter::emitTree() {
     else
       t = fmt::format("substrate_transmittance({}, {})", mfpOf(s), v >= 0 ? expr(m_.nodes[v].a) : Syntax::literal(d));
     line(fmt::format("// slab '{}' (Id={}, BSDF {}){}", node.id, t_.reportId[n], t_.bsdfId[node.slab],
-                     v >= 0 ? fmt::format(", the top of vertical '{}'", m_.nodes[v].id) : ""));
+                     v >= 0 ? fmt::format(", in the top layer of vertical '{}'", m_.nodes[v].id) : ""));
     line(fmt::format("float C_{} = {};", node.id, c));
     line(fmt::format("{} T_{} = {};", v3, node.id, t));
   }

@@ -19,6 +19,7 @@ TreeInfo analyzeTree(const Material& m) {
   t.unitCoverage.assign(n, false);
   t.bsdfId.assign(m.slabs.size(), -1);
   t.slabNode.assign(m.slabs.size(), -1);
+  t.layerVertical.assign(n, -1);
   if (m.root < 0) return t;
 
   // Pre-order with the facts that flow down from the root.
@@ -30,6 +31,7 @@ TreeInfo analyzeTree(const Material& m) {
     bool onTopSide;   // some ancestor vertical has this subtree as its top
     bool unit;        // every weight on the path so far is exactly 1
     bool coverAbove;  // every layer above has coverage exactly 1
+    int layer;        // the nearest vertical whose top layer holds this subtree (-1: none)
   };
   // Static coverage first (children before parents): the coverage of a subtree
   // is 1 for a slab and stays 1 through operators whose rule keeps it there.
@@ -62,7 +64,7 @@ TreeInfo analyzeTree(const Material& m) {
       t.unitCoverage[*it] = one;
     }
   }
-  std::vector<Item> stack{{m.root, -1, 0, 0, false, true, true}};
+  std::vector<Item> stack{{m.root, -1, 0, 0, false, true, true, -1}};
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
@@ -72,6 +74,7 @@ TreeInfo analyzeTree(const Material& m) {
     t.parent[it.node] = it.parent;
     t.depth[it.node] = it.depth;
     t.layerDepth[it.node] = it.layerDepth;
+    t.layerVertical[it.node] = it.layer;
     if (node.op == TreeOp::Slab) {
       t.isTop[it.node] = it.layerDepth == 0;
       t.isBottom[it.node] = !it.onTopSide;
@@ -82,11 +85,12 @@ TreeInfo analyzeTree(const Material& m) {
       t.slabOrder.push_back(node.slab);
       continue;
     }
-    Item l{node.left, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove};
-    Item r{node.right, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove};
+    Item l{node.left, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove, it.layer};
+    Item r{node.right, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove, it.layer};
     switch (node.op) {
       case TreeOp::Vertical:
         l.onTopSide = true;           // the top has a layer below it
+        l.layer = it.node;            // the top is this vertical's layer (the base stays in the enclosing one)
         r.layerDepth += 1;            // the base is under one more layer
         r.coverAbove = it.coverAbove && t.unitCoverage[node.left];
         break;

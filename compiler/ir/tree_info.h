@@ -24,6 +24,10 @@ struct TreeInfo {
   std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order)
   std::vector<int> bsdfId;       // slab index -> position in slabOrder
   std::vector<int> slabNode;     // slab index -> its tree node (-1 if not in the tree)
+  std::vector<int> layerVertical;  // node -> the nearest vertical whose top layer holds it, through
+                                   // mixes, adds, weights, selects and the bases of verticals nested in
+                                   // that layer (its thickness is the node's); -1: none (the surface
+                                   // thickness applies)
   int maxDistanceFromLeaves = 0;
 };
 

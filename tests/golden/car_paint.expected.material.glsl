@@ -45,7 +45,7 @@ void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_P
   vec2 v11 = car_paint_inputs.i_flake_scale.xx;
   vec2 v12 = (g.uv0 * v11);
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'clearcoat' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'clearcoat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_clearcoat = 1.0;
   vec3 T_clearcoat = substrate_transmittance(vec3(10.0, 10.0, 10.0), car_paint_inputs.i_clearcoat_thickness);
   // slab 'base' (Id=2, BSDF 1)

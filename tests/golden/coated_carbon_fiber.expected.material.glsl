@@ -64,7 +64,7 @@ void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure clos
   float n_coat_absorption_thickness = substrate_transmittance_to_mfp_thickness(coated_carbon_fiber_inputs.i_tint, coated_carbon_fiber_inputs.i_coat_thickness);
   float v31 = (n_metal_mask_tex_r * coated_carbon_fiber_inputs.i_mask);
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'root_top' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'root_top' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_root_top = 1.0;
   vec3 T_root_top = substrate_transmittance(n_coat_absorption_mfp, n_coat_absorption_thickness);
   // slab 'carbon' (Id=3, BSDF 1)

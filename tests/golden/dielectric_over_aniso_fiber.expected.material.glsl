@@ -38,7 +38,7 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   // Values (the value DAG, in dependency order)
   vec3 v2 = substrate_rotation_to_tangent(dielectric_over_aniso_fiber_inputs.i_fiber_angle, vec3(0.0, 0.0, 1.0));
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'dielectric' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'dielectric' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_dielectric = 1.0;
   vec3 T_dielectric = substrate_transmittance(dielectric_over_aniso_fiber_inputs.i_absorption_mfp, dielectric_over_aniso_fiber_inputs.i_layer_thickness);
   // slab 'fiber' (Id=2, BSDF 1)

@@ -38,7 +38,7 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   // Values (the value DAG, in dependency order)
   float3 v2 = substrate_rotation_to_tangent(dielectric_over_aniso_fiber_i_fiber_angle, float3(0.0, 0.0, 1.0));
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'dielectric' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'dielectric' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_dielectric = 1.0;
   float3 T_dielectric = substrate_transmittance(dielectric_over_aniso_fiber_i_absorption_mfp, dielectric_over_aniso_fiber_i_layer_thickness);
   // slab 'fiber' (Id=2, BSDF 1)

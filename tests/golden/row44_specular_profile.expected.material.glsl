@@ -42,7 +42,7 @@ layout(set = 1, binding = 0, std140) uniform row44_specular_profile_Inputs {
 void row44_specular_profile_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW44_SPECULAR_PROFILE_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
   vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'coat' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
   vec3 T_coat = substrate_transmittance(vec3(10.0, 10.0, 10.0), row44_specular_profile_inputs.i_coat_thickness);
   // slab 'base' (Id=2, BSDF 1)

@@ -42,7 +42,7 @@
 void row44_specular_profile_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW44_SPECULAR_PROFILE_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
   float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'coat' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
   float3 T_coat = substrate_transmittance(float3(10.0, 10.0, 10.0), row44_specular_profile_i_coat_thickness);
   // slab 'base' (Id=2, BSDF 1)

@@ -47,7 +47,7 @@ void row60_glint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW
   vec2 v2 = row60_glint_inputs.i_glint_tiling.xx;
   vec2 v3 = (g.uv0 * v2);
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'coat' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
   vec3 T_coat = substrate_transmittance(vec3(10.0, 10.0, 10.0), row60_glint_inputs.i_coat_thickness);
   // slab 'base' (Id=2, BSDF 1)

@@ -47,7 +47,7 @@ void row60_glint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW
   float2 v2 = row60_glint_i_glint_tiling.xx;
   float2 v3 = (g.uv0 * v2);
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'coat' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
   float3 T_coat = substrate_transmittance(float3(10.0, 10.0, 10.0), row60_glint_i_coat_thickness);
   // slab 'base' (Id=2, BSDF 1)

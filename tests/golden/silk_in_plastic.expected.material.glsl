@@ -53,7 +53,7 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   vec3 v12 = substrate_rotation_to_tangent(0.0, vec3(0.0, 0.0, 1.0));
   vec3 v14 = substrate_rotation_to_tangent(1.5707963, vec3(0.0, 0.0, 1.0));
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'root_top' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'root_top' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_root_top = 1.0;
   vec3 T_root_top = substrate_transmittance(vec3(10.0, 10.0, 10.0), silk_in_plastic_inputs.i_plastic_thickness);
   // slab 'warp' (Id=3, BSDF 1)

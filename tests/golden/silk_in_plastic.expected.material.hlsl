@@ -54,7 +54,7 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   float3 v12 = substrate_rotation_to_tangent(0.0, float3(0.0, 0.0, 1.0));
   float3 v14 = substrate_rotation_to_tangent(1.5707963, float3(0.0, 0.0, 1.0));
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'root_top' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'root_top' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_root_top = 1.0;
   float3 T_root_top = substrate_transmittance(float3(10.0, 10.0, 10.0), silk_in_plastic_i_plastic_thickness);
   // slab 'warp' (Id=3, BSDF 1)

@@ -47,9 +47,9 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
   float n_sweat_mask_tex_r = v1.x;
   float v10 = (n_sweat_mask_tex_r * skin_coated_inputs.i_sweat_amount);
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'sweat_a' (Id=2, BSDF 0)
+  // slab 'sweat_a' (Id=2, BSDF 0), in the top layer of vertical 'root'
   float C_sweat_a = 1.0;
-  vec3 T_sweat_a = substrate_transmittance(vec3(10.0, 10.0, 10.0), 0.0001);
+  vec3 T_sweat_a = substrate_transmittance(vec3(10.0, 10.0, 10.0), skin_coated_inputs.i_coat_thickness);
   // slab 'skin' (Id=3, BSDF 1)
   float C_skin = 1.0;
   vec3 T_skin = substrate_transmittance(skin_coated_inputs.i_skin_mfp, 0.0001);

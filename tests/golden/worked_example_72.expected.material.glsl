@@ -63,7 +63,7 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   vec3 v34 = substrate_value_normalize(v33);
   vec3 v36 = substrate_rotation_to_tangent(1.5707963, v34);
   // Tree: coverage C and transmittance T (along the normal) of every node.
-  // slab 'coat' (Id=1, BSDF 0), the top of vertical 'root'
+  // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
   vec3 T_coat = substrate_transmittance(n_coat_medium_mfp, worked_example_72_inputs.i_coat_thickness);
   // slab 'fabric_a' (Id=3, BSDF 1)

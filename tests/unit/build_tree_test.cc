@@ -10,6 +10,7 @@
 
 #include <algorithm>
 
+#include "ir/tree_info.h"
 #include "test_util.h"
 
 namespace substratec {
@@ -352,6 +353,45 @@ TEST(BuildTree, TreeLimitIsConfigurable) {
               "test.json: /nodes/a1: error: the Substrate tree would have more than 2 nodes after instancing (a "
               "node referenced twice is instanced twice); this is the tree-size limit\n");
   }
+}
+
+// ---------------------------------------------------------------------------
+// Tree facts (ir/tree_info.h): the layer a slab's medium belongs to
+
+/// The id of the vertical whose top layer holds node `id`, or "-".
+std::string layerOf(const Material& m, const std::string& id) {
+  TreeInfo t = analyzeTree(m);
+  for (std::size_t i = 0; i < m.nodes.size(); ++i)
+    if (m.nodes[i].id == id && t.reportId[i] >= 0) return t.layerVertical[i] < 0 ? "-" : m.nodes[t.layerVertical[i]].id;
+  return "?";
+}
+
+TEST(TreeInfo, TheTopLayerOfAVerticalReachesThroughWeightsAndMixes) {
+  // The coat under a coverage weight, and both sides of a mix, are the top
+  // layer of the vertical (its thickness is theirs); the base is not.
+  Material m = tree(material(R"(
+    "a": {"kind": "slab"}, "b": {"kind": "slab"}, "base": {"kind": "slab"},
+    "w": {"kind": "coverage_weight", "a": "a", "weight": 0.5},
+    "mix": {"kind": "horizontal", "background": "w", "foreground": "b", "mix": 0.5},
+    "root": {"kind": "vertical", "top": "mix", "base": "base", "thickness": 0.002})"));
+  EXPECT_EQ(layerOf(m, "a"), "root");
+  EXPECT_EQ(layerOf(m, "b"), "root");
+  EXPECT_EQ(layerOf(m, "w"), "root");
+  EXPECT_EQ(layerOf(m, "base"), "-");
+  EXPECT_EQ(layerOf(m, "root"), "-");
+}
+
+TEST(TreeInfo, NestedVerticalsTakeTheNearestLayer) {
+  // outer = (inner = a over b) over c: a is inner's top layer; b, the base of a
+  // vertical inside outer's top layer, is in outer's layer; c is in none.
+  Material m = tree(material(R"(
+    "a": {"kind": "slab"}, "b": {"kind": "slab"}, "c": {"kind": "slab"},
+    "inner": {"kind": "vertical", "top": "a", "base": "b", "thickness": 0.001},
+    "root": {"kind": "vertical", "top": "inner", "base": "c", "thickness": 0.003})"));
+  EXPECT_EQ(layerOf(m, "a"), "inner");
+  EXPECT_EQ(layerOf(m, "b"), "root");
+  EXPECT_EQ(layerOf(m, "inner"), "root");
+  EXPECT_EQ(layerOf(m, "c"), "-");
 }
 
 }  // namespace
