@@ -152,9 +152,9 @@ std::string emitForwardEntry(const Material& m, const StorageLayout& L, const Sy
   const std::string in = loop ? "    " : "  ";
   s += fmt::format("{}color += substrate_light_closure({}, g.V, L, frame.lightRadiance.rgb);\n", in, cl);
   std::string pre = glsl ? fmt::format("textureLod(envPrefiltered, substrate_reflection_dir({0}, g.V), "
-                                       "substrate_env_mip({0}.roughness, frame.envParams.x)).rgb", cl)
+                                       "substrate_env_mip(substrate_env_roughness({0}), frame.envParams.x)).rgb", cl)
                          : fmt::format("envPrefiltered.SampleLevel(envSampler, substrate_reflection_dir({0}, g.V), "
-                                       "substrate_env_mip({0}.roughness, frame.envParams.x)).rgb", cl);
+                                       "substrate_env_mip(substrate_env_roughness({0}), frame.envParams.x)).rgb", cl);
   std::string irr = glsl ? fmt::format("textureLod(envIrradiance, {}.N, 0.0).rgb", cl)
                          : fmt::format("envIrradiance.SampleLevel(envSampler, {}.N, 0.0).rgb", cl);
   s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * "
