@@ -276,6 +276,22 @@ TEST(Golden, OptimizedForwardShadersKeepEveryMaterialInputLive) {
   }
 }
 
+// The compute kernels that run a material over samples (tests against the CPU
+// reference) or over a sphere (preview) compile and validate for every
+// example, in both languages and in every mode.
+TEST(Golden, EveryExampleKernelValidates) {
+  for (const auto& e : filesIn(kSource / "examples", ".json")) {
+    SCOPED_TRACE(e.filename().string());
+    auto [r, diags] = compileAs(e, e.filename().string());
+    ASSERT_TRUE(r) << diags;
+    for (Target t : {Target::Glsl, Target::Hlsl})
+      for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred, KernelMode::Preview}) {
+        ShaderValidation v = compileKernel(*r, t, mode);
+        EXPECT_TRUE(v.ok) << v.log;
+      }
+  }
+}
+
 TEST(Golden, SameInputTwiceGivesIdenticalOutput) {
   for (const auto& e : filesIn(kSource / "examples", ".json")) {
     SCOPED_TRACE(e.filename().string());

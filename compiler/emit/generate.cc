@@ -15,17 +15,25 @@
 
 namespace substratec {
 
+namespace {
+
+/// `<name>.material.{glsl,hlsl}`: the material function, then its packing
+/// function (the base pass calls it) before the closing include guard.
+std::string materialFile(const CompileResult& r, const Syntax& syn, const EmitOptions& emit) {
+  std::string material = emitMaterial(r.material, r.tree, r.after, syn, emit);
+  material.insert(material.rfind("#endif"), emitPackFunction(r.material, r.after, syn) + "\n");
+  return material;
+}
+
+}  // namespace
+
 Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
   Generated g;
   const Material& m = r.material;
   for (Target t : {Target::Glsl, Target::Hlsl}) {
     if ((t == Target::Glsl && !o.glsl) || (t == Target::Hlsl && !o.hlsl)) continue;
     const Syntax& syn = syntaxFor(t);
-    std::string material = emitMaterial(m, r.tree, r.after, syn, o.emit);
-    // The packing function lives with the material (the base pass calls it).
-    auto end = material.rfind("#endif");
-    material.insert(end, emitPackFunction(m, r.after, syn) + "\n");
-    g.files.push_back({m.name + std::string(syn.materialExtension), material});
+    g.files.push_back({m.name + std::string(syn.materialExtension), materialFile(r, syn, o.emit)});
     g.files.push_back({basePassFileName(m, syn), emitBasePassEntry(m, r.after, syn)});
     g.files.push_back({forwardFileName(m, syn), emitForwardEntry(m, r.after, syn)});
   }
@@ -77,6 +85,23 @@ void validateGenerated(Generated& g, const ValidateOptions& options) {
     }
     g.entries.push_back({entries[i]->name, v.instructionCount, v.optimizedInstructionCount, std::move(v.optimized)});
   }
+}
+
+ShaderValidation compileKernel(const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit) {
+  const Syntax& syn = syntaxFor(target);
+  const Material& m = r.material;
+  const std::string material = materialFile(r, syn, emit);
+  const std::string materialName = m.name + std::string(syn.materialExtension);
+  ShaderSource src;
+  src.name = kernelFileName(m, syn, mode);
+  src.text = emitKernel(m, r.after, syn, mode);
+  src.language = target == Target::Glsl ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
+  src.stage = ShaderStage::Compute;
+  for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
+  src.memoryFiles[materialName] = material;
+  ShaderValidation v = compileAndValidate(src);
+  if (!v.ok) v.log = fmt::format("{}\n{}\n{}", src.name, numberLines(src.text), v.log);
+  return v;
 }
 
 }  // namespace substratec

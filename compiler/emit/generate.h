@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "emit/kernel_emitter.h"
 #include "emit/material_emitter.h"
 #include "output/atomic_write.h"
 #include "pipeline/pipeline.h"
@@ -41,5 +42,11 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o);
 /// Entries compile in parallel. Fills `entries`, `valid`, `failure` (the first
 /// failing entry in file order).
 void validateGenerated(Generated& g, const ValidateOptions& options = {});
+
+/// Compiles one compute kernel of the material (emit/kernel_emitter.h) for
+/// `target` to validated SPIR-V, against the material file generated with
+/// `emit` and the embedded runtime. `ok` false with the numbered kernel source
+/// and the log in `log` when it does not validate (a compiler bug).
+ShaderValidation compileKernel(const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit = {});
 
 }  // namespace substratec

@@ -30,7 +30,14 @@ std::vector<std::array<double, 4>> evaluateDag(const Material& m, const EvalPoin
           case GeometryAttr::VertexColor: out = p.vertexColor; break;
         }
         continue;
-      case Op::Sample: out = p.textureSample; continue;
+      case Op::Sample:
+        if (p.sampler) {
+          const std::array<double, 4>& uv = val[n.args[0]];
+          out = p.sampler(static_cast<int>(n.attr), uv[0], uv[1]);
+        } else {
+          out = p.textureSample;
+        }
+        continue;
       default: break;
     }
     for (int i = 0; i < n.argCount; ++i) {

@@ -1,0 +1,131 @@
+// A small Vulkan compute harness for lavapipe (Mesa's software Vulkan driver):
+// tests and `substratec preview` run generated compute shaders on it and read
+// the results back. Vulkan is loaded at run time (vulkan_loader.h), the
+// Khronos validation layer is always on, and any warning or error it reports
+// fails the dispatch: lavapipe runs shaders with broken interfaces and still
+// returns plausible numbers, so the layer is the only witness.
+//
+// Usage: Context::create -> createPipeline(spirv) -> dispatch(pipeline, resources, ...)
+// as often as needed. A Context and its pipelines are used from one thread at a
+// time; pipelines must not outlive their Context.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+#include <variant>
+#include <vector>
+
+#include "gpu/spirv_reflect.h"
+
+namespace substratec::gpu {
+
+enum class Filter { Nearest, Linear };           // for magnification, minification and between mips
+enum class Address { Repeat, ClampToEdge };      // for all three coordinates
+enum class StorageFormat { R32Uint, R32G32B32A32Sfloat };
+
+/// A uniform or storage buffer (the descriptor type comes from reflection). Not output: `data` is
+/// uploaded. Output: `data` only gives the size; before each dispatch the buffer is filled with
+/// quiet-NaN words (0x7fc00000), and afterwards it is read back into `data`.
+struct BufferResource {
+  std::vector<std::byte> data;
+  bool output = false;
+};
+
+/// An RGBA32F sampled texture, for CombinedImageSampler and SampledImage bindings. A Cube binding
+/// needs layers == 6 (faces +X,-X,+Y,-Y,+Z,-Z) and width == height; an arrayed 2D binding any layers.
+struct ImageResource {
+  uint32_t width = 0, height = 0;
+  uint32_t layers = 1;
+  std::vector<std::vector<float>> mips;  // mips[level]: 4 floats per texel, layer-major then row-major
+  Filter filter = Filter::Nearest;       // ignored for a SampledImage binding (no sampler there)
+  Address address = Address::Repeat;
+};
+
+/// A separate sampler (HLSL SamplerState) for a Sampler binding.
+struct SamplerResource {
+  Filter filter = Filter::Nearest;
+  Address address = Address::Repeat;
+};
+
+/// An output storage image: cleared to NaN (float) or 0xFFFFFFFF (uint) before each dispatch, and
+/// read back into `data` afterwards (layer-major, row-major, 4 or 16 bytes a texel).
+struct StorageImageResource {
+  uint32_t width = 0, height = 0, layers = 1;
+  StorageFormat format = StorageFormat::R32G32B32A32Sfloat;
+  std::vector<std::byte> data;
+};
+
+using Resource = std::variant<BufferResource, ImageResource, SamplerResource, StorageImageResource>;
+/// (set, binding) -> resource. Every binding the shader uses needs exactly one entry, and every entry
+/// must be used.
+using Resources = std::map<std::pair<uint32_t, uint32_t>, Resource>;
+
+class Context;
+
+/// A compute pipeline: the module's reflection, descriptor set layouts (empty ones for unused set
+/// numbers below the highest), pipeline layout and pipeline. Reusable for any number of dispatches.
+class ComputePipeline {
+ public:
+  ~ComputePipeline();
+  ComputePipeline(const ComputePipeline&) = delete;
+  ComputePipeline& operator=(const ComputePipeline&) = delete;
+
+  const ShaderReflection& reflection() const { return reflection_; }
+
+ private:
+  friend class Context;
+  struct Impl;
+  ComputePipeline(ShaderReflection reflection, std::unique_ptr<Impl> impl);
+  ShaderReflection reflection_;
+  std::unique_ptr<Impl> impl_;
+};
+
+class Context {
+ public:
+  struct Options {
+    std::string shaderCacheDir;  // non-empty: MESA_SHADER_CACHE_DIR (set, overwriting) before the instance
+    uint64_t fenceTimeoutNs = std::chrono::nanoseconds(std::chrono::seconds(120)).count();
+  };
+
+  /// Loads libvulkan.so.1, creates an instance (Vulkan 1.2, VK_LAYER_KHRONOS_validation with
+  /// synchronization validation, and a VK_EXT_debug_utils messenger recording warnings and errors;
+  /// the messenger also watches vkCreateInstance itself) and a device on lavapipe with one
+  /// compute queue. Sets VK_DRIVER_FILES to lavapipe's ICD unless VK_DRIVER_FILES or VK_ICD_FILENAMES
+  /// is set non-empty (setenv: call before starting threads). Null with `*error` set when anything is missing.
+  static std::unique_ptr<Context> create(const Options& options, std::string* error);
+  ~Context();
+  Context(const Context&) = delete;
+  Context& operator=(const Context&) = delete;
+
+  std::string deviceName() const;  // "llvmpipe (LLVM 15.0.6, 256 bits)"
+  std::string driverInfo() const;  // "Mesa 22.3.6 (LLVM 15.0.6)"
+
+  /// Reflects `spirv` (a GLCompute entry point is required) and builds its pipeline. Null with
+  /// `*error` set on a reflection or Vulkan failure, or when the validation layer reported anything.
+  std::unique_ptr<ComputePipeline> createPipeline(const std::vector<uint32_t>& spirv, std::string* error);
+
+  /// Binds `resources` (checked against the reflection: a missing, unused or incompatible resource
+  /// is an error naming set, binding and variable), records and submits one dispatch of
+  /// groupsX*groupsY*groupsZ workgroups, waits for it (at most Options::fenceTimeoutNs) and reads the
+  /// outputs back into `resources`. False with `*error` set on any failed Vulkan call (with its
+  /// VkResult), a timeout, or any validation message recorded meanwhile (all of them listed). After a
+  /// timeout the Context is unusable: its objects may still be in use and are leaked, never waited on.
+  bool dispatch(const ComputePipeline& pipeline, Resources& resources, uint32_t groupsX, uint32_t groupsY,
+                uint32_t groupsZ, std::string* error);
+
+  /// Every message recorded so far ("ERROR [validation] Validation Error: [ VUID-... ] ..."); clears the list.
+  std::vector<std::string> takeMessages();
+
+ private:
+  friend class ComputePipeline;
+  struct Impl;
+  explicit Context(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace substratec::gpu

@@ -1,0 +1,445 @@
+// Mirrors runtime_shaders/substrate_bsdf.h: substrate_eval_closure (BSDF * NoL)
+// and its lobes — GGX (anisotropic, height-correlated Smith), Schlick/F90
+// Fresnel, Turquin 2019 energy compensation from the tables, the four diffuse
+// models, SSS wrap, haze, Charlie fuzz, glints — with the shader's guards
+// (clamps, epsilons, fallbacks) cited function by function. The runtime's
+// SUBSTRATE_USE_* switches are all on here: the generated code turns a feature
+// off only when no closure has its bit, and every optional lobe is gated by the
+// closure's bits (or, for SSS wrap, by sssType, which the emitter sets only for
+// slabs with the SSS feature), so the result is the same.
+#include "reference/bsdf.h"
+
+#include <cmath>
+#include <cstdint>
+
+#include "reference/common.h"
+#include "reference/energy_lut.h"
+
+namespace substratec::reference {
+using namespace detail;
+
+namespace {
+// substrate_bsdf.h constants and default macros.
+template <class T> constexpr T kNoVBias = T(1e-3);         // SUBSTRATE_NOV_BIAS
+template <class T> constexpr T kWrapMfpScale = T(0.005);   // SUBSTRATE_SSS_WRAP_MFP_SCALE
+template <class T> constexpr T kGlintLog2Min = T(8.0);     // SUBSTRATE_GLINT_LOG2_DENSITY_MIN
+template <class T> constexpr T kGlintLog2Max = T(40.0);    // SUBSTRATE_GLINT_LOG2_DENSITY_MAX
+template <class T> constexpr T kGlintCone = T(0.05);       // SUBSTRATE_GLINT_CONE_ANGLE
+template <class T> constexpr T kMinAlpha = T(1e-3);        // SUBSTRATE_MIN_ALPHA
+template <class T> constexpr T kFuzzMinAlpha = T(1e-3);    // SUBSTRATE_FUZZ_MIN_ALPHA
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Frames.
+
+// substrate_closure_normal: safe_normalize(c.N, +Z).
+template <class T>
+V3<T> closureNormal(const Closure<T>& c) {
+  return safeNormalize(c.N, V3<T>{T(0), T(0), T(1)});
+}
+
+// substrate_closure_frame: c.T made orthogonal to N by one Gram-Schmidt step,
+// the Duff basis's tangent when that fails; B = N x T.
+template <class T>
+void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>& Tn, V3<T>& Bn) {
+  V3<T> t0, b0;
+  orthonormalBasis(N, t0, b0);
+  Tn = safeNormalize(c.T_ - N * dot(N, c.T_), t0);
+  Bn = cross(N, Tn);
+}
+
+// ---------------------------------------------------------------------------
+// GGX.
+
+// substrate_ggx_alpha: a = sat(r)^2, (a (1 + A), a (1 - A)) clamped to [1e-3, 1].
+template <class T>
+V2<T> ggxAlpha(T roughness, T anisotropy) {
+  T r = saturate(roughness);
+  T a = r * r;
+  T A = clampT(anisotropy, T(-1), T(1));
+  return {clampT(a * (T(1) + A), kMinAlpha<T>, T(1)), clampT(a * (T(1) - A), kMinAlpha<T>, T(1))};
+}
+
+// substrate_ggx_d: a2 / (pi max(d^2, 1e-30)), d = (n a2 - n) n + 1, n = sat(NoH).
+template <class T>
+T ggxD(T a, T NoH) {
+  T a2 = a * a;
+  T n = saturate(NoH);
+  T d = (n * a2 - n) * n + T(1);
+  return a2 / (K<T>::pi * std::max(d * d, T(1e-30)));
+}
+
+// substrate_ggx_d_aniso: a2 w^2 / pi, w = a2 / max(|(ay ToH, ax BoH, a2 NoH)|^2, 1e-30).
+template <class T>
+T ggxDAniso(const V2<T>& alpha, T ToH, T BoH, T NoH) {
+  T a2 = alpha[0] * alpha[1];
+  V3<T> v{alpha[1] * ToH, alpha[0] * BoH, a2 * NoH};
+  T w = a2 / std::max(dot(v, v), T(1e-30));
+  return a2 * w * w * K<T>::invPi;
+}
+
+// substrate_ggx_vis: 0.5 / max(gv + gl, 1e-30).
+template <class T>
+T ggxVis(T a, T NoV, T NoL) {
+  T a2 = a * a;
+  T gv = NoL * std::sqrt(NoV * NoV * (T(1) - a2) + a2);
+  T gl = NoV * std::sqrt(NoL * NoL * (T(1) - a2) + a2);
+  return T(0.5) / std::max(gv + gl, T(1e-30));
+}
+
+// substrate_ggx_vis_aniso.
+template <class T>
+T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL, T BoL, T NoL) {
+  T gv = NoL * length(V3<T>{alpha[0] * ToV, alpha[1] * BoV, NoV});
+  T gl = NoV * length(V3<T>{alpha[0] * ToL, alpha[1] * BoL, NoL});
+  return T(0.5) / std::max(gv + gl, T(1e-30));
+}
+
+// substrate_fresnel: F0 + (F90 - F0) pow5(1 - VoH).
+template <class T>
+V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH) {
+  return f0 + (f90 - f0) * pow5(T(1) - VoH);
+}
+
+// substrate_specular_energy: e = max(E - B + B, 1e-3) from the dfg pair (the
+// shader sums the pair back), W = 1 + F0 (1 - e) / e, E_spec = sat((F0 x + F90 y) W).
+template <class T>
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo) {
+  V2<T> dfg = energyDfg(NoV, roughness);
+  T e = std::max(dfg[0] + dfg[1], T(1e-3));
+  V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
+  albedo = saturate((f0 * dfg[0] + f90 * dfg[1]) * w);
+  return w;
+}
+
+// ---------------------------------------------------------------------------
+// Diffuse models.
+
+template <class T>
+V3<T> diffuseLambert(const V3<T>& albedo, T NoL) {
+  return albedo * (K<T>::invPi * saturate(NoL));
+}
+
+// substrate_diffuse_chan2018: a2 = max(r^4, 1e-7); lobe capped at 1 (as UE).
+template <class T>
+V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH) {
+  T r = saturate(roughness);
+  T a2 = std::max(r * r * r * r, T(1e-7));
+  T g = saturate((T(1) / T(18)) * std::log2(T(2) / a2 - T(1)));
+  T rough = VoH + pow5(T(1) - VoH);
+  T smoothTerm = (T(1) - T(0.75) * pow5(T(1) - NoV)) * (T(1) - T(0.75) * pow5(T(1) - NoL));
+  T fd = lerp(rough, smoothTerm, saturate(T(2.2) * g - T(0.5)));
+  T fb = ((T(34.5) * g - T(59)) * g + T(24.5)) * VoH *
+         std::exp2(-std::max(T(73.2) * g - T(21.2), T(8.9)) * std::sqrt(saturate(NoH)));
+  T lobe = std::min(T(1), K<T>::invPi * (fd + fb));
+  return albedo * (lobe * saturate(NoL));
+}
+
+// substrate_diffuse_chan2024 (UE's, Lambertian smooth limit).
+template <class T>
+V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoL, T NoH, T VoH) {
+  T r = saturate(roughness);
+  T a = r * r;
+  T scale = std::max(T(0.55) - T(0.2) * r, T(1.25) - T(1.6) * r);
+  T bias = saturate(T(4) * a);
+  T n = saturate(NoH);
+  T fRough = scale * (n + bias) / (n + T(0.025)) * VoH * VoH;
+  T f = lerp(T(1), fRough, r) + T(0.38) * a;
+  return albedo * (K<T>::invPi * f * saturate(NoL));
+}
+
+// substrate_eon_albedo: Portsmouth et al. 2025's quartic fit of E_FON.
+template <class T>
+T eonAlbedo(T mu, T r) {
+  T m = T(1) - saturate(mu);
+  T gOverPi = m * (T(0.0571085289) + m * (T(0.491881867) + m * (T(-0.332181442) + m * T(0.0714429953))));
+  return (T(1) + r * gOverPi) / (T(1) + T(0.287793409) * r);
+}
+
+// substrate_diffuse_eon: r_EON = 0.4 sat(r); s/t = s / max(max(NoV, NoL), 1e-6)
+// for s > 0; the albedo inverted for the model's hemispherical mean; the
+// multiple-scattering factors floored at 1e-7.
+template <class T>
+V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL) {
+  T r = T(0.4) * saturate(roughness);
+  T mo = saturate(NoV);
+  T mi = saturate(NoL);
+  T s = VoL - mo * mi;
+  T sOverT = s > T(0) ? s / std::max(std::max(mo, mi), T(1e-6)) : s;
+  T af = T(1) / (T(1) + T(0.287793409) * r);
+  T eAvg = af * (T(1) + T(0.0724882125) * r);
+  V3<T> rho = albedo / (splat3(eAvg) + albedo * (T(1) - eAvg));
+  V3<T> rhoMs = rho * rho * eAvg / (splat3(T(1)) - rho * (T(1) - eAvg));
+  T fss = af * (T(1) + r * sOverT);
+  T ms = std::max(T(1e-7), T(1) - eonAlbedo(mo, r)) * std::max(T(1e-7), T(1) - eonAlbedo(mi, r)) /
+         std::max(T(1e-7), T(1) - eAvg);
+  return (rho * fss + rhoMs * ms) * (K<T>::invPi * mi);
+}
+
+template <class T>
+V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL) {
+  switch (model) {
+    case kDiffuseChan2018: return diffuseChan2018(albedo, roughness, NoV, NoL, NoH, VoH);
+    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoL, NoH, VoH);
+    case kDiffuseEon: return diffuseEon(albedo, roughness, NoV, NoL, VoL);
+    default: return diffuseLambert(albedo, NoL);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// SSS wrap.
+
+// substrate_sss_wrap_amount: m / (m + 0.005), m = max(mfp, 0).
+template <class T>
+V3<T> sssWrapAmount(const V3<T>& mfp) {
+  V3<T> m = vmax(mfp, splat3(T(0)));
+  return m / (m + splat3(kWrapMfpScale<T>));
+}
+
+// substrate_diffuse_wrap: albedo / pi max(NoL + w, 0) / (1 + w)^2, w saturated.
+template <class T>
+V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL) {
+  V3<T> w = saturate(wrap);
+  V3<T> onePlus = splat3(T(1)) + w;
+  return albedo * K<T>::invPi * vmax(splat3(NoL) + w, splat3(T(0))) / (onePlus * onePlus);
+}
+
+// ---------------------------------------------------------------------------
+// Fuzz.
+
+// substrate_charlie_d: (2 + 1/a) substrate_pow(max(1 - NoH^2, 0), 0.5/a) / (2 pi).
+template <class T>
+T charlieD(T a, T NoH) {
+  T inv = T(1) / a;
+  T sin2 = std::max(T(1) - NoH * NoH, T(0));
+  return (T(2) + inv) * substratePow(sin2, T(0.5) * inv) * (T(0.5) * K<T>::invPi);
+}
+
+// substrate_charlie_l: the paper's two rows lerped by (1 - a)^2.
+template <class T>
+T charlieL(T x, T a) {
+  T t = (T(1) - a) * (T(1) - a);
+  T pa = lerp(T(21.5473), T(25.3245), t);
+  T pb = lerp(T(3.82987), T(3.32435), t);
+  T pc = lerp(T(0.19823), T(0.16801), t);
+  T pd = lerp(T(-1.97760), T(-1.27393), t);
+  T pe = lerp(T(-4.32054), T(-4.85967), t);
+  return pa / (T(1) + pb * substratePow(x, pc)) + pd * x + pe;
+}
+
+// substrate_charlie_lambda: exp(min(l, 80)).
+template <class T>
+T charlieLambda(T mu, T a) {
+  T m = saturate(mu);
+  T l = m < T(0.5) ? charlieL(m, a) : T(2) * charlieL(T(0.5), a) - charlieL(T(1) - m, a);
+  return std::exp(std::min(l, T(80)));
+}
+
+// substrate_charlie_sheen: D G / (4 max(NoV, 1e-4)), a = max(sat(r)^2, 1e-3).
+template <class T>
+T charlieSheen(T fuzzRoughness, T NoV, T NoL, T NoH) {
+  T r = saturate(fuzzRoughness);
+  T a = std::max(r * r, kFuzzMinAlpha<T>);
+  T g = T(1) / (T(1) + charlieLambda(NoV, a) + charlieLambda(NoL, a));
+  return charlieD(a, NoH) * g / (T(4) * std::max(NoV, K<T>::minCos));
+}
+
+// ---------------------------------------------------------------------------
+// Glints.
+
+namespace {
+// GLSL float -> int conversion truncates toward zero; uint(int) wraps modulo 2^32.
+template <class T>
+std::uint32_t uintOfInt(T x) {
+  return static_cast<std::uint32_t>(static_cast<std::int32_t>(x));
+}
+}  // namespace
+
+// substrate_glint_level_sample.
+template <class T>
+T glintLevelSample(const V2<T>& uv, T level, const std::array<int, 2>& slopeBin, T expected) {
+  T size = std::exp2(level);
+  V2<T> cell{clampT(std::floor(uv[0] / size), T(-8388608.0), T(8388607.0)),
+             clampT(std::floor(uv[1] / size), T(-8388608.0), T(8388607.0))};
+  std::array<std::uint32_t, 3> key{
+      uintOfInt(cell[0]), uintOfInt(cell[1]),
+      (static_cast<std::uint32_t>(slopeBin[0]) & 0xffffu) | (static_cast<std::uint32_t>(slopeBin[1]) << 16u)};
+  key[2] ^= static_cast<std::uint32_t>(static_cast<std::int32_t>(level) + 128) * 0x9E3779B9u;
+  std::array<std::uint32_t, 3> h = pcg3d(key);
+  T q = std::min(expected, T(1));
+  T v = q * (T(1) + T(1) / expected) - T(1);
+  T sigma2 = std::log(T(1) + std::max(v, T(0)));
+  T z = std::sqrt(T(-2) * std::log(hashToUnit<T>(h[0]))) * std::cos(K<T>::twoPi * hashToUnit<T>(h[1]));
+  T y = std::exp(std::sqrt(sigma2) * z - T(0.5) * sigma2);
+  return hashToUnit<T>(h[2]) <= q ? y / q : T(0);
+}
+
+// substrate_glint_factor: footprint area >= (longer axis)^2 / 64 with the axis
+// clamped to [1e-6, 1e6]; expected count clamped to [1e-4, 1e30]; slope over
+// max(NoH, 0.05); level clamped to [-40, 20]; two levels blended.
+template <class T>
+T glintFactor(const Closure<T>& c, T d, T ToH, T BoH, T NoH) {
+  T density = saturate(c.glintValue);
+  if (density >= T(1)) return T(1);
+  const V4<T>& g = c.glintUvDerivatives;
+  T lx = std::sqrt(g[0] * g[0] + g[1] * g[1]);
+  T ly = std::sqrt(g[2] * g[2] + g[3] * g[3]);
+  T wide = clampT(std::max(lx, ly), T(1e-6), T(1e6));
+  T area = std::max(std::fabs(g[0] * g[3] - g[1] * g[2]), wide * wide * (T(1) / T(64)));
+  T rho = std::exp2(lerp(kGlintLog2Min<T>, kGlintLog2Max<T>, density));
+  T gamma = kGlintCone<T>;
+  T p = std::min(T(1), d * saturate(NoH) * (K<T>::pi * gamma * gamma));
+  T expected = clampT(rho * area * p, T(1e-4), T(1e30));
+  T den = std::max(NoH, T(0.05));
+  std::array<int, 2> bin{static_cast<int>(std::floor(ToH / den / (T(2) * gamma))),
+                         static_cast<int>(std::floor(BoH / den / (T(2) * gamma)))};
+  T level = clampT(T(0.5) * std::log2(area), T(-40), T(20));
+  T l0 = std::floor(level);
+  T t = level - l0;
+  T m0 = glintLevelSample(c.glintUv, l0, bin, expected);
+  T m1 = glintLevelSample(c.glintUv, l0 + T(1), bin, expected);
+  return lerp(m0, m1, t);
+}
+
+// ---------------------------------------------------------------------------
+// substrate_eval_closure.
+
+template <class T>
+V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffuseModel) {
+  const V3<T> zero = splat3(T(0));
+  V3<T> N = closureNormal(c);
+  T NoVraw = dot(N, V);
+  // Back-facing beyond SUBSTRATE_NOV_BIAS (or NaN): nothing; else NoV >= 1e-4.
+  if (!(NoVraw > -kNoVBias<T>)) return zero;
+  T NoV = clampT(NoVraw, K<T>::minCos, T(1));
+  T NoL = clampT(dot(N, L), T(-1), T(1));
+
+  bool isWrap = false;
+  V3<T> wrap = zero;
+  if (c.sssType == kSssWrap) {
+    isWrap = true;
+    wrap = sssWrapAmount(c.sssMfp);
+  }
+  bool lightFacing = NoL > T(0);
+  // Wrap lighting reaches below the horizon, down to NoL = -max(w).
+  if (!lightFacing && !(isWrap && NoL > -max3(wrap))) return zero;
+  T NoLc = std::max(NoL, T(0));
+  V3<T> H = safeNormalize(V + L, N);  // V = -L: H = N
+  T NoH = saturate(dot(N, H));
+  T VoH = saturate(dot(V, H));
+  T VoL = clampT(dot(V, L), T(-1), T(1));
+
+  V3<T> f0 = saturate(c.f0);
+  V3<T> f90 = splat3(T(1));
+  if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  T roughness = saturate(c.roughness);
+
+  // Energy terms (needed by the diffuse even when NoL <= 0).
+  V3<T> specAlbedo;
+  V3<T> w1 = specularEnergy(f0, f90, NoV, roughness, specAlbedo);
+  T hazeWeight = T(0);
+  T hazeRoughness = roughness;
+  if (c.features & kFeatureHaze) {
+    hazeWeight = saturate(c.secondRoughnessWeight);
+    hazeRoughness = saturate(c.secondRoughness);
+  }
+  V3<T> w2 = w1;
+  if (hazeWeight > T(0)) {
+    V3<T> specAlbedo2;
+    w2 = specularEnergy(f0, f90, NoV, hazeRoughness, specAlbedo2);
+    specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
+  }
+
+  V3<T> spec = zero;
+  if (lightFacing) {
+    T anisotropy = T(0);
+    if (c.features & kFeatureAnisotropy) anisotropy = clampT(c.anisotropy, T(-1), T(1));
+    bool needFrame = anisotropy != T(0);
+    needFrame = needFrame || ((c.features & kFeatureGlint) != 0u && c.glintValue < T(1));
+    T ToV = T(0), BoV = T(0), ToL = T(0), BoL = T(0), ToH = T(0), BoH = T(0);
+    if (needFrame) {
+      V3<T> Tn, Bn;
+      closureFrame(c, N, Tn, Bn);
+      ToV = dot(Tn, V);
+      BoV = dot(Bn, V);
+      ToL = dot(Tn, L);
+      BoL = dot(Bn, L);
+      ToH = dot(Tn, H);
+      BoH = dot(Bn, H);
+    }
+    V2<T> alpha1 = ggxAlpha(roughness, anisotropy);
+    T d1, vis1;
+    if (anisotropy != T(0)) {
+      d1 = ggxDAniso(alpha1, ToH, BoH, NoH);
+      vis1 = ggxVisAniso(alpha1, ToV, BoV, NoV, ToL, BoL, NoLc);
+    } else {
+      d1 = ggxD(alpha1[0], NoH);
+      vis1 = ggxVis(alpha1[0], NoV, NoLc);
+    }
+    V3<T> lobe = w1 * (d1 * vis1 * NoLc);
+    if (hazeWeight > T(0)) {
+      V2<T> alpha2 = ggxAlpha(hazeRoughness, anisotropy);
+      T d2, vis2;
+      if (anisotropy != T(0)) {
+        d2 = ggxDAniso(alpha2, ToH, BoH, NoH);
+        vis2 = ggxVisAniso(alpha2, ToV, BoV, NoV, ToL, BoL, NoLc);
+      } else {
+        d2 = ggxD(alpha2[0], NoH);
+        vis2 = ggxVis(alpha2[0], NoV, NoLc);
+      }
+      lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
+    }
+    spec = fresnel(f0, f90, VoH) * lobe;
+    if (c.features & kFeatureGlint) spec = spec * glintFactor(c, d1, ToH, BoH, NoH);
+    // Specular profile: SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint is 1.
+  }
+
+  // Diffuse, below the specular interface.
+  V3<T> albedo = saturate(c.diffuseAlbedo);
+  V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
+                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
+  V3<T> result = spec + diff * (splat3(T(1)) - specAlbedo);
+
+  if (c.features & kFeatureFuzz) {
+    T amount = saturate(c.fuzzAmount);
+    T eFuzz = fuzzAlbedo(NoV, c.fuzzRoughness);
+    // The lobe is normalized where the model's albedo exceeds 1; what it
+    // reflects no longer reaches the layers below.
+    V3<T> fuzz = zero;
+    if (lightFacing)
+      fuzz = saturate(c.fuzzColor) * (amount * charlieSheen(c.fuzzRoughness, NoV, NoLc, NoH) / std::max(T(1), eFuzz));
+    result = result * (T(1) - amount * std::min(eFuzz, T(1))) + fuzz;
+  }
+  return result;
+}
+
+#define SUBSTRATEC_INSTANTIATE(T)                                                                      \
+  template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
+  template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
+  template V2<T> ggxAlpha<T>(T, T);                                                                    \
+  template T ggxD<T>(T, T);                                                                            \
+  template T ggxDAniso<T>(const V2<T>&, T, T, T);                                                      \
+  template T ggxVis<T>(T, T, T);                                                                       \
+  template T ggxVisAniso<T>(const V2<T>&, T, T, T, T, T, T);                                           \
+  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T);                                            \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, V3<T>&);                          \
+  template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
+  template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
+  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T);                                         \
+  template T eonAlbedo<T>(T, T);                                                                       \
+  template V3<T> diffuseEon<T>(const V3<T>&, T, T, T, T);                                              \
+  template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
+  template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
+  template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
+  template T charlieD<T>(T, T);                                                                        \
+  template T charlieL<T>(T, T);                                                                        \
+  template T charlieLambda<T>(T, T);                                                                   \
+  template T charlieSheen<T>(T, T, T, T);                                                              \
+  template T glintLevelSample<T>(const V2<T>&, T, const std::array<int, 2>&, T);                       \
+  template T glintFactor<T>(const Closure<T>&, T, T, T, T);                                            \
+  template V3<T> evalClosure<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);
+SUBSTRATEC_INSTANTIATE(float)
+SUBSTRATEC_INSTANTIATE(double)
+#undef SUBSTRATEC_INSTANTIATE
+
+}  // namespace substratec::reference

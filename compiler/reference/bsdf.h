@@ -1,0 +1,48 @@
+// The lobes of runtime_shaders/substrate_bsdf.h, one function per shader
+// function (same names in camelCase), for evalClosure (reference.h), the
+// lighting and the tests. Templated on the scalar type (float and double).
+#pragma once
+#include <cstdint>
+
+#include "reference/reference.h"
+
+namespace substratec::reference {
+
+// Frames.
+template <class T> V3<T> closureNormal(const Closure<T>& c);                                 // substrate_closure_normal
+template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>& Tn, V3<T>& Bn);  // substrate_closure_frame
+
+// GGX.
+template <class T> V2<T> ggxAlpha(T roughness, T anisotropy);                               // substrate_ggx_alpha
+template <class T> T ggxD(T a, T NoH);                                                      // substrate_ggx_d
+template <class T> T ggxDAniso(const V2<T>& alpha, T ToH, T BoH, T NoH);                    // substrate_ggx_d_aniso
+template <class T> T ggxVis(T a, T NoV, T NoL);                                             // substrate_ggx_vis
+template <class T> T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL, T BoL, T NoL);
+template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH);                 // substrate_fresnel
+/// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`.
+template <class T> V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo);
+
+// Diffuse models (BRDF * NoL).
+template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);
+template <class T> V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
+template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoL, T NoH, T VoH);
+template <class T> T eonAlbedo(T mu, T r);
+template <class T> V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL);
+/// substrate_diffuse with SUBSTRATE_DIFFUSE_MODEL = model (anything else than 1..3: Lambert).
+template <class T> V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL);
+
+// SSS wrap.
+template <class T> V3<T> sssWrapAmount(const V3<T>& mfp);
+template <class T> V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL);
+
+// Fuzz (Charlie sheen).
+template <class T> T charlieD(T a, T NoH);
+template <class T> T charlieL(T x, T a);
+template <class T> T charlieLambda(T mu, T a);
+template <class T> T charlieSheen(T fuzzRoughness, T NoV, T NoL, T NoH);
+
+// Glints.
+template <class T> T glintLevelSample(const V2<T>& uv, T level, const std::array<int, 2>& slopeBin, T expected);
+template <class T> T glintFactor(const Closure<T>& c, T d, T ToH, T BoH, T NoH);
+
+}  // namespace substratec::reference

@@ -1,0 +1,29 @@
+// Mirrors runtime_shaders/substrate_energy_lut.h: bilinear lookups into the
+// directional-albedo tables (E, B, E_fuzz; 32 x 32 each, validate/runtime_files.h's
+// energyLutTables(), the floats the host uploads), with the shader's edge
+// extrapolation and output clamps.
+#pragma once
+#include <array>
+
+#include "reference/reference.h"
+
+namespace substratec::reference {
+
+/// substrate_lut_coords: the four indices (x0y0, x1y0, x0y1, x1y1) into a table
+/// and the weights, for x = NoV and y = roughness (both saturated).
+template <class T>
+void lutCoords(T x, T y, std::array<int, 4>& idx, V2<T>& f);
+
+/// substrate_energy_albedo: E(NoV, r), clamped to [1e-3, 1].
+template <class T>
+T energyAlbedo(T NoV, T roughness);
+
+/// substrate_energy_dfg: (E - B, B), E clamped to [1e-3, 1] and B to [0, E].
+template <class T>
+V2<T> energyDfg(T NoV, T roughness);
+
+/// substrate_fuzz_albedo: E_fuzz(NoV, r), >= 0.
+template <class T>
+T fuzzAlbedo(T NoV, T fuzzRoughness);
+
+}  // namespace substratec::reference

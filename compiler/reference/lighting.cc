@@ -1,0 +1,155 @@
+// Mirrors runtime_shaders/substrate_lighting.h: the throughput of the layers
+// above along the view and the light, one closure lit by one light
+// (substrate_light_closure), the split-sum environment (substrate_env_roughness,
+// substrate_reflection_dir, substrate_env_mip, substrate_env_split_sum) and
+// translucency (substrate_translucency). As in bsdf.cc every SUBSTRATE_USE_*
+// switch is on: the closure's feature bits gate each optional part.
+#include <cmath>
+
+#include "reference/bsdf.h"
+#include "reference/common.h"
+#include "reference/energy_lut.h"
+#include "reference/reference.h"
+
+namespace substratec::reference {
+using namespace detail;
+
+namespace {
+
+template <class T> constexpr T kDiffuseMeanCos = T(0.5);  // SUBSTRATE_DIFFUSE_MEAN_COS
+template <class T> constexpr T kNoVBias = T(1e-3);        // SUBSTRATE_NOV_BIAS
+
+// substrate_closure_above_throughput: lerp(1, T_N^(1/max(mu, 1e-4)), sat(coverageAbove)),
+// and exactly 1 (no transcendental) when nothing covers the closure.
+template <class T>
+V3<T> aboveThroughput(const Closure<T>& c, T mu) {
+  T cover = saturate(c.coverageAbove);
+  if (cover > T(0)) return lerp(splat3(T(1)), transmittanceAtCosine(c.topTransmittance, mu), cover);
+  return splat3(T(1));
+}
+
+// substrate_env_roughness: r lerped toward the haze roughness by its weight.
+template <class T>
+T envRoughness(const Closure<T>& c) {
+  T r = saturate(c.roughness);
+  if (c.features & kFeatureHaze) r = lerp(r, saturate(c.secondRoughness), saturate(c.secondRoughnessWeight));
+  return r;
+}
+
+// E_spec at NoV (haze lerped in when its weight is > 0), as the split sum and
+// translucency compute it (both test c.secondRoughnessWeight > 0, unsaturated).
+template <class T>
+V3<T> specularAlbedo(const Closure<T>& c, T NoV) {
+  V3<T> f0 = saturate(c.f0);
+  V3<T> f90 = splat3(T(1));
+  if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  V3<T> specAlbedo;
+  specularEnergy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
+  if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
+    V3<T> specAlbedo2;
+    specularEnergy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
+    specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
+  }
+  return specAlbedo;
+}
+
+}  // namespace
+
+template <class T>
+V3<T> viewThroughput(const Closure<T>& c, T NoV) {
+  return aboveThroughput(c, NoV) * std::max(c.weight, T(0));  // max(weight, 0) * above
+}
+
+template <class T>
+V3<T> lightThroughput(const Closure<T>& c, T NoL) {
+  return aboveThroughput(c, NoL);  // the weight counts once, on the view side
+}
+
+template <class T>
+V3<T> lightClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, const V3<T>& radiance, int diffuseModel) {
+  V3<T> N = closureNormal(c);
+  V3<T> f = evalClosure(c, V, L, diffuseModel);
+  V3<T> throughput = viewThroughput(c, dot(N, V)) * lightThroughput(c, dot(N, L));
+  return throughput * f * radiance;
+}
+
+// substrate_reflection_dir: the dominant direction lerp(N, R, (1 - a)(sqrt(1 - a) + a)),
+// a = r^2 of the env roughness; anisotropic closures first bend N toward V in the
+// plane orthogonal to B (A > 0) or T (A < 0) by |A| sat(5 r).
+template <class T>
+V3<T> reflectionDir(const Closure<T>& c, const V3<T>& V) {
+  V3<T> N = closureNormal(c);
+  T r = envRoughness(c);
+  if ((c.features & kFeatureAnisotropy) && c.anisotropy != T(0)) {
+    V3<T> Tn, Bn;
+    closureFrame(c, N, Tn, Bn);
+    T A = clampT(c.anisotropy, T(-1), T(1));
+    V3<T> axis = A < T(0) ? Tn : Bn;
+    V3<T> side = cross(axis, V);
+    V3<T> bentN = safeNormalize(cross(side, axis), N);
+    N = safeNormalize(lerp(N, bentN, std::fabs(A) * saturate(T(5) * r)), N);
+  }
+  T NoV = dot(N, V);
+  V3<T> R = (T(2) * NoV) * N - V;
+  T a = r * r;
+  T k = (T(1) - a) * (std::sqrt(T(1) - a) + a);
+  return safeNormalize(lerp(N, R, k), N);
+}
+
+template <class T>
+T envMip(T roughness, T mipCount) {
+  return saturate(roughness) * std::max(mipCount - T(1), T(0));
+}
+
+// substrate_env_split_sum: specular E_spec * prefiltered through the layers above
+// at NoV; diffuse albedo (1 - E_spec) irradiance / pi and fuzz through them at
+// SUBSTRATE_DIFFUSE_MEAN_COS (every diffuse model, wrap included, uses albedo as
+// its hemispherical albedo). The view-side throughput is the caller's.
+template <class T>
+V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredRadiance, const V3<T>& irradiance,
+                  int /*diffuseModel: the split sum uses albedo for every model*/) {
+  V3<T> N = closureNormal(c);
+  T NoVraw = dot(N, V);
+  if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));
+  T NoV = clampT(NoVraw, K<T>::minCos, T(1));
+  V3<T> specAlbedo = specularAlbedo(c, NoV);
+  V3<T> spec = specAlbedo * vmax(prefilteredRadiance, splat3(T(0)));
+  // Specular profile: the default tint is 1.
+  V3<T> irr = vmax(irradiance, splat3(T(0))) * K<T>::invPi;
+  V3<T> diff = saturate(c.diffuseAlbedo) * (splat3(T(1)) - specAlbedo) * irr;
+  V3<T> specLight = lightThroughput(c, NoV);
+  V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
+  V3<T> result = spec * specLight + diff * diffuseLight;
+  if (c.features & kFeatureFuzz) {
+    T amount = saturate(c.fuzzAmount);
+    T eFuzz = std::min(fuzzAlbedo(NoV, c.fuzzRoughness), T(1));
+    result = result * (T(1) - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
+  }
+  return result;
+}
+
+// substrate_translucency: coverage sat(weight); transmittance = the layers above
+// at mu = clamp(NoV, 1e-4, 1), times (1 - E_spec(mu)), times (1 - fuzz min(E_fuzz, 1)).
+template <class T>
+void translucency(const Closure<T>& c, T NoV, T& coverage, V3<T>& transmittanceOut) {
+  coverage = saturate(c.weight);
+  T mu = clampT(NoV, K<T>::minCos, T(1));
+  V3<T> specAlbedo = specularAlbedo(c, mu);
+  transmittanceOut = aboveThroughput(c, mu) * (splat3(T(1)) - specAlbedo);
+  if (c.features & kFeatureFuzz)
+    transmittanceOut = transmittanceOut * (T(1) - saturate(c.fuzzAmount) * std::min(fuzzAlbedo(mu, c.fuzzRoughness), T(1)));
+}
+
+#define SUBSTRATEC_INSTANTIATE(T)                                                                         \
+  template V3<T> viewThroughput<T>(const Closure<T>&, T);                                                 \
+  template V3<T> lightThroughput<T>(const Closure<T>&, T);                                                \
+  template V3<T> lightClosure<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V3<T>&, int);       \
+  template V3<T> reflectionDir<T>(const Closure<T>&, const V3<T>&);                                       \
+  template T envMip<T>(T, T);                                                                             \
+  template V3<T> envSplitSum<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V3<T>&, int);        \
+  template void translucency<T>(const Closure<T>&, T, T&, V3<T>&);
+SUBSTRATEC_INSTANTIATE(float)
+SUBSTRATEC_INSTANTIATE(double)
+#undef SUBSTRATEC_INSTANTIATE
+
+}  // namespace substratec::reference

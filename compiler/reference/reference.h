@@ -1,0 +1,153 @@
+// The CPU reference of the shading model: a second, independent implementation
+// of what the generated material function (compiler/emit/material_emitter.cc,
+// docs/codegen.md) and the runtime library (runtime_shaders/) compute, templated
+// on the scalar type. It is the oracle of the GPU tests: ref64 (double) is the
+// value, and |ref32 - ref64| (float) measures how well conditioned a sample is.
+//
+// Written from the documented model and the IR, not from the emitter's output;
+// where the shaders make a specific choice (a clamp, an epsilon, a guard, a
+// fit) the reference mirrors it and cites the shader in a comment.
+//
+// Precision: the value DAG (inputs, textures, math and helper nodes) is always
+// evaluated in double (compiler/ir/value_eval.h); for T = float its results are
+// rounded to float before the tree walk. Everything after the value DAG (slab
+// coverage and transmittance, the tree operators, the walk to the root, the
+// tangent frames, the BSDF, the energy tables and the lighting) runs in T.
+//
+// Files: tree_walk.cc (evaluateMaterial), bsdf.cc (evalClosure and its lobes,
+// bsdf.h), energy_lut.cc (the table lookups, energy_lut.h), lighting.cc
+// (throughputs, split sum, translucency), integrate.cc (envIntegrated),
+// common.h (substrate_common.h's primitives and small vector algebra).
+#pragma once
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+
+namespace substratec::reference {
+
+template <class T> using V2 = std::array<T, 2>;
+template <class T> using V3 = std::array<T, 3>;
+template <class T> using V4 = std::array<T, 4>;
+
+// Closure feature bits (runtime_shaders/substrate_closure.h, SUBSTRATE_FEATURE_*).
+inline constexpr std::uint32_t kFeatureF90 = 1, kFeatureAnisotropy = 2, kFeatureHaze = 4, kFeatureFuzz = 8,
+                               kFeatureGlint = 16, kFeatureSpecularProfile = 32, kFeatureWeight = 64,
+                               kFeatureCoverageAbove = 128;
+// sssType values (SUBSTRATE_SSS_*).
+inline constexpr std::uint32_t kSssNone = 0, kSssWrap = 1, kSssDiffusion = 2, kSssSimpleVolume = 3;
+// Diffuse models (SUBSTRATE_DIFFUSE_MODEL).
+inline constexpr int kDiffuseLambert = 0, kDiffuseChan2018 = 1, kDiffuseChan2024 = 2, kDiffuseEon = 3;
+
+/// SubstrateClosure (substrate_closure.h): the same fields, names and neutral
+/// values (substrate_closure_init); the tangent is `T_`.
+template <class T>
+struct Closure {
+  V3<T> diffuseAlbedo{T(0.18), T(0.18), T(0.18)};
+  V3<T> f0{T(0.04), T(0.04), T(0.04)};
+  V3<T> f90{T(1), T(1), T(1)};
+  T roughness = T(0.5);
+  T anisotropy = T(0);
+  V3<T> N{T(0), T(0), T(1)};
+  V3<T> T_{T(1), T(0), T(0)};
+  V3<T> sssMfp{T(0), T(0), T(0)};
+  T sssPhaseAnisotropy = T(0);
+  std::uint32_t sssType = kSssNone;
+  T secondRoughness = T(0.5);
+  T secondRoughnessWeight = T(0);
+  T fuzzAmount = T(0);
+  V3<T> fuzzColor{T(0), T(0), T(0)};
+  T fuzzRoughness = T(0.5);
+  T glintValue = T(1);
+  V2<T> glintUv{T(0), T(0)};
+  V4<T> glintUvDerivatives{T(0), T(0), T(0), T(0)};
+  std::uint32_t specularProfile = 0;
+  V3<T> emissive{T(0), T(0), T(0)};
+  T weight = T(1);
+  V3<T> topTransmittance{T(1), T(1), T(1)};
+  T coverageAbove = T(0);
+  std::uint32_t features = 0;
+  bool isTop = true;
+};
+
+/// One shading point, as SubstrateGeometry (world space; converted to T inside).
+struct Geometry {
+  std::array<double, 3> N{0, 0, 1}, T{1, 0, 0}, V{0, 0, 1}, position{0, 0, 0};
+  std::array<double, 2> uv0{0.5, 0.5}, uv1{0.5, 0.5};
+  std::array<double, 4> vertexColor{1, 1, 1, 1}, uvDerivatives{0, 0, 0, 0};
+  double dither = 0.5;
+};
+
+/// The texture input `inputIndex` (index into Material::inputs) sampled at (u, v):
+/// the generated shader's SUBSTRATE_SAMPLE at the texture node's uv. Wrap, filter
+/// and colour-space policy are the caller's.
+using TextureFn = std::function<std::array<double, 4>(int inputIndex, double u, double v)>;
+
+/// One value per Material::inputs entry (texture inputs ignored); empty: every default.
+struct InputValues {
+  std::vector<std::array<double, 4>> values;
+};
+
+template <class T>
+struct MaterialResult {
+  std::vector<Closure<T>> closures;  // in closure order (r.after.closures)
+  T coverage;                        // the root's C
+  V3<T> transmittance;               // the root's T
+};
+
+/// <name>_evaluate: the value DAG, the tree walk (C and T per node, operators
+/// bottom-up) and each closure's walk to the root. An unset `tex` samples every
+/// texture as value_eval's constant sample.
+template <class T>
+MaterialResult<T> evaluateMaterial(const CompileResult& r, const Geometry& g, const InputValues& in,
+                                   const TextureFn& tex);
+
+/// substrate_eval_closure: BSDF * NoL (no weight, no throughput of the layers
+/// above). diffuseModel is SUBSTRATE_DIFFUSE_MODEL (0..3); the specular profile
+/// tint is the runtime's default (SUBSTRATE_SPECULAR_PROFILE_SAMPLE = 1).
+template <class T>
+V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffuseModel);
+
+/// substrate_closure_view_throughput / substrate_closure_light_throughput.
+template <class T>
+V3<T> viewThroughput(const Closure<T>& c, T NoV);
+template <class T>
+V3<T> lightThroughput(const Closure<T>& c, T NoL);
+
+/// substrate_light_closure: viewT(NoV) * lightT(NoL) * evalClosure * radiance.
+template <class T>
+V3<T> lightClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, const V3<T>& radiance, int diffuseModel);
+
+/// substrate_reflection_dir and substrate_env_mip.
+template <class T>
+V3<T> reflectionDir(const Closure<T>& c, const V3<T>& V);
+template <class T>
+T envMip(T roughness, T mipCount);
+
+/// substrate_env_split_sum (light-side throughput included, view-side not).
+/// `irradiance` is E = integral of L cos over the hemisphere (pi for a constant
+/// unit environment); `prefilteredRadiance` is the prefiltered radiance (1 for it).
+template <class T>
+V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredRadiance, const V3<T>& irradiance,
+                  int diffuseModel);
+
+/// substrate_translucency.
+template <class T>
+void translucency(const Closure<T>& c, T NoV, T& coverage, V3<T>& transmittance);
+
+/// The reference for environment lighting: the integral over the sphere of
+/// radiance(L) * lightThroughput(c, N.L) * evalClosure(c, V, L) dL (the
+/// light-side throughput is what envSplitSum includes: 1 for a top closure), by
+/// importance sampling with the balance heuristic: `samples` points per strategy
+/// (GGX visible normals of the primary lobe and of the haze lobe when it has
+/// weight, cosine-weighted hemisphere, and the uniform sphere for SSS wrap, which
+/// is lit from below the horizon), a Hammersley set with a Cranley-Patterson
+/// rotation per strategy drawn from `seed`. Deterministic. Not split sum: it
+/// measures split sum's error.
+V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
+                         const std::function<V3<double>(const V3<double>&)>& radiance, int diffuseModel, int samples,
+                         std::uint32_t seed);
+
+}  // namespace substratec::reference

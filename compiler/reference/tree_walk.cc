@@ -1,0 +1,391 @@
+// Mirrors the generated <name>_evaluate (compiler/emit/material_emitter.cc,
+// docs/codegen.md "The material function") with the runtime's tree operators
+// (runtime_shaders/substrate_tree.h) and tree-walk helpers (the end of
+// runtime_shaders/substrate_values.h):
+//   1. values: the value DAG in double (ir/value_eval.h), directions in tangent
+//      space (normal (0,0,1), tangent (1,0,0), view = ts_view), textures through
+//      the caller's TextureFn; rounded to T;
+//   2. tree: each slab's coverage C and transmittance T along the normal, then
+//      the operators bottom-up; the root's C/T are the material's;
+//   3. closures: per closure (r.after.closures order) the walk to the root
+//      (weights, layers above, roughness widening) and the pins its features use.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+
+#include "ir/value_eval.h"
+#include "reference/common.h"
+#include "reference/reference.h"
+
+namespace substratec::reference {
+using namespace detail;
+
+namespace {
+
+template <class T> constexpr T kTreeEpsilon = T(1e-6);                 // SUBSTRATE_TREE_EPSILON
+template <class T> constexpr T kFltMin = T(1.175494351e-38);           // SUBSTRATE_VALUES_FLT_MIN
+template <class T> constexpr T kValuesFltMax = T(3.402823466e+38);     // SUBSTRATE_VALUES_FLT_MAX
+
+// --- substrate_tree.h
+
+// substrate_op_horizontal: C = (1-w)Cb + w Cf, T = ((1-w)Cb Tb + w Cf Tf) / max(1e-6, C).
+template <class T>
+void opHorizontal(T cb, const V3<T>& tb, T cf, const V3<T>& tf, T w, T& c, V3<T>& t) {
+  c = (T(1) - w) * cb + w * cf;
+  t = ((T(1) - w) * cb * tb + w * cf * tf) / std::max(kTreeEpsilon<T>, c);
+}
+
+// substrate_op_vertical: C = Ct + Cb(1-Ct), T = Tt Ct(1-Cb) + Tb Cb(1-Ct) + Tt Tb Ct Cb.
+template <class T>
+void opVertical(T ct, const V3<T>& tt, T cb, const V3<T>& tb, T& c, V3<T>& t) {
+  c = ct + cb * (T(1) - ct);
+  t = tt * (ct * (T(1) - cb)) + tb * (cb * (T(1) - ct)) + tt * tb * (ct * cb);
+}
+
+// substrate_op_add: C = sat(Ca + Cb), T = (Ca Ta + Cb Tb) / max(1e-6, Ca + Cb).
+template <class T>
+void opAdd(T ca, const V3<T>& ta, T cb, const V3<T>& tb, T& c, V3<T>& t) {
+  c = saturate(ca + cb);
+  t = (ca * ta + cb * tb) / std::max(kTreeEpsilon<T>, ca + cb);
+}
+
+// substrate_layer_above: the layers above as one (coverage, transmittance) pair
+// whose normal-incidence throughput 1 - C + C T is the product of the layers'.
+template <class T>
+void layerAbove(T& c, V3<T>& t, T cLayer, const V3<T>& tLayer) {
+  V3<T> through = (splat3(T(1) - c) + c * t) * (splat3(T(1) - cLayer) + cLayer * tLayer);
+  T cNew = T(1) - (T(1) - c) * (T(1) - cLayer);
+  t = saturate((through - splat3(T(1) - cNew)) / std::max(kTreeEpsilon<T>, cNew));
+  c = cNew;
+}
+
+// --- substrate_values.h, tree-walk helpers
+
+// substrate_value_pow: y == 0 -> 1; max(x, 0) == 0 -> 0; else min(pow, FLT_MAX).
+template <class T>
+T valuePow(T x, T y) {
+  if (y == T(0)) return T(1);
+  T b = std::max(x, T(0));
+  if (b == T(0)) return T(0);
+  return std::min(std::pow(b, y), kValuesFltMax<T>);
+}
+
+// substrate_roughness_to_variance: r^1.1 / (1 - r), r clamped to [0, 0.999].
+template <class T>
+T roughnessToVariance(T r) {
+  T rc = clampT(r, T(0), T(0.999));
+  return valuePow(rc, T(1.1)) / (T(1) - rc);
+}
+
+// substrate_variance_to_roughness: exactly the shader's two Newton steps in
+// x = logit(r) from x0 = ln v (ln v >= 0) or ln v / 1.1, v clamped to
+// [1e-30, variance(0.999)]; v <= 0 (or NaN) gives 0. Not an exact inverse: the
+// reference computes what the shader computes.
+template <class T>
+T varianceToRoughness(T v) {
+  if (!(v > T(0))) return T(0);
+  T L = std::log(clampT(v, T(1e-30), roughnessToVariance(T(0.999))));
+  T x = L >= T(0) ? L : L / T(1.1);
+  for (int i = 0; i < 2; ++i) {
+    T r = T(1) / (T(1) + std::exp(-x));
+    T h = T(1.1) * std::log(r) - std::log(T(1) - r) - L;
+    x = x - h / (T(1.1) - T(0.1) * r);
+  }
+  return clampT(T(1) / (T(1) + std::exp(-x)), T(0), T(0.999));
+}
+
+// substrate_values_normalize_or: fallback for a non-finite v or max|v_i| < FLT_MIN.
+template <class T>
+V3<T> normalizeOr(const V3<T>& v, const V3<T>& fallback) {
+  if (!finite3(v)) return fallback;
+  T m = max3(vabs(v));
+  if (!(m >= kFltMin<T>)) return fallback;
+  return normalize(v / m);
+}
+
+// substrate_tangent_to_world: normalize(T v.x + (N x T) v.y + N v.z), v scaled by
+// its largest |component| first; a zero, denormal or infinite v gives N.
+template <class T>
+V3<T> tangentToWorld(const V3<T>& v, const V3<T>& N, const V3<T>& Tg) {
+  T m = max3(vabs(v));
+  if (!(m >= kFltMin<T>) || std::isinf(m)) return N;
+  V3<T> vs = v / m;
+  V3<T> B = cross(N, Tg);
+  return normalizeOr(Tg * vs[0] + B * vs[1] + N * vs[2], N);
+}
+
+// substrate_orthogonal_tangent: T made orthogonal to the normalized N (two
+// Gram-Schmidt steps); Duff's b1 with s = N.z >= 0 ? 1 : -1 (here -0 counts as
+// positive, unlike substrate_orthonormal_basis) when T is zero, non-finite or
+// within 1e-3 of parallel (|t|^2 <= 1e-6 |T|^2).
+template <class T>
+V3<T> orthogonalTangent(const V3<T>& N, const V3<T>& Tg) {
+  V3<T> n = normalizeOr(N, V3<T>{T(0), T(0), T(1)});
+  T s = n[2] >= T(0) ? T(1) : T(-1);
+  T a = T(-1) / (s + n[2]);
+  T b = n[0] * n[1] * a;
+  V3<T> t0{T(1) + s * n[0] * n[0] * a, s * b, -s * n[0]};
+  if (!finite3(Tg)) return t0;
+  T m = max3(vabs(Tg));
+  if (!(m >= kFltMin<T>)) return t0;
+  V3<T> ts = Tg / m;
+  V3<T> t = ts - n * dot(n, ts);
+  if (!(dot(t, t) > T(1e-6) * dot(ts, ts))) return t0;
+  t = t - n * dot(n, t);
+  return normalize(t);
+}
+
+// Feature bits of the IR (ir/material.h) the emitter tests.
+bool has(std::uint16_t f, Feature bit) { return (f & bit) != 0; }
+
+template <class T>
+class Walk {
+ public:
+  Walk(const CompileResult& r, const std::vector<std::array<double, 4>>& values, const Geometry& g)
+      : m_(r.material), t_(r.tree), L_(r.after), vals_(values),
+        gN_(cast<T>(g.N)), gT_(cast<T>(g.T)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
+
+  MaterialResult<T> run() {
+    const std::size_t n = m_.nodes.size();
+    C_.assign(n, T(1));
+    Tr_.assign(n, splat3(T(1)));
+    slabs();
+    operators();
+    MaterialResult<T> out;
+    if (m_.root >= 0) {
+      out.coverage = C_[m_.root];
+      out.transmittance = Tr_[m_.root];
+    } else {
+      out.coverage = T(0);
+      out.transmittance = splat3(T(1));
+    }
+    assignProfiles();
+    for (const ClosureLayout& cl : L_.closures) out.closures.push_back(closure(cl));
+    return out;
+  }
+
+ private:
+  // A value of the DAG rounded to T; a Float broadcasts (as the pins' own
+  // broadcast, and as GLSL's vec3 * float).
+  T scalar(ValueId v) const { return static_cast<T>(vals_[v][0]); }
+  V3<T> vec3(ValueId v) const {
+    const auto& x = vals_[v];
+    if (m_.values.node(v).type == VType::Float) return splat3(static_cast<T>(x[0]));
+    return {static_cast<T>(x[0]), static_cast<T>(x[1]), static_cast<T>(x[2])};
+  }
+  V2<T> vec2(ValueId v) const { return {static_cast<T>(vals_[v][0]), static_cast<T>(vals_[v][1])}; }
+
+  /// mfpOf: mfp * sss_mfp_scale, without the product when the scale is the constant 1.
+  V3<T> mfpOf(const Slab& s) const {
+    ValueId scale = s.pin(SlabPin::SssMfpScale);
+    if (m_.values.isConstEqual(scale, 1.0)) return vec3(s.pin(SlabPin::SssMfp));
+    return vec3(s.pin(SlabPin::SssMfp)) * scalar(scale);
+  }
+
+  // emitTree, slabs: C = coverage (1 without one); T = substrate_transmittance(mfp,
+  // d) with d the thickness of TreeInfo::layerVertical's vertical, else the
+  // surface thickness; the constant (0, 0, 0) when the MFP is the constant 0 and
+  // d is a positive constant (no medium: opaque).
+  void slabs() {
+    for (int n : t_.preorder) {
+      const TreeNode& node = m_.nodes[n];
+      if (node.op != TreeOp::Slab) continue;
+      const Slab& s = m_.slabs[node.slab];
+      C_[n] = s.coverage == kNoValue ? T(1) : scalar(s.coverage);
+      const int v = t_.layerVertical[n];
+      const ValueId mfp = s.pin(SlabPin::SssMfp);
+      const double d = m_.settings.surfaceThickness;
+      const bool opaque =
+          m_.values.isConstEqual(mfp, 0.0) &&
+          (v < 0 ? d > 0 : m_.values.isConst(m_.nodes[v].a) && m_.values.node(m_.nodes[v].a).c[0] > 0);
+      if (opaque)
+        Tr_[n] = splat3(T(0));
+      else
+        Tr_[n] = transmittance(mfpOf(s), v >= 0 ? scalar(m_.nodes[v].a) : static_cast<T>(d));
+    }
+  }
+
+  // emitTree, operators bottom-up (by distance from leaves, then pre-order).
+  void operators() {
+    std::vector<int> ops;
+    for (int n : t_.preorder)
+      if (m_.nodes[n].op != TreeOp::Slab) ops.push_back(n);
+    std::stable_sort(ops.begin(), ops.end(),
+                     [&](int a, int b) { return t_.distanceFromLeaves[a] < t_.distanceFromLeaves[b]; });
+    for (int n : ops) {
+      const TreeNode& node = m_.nodes[n];
+      const int l = node.left, r = node.right;
+      switch (node.op) {
+        case TreeOp::Horizontal:
+          opHorizontal(C_[l], Tr_[l], C_[r], Tr_[r], scalar(node.a), C_[n], Tr_[n]);
+          break;
+        case TreeOp::Select:  // foreground when value > threshold: 1 - step(value, threshold)
+          opHorizontal(C_[l], Tr_[l], C_[r], Tr_[r], T(1) - step(node), C_[n], Tr_[n]);
+          break;
+        case TreeOp::Vertical: opVertical(C_[l], Tr_[l], C_[r], Tr_[r], C_[n], Tr_[n]); break;
+        case TreeOp::Add: opAdd(C_[l], Tr_[l], C_[r], Tr_[r], C_[n], Tr_[n]); break;
+        case TreeOp::CoverageWeight:
+          C_[n] = scalar(node.a) * C_[l];
+          Tr_[n] = Tr_[l];
+          break;
+        case TreeOp::Slab: break;
+      }
+    }
+  }
+
+  /// GLSL step(edge = value, x = threshold): threshold >= value ? 1 : 0.
+  T step(const TreeNode& node) const { return scalar(node.b) >= scalar(node.a) ? T(1) : T(0); }
+
+  // collectNeeded: specular profile indices in order of first use over the closures.
+  void assignProfiles() {
+    for (const ClosureLayout& cl : L_.closures) {
+      const Slab& s = m_.slabs[cl.slab];
+      if (s.specularProfileInput >= 0 && !profileIndex_.count(s.specularProfileInput)) {
+        const int k = static_cast<int>(profileIndex_.size());
+        profileIndex_[s.specularProfileInput] = k;
+      }
+    }
+  }
+
+  // emitClosures.
+  Closure<T> closure(const ClosureLayout& cl) const {
+    const Slab& s = m_.slabs[cl.slab];
+    const int node = t_.slabNode[cl.slab];
+    // The walk up to the root: the weight is C (when the slab has a coverage) times
+    // each mix/coverage/select factor, multiplied in walk order.
+    T weight = s.coverage == kNoValue ? T(1) : C_[node];
+    struct Layer {
+      int top;  // node index of the vertical's top layer
+    };
+    std::vector<Layer> layers;
+    for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
+      const TreeNode& op = m_.nodes[p];
+      switch (op.op) {
+        case TreeOp::Horizontal: weight = weight * (op.right == x ? scalar(op.a) : T(1) - scalar(op.a)); break;
+        case TreeOp::CoverageWeight: weight = weight * scalar(op.a); break;
+        case TreeOp::Select: weight = weight * (op.right == x ? T(1) - step(op) : step(op)); break;
+        case TreeOp::Vertical:
+          if (op.right == x) layers.push_back({op.left});
+          break;
+        default: break;
+      }
+    }
+    // The layers above, from the root down (substrate_layer_above); a slab on
+    // top of a vertical transmits T (1 - F0) and widens the roughness below by
+    // C * variance(its roughness). An operator on top: its T, no widening.
+    T ca = T(0), va = T(0);
+    V3<T> ta = splat3(T(1));
+    if (!cl.isTop) {
+      for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
+        const TreeNode& top = m_.nodes[it->top];
+        V3<T> tTop = Tr_[it->top];
+        if (top.op == TreeOp::Slab) {
+          const Slab& ts = m_.slabs[top.slab];
+          va = va + C_[it->top] * roughnessToVariance(scalar(ts.pin(SlabPin::Roughness)));
+          tTop = tTop * (splat3(T(1)) - vec3(ts.pin(SlabPin::F0)));
+        }
+        layerAbove(ca, ta, C_[it->top], tTop);
+      }
+    }
+
+    Closure<T> c;  // substrate_closure_init
+    c.diffuseAlbedo = vec3(s.pin(SlabPin::DiffuseAlbedo));
+    c.f0 = vec3(s.pin(SlabPin::F0));
+    T rough = scalar(s.pin(SlabPin::Roughness));
+    // Under a layer the roughness always goes through the variance round trip
+    // (the emitter writes it even when no slab above widens it, va = 0).
+    if (!cl.isTop) rough = varianceToRoughness(roughnessToVariance(rough) + va);
+    c.roughness = rough;
+    c.N = tangentToWorld(vec3(s.pin(SlabPin::Normal)), gN_, gT_);
+    std::uint32_t bits = 0;
+    const std::uint16_t f = s.features;
+    if (has(f, kFeatF90)) {
+      bits |= kFeatureF90;
+      c.f90 = vec3(s.pin(SlabPin::F90));
+    }
+    if (has(f, kFeatAnisotropy)) {
+      bits |= kFeatureAnisotropy;
+      c.anisotropy = scalar(s.pin(SlabPin::Anisotropy));
+      c.T_ = orthogonalTangent(c.N, tangentToWorld(vec3(s.pin(SlabPin::Tangent)), gN_, gT_));
+    }
+    if (has(f, kFeatSss)) {
+      c.sssMfp = mfpOf(s);
+      c.sssPhaseAnisotropy = scalar(s.pin(SlabPin::SssPhaseAnisotropy));
+      c.sssType = static_cast<std::uint32_t>(s.sssType);
+    }
+    if (has(f, kFeatHaze)) {
+      bits |= kFeatureHaze;
+      c.secondRoughness = scalar(s.pin(SlabPin::SecondRoughness));
+      c.secondRoughnessWeight = scalar(s.pin(SlabPin::SecondRoughnessWeight));
+    }
+    if (has(f, kFeatFuzz)) {
+      bits |= kFeatureFuzz;
+      c.fuzzAmount = scalar(s.pin(SlabPin::FuzzAmount));
+      c.fuzzColor = vec3(s.pin(SlabPin::FuzzColor));
+      c.fuzzRoughness = scalar(s.pin(SlabPin::FuzzRoughness));
+    }
+    if (has(f, kFeatGlint)) {
+      bits |= kFeatureGlint;
+      c.glintValue = scalar(s.pin(SlabPin::GlintValue));
+      c.glintUv = vec2(s.pin(SlabPin::GlintUv));
+      c.glintUvDerivatives = uvDerivatives_;
+    }
+    if (has(f, kFeatSpecularProfile)) {
+      bits |= kFeatureSpecularProfile;
+      c.specularProfile = static_cast<std::uint32_t>(profileIndex_.at(s.specularProfileInput) + 1);
+    }
+    if (has(f, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
+    if (cl.storesWeight) bits |= kFeatureWeight;
+    if (cl.storesCoverageAbove) bits |= kFeatureCoverageAbove;
+    c.weight = weight;
+    if (!cl.isTop) {
+      c.topTransmittance = ta;
+      c.coverageAbove = ca;
+      c.isTop = false;
+    }
+    c.features = bits;
+    return c;
+  }
+
+  const Material& m_;
+  const TreeInfo& t_;
+  const StorageLayout& L_;
+  const std::vector<std::array<double, 4>>& vals_;
+  V3<T> gN_, gT_;
+  V4<T> uvDerivatives_;
+  std::vector<T> C_;
+  std::vector<V3<T>> Tr_;
+  std::map<int, int> profileIndex_;
+};
+
+}  // namespace
+
+template <class T>
+MaterialResult<T> evaluateMaterial(const CompileResult& r, const Geometry& g, const InputValues& in,
+                                   const TextureFn& tex) {
+  const Material& m = r.material;
+  // The value DAG in double. Tangent space as the generated code: normal (0,0,1),
+  // tangent (1,0,0), view = ts_view = (V.T, V.(N x T), V.N) (not renormalized).
+  EvalPoint p;
+  p.normal = {0, 0, 1};
+  p.tangent = {1, 0, 0};
+  const V3<double> B = cross(g.N, g.T);
+  p.view = {dot(g.V, g.T), dot(g.V, B), dot(g.V, g.N)};
+  p.position = g.position;
+  p.uv0 = g.uv0;
+  p.uv1 = g.uv1;
+  p.vertexColor = g.vertexColor;
+  p.inputs = in.values;
+  if (tex) p.sampler = tex;
+  std::vector<std::array<double, 4>> values;
+  if (m.values.size() > 0) values = evaluateDag(m, p, static_cast<ValueId>(m.values.size() - 1));
+  return Walk<T>(r, values, g).run();
+}
+
+template MaterialResult<float> evaluateMaterial<float>(const CompileResult&, const Geometry&, const InputValues&,
+                                                       const TextureFn&);
+template MaterialResult<double> evaluateMaterial<double>(const CompileResult&, const Geometry&, const InputValues&,
+                                                         const TextureFn&);
+
+}  // namespace substratec::reference
