@@ -10,6 +10,10 @@
 #include "validate/toolchain.h"
 #include "emit/generate.h"
 #include "output/atomic_write.h"
+#include "gpu/harness.h"
+#include "preview/contact_sheet.h"
+#include "preview/environment.h"
+#include "preview/render.h"
 
 #include <filesystem>
 
@@ -90,6 +94,14 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
   return status;
 }
 
+/// The SUBSTRATE_DIFFUSE_MODEL number of a --diffuse name.
+int diffuseModelOf(const std::string& name) {
+  static const char* const kModels[] = {"lambert", "chan2018", "chan2024", "eon"};
+  for (int i = 0; i < 4; ++i)
+    if (name == kModels[i]) return i;
+  return 2;
+}
+
 struct CompileArgs {
   std::string file;
   std::string outDir;
@@ -116,9 +128,7 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
   go.glsl = a.target != "hlsl";
   go.hlsl = a.target != "glsl";
   go.emit.sourceName = std::filesystem::path(a.file).filename().string();
-  static const char* const kModels[] = {"lambert", "chan2018", "chan2024", "eon"};
-  for (int i = 0; i < 4; ++i)
-    if (a.diffuse == kModels[i]) go.emit.diffuseModel = i;
+  go.emit.diffuseModel = diffuseModelOf(a.diffuse);
   Generated gen = generateFiles(*result, go);
   // Validate in-process before anything is written: a shader that does not
   // compile is the compiler's bug (exit 3), and the output folder stays as it was.
@@ -134,6 +144,91 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   for (const auto& f : files) out << (std::filesystem::path(a.outDir) / f.name).string() << "\n";
+  return kExitOk;
+}
+
+struct PreviewArgs {
+  std::string file;
+  std::string output;
+  int budget = 0;
+  int maxClosures = 0;
+  bool fullSimplification = false;
+  int size = 256;
+  std::string environment = preview::kDefaultEnvironment;
+  bool sweep = false;
+  std::string target = "glsl";
+  std::string diffuse = "chan2024";
+  double exposure = 0;
+  std::size_t maxInputSize = 16u << 20;
+};
+
+/// Renders the material (or, with --sweep, a labelled contact sheet of its
+/// simplification steps) on lavapipe and writes an 8-bit sRGB PNG.
+int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
+  CompileOptions o;
+  if (a.budget > 0) o.budgetOverride = a.budget;
+  if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
+  o.fullSimplification = a.fullSimplification;
+  o.read.maxInputBytes = a.maxInputSize;
+  std::string text;
+  {
+    Diagnostics diags(a.file);
+    auto read = readSourceFile(a.file, o.read, diags);
+    if (!read) {
+      err << diags.formatAll();
+      return kExitBadInput;
+    }
+    text = std::move(*read);
+  }
+  std::vector<preview::SweepEntry> entries;
+  std::string error;
+  if (a.sweep) {
+    if (!preview::simplificationSweep(a.file, text, o, &entries, &error)) {
+      err << error;
+      return kExitBadInput;
+    }
+  } else {
+    Diagnostics diags(a.file);
+    auto r = compileText(a.file, text, o, diags);
+    err << diags.formatAll();
+    if (!r) return kExitBadInput;
+    entries.push_back({std::move(*r), ""});
+  }
+  gpu::Context::Options go;
+  auto ctx = gpu::Context::create(go, &error);
+  if (!ctx) {
+    err << "substratec: error: preview renders on Vulkan (Mesa lavapipe): " << error << "\n";
+    return kExitBadInput;
+  }
+  preview::RenderOptions ro;
+  ro.size = a.size;
+  ro.environment = a.environment;
+  ro.target = a.target == "hlsl" ? Target::Hlsl : Target::Glsl;
+  ro.diffuseModel = diffuseModelOf(a.diffuse);
+  ro.exposure = a.exposure;
+  std::vector<preview::Image> tiles;
+  std::vector<std::string> labels;
+  for (const auto& e : entries) {
+    preview::Image hdr;
+    if (!preview::renderSphere(*ctx, e.result, ro, &hdr, &error)) {
+      err << "substratec: internal compiler error: " << error << "\n";
+      return kExitInternal;
+    }
+    tiles.push_back(preview::tonemap(hdr, a.exposure));
+    labels.push_back(e.label);
+  }
+  preview::Image image = a.sweep ? preview::contactSheet(tiles, labels, std::min<int>(4, static_cast<int>(tiles.size())))
+                                 : tiles.front();
+  preview::Srgb8 srgb = preview::encodeSrgb8(image);
+  if (srgb.nanCount > 0) {
+    err << "substratec: internal compiler error: " << srgb.nanCount << " pixels of the preview are NaN\n";
+    return kExitInternal;
+  }
+  if (!preview::writePng(a.output, image.width, image.height, srgb.rgba, &error)) {
+    err << "substratec: error: " << error << "\n";
+    return kExitBadInput;
+  }
+  out << a.output << "\n";
   return kExitOk;
 }
 
@@ -178,6 +273,25 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   comp->add_option("--max-input-size", compile.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
 
+  PreviewArgs prev;
+  CLI::App* pre = app.add_subcommand("preview", "Render the material on a sphere (Vulkan, Mesa lavapipe) into a PNG");
+  pre->add_option("file", prev.file, "Material file (substrate-material/1 JSON)")->required();
+  pre->add_option("-o,--output", prev.output, "PNG file to write")->required();
+  pre->add_option("--budget", prev.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
+  pre->add_option("--max-closures", prev.maxClosures, "Closure budget")->check(CLI::Range(1, 8));
+  pre->add_flag("--full-simplification", prev.fullSimplification, "Collapse everything into one closure");
+  pre->add_option("--size", prev.size, "Image width and height in pixels")->check(CLI::Range(16, 2048));
+  pre->add_option("--env", prev.environment, "Procedural environment")->check(CLI::IsMember(preview::environmentNames()));
+  pre->add_flag("--sweep", prev.sweep,
+                "A contact sheet: the material at each simplification step, labelled with bytes and closures");
+  pre->add_option("--target", prev.target, "Which generated language renders: glsl or hlsl")
+      ->check(CLI::IsMember({"glsl", "hlsl"}));
+  pre->add_option("--diffuse", prev.diffuse, "Diffuse model")
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
+  pre->add_option("--exposure", prev.exposure, "Exposure in stops before the tone curve")->check(CLI::Range(-16.0, 16.0));
+  pre->add_option("--max-input-size", prev.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
   try {
@@ -199,6 +313,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   try {
     if (rep->parsed()) return runReport(report, out, err);
     if (comp->parsed()) return runCompile(compile, out, err);
+    if (pre->parsed()) return runPreview(prev, out, err);
   } catch (const std::exception& e) {
     err << "substratec: internal compiler error: " << e.what() << "\n";
     return kExitInternal;

@@ -1,0 +1,135 @@
+// Tone mapping, sRGB encoding and PNG output of preview images (image.h).
+#include "preview/image.h"
+
+#include <png.h>
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+namespace substratec::preview {
+
+Image::Image(int w, int h, std::array<float, 4> fill) : width(w), height(h) {
+  rgba.resize(static_cast<size_t>(w) * h * 4);
+  for (size_t i = 0; i < rgba.size(); ++i) rgba[i] = fill[i % 4];
+}
+
+namespace {
+
+/// Narkowicz's ACES fit on one channel (already exposed).
+float acesFitted(float x) {
+  if (std::isnan(x)) return x;
+  if (!(x > 0.0f)) return 0.0f;
+  if (std::isinf(x)) return 1.0f;
+  double v = x;
+  double y = (v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14);
+  return static_cast<float>(y < 0.0 ? 0.0 : (y > 1.0 ? 1.0 : y));
+}
+
+/// round(255 clamp(v)); `srgb` applies the OETF first.
+uint8_t quantize(float value, bool srgb) {
+  double v = value;
+  v = v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v);
+  if (srgb) v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+  return static_cast<uint8_t>(std::floor(v * 255.0 + 0.5));
+}
+
+bool fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace
+
+Image tonemap(const Image& hdr, double exposure) {
+  Image out = hdr;
+  const float scale = static_cast<float>(std::exp2(exposure));
+  for (size_t i = 0; i < out.rgba.size(); ++i)
+    if (i % 4 != 3) out.rgba[i] = acesFitted(out.rgba[i] * scale);
+  return out;
+}
+
+Srgb8 encodeSrgb8(const Image& img) {
+  Srgb8 out;
+  out.rgba.resize(img.rgba.size());
+  for (size_t p = 0; p + 3 < img.rgba.size(); p += 4) {
+    bool nan = false;
+    for (size_t c = 0; c < 4; ++c) {
+      float v = img.rgba[p + c];
+      if (std::isnan(v)) {
+        nan = true;
+        v = 0.0f;
+      }
+      out.rgba[p + c] = quantize(v, c != 3);
+    }
+    if (nan) ++out.nanCount;
+  }
+  return out;
+}
+
+bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint8_t>& png, std::string* error) {
+  if (w < 1 || h < 1 || rgba8.size() != static_cast<size_t>(w) * h * 4)
+    return fail(error, "PNG of " + std::to_string(w) + "x" + std::to_string(h) + " pixels needs " +
+                           std::to_string(static_cast<size_t>(w > 0 ? w : 0) * (h > 0 ? h : 0) * 4) + " bytes, got " +
+                           std::to_string(rgba8.size()));
+  // libpng's simplified API: 8-bit sRGB output writes an sRGB chunk and never
+  // a tIME chunk; the first call sizes the buffer.
+  png_image image;
+  std::memset(&image, 0, sizeof image);
+  image.version = PNG_IMAGE_VERSION;
+  image.width = static_cast<png_uint_32>(w);
+  image.height = static_cast<png_uint_32>(h);
+  image.format = PNG_FORMAT_RGBA;
+  png_alloc_size_t size = 0;
+  if (!png_image_write_to_memory(&image, nullptr, &size, 0, rgba8.data(), 0, nullptr))
+    return fail(error, std::string("libpng: ") + image.message);
+  png.resize(size);
+  if (!png_image_write_to_memory(&image, png.data(), &size, 0, rgba8.data(), 0, nullptr))
+    return fail(error, std::string("libpng: ") + image.message);
+  png.resize(size);
+  return true;
+}
+
+bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba8, std::string* error) {
+  std::vector<uint8_t> png;
+  std::string why;
+  if (!encodePng(w, h, rgba8, png, &why)) return fail(error, "cannot encode '" + path + "': " + why);
+  namespace fs = std::filesystem;
+  fs::path target(path);
+  fs::path dir = target.parent_path();
+  std::string tmpl = ((dir.empty() ? fs::path(".") : dir) / ("." + target.filename().string() + ".tmpXXXXXX")).string();
+  int fd = ::mkstemp(tmpl.data());
+  if (fd < 0) return fail(error, "cannot write '" + path + "': " + std::strerror(errno));
+  // mkstemp creates 0600; a PNG is an ordinary readable file.
+  ::fchmod(fd, 0644);
+  size_t done = 0;
+  while (done < png.size()) {
+    ssize_t n = ::write(fd, png.data() + done, png.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      std::string message = std::strerror(n < 0 ? errno : EIO);
+      ::close(fd);
+      ::unlink(tmpl.c_str());
+      return fail(error, "cannot write '" + path + "': " + message);
+    }
+    done += static_cast<size_t>(n);
+  }
+  if (::close(fd) != 0) {
+    std::string message = std::strerror(errno);
+    ::unlink(tmpl.c_str());
+    return fail(error, "cannot write '" + path + "': " + message);
+  }
+  if (::rename(tmpl.c_str(), path.c_str()) != 0) {
+    std::string message = std::strerror(errno);
+    ::unlink(tmpl.c_str());
+    return fail(error, "cannot rename into '" + path + "': " + message);
+  }
+  return true;
+}
+
+}  // namespace substratec::preview

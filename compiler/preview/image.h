@@ -1,0 +1,52 @@
+// Images of `substratec preview`: linear RGBA32F pixels, the tone curve that
+// takes them to display range, the sRGB 8-bit encoding, and PNG output.
+#pragma once
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace substratec::preview {
+
+/// Linear RGBA32F pixels, row-major, top row first.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgba;
+
+  Image() = default;
+  /// A width x height image filled with `fill`.
+  Image(int w, int h, std::array<float, 4> fill = {0.0f, 0.0f, 0.0f, 1.0f});
+  float* pixel(int x, int y) { return rgba.data() + (static_cast<size_t>(y) * width + x) * 4; }
+  const float* pixel(int x, int y) const { return rgba.data() + (static_cast<size_t>(y) * width + x) * 4; }
+};
+
+/// Display-referred linear RGB in [0, 1]: each channel times 2^exposure, then
+/// the ACES filmic fit of Narkowicz 2015, f(x) = x (2.51 x + 0.03) /
+/// (x (2.43 x + 0.59) + 0.14), per channel, clamped to [0, 1] (f(1) = 0.80,
+/// f(0.18) = 0.27). Negative values go to 0, +inf to 1; NaN stays NaN (so
+/// encodeSrgb8 can count it). Alpha is kept.
+Image tonemap(const Image& hdr, double exposure);
+
+/// 8-bit sRGB pixels and how many pixels had a NaN channel.
+struct Srgb8 {
+  std::vector<uint8_t> rgba;  // width * height * 4, row-major, top row first
+  size_t nanCount = 0;        // pixels with at least one NaN channel
+};
+
+/// RGB through the exact sRGB OETF (12.92 v for v <= 0.0031308, else
+/// 1.055 v^(1/2.4) - 0.055), alpha linear; clamped to [0, 1], then
+/// round(255 v). NaN channels become 0 and are counted.
+Srgb8 encodeSrgb8(const Image& img);
+
+/// A PNG (8-bit RGBA, sRGB chunk, no time chunk: the same pixels always give
+/// the same bytes) of w x h pixels `rgba8`. Returns false (and an error
+/// message) for a size mismatch or a libpng failure.
+bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint8_t>& png, std::string* error);
+
+/// encodePng written to `path` through a temporary file in the same directory
+/// renamed into place: on failure nothing is left behind and an existing file
+/// at `path` is untouched. Returns false and sets `*error` (if non-null).
+bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba8, std::string* error);
+
+}  // namespace substratec::preview

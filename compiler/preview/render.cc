@@ -1,0 +1,202 @@
+#include "preview/render.h"
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <set>
+
+#include <fmt/format.h>
+
+#include "emit/generate.h"
+#include "emit/kernel_emitter.h"
+#include "gpu/block_layout.h"
+#include "preview/cubemap.h"
+#include "preview/environment.h"
+#include "validate/runtime_files.h"
+
+namespace substratec::preview {
+
+namespace {
+
+using namespace kernel;
+
+constexpr int kTextureSize = 64;
+
+/// The environment's cube maps, built once per name in a process (a sweep
+/// renders many tiles under the same light).
+struct EnvironmentMaps {
+  CubeMap prefiltered, irradiance;
+};
+const EnvironmentMaps& environmentMaps(const std::string& name) {
+  static std::mutex mutex;
+  static std::map<std::string, EnvironmentMaps> cache;
+  std::lock_guard<std::mutex> lock(mutex);
+  auto it = cache.find(name);
+  if (it == cache.end()) {
+    const Environment env = makeEnvironment(name);
+    it = cache.emplace(name, EnvironmentMaps{prefilterRadiance(env), irradianceMap(env)}).first;
+  }
+  return it->second;
+}
+
+gpu::ImageResource cubeResource(const CubeMap& map) {
+  gpu::ImageResource img;
+  img.width = img.height = static_cast<uint32_t>(map.size);
+  img.layers = 6;
+  img.mips = map.mips;
+  img.filter = gpu::Filter::Linear;
+  img.address = gpu::Address::ClampToEdge;
+  return img;
+}
+
+template <class T>
+std::vector<std::byte> bytesOf(const std::vector<T>& v) {
+  std::vector<std::byte> b(v.size() * sizeof(T));
+  std::memcpy(b.data(), v.data(), b.size());
+  return b;
+}
+
+/// The three preview lights: a warm key from the upper left, a cool fill from
+/// the right and a rim from behind (unit directions toward the light, +Y up,
+/// the camera on +Z).
+struct Light {
+  std::array<double, 3> direction, radiance;
+};
+std::array<double, 3> unit(std::array<double, 3> v) {
+  const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  return {v[0] / l, v[1] / l, v[2] / l};
+}
+const Light kLights[kPreviewLights] = {
+    {unit({-0.6, 0.7, 0.6}), {2.6, 2.4, 2.1}},
+    {unit({0.8, 0.1, 0.5}), {0.5, 0.6, 0.75}},
+    {unit({0.2, 0.5, -0.9}), {1.2, 1.2, 1.2}},
+};
+
+}  // namespace
+
+std::vector<float> previewTexture(int size) {
+  std::vector<float> t(static_cast<std::size_t>(size) * size * 4);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const int cell = size / 8 > 0 ? size / 8 : 1;
+      const float v = ((x / cell + y / cell) % 2) ? 0.65f : 0.35f;
+      float* p = &t[(static_cast<std::size_t>(y) * size + x) * 4];
+      p[0] = p[1] = v;
+      p[2] = 0.5f + 0.5f * v;  // a normal map reads it as a gentle tilt
+      p[3] = 1.0f;
+    }
+  return t;
+}
+
+bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions& o, Image* out, std::string* error) {
+  EmitOptions emit;
+  emit.diffuseModel = o.diffuseModel;
+  ShaderValidation v = compileKernel(r, o.target, KernelMode::Preview, emit);
+  if (!v.ok) {
+    *error = "internal compiler error: the preview kernel does not validate\n" + v.log;
+    return false;
+  }
+  auto pipeline = ctx.createPipeline(v.spirv, error);
+  if (!pipeline) return false;
+  const EnvironmentMaps& maps = environmentMaps(o.environment);
+
+  // Preview parameters (kernel_emitter.h): camera, viewport, lights.
+  std::vector<float> params(kPreviewParamVec4s * 4, 0.0f);
+  const double tanHalfFov = std::tan(0.5 * 30.0 * M_PI / 180.0);
+  const float camera[4] = {0.0f, 0.0f, 4.2f, static_cast<float>(tanHalfFov)};
+  const float viewport[4] = {static_cast<float>(o.size), static_cast<float>(o.size),
+                             static_cast<float>(maps.prefiltered.mipCount()), static_cast<float>(o.exposure)};
+  std::memcpy(&params[0], camera, sizeof camera);
+  std::memcpy(&params[4], viewport, sizeof viewport);
+  for (int l = 0; l < kPreviewLights; ++l)
+    for (int c = 0; c < 3; ++c) {
+      params[(2 + l) * 4 + c] = static_cast<float>(kLights[l].direction[c]);
+      params[(2 + kPreviewLights + l) * 4 + c] = static_cast<float>(kLights[l].radiance[c]);
+    }
+
+  gpu::Resources res;
+  for (const gpu::DescriptorBinding& b : pipeline->reflection().bindings) {
+    const auto key = std::make_pair(b.set, b.binding);
+    if (b.set == 0 && b.binding == 0) {
+      res[key] = gpu::BufferResource{bytesOf(params), false};
+    } else if (b.set == 0 && b.binding == 1) {
+      res[key] = cubeResource(maps.prefiltered);
+    } else if (b.set == 0 && b.binding == 2) {
+      res[key] = cubeResource(maps.irradiance);
+    } else if (b.set == 0 && b.binding == 3) {
+      res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::ClampToEdge};
+    } else if (b.set == 0 && b.binding == 5) {
+      auto lut = energyLutTables();
+      res[key] = gpu::BufferResource{bytesOf(std::vector<float>(lut.begin(), lut.end())), false};
+    } else if (b.set == 0 && b.binding == 7) {
+      gpu::BufferResource buf;
+      buf.data.resize(static_cast<std::size_t>(o.size) * o.size * 4 * sizeof(float));
+      buf.output = true;
+      res[key] = buf;
+    } else if (b.set == 1 && b.binding == 0) {
+      res[key] = gpu::BufferResource{gpu::inputBlockBytes(r.material, gpu::blockMembers(v.spirv, 1, 0), {}), false};
+    } else if (b.set == 1 && b.kind == gpu::DescriptorKind::Sampler) {
+      res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::Repeat};
+    } else if (b.set == 1) {
+      gpu::ImageResource img;
+      img.width = img.height = kTextureSize;
+      img.mips = {previewTexture(kTextureSize)};
+      img.filter = gpu::Filter::Linear;
+      res[key] = img;
+    }
+  }
+  const uint32_t groups = static_cast<uint32_t>((o.size + 7) / 8);
+  if (!ctx.dispatch(*pipeline, res, groups, groups, 1, error)) return false;
+  const auto& buf = std::get<gpu::BufferResource>(res.at({0, 7}));
+  *out = Image(o.size, o.size);
+  std::memcpy(out->rgba.data(), buf.data.data(), out->rgba.size() * sizeof(float));
+  return true;
+}
+
+bool simplificationSweep(const std::string& path, const std::string& text, const CompileOptions& base,
+                         std::vector<SweepEntry>* out, std::string* error) {
+  auto compile = [&](const CompileOptions& o) -> std::optional<CompileResult> {
+    Diagnostics diags(path);
+    auto r = compileText(path, text, o, diags);
+    if (!r) *error = diags.formatAll();
+    return r;
+  };
+  auto label = [](const std::string& what, const CompileResult& r) {
+    const int closures = static_cast<int>(r.after.closures.size());
+    return fmt::format("{}: {} B, {} closure{}", what, r.after.bytes(), closures, closures == 1 ? "" : "s");
+  };
+  // The whole path, from the full simplification's steps.
+  CompileOptions full = base;
+  full.budgetOverride.reset();
+  full.maxClosuresOverride.reset();
+  full.fullSimplification = true;
+  auto all = compile(full);
+  if (!all) return false;
+  CompileOptions start = base;
+  start.budgetOverride = 1024;
+  start.maxClosuresOverride = 8;
+  start.fullSimplification = false;
+  auto first = compile(start);
+  if (!first) return false;
+  std::set<std::pair<int, int>> seen{{first->after.bytes(), static_cast<int>(first->after.closures.size())}};
+  out->push_back({*first, label("as authored", *first)});
+  for (std::size_t i = 0; i < all->steps.size(); ++i) {
+    const SimplifyStep& step = all->steps[i];
+    CompileOptions o = base;
+    o.fullSimplification = false;
+    o.budgetOverride = std::max(step.bytesAfter, 8);
+    o.maxClosuresOverride = std::max(step.closuresAfter, 1);
+    Diagnostics diags(path);
+    auto r = compileText(path, text, o, diags);
+    if (!r) continue;  // a step only full simplification reaches (below the smallest budget)
+    const std::pair<int, int> key{r->after.bytes(), static_cast<int>(r->after.closures.size())};
+    if (!seen.insert(key).second) continue;
+    out->push_back({*r, label(fmt::format("step {}", i + 1), *r)});
+  }
+  const std::pair<int, int> key{all->after.bytes(), static_cast<int>(all->after.closures.size())};
+  if (seen.insert(key).second) out->push_back({*all, label("full", *all)});
+  return true;
+}
+
+}  // namespace substratec::preview

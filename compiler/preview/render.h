@@ -1,0 +1,50 @@
+// `substratec preview`: a compiled material on a unit sphere, rendered on
+// lavapipe by the generated preview kernel (emit/kernel_emitter.h) under three
+// lights and a procedural split-sum environment (preview/environment.h,
+// preview/cubemap.h), tone-mapped and written as an 8-bit sRGB PNG; and the
+// contact sheet of a material at each step of its simplification.
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "emit/syntax.h"
+#include "gpu/harness.h"
+#include "pipeline/pipeline.h"
+#include "preview/image.h"
+
+namespace substratec::preview {
+
+struct RenderOptions {
+  int size = 256;                            // pixels, square
+  std::string environment = "studio";        // preview/environment.h
+  Target target = Target::Glsl;              // which generated language runs
+  int diffuseModel = 2;                      // SUBSTRATE_DIFFUSE_MODEL
+  double exposure = 0;                       // stops, for the tone map
+};
+
+/// Renders `r` (linear HDR, background = the environment). False with `*error`
+/// on a kernel that does not validate (a compiler bug) or a failed dispatch.
+bool renderSphere(gpu::Context& gpu, const CompileResult& r, const RenderOptions& options, Image* out,
+                  std::string* error);
+
+/// One tile of a simplification sweep: the material compiled to stop after a
+/// step, and its label ("step 2: 48 B, 2 closures"; the steps themselves are
+/// in `substratec report --full-simplification`).
+struct SweepEntry {
+  CompileResult result;
+  std::string label;
+};
+
+/// The material at its full budget, after each simplification step that
+/// changes its size (compiled with that step's bytes and closures as the
+/// budget), and fully simplified. Diagnostics of a failed compile in `*error`.
+bool simplificationSweep(const std::string& path, const std::string& text, const CompileOptions& base,
+                         std::vector<SweepEntry>* out, std::string* error);
+
+/// The procedural texture bound to every texture input of a preview: a soft
+/// 8 x 8 checker around mid grey (a mask, a colour or a normal map all show
+/// their effect without dominating), `size` x `size` RGBA.
+std::vector<float> previewTexture(int size);
+
+}  // namespace substratec::preview

@@ -1,0 +1,134 @@
+// `substratec preview` (issue 5): the material on a sphere, rendered on
+// lavapipe by the generated preview kernel, written as an 8-bit sRGB PNG; and
+// `--sweep`, the contact sheet of its simplification steps. Driven in-process
+// through runCli, like tests/cli_test.cc.
+#include <png.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cli/cli.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using substratec::runCli;
+
+const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
+
+struct CliRun {
+  int status;
+  std::string out, err;
+};
+
+CliRun cli(std::vector<std::string> args) {
+  std::ostringstream out, err;
+  int status = runCli(args, out, err);
+  return CliRun{status, out.str(), err.str()};
+}
+
+/// A scratch folder for this process's PNGs, removed at exit.
+fs::path workDir() {
+  static struct Dir {
+    fs::path path = fs::temp_directory_path() / ("substratec_preview_test_" + std::to_string(::getpid()));
+    Dir() { fs::create_directories(path); }
+    ~Dir() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  } dir;
+  return dir.path;
+}
+
+std::string example(const char* name) { return (kSource / "examples" / name).string(); }
+
+struct Png {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgba;
+};
+
+/// Reads a PNG back with libpng (false when it is not one).
+bool readPng(const fs::path& path, Png* out) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) return false;
+  image.format = PNG_FORMAT_RGBA;
+  out->width = static_cast<int>(image.width);
+  out->height = static_cast<int>(image.height);
+  out->rgba.resize(PNG_IMAGE_SIZE(image));
+  return png_image_finish_read(&image, nullptr, out->rgba.data(), 0, nullptr) != 0;
+}
+
+std::string bytesOf(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+TEST(Preview, WritesAnSrgbPngOfTheSphere) {
+  const fs::path png = workDir() / "car_paint.png";
+  CliRun r = cli({"preview", example("car_paint.json"), "-o", png.string(), "--size", "64"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, png.string() + "\n");
+  Png img;
+  ASSERT_TRUE(readPng(png, &img));
+  EXPECT_EQ(img.width, 64);
+  EXPECT_EQ(img.height, 64);
+  // The sphere (red paint) is in the middle; the corners are the environment.
+  auto at = [&](int x, int y) { return &img.rgba[(static_cast<std::size_t>(y) * img.width + x) * 4]; };
+  const unsigned char* centre = at(32, 32);
+  const unsigned char* corner = at(1, 1);
+  EXPECT_GT(centre[0], centre[2] + 40) << "the car paint is red";
+  EXPECT_NE(std::vector<unsigned char>(centre, centre + 3), std::vector<unsigned char>(corner, corner + 3));
+  EXPECT_EQ(centre[3], 255);
+}
+
+TEST(Preview, TheSameCommandTwiceAndBothLanguagesGiveTheSameBytes) {
+  const fs::path dir = workDir();
+  ASSERT_EQ(cli({"preview", example("worked_example_72.json"), "-o", (dir / "a.png").string(), "--size", "48"}).status, 0);
+  ASSERT_EQ(cli({"preview", example("worked_example_72.json"), "-o", (dir / "b.png").string(), "--size", "48"}).status, 0);
+  ASSERT_EQ(cli({"preview", example("worked_example_72.json"), "-o", (dir / "c.png").string(), "--size", "48",
+                 "--target", "hlsl"})
+                .status,
+            0);
+  EXPECT_EQ(bytesOf(dir / "a.png"), bytesOf(dir / "b.png"));
+  EXPECT_EQ(bytesOf(dir / "a.png"), bytesOf(dir / "c.png"));
+}
+
+TEST(Preview, SweepIsAContactSheetOfTheSimplificationSteps) {
+  const fs::path one = workDir() / "one.png", sheet = workDir() / "sheet.png";
+  ASSERT_EQ(cli({"preview", example("worked_example_72.json"), "-o", one.string(), "--size", "48"}).status, 0);
+  CliRun r = cli({"preview", example("worked_example_72.json"), "-o", sheet.string(), "--size", "48", "--sweep"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  Png a, b;
+  ASSERT_TRUE(readPng(one, &a));
+  ASSERT_TRUE(readPng(sheet, &b));
+  // worked_example_72 (72 B, 3 closures) has at least the authored and the fully simplified tiles.
+  EXPECT_GE(b.width, 2 * a.width);
+  EXPECT_GT(b.height, a.height) << "room for the labels";
+}
+
+TEST(Preview, ABrokenMaterialWritesNothing) {
+  const fs::path dir = workDir();
+  const fs::path broken = dir / "broken.json", png = dir / "broken.png";
+  std::ofstream(broken) << R"({"format": "substrate-material/1", "name": "m", "nodes": {}, "output": "nope"})";
+  CliRun r = cli({"preview", broken.string(), "-o", png.string()});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("broken.json"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
+}
+
+TEST(Preview, AnUnknownEnvironmentIsAUsageError) {
+  CliRun r = cli({"preview", example("row12_simple.json"), "-o", (workDir() / "x.png").string(), "--env", "moon"});
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.err.find("moon"), std::string::npos) << r.err;
+}
+
+}  // namespace
