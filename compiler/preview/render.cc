@@ -164,7 +164,7 @@ bool simplificationSweep(const std::string& path, const std::string& text, const
   };
   auto label = [](const std::string& what, const CompileResult& r) {
     const int closures = static_cast<int>(r.after.closures.size());
-    return fmt::format("{}: {} B, {} closure{}", what, r.after.bytes(), closures, closures == 1 ? "" : "s");
+    return fmt::format("{}: {} B, {} cl", what, r.after.bytes(), closures);
   };
   // The whole path, from the full simplification's steps.
   CompileOptions full = base;
@@ -180,7 +180,7 @@ bool simplificationSweep(const std::string& path, const std::string& text, const
   auto first = compile(start);
   if (!first) return false;
   std::set<std::pair<int, int>> seen{{first->after.bytes(), static_cast<int>(first->after.closures.size())}};
-  out->push_back({*first, label("as authored", *first)});
+  out->push_back({*first, label("authored", *first)});
   for (std::size_t i = 0; i < all->steps.size(); ++i) {
     const SimplifyStep& step = all->steps[i];
     CompileOptions o = base;

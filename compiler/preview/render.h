@@ -29,7 +29,7 @@ bool renderSphere(gpu::Context& gpu, const CompileResult& r, const RenderOptions
                   std::string* error);
 
 /// One tile of a simplification sweep: the material compiled to stop after a
-/// step, and its label ("step 2: 48 B, 2 closures"; the steps themselves are
+/// step, and its label ("step 2: 48 B, 2 cl": bytes per pixel and closures; the steps themselves are
 /// in `substratec report --full-simplification`).
 struct SweepEntry {
   CompileResult result;
