@@ -292,12 +292,7 @@ void Emitter::emitTree() {
     line(fmt::format("{} T_{} = {};", v3, node.id, t));
   }
   // Operators bottom-up: by distance from leaves, then tree id.
-  std::vector<int> ops;
-  for (int n : t_.preorder)
-    if (m_.nodes[n].op != TreeOp::Slab) ops.push_back(n);
-  std::stable_sort(ops.begin(), ops.end(),
-                   [&](int a, int b) { return t_.distanceFromLeaves[a] < t_.distanceFromLeaves[b]; });
-  for (int n : ops) {
+  for (int n : t_.bottomUpOperators) {
     const TreeNode& node = m_.nodes[n];
     const std::string id = node.id, l = nodeName(node.left), r = node.right >= 0 ? nodeName(node.right) : "";
     line(fmt::format("// {} '{}' (Id={}, DistanceFromLeaves={})", treeOpName(node.op), id, t_.reportId[n],

@@ -113,6 +113,10 @@ TreeInfo analyzeTree(const Material& m) {
     t.distanceFromLeaves[*it] = d;
   }
   t.maxDistanceFromLeaves = t.distanceFromLeaves[m.root];
+  for (int n : t.preorder)
+    if (m.nodes[n].op != TreeOp::Slab) t.bottomUpOperators.push_back(n);
+  std::stable_sort(t.bottomUpOperators.begin(), t.bottomUpOperators.end(),
+                   [&](int a, int b) { return t.distanceFromLeaves[a] < t.distanceFromLeaves[b]; });
   return t;
 }
 

@@ -28,6 +28,8 @@ struct TreeInfo {
                                    // mixes, adds, weights, selects and the bases of verticals nested in
                                    // that layer (its thickness is the node's); -1: none (the surface
                                    // thickness applies)
+  std::vector<int> bottomUpOperators;  // operator nodes by distance from leaves, then pre-order:
+                                       // an order that evaluates every operand before its operator
   int maxDistanceFromLeaves = 0;
 };
 

@@ -208,12 +208,7 @@ class Walk {
 
   // emitTree, operators bottom-up (by distance from leaves, then pre-order).
   void operators() {
-    std::vector<int> ops;
-    for (int n : t_.preorder)
-      if (m_.nodes[n].op != TreeOp::Slab) ops.push_back(n);
-    std::stable_sort(ops.begin(), ops.end(),
-                     [&](int a, int b) { return t_.distanceFromLeaves[a] < t_.distanceFromLeaves[b]; });
-    for (int n : ops) {
+    for (int n : t_.bottomUpOperators) {
       const TreeNode& node = m_.nodes[n];
       const int l = node.left, r = node.right;
       switch (node.op) {
