@@ -285,7 +285,7 @@ TEST(Golden, EveryExampleKernelValidates) {
     auto [r, diags] = compileAs(e, e.filename().string());
     ASSERT_TRUE(r) << diags;
     for (Target t : {Target::Glsl, Target::Hlsl})
-      for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred, KernelMode::Preview}) {
+      for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred, KernelMode::Preview, KernelMode::Throughput}) {
         ShaderValidation v = compileKernel(*r, t, mode);
         EXPECT_TRUE(v.ok) << v.log;
       }

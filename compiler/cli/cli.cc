@@ -14,6 +14,7 @@
 #include "preview/contact_sheet.h"
 #include "preview/environment.h"
 #include "preview/render.h"
+#include "sweep/sweep.h"
 
 #include <filesystem>
 
@@ -180,10 +181,11 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
     }
     text = std::move(*read);
   }
-  std::vector<preview::SweepEntry> entries;
+  std::vector<sweep::Step> entries;
   std::string error;
   if (a.sweep) {
-    if (!preview::simplificationSweep(a.file, text, o, &entries, &error)) {
+    CompileResult full;
+    if (!sweep::simplificationSteps(a.file, text, o, &entries, &full, &error)) {
       err << error;
       return kExitBadInput;
     }
@@ -192,7 +194,7 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
     auto r = compileText(a.file, text, o, diags);
     err << diags.formatAll();
     if (!r) return kExitBadInput;
-    entries.push_back({std::move(*r), ""});
+    entries.push_back({std::move(*r), "", 0});
   }
   gpu::Context::Options go;
   auto ctx = gpu::Context::create(go, &error);
@@ -215,7 +217,8 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
       return kExitInternal;
     }
     tiles.push_back(preview::tonemap(hdr, a.exposure));
-    labels.push_back(e.label);
+    const int closures = static_cast<int>(e.result.after.closures.size());
+    labels.push_back(fmt::format("{}: {} B, {} cl", e.label, e.result.after.bytes(), closures));
   }
   preview::Image image = a.sweep ? preview::contactSheet(tiles, labels, std::min<int>(4, static_cast<int>(tiles.size())))
                                  : tiles.front();
@@ -229,6 +232,82 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   out << a.output << "\n";
+  return kExitOk;
+}
+
+struct SweepArgs {
+  std::string file;
+  bool json = false;
+  bool csv = false;
+  std::string plot;
+  double maxError = -1;
+  int pixels = 1 << 20;
+  int runs = 5;
+  std::string diffuse = "chan2024";
+  std::size_t maxInputSize = 16u << 20;
+};
+
+/// The material at its full budget and at each simplification step: cost
+/// (bytes, closures, instructions, lavapipe time) against error (vs the
+/// unsimplified tree). --max-error chooses the cheapest row within the error.
+int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
+  CompileOptions o;
+  o.read.maxInputBytes = a.maxInputSize;
+  std::string text;
+  {
+    Diagnostics diags(a.file);
+    auto read = readSourceFile(a.file, o.read, diags);
+    if (!read) {
+      err << diags.formatAll();
+      return kExitBadInput;
+    }
+    text = std::move(*read);
+  }
+  std::vector<sweep::Step> steps;
+  CompileResult full;
+  std::string error;
+  if (!sweep::simplificationSteps(a.file, text, o, &steps, &full, &error)) {
+    err << error;
+    return kExitBadInput;
+  }
+  auto ctx = gpu::Context::create(gpu::Context::Options{}, &error);
+  if (!ctx) {
+    err << "substratec: error: sweep times the generated code on Vulkan (Mesa lavapipe): " << error << "\n";
+    return kExitBadInput;
+  }
+  sweep::Options so;
+  so.pixels = a.pixels;
+  so.timedRuns = a.runs;
+  so.diffuseModel = diffuseModelOf(a.diffuse);
+  std::vector<sweep::Row> rows;
+  if (!sweep::measure(*ctx, steps, full, so, &rows, &error)) {
+    err << "substratec: internal compiler error: " << error << "\n";
+    return kExitInternal;
+  }
+  const std::string& name = full.material.name;
+  if (!a.plot.empty()) {
+    std::string failure = writeFilesAtomically(
+        std::filesystem::path(a.plot).parent_path().string().empty() ? "." : std::filesystem::path(a.plot).parent_path().string(),
+        {{std::filesystem::path(a.plot).filename().string(), sweep::plotSvg(name, rows)}});
+    if (!failure.empty()) {
+      err << "substratec: error: " << failure << "\n";
+      return kExitBadInput;
+    }
+  }
+  if (a.json) out << sweep::formatJson(name, rows);
+  else if (a.csv) out << sweep::formatCsv(rows);
+  else out << sweep::formatTable(name, rows);
+  if (a.maxError >= 0) {
+    auto best = sweep::cheapestWithin(rows, a.maxError);
+    if (!best) {
+      err << fmt::format("substratec: error: no step of '{}' is within rel_mse {} (the full budget's is {:.3e})\n", name,
+                         a.maxError, rows.empty() ? 0.0 : rows.front().relMse);
+      return kExitBadInput;
+    }
+    (a.json || a.csv ? err : out) << fmt::format("budget {} ({}: {} B, {} closures, rel_mse {:.3e})\n",
+                                                 rows[*best].budget, rows[*best].label, rows[*best].bytes,
+                                                 rows[*best].closures, rows[*best].relMse);
+  }
   return kExitOk;
 }
 
@@ -292,6 +371,22 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   pre->add_option("--max-input-size", prev.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
 
+  SweepArgs sw;
+  CLI::App* swp = app.add_subcommand("sweep", "Cost against error at the full budget and at each simplification step");
+  swp->add_option("file", sw.file, "Material file (substrate-material/1 JSON)")->required();
+  swp->add_flag("--json", sw.json, "Print {\"material\": ..., \"rows\": [...]}");
+  swp->add_flag("--csv", sw.csv, "Print the rows as CSV");
+  swp->add_option("--plot", sw.plot, "Also write an SVG plot of error against cost");
+  swp->add_option("--max-error", sw.maxError, "Choose the cheapest row with rel_mse <= E and print its budget")
+      ->check(CLI::Range(0.0, 1e30));
+  swp->add_option("--pixels", sw.pixels, "Shading points per timed dispatch")->check(CLI::Range(64, 1 << 24));
+  swp->add_option("--runs", sw.runs, "Timed dispatches after the warm-up (the median is reported)")
+      ->check(CLI::Range(1, 100));
+  swp->add_option("--diffuse", sw.diffuse, "Diffuse model")
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
+  swp->add_option("--max-input-size", sw.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
   try {
@@ -314,6 +409,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (rep->parsed()) return runReport(report, out, err);
     if (comp->parsed()) return runCompile(compile, out, err);
     if (pre->parsed()) return runPreview(prev, out, err);
+    if (swp->parsed()) return runSweep(sw, out, err);
   } catch (const std::exception& e) {
     err << "substratec: internal compiler error: " << e.what() << "\n";
     return kExitInternal;

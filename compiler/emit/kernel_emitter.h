@@ -13,6 +13,7 @@
 //   5     the runtime's energy tables (substrate_energy_lut.h)
 //   0     preview parameters (SubstratePreview below; preview only)
 //   6     samples: kSampleVec4s float4 per sample (sample kernels only)
+//   (Throughput reads nothing but the material's resources and the tables)
 //   7     results: floats, see below
 #pragma once
 #include <string>
@@ -25,6 +26,8 @@ enum class KernelMode {
   Forward,   // evaluate, then light the closures inline (the forward pass)
   Deferred,  // evaluate, pack into the uint stream, unpack generically, then light (base pass + deferred lighting)
   Preview,   // a sphere, three lights and a split-sum environment, one RGBA float4 per pixel
+  Throughput,  // cost: each invocation hashes its own shading point, evaluates, lights it (one light and a
+               // constant split-sum environment) and writes one float4 (results[i]): no input buffer to read
 };
 
 /// Sample layout (float4 index within a sample; `kSampleVec4s` per sample).
@@ -74,7 +77,7 @@ inline constexpr int kPreviewParamVec4s = 2 + 2 * kPreviewLights;
 /// The kernel source; it includes "<name>.material.{glsl,hlsl}" and the runtime.
 std::string emitKernel(const Material& m, const StorageLayout& layout, const Syntax& syn, KernelMode mode);
 
-/// `<name>.<mode>.comp` / `<name>.<mode>.cs.hlsl` (mode: forward_samples, deferred_samples, preview).
+/// `<name>.<mode>.comp` / `<name>.<mode>.cs.hlsl` (mode: forward_samples, deferred_samples, preview, throughput).
 std::string kernelFileName(const Material& m, const Syntax& syn, KernelMode mode);
 
 }  // namespace substratec

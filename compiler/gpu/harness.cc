@@ -110,6 +110,7 @@ struct DispatchObjects {
   VkDescriptorPool descriptorPool = VK_NULL_HANDLE;
   VkCommandBuffer commandBuffer = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
+  VkQueryPool timestamps = VK_NULL_HANDLE;  // two timestamps around the dispatch, when timed
 };
 
 /// An image to fill before the dispatch: from a staging buffer, or cleared.
@@ -147,6 +148,7 @@ struct Context::Impl {
   VkQueue queue = VK_NULL_HANDLE;
   VkCommandPool commandPool = VK_NULL_HANDLE;
   std::string deviceName, driverInfo;
+  double timestampPeriodNs = 1;  // VkPhysicalDeviceLimits::timestampPeriod
   bool lost = false;  // a fence wait timed out or the device was lost: leak, never wait
 
   ~Impl() {
@@ -298,6 +300,7 @@ bool Context::Impl::createDevice(std::string* error) {
     physical = devices[i];
     deviceName = props.properties.deviceName;
     driverInfo = driver.driverInfo;
+    timestampPeriodNs = props.properties.limits.timestampPeriod;
   }
   if (!physical) {
     *error = "no lavapipe (VK_DRIVER_ID_MESA_LLVMPIPE) device among: " + (seen.empty() ? std::string("none") : seen) +
@@ -425,6 +428,7 @@ bool Context::Impl::createSampler(Filter filter, Address address, DispatchObject
 
 void Context::Impl::destroy(DispatchObjects& objs) {
   if (objs.fence) vk.vkDestroyFence(device, objs.fence, nullptr);
+  if (objs.timestamps) vk.vkDestroyQueryPool(device, objs.timestamps, nullptr);
   if (objs.commandBuffer) vk.vkFreeCommandBuffers(device, commandPool, 1, &objs.commandBuffer);
   if (objs.descriptorPool) vk.vkDestroyDescriptorPool(device, objs.descriptorPool, nullptr);
   for (VkSampler s : objs.samplers) vk.vkDestroySampler(device, s, nullptr);
@@ -542,7 +546,7 @@ std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint3
 }
 
 bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, uint32_t groupsX, uint32_t groupsY,
-                       uint32_t groupsZ, std::string* error) {
+                       uint32_t groupsZ, std::string* error, double* dispatchNs) {
   Impl& c = *impl_;
   const VulkanFunctions& vk = c.vk;
   const ShaderReflection& refl = pipeline.reflection();
@@ -771,7 +775,18 @@ bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, ui
     if (!sets.empty())
       vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, static_cast<uint32_t>(sets.size()),
                                  sets.data(), 0, nullptr);
+    if (dispatchNs) {
+      VkQueryPoolCreateInfo q{};
+      q.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+      q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+      q.queryCount = 2;
+      if (!succeeded(vk.vkCreateQueryPool(c.device, &q, nullptr, &objs.timestamps), "vkCreateQueryPool", &why))
+        return false;
+      vk.vkCmdResetQueryPool(cmd, objs.timestamps, 0, 2);
+      vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, objs.timestamps, 0);
+    }
     vk.vkCmdDispatch(cmd, groupsX, groupsY, groupsZ);
+    if (dispatchNs) vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, objs.timestamps, 1);
     for (const Readback& rb : readbacks)
       if (rb.image)
         out.push_back(transition(rb.image, rb.region.imageSubresource.layerCount, 1, VK_IMAGE_LAYOUT_GENERAL,
@@ -809,6 +824,14 @@ bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, ui
     for (const Readback& rb : readbacks) {
       rb.target->resize(rb.size);
       std::memcpy(rb.target->data(), rb.mapped, rb.size);
+    }
+    if (dispatchNs) {
+      uint64_t t[2] = {0, 0};
+      if (!succeeded(vk.vkGetQueryPoolResults(c.device, objs.timestamps, 0, 2, sizeof t, t, sizeof(uint64_t),
+                                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                     "vkGetQueryPoolResults", &why))
+        return false;
+      *dispatchNs = static_cast<double>(t[1] - t[0]) * c.timestampPeriodNs;
     }
     return true;
   }();

@@ -115,8 +115,10 @@ class Context {
   /// outputs back into `resources`. False with `*error` set on any failed Vulkan call (with its
   /// VkResult), a timeout, or any validation message recorded meanwhile (all of them listed). After a
   /// timeout the Context is unusable: its objects may still be in use and are leaked, never waited on.
+  /// With `dispatchNs`, two timestamp queries around the dispatch give its execution time in ns
+  /// (uploads, clears and read-backs excluded).
   bool dispatch(const ComputePipeline& pipeline, Resources& resources, uint32_t groupsX, uint32_t groupsY,
-                uint32_t groupsZ, std::string* error);
+                uint32_t groupsZ, std::string* error, double* dispatchNs = nullptr);
 
   /// Every message recorded so far ("ERROR [validation] Validation Error: [ VUID-... ] ..."); clears the list.
   std::vector<std::string> takeMessages();

@@ -79,7 +79,12 @@ namespace substratec::gpu {
   X(vkCmdClearColorImage)                 \
   X(vkCmdBindPipeline)                    \
   X(vkCmdBindDescriptorSets)              \
-  X(vkCmdDispatch)
+  X(vkCmdDispatch)                        \
+  X(vkCreateQueryPool)                    \
+  X(vkDestroyQueryPool)                   \
+  X(vkCmdResetQueryPool)                  \
+  X(vkCmdWriteTimestamp)                  \
+  X(vkGetQueryPoolResults)
 
 /// The function-pointer table; a null member means "not loaded yet".
 struct VulkanFunctions {

@@ -4,7 +4,6 @@
 #include <cstring>
 #include <map>
 #include <mutex>
-#include <set>
 
 #include <fmt/format.h>
 
@@ -151,51 +150,6 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
   const auto& buf = std::get<gpu::BufferResource>(res.at({0, 7}));
   *out = Image(o.size, o.size);
   std::memcpy(out->rgba.data(), buf.data.data(), out->rgba.size() * sizeof(float));
-  return true;
-}
-
-bool simplificationSweep(const std::string& path, const std::string& text, const CompileOptions& base,
-                         std::vector<SweepEntry>* out, std::string* error) {
-  auto compile = [&](const CompileOptions& o) -> std::optional<CompileResult> {
-    Diagnostics diags(path);
-    auto r = compileText(path, text, o, diags);
-    if (!r) *error = diags.formatAll();
-    return r;
-  };
-  auto label = [](const std::string& what, const CompileResult& r) {
-    const int closures = static_cast<int>(r.after.closures.size());
-    return fmt::format("{}: {} B, {} cl", what, r.after.bytes(), closures);
-  };
-  // The whole path, from the full simplification's steps.
-  CompileOptions full = base;
-  full.budgetOverride.reset();
-  full.maxClosuresOverride.reset();
-  full.fullSimplification = true;
-  auto all = compile(full);
-  if (!all) return false;
-  CompileOptions start = base;
-  start.budgetOverride = 1024;
-  start.maxClosuresOverride = 8;
-  start.fullSimplification = false;
-  auto first = compile(start);
-  if (!first) return false;
-  std::set<std::pair<int, int>> seen{{first->after.bytes(), static_cast<int>(first->after.closures.size())}};
-  out->push_back({*first, label("authored", *first)});
-  for (std::size_t i = 0; i < all->steps.size(); ++i) {
-    const SimplifyStep& step = all->steps[i];
-    CompileOptions o = base;
-    o.fullSimplification = false;
-    o.budgetOverride = std::max(step.bytesAfter, 8);
-    o.maxClosuresOverride = std::max(step.closuresAfter, 1);
-    Diagnostics diags(path);
-    auto r = compileText(path, text, o, diags);
-    if (!r) continue;  // a step only full simplification reaches (below the smallest budget)
-    const std::pair<int, int> key{r->after.bytes(), static_cast<int>(r->after.closures.size())};
-    if (!seen.insert(key).second) continue;
-    out->push_back({*r, label(fmt::format("step {}", i + 1), *r)});
-  }
-  const std::pair<int, int> key{all->after.bytes(), static_cast<int>(all->after.closures.size())};
-  if (seen.insert(key).second) out->push_back({*all, label("full", *all)});
   return true;
 }
 

@@ -28,20 +28,6 @@ struct RenderOptions {
 bool renderSphere(gpu::Context& gpu, const CompileResult& r, const RenderOptions& options, Image* out,
                   std::string* error);
 
-/// One tile of a simplification sweep: the material compiled to stop after a
-/// step, and its label ("step 2: 48 B, 2 cl": bytes per pixel and closures; the steps themselves are
-/// in `substratec report --full-simplification`).
-struct SweepEntry {
-  CompileResult result;
-  std::string label;
-};
-
-/// The material at its full budget, after each simplification step that
-/// changes its size (compiled with that step's bytes and closures as the
-/// budget), and fully simplified. Diagnostics of a failed compile in `*error`.
-bool simplificationSweep(const std::string& path, const std::string& text, const CompileOptions& base,
-                         std::vector<SweepEntry>* out, std::string* error);
-
 /// The procedural texture bound to every texture input of a preview: a soft
 /// 8 x 8 checker around mid grey (a mask, a colour or a normal map all show
 /// their effect without dominating), `size` x `size` RGBA.

@@ -1,0 +1,58 @@
+// Running a compiled material's sample kernels (emit/kernel_emitter.h) on
+// lavapipe: the sample set, the material's resources (inputs block,
+// procedural textures, energy tables) and the result buffer. Used by the GPU
+// tests (against the CPU reference) and by `substratec sweep`.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "emit/kernel_emitter.h"
+#include "gpu/harness.h"
+#include "pipeline/pipeline.h"
+#include "reference/reference.h"
+
+namespace substratec::gpu {
+
+/// One shading point and its lighting, as the sample kernels read it.
+struct Sample {
+  reference::Geometry geometry;
+  std::array<double, 3> light{0, 0, 1};     // unit, toward the light
+  std::array<double, 3> radiance{1, 1, 1};  // of the light
+  std::array<double, 3> prefiltered{0, 0, 0};
+  std::array<double, 3> irradiance{0, 0, 0};
+};
+
+inline constexpr int kTextureSize = 16;
+
+/// `count` samples (a multiple of kernel::kLocalSize) from a fixed seed: normals
+/// and tangents all around, views from head-on to 1e-4 from grazing (and a few
+/// just behind the surface), lights above and below the horizon, uvs inside
+/// texels of kTextureSize-texel textures (never on a texel edge), dithers in [0, 1).
+std::vector<Sample> makeSamples(int count, uint32_t seed);
+
+/// The kernel's sample buffer for `samples`.
+std::vector<std::byte> sampleBuffer(const std::vector<Sample>& samples);
+
+/// The procedural kTextureSize² RGBA texture bound to texture input `input`
+/// (smooth gradients and a checker, values in [0, 1]), and its nearest/repeat lookup.
+std::vector<float> textureTexels(int input);
+std::array<double, 4> sampleTexture(int input, double u, double v);
+
+/// The resources of one sample-kernel dispatch: the inputs block filled from
+/// the module's own member offsets (GLSL std140 and HLSL cbuffer packing
+/// differ) with `inputValues` (empty: defaults), the textures and samplers by
+/// name, the energy tables, the samples, and an output buffer of `resultFloats` floats.
+Resources kernelResources(const Material& m, const ShaderReflection& reflection, const std::vector<uint32_t>& spirv,
+                          const std::vector<std::array<double, 4>>& inputValues, const std::vector<std::byte>& samples,
+                          std::size_t resultFloats);
+
+/// Floats per sample in a sample kernel's results.
+int resultStride(const CompileResult& r);
+
+/// Reads a float result buffer back from a BufferResource.
+std::vector<float> floatsOf(const Resources& resources, uint32_t set, uint32_t binding);
+
+}  // namespace substratec::gpu

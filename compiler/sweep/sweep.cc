@@ -1,0 +1,349 @@
+#include "sweep/sweep.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "emit/generate.h"
+#include "gpu/sample_run.h"
+#include "reference/reference.h"
+#include "storage/pack.h"
+
+namespace substratec::sweep {
+
+namespace {
+
+constexpr int kProbes = 1024;           // shading points of the error measurement
+constexpr uint32_t kProbeSeed = 0x5ee9u;
+
+using V3 = std::array<double, 3>;
+
+/// Linear radiance (rgb per probe) of a material through the double reference:
+/// direct light + split-sum environment + emissive, as the forward pass sums them.
+std::vector<double> radiance(const CompileResult& r, const std::vector<gpu::Sample>& probes, int diffuseModel,
+                             std::vector<std::vector<reference::Closure<double>>>* closures) {
+  std::vector<double> out;
+  out.reserve(probes.size() * 3);
+  for (const gpu::Sample& s : probes) {
+    auto m = reference::evaluateMaterial<double>(r, s.geometry, {}, gpu::sampleTexture);
+    V3 sum{0, 0, 0};
+    for (const auto& c : m.closures) {
+      const V3 direct = reference::lightClosure<double>(c, s.geometry.V, s.light, s.radiance, diffuseModel);
+      const double NoV = c.N[0] * s.geometry.V[0] + c.N[1] * s.geometry.V[1] + c.N[2] * s.geometry.V[2];
+      const V3 viewT = reference::viewThroughput<double>(c, NoV);
+      const V3 env = reference::envSplitSum<double>(c, s.geometry.V, s.prefiltered, s.irradiance, diffuseModel);
+      for (int k = 0; k < 3; ++k) sum[k] += direct[k] + viewT[k] * (env[k] + c.emissive[k]);
+    }
+    out.insert(out.end(), sum.begin(), sum.end());
+    if (closures) closures->push_back(std::move(m.closures));
+  }
+  return out;
+}
+
+/// The forward shader's SPIR-V instruction count after the performance passes.
+bool forwardInstructions(const CompileResult& r, std::size_t* count, std::string* error) {
+  GenerateOptions o;
+  o.hlsl = false;
+  Generated g = generateFiles(r, o);
+  validateGenerated(g, {.optimize = true});
+  if (!g.valid) {
+    *error = "internal compiler error: generated code does not validate\n" + g.failure;
+    return false;
+  }
+  for (const EntryReport& e : g.entries)
+    if (e.file.ends_with(".forward.frag")) *count = e.optimizedInstructions;
+  return true;
+}
+
+/// Median lavapipe time per shading point of the throughput kernel.
+bool nsPerPixel(gpu::Context& ctx, const CompileResult& r, const Options& o, double* ns, std::string* error) {
+  ShaderValidation v = compileKernel(r, Target::Glsl, KernelMode::Throughput);
+  if (!v.ok) {
+    *error = "internal compiler error: the throughput kernel does not validate\n" + v.log;
+    return false;
+  }
+  auto pipeline = ctx.createPipeline(v.spirv, error);
+  if (!pipeline) return false;
+  const int pixels = (o.pixels + kernel::kLocalSize - 1) / kernel::kLocalSize * kernel::kLocalSize;
+  std::vector<double> times;
+  for (int run = 0; run <= o.timedRuns; ++run) {  // run 0 warms up (JIT, caches)
+    gpu::Resources res =
+        gpu::kernelResources(r.material, pipeline->reflection(), v.spirv, {}, {}, static_cast<std::size_t>(pixels) * 4);
+    double t = 0;
+    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(pixels / kernel::kLocalSize), 1, 1, error, &t)) return false;
+    if (run > 0) times.push_back(t / pixels);
+  }
+  std::sort(times.begin(), times.end());
+  *ns = times[times.size() / 2];
+  return true;
+}
+
+/// The colour fields a closure stores, by the layout's field names.
+std::vector<std::pair<const V3*, std::string>> storedColours(const reference::Closure<double>& c, const StorageLayout& L,
+                                                             int k) {
+  std::set<std::string> names;
+  for (const LayoutField& f : L.fields) names.insert(f.name);
+  const std::string pre = fmt::format("closure{}.", k);
+  std::vector<std::pair<const V3*, std::string>> out;
+  if (names.count(pre + "diffuse_albedo")) out.push_back({&c.diffuseAlbedo, "diffuse_albedo"});
+  if (names.count(pre + "f0")) out.push_back({&c.f0, "f0"});
+  if (names.count(pre + "f90")) out.push_back({&c.f90, "f90"});
+  if (names.count(pre + "top_transmittance")) out.push_back({&c.topTransmittance, "top_transmittance"});
+  if (names.count(pre + "fuzz")) out.push_back({&c.fuzzColor, "fuzz"});
+  return out;
+}
+
+std::array<double, 3> toLab(const std::array<double, 3>& rgb) {
+  const double x = 0.4124564 * rgb[0] + 0.3575761 * rgb[1] + 0.1804375 * rgb[2];
+  const double y = 0.2126729 * rgb[0] + 0.7151522 * rgb[1] + 0.0721750 * rgb[2];
+  const double z = 0.0193339 * rgb[0] + 0.1191920 * rgb[1] + 0.9503041 * rgb[2];
+  auto f = [](double t) { return t > 216.0 / 24389.0 ? std::cbrt(t) : (24389.0 / 27.0 * t + 16.0) / 116.0; };
+  const double fx = f(x / 0.95047), fy = f(y), fz = f(z / 1.08883);
+  return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
+}
+
+double percentile(std::vector<double> v, double p) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
+}
+
+}  // namespace
+
+double deltaE2000(const std::array<double, 3>& linearA, const std::array<double, 3>& linearB) {
+  return deltaE2000Lab(toLab(linearA), toLab(linearB));
+}
+
+double deltaE2000Lab(const std::array<double, 3>& lab1, const std::array<double, 3>& lab2) {
+  // Sharma, Wu & Dalal 2005, "The CIEDE2000 color-difference formula".
+  const auto [L1, a1, b1] = lab1;
+  const auto [L2, a2, b2] = lab2;
+  const double kPi = 3.14159265358979323846;
+  const double C1 = std::hypot(a1, b1), C2 = std::hypot(a2, b2), Cbar = 0.5 * (C1 + C2);
+  const double G = 0.5 * (1 - std::sqrt(std::pow(Cbar, 7) / (std::pow(Cbar, 7) + std::pow(25.0, 7))));
+  const double a1p = (1 + G) * a1, a2p = (1 + G) * a2;
+  const double C1p = std::hypot(a1p, b1), C2p = std::hypot(a2p, b2);
+  auto hue = [&](double b, double ap) {
+    if (b == 0 && ap == 0) return 0.0;
+    double h = std::atan2(b, ap) * 180 / kPi;
+    return h < 0 ? h + 360 : h;
+  };
+  const double h1p = hue(b1, a1p), h2p = hue(b2, a2p);
+  const double dLp = L2 - L1, dCp = C2p - C1p;
+  double dhp = 0;
+  if (C1p * C2p != 0) {
+    dhp = h2p - h1p;
+    if (dhp > 180) dhp -= 360;
+    if (dhp < -180) dhp += 360;
+  }
+  const double dHp = 2 * std::sqrt(C1p * C2p) * std::sin(dhp * kPi / 360);
+  const double Lbarp = 0.5 * (L1 + L2), Cbarp = 0.5 * (C1p + C2p);
+  double hbarp = h1p + h2p;
+  if (C1p * C2p != 0) {
+    if (std::abs(h1p - h2p) <= 180) hbarp *= 0.5;
+    else hbarp = h1p + h2p < 360 ? 0.5 * (h1p + h2p + 360) : 0.5 * (h1p + h2p - 360);
+  }
+  const double rad = kPi / 180;
+  const double T = 1 - 0.17 * std::cos((hbarp - 30) * rad) + 0.24 * std::cos(2 * hbarp * rad) +
+                   0.32 * std::cos((3 * hbarp + 6) * rad) - 0.20 * std::cos((4 * hbarp - 63) * rad);
+  const double dTheta = 30 * std::exp(-std::pow((hbarp - 275) / 25, 2));
+  const double Rc = 2 * std::sqrt(std::pow(Cbarp, 7) / (std::pow(Cbarp, 7) + std::pow(25.0, 7)));
+  const double Sl = 1 + 0.015 * std::pow(Lbarp - 50, 2) / std::sqrt(20 + std::pow(Lbarp - 50, 2));
+  const double Sc = 1 + 0.045 * Cbarp, Sh = 1 + 0.015 * Cbarp * T;
+  const double Rt = -std::sin(2 * dTheta * rad) * Rc;
+  return std::sqrt(std::pow(dLp / Sl, 2) + std::pow(dCp / Sc, 2) + std::pow(dHp / Sh, 2) +
+                   Rt * (dCp / Sc) * (dHp / Sh));
+}
+
+bool simplificationSteps(const std::string& path, const std::string& text, const CompileOptions& base,
+                         std::vector<Step>* steps, CompileResult* full, std::string* error) {
+  auto compile = [&](const CompileOptions& o) -> std::optional<CompileResult> {
+    Diagnostics diags(path);
+    auto r = compileText(path, text, o, diags);
+    if (!r && error) *error = diags.formatAll();
+    return r;
+  };
+  CompileOptions unsimplified = base;
+  unsimplified.budgetOverride = 1024;
+  unsimplified.maxClosuresOverride = 8;
+  unsimplified.fullSimplification = false;
+  auto whole = compile(unsimplified);
+  CompileOptions own = base;
+  own.fullSimplification = false;
+  auto first = compile(own);
+  CompileOptions collapse = base;
+  collapse.budgetOverride.reset();
+  collapse.maxClosuresOverride.reset();
+  collapse.fullSimplification = true;
+  auto all = compile(collapse);
+  if (!whole || !first || !all) return false;
+  *full = *whole;
+  std::set<std::pair<int, int>> seen{{first->after.bytes(), static_cast<int>(first->after.closures.size())}};
+  steps->push_back({*first, "full budget", first->budgetBytes});
+  for (std::size_t i = 0; i < all->steps.size(); ++i) {
+    const SimplifyStep& s = all->steps[i];
+    if (s.bytesAfter >= first->after.bytes() && s.closuresAfter >= static_cast<int>(first->after.closures.size()))
+      continue;  // a step the material's own budget already took
+    CompileOptions o = base;
+    o.fullSimplification = false;
+    o.budgetOverride = std::max(s.bytesAfter, 8);
+    o.maxClosuresOverride = std::max(s.closuresAfter, 1);
+    Diagnostics diags(path);
+    auto r = compileText(path, text, o, diags);
+    if (!r) continue;  // only full simplification gets there (below the smallest budget)
+    if (!seen.insert({r->after.bytes(), static_cast<int>(r->after.closures.size())}).second) continue;
+    steps->push_back({*r, fmt::format("step {}", i + 1), *o.budgetOverride});
+  }
+  if (seen.insert({all->after.bytes(), static_cast<int>(all->after.closures.size())}).second)
+    steps->push_back({*all, "full simplification", all->budgetBytes});
+  return true;
+}
+
+bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileResult& full, const Options& o,
+             std::vector<Row>* rows, std::string* error) {
+  const std::vector<gpu::Sample> probes = gpu::makeSamples(kProbes, kProbeSeed);
+  const std::vector<double> y = radiance(full, probes, o.diffuseModel, nullptr);
+  for (const Step& step : steps) {
+    const CompileResult& r = step.result;
+    Row row;
+    row.label = step.label;
+    row.budget = step.budget;
+    row.bytes = r.after.bytes();
+    row.closures = static_cast<int>(r.after.closures.size());
+    if (!forwardInstructions(r, &row.spirvInstructions, error)) return false;
+    if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, error)) return false;
+    std::vector<std::vector<reference::Closure<double>>> closures;
+    const std::vector<double> x = radiance(r, probes, o.diffuseModel, &closures);
+    std::vector<double> abs(x.size());
+    double sum = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      abs[i] = std::abs(x[i] - y[i]);
+      sum += abs[i] * abs[i] / (y[i] * y[i] + 0.01);
+      row.maxAbs = std::max(row.maxAbs, abs[i]);
+    }
+    row.relMse = x.empty() ? 0 : sum / static_cast<double>(x.size());
+    row.p99Abs = percentile(abs, 0.99);
+    // The packed colours: what the storage's quantizer gives back, at each probe's dither.
+    double deSum = 0;
+    long deCount = 0;
+    for (std::size_t p = 0; p < probes.size(); ++p)
+      for (std::size_t k = 0; k < closures[p].size(); ++k)
+        for (const auto& [colour, name] : storedColours(closures[p][k], r.after, static_cast<int>(k))) {
+          Vec3d clamped;
+          for (int c = 0; c < 3; ++c) clamped[c] = std::clamp((*colour)[c], 0.0, 1.0);
+          const Vec3d decoded = dequantizeColor(quantizeColor(clamped, probes[p].geometry.dither));
+          const double de = deltaE2000(*colour, decoded);
+          deSum += de;
+          ++deCount;
+          row.deltaE2000Max = std::max(row.deltaE2000Max, de);
+        }
+    row.deltaE2000Mean = deCount ? deSum / static_cast<double>(deCount) : 0;
+    rows->push_back(row);
+  }
+  return true;
+}
+
+std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double maxError) {
+  std::optional<std::size_t> best;
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    if (!(rows[i].relMse <= maxError)) continue;
+    if (!best || rows[i].bytes < rows[*best].bytes ||
+        (rows[i].bytes == rows[*best].bytes && rows[i].gpuNsPerPixel < rows[*best].gpuNsPerPixel))
+      best = i;
+  }
+  return best;
+}
+
+std::string formatTable(const std::string& material, const std::vector<Row>& rows) {
+  std::string s = fmt::format("----- SWEEP - {} -----\n", material);
+  s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8}\n", "row", "budget",
+                   "bytes", "closures", "spirv_instr", "ns/pixel", "rel_mse", "max_abs", "p99_abs", "dE00_avg",
+                   "dE00_max");
+  for (const Row& r : rows)
+    s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10.1f} {:>10.3e} {:>10.3e} {:>10.3e} {:>8.3f} {:>8.3f}\n",
+                     r.label, r.budget, r.bytes, r.closures, r.spirvInstructions, r.gpuNsPerPixel, r.relMse, r.maxAbs,
+                     r.p99Abs, r.deltaE2000Mean, r.deltaE2000Max);
+  return s;
+}
+
+std::string formatJson(const std::string& material, const std::vector<Row>& rows) {
+  nlohmann::ordered_json j;
+  j["material"] = material;
+  j["rows"] = nlohmann::ordered_json::array();
+  for (const Row& r : rows) {
+    nlohmann::ordered_json row;
+    row["label"] = r.label;
+    row["budget"] = r.budget;
+    row["bytes"] = r.bytes;
+    row["closures"] = r.closures;
+    row["spirv_instructions"] = r.spirvInstructions;
+    row["gpu_ns_per_pixel"] = r.gpuNsPerPixel;
+    row["rel_mse"] = r.relMse;
+    row["max_abs"] = r.maxAbs;
+    row["p99_abs"] = r.p99Abs;
+    row["delta_e2000"] = {{"mean", r.deltaE2000Mean}, {"max", r.deltaE2000Max}};
+    j["rows"].push_back(row);
+  }
+  return j.dump(2) + "\n";
+}
+
+std::string formatCsv(const std::vector<Row>& rows) {
+  std::string s =
+      "label,budget,bytes,closures,spirv_instructions,gpu_ns_per_pixel,rel_mse,max_abs,p99_abs,delta_e2000_mean,"
+      "delta_e2000_max\n";
+  for (const Row& r : rows)
+    s += fmt::format("{},{},{},{},{},{:.3f},{:.6e},{:.6e},{:.6e},{:.4f},{:.4f}\n", r.label, r.budget, r.bytes,
+                     r.closures, r.spirvInstructions, r.gpuNsPerPixel, r.relMse, r.maxAbs, r.p99Abs, r.deltaE2000Mean,
+                     r.deltaE2000Max);
+  return s;
+}
+
+std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
+  // Error (log10 rel_mse, floored at 1e-8: the full budget may be exact) against cost (ns per pixel).
+  constexpr double W = 640, H = 400, L = 70, R = 20, T = 40, B = 50;
+  double xMin = 1e300, xMax = 0, yMin = 1e300, yMax = -1e300;
+  auto ly = [](double e) { return std::log10(std::max(e, 1e-8)); };
+  for (const Row& r : rows) {
+    xMin = std::min(xMin, r.gpuNsPerPixel);
+    xMax = std::max(xMax, r.gpuNsPerPixel);
+    yMin = std::min(yMin, ly(r.relMse));
+    yMax = std::max(yMax, ly(r.relMse));
+  }
+  if (rows.empty()) xMin = xMax = yMin = yMax = 0;
+  if (xMax - xMin < 1e-9) xMax = xMin + 1;
+  yMin = std::floor(yMin);
+  yMax = std::max(std::ceil(yMax), yMin + 1);
+  auto px = [&](double x) { return L + (x - xMin) / (xMax - xMin) * (W - L - R); };
+  auto py = [&](double y) { return T + (yMax - y) / (yMax - yMin) * (H - T - B); };
+  std::string s = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" font-family=\"sans-serif\" "
+      "font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
+      W, H);
+  s += fmt::format("<text x=\"{}\" y=\"20\" font-size=\"14\">{}: error against cost</text>\n", L, material);
+  s += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"black\"/>\n", L, H - B, W - R);
+  s += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"black\"/>\n", L, T, H - B);
+  s += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">lavapipe ns per shading point</text>\n",
+                   (L + W - R) / 2, H - 12);
+  s += fmt::format("<text x=\"16\" y=\"{}\" transform=\"rotate(-90 16 {})\" text-anchor=\"middle\">rel_mse vs the "
+                   "full tree (log10)</text>\n",
+                   (T + H - B) / 2, (T + H - B) / 2);
+  for (int e = static_cast<int>(yMin); e <= static_cast<int>(yMax); ++e)
+    s += fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"end\">1e{}</text>\n", L - 6, py(e) + 4, e);
+  for (int k = 0; k <= 4; ++k) {
+    const double x = xMin + (xMax - xMin) * k / 4;
+    s += fmt::format("<text x=\"{:.1f}\" y=\"{}\" text-anchor=\"middle\">{:.0f}</text>\n", px(x), H - B + 16, x);
+  }
+  for (const Row& r : rows) {
+    const double x = px(r.gpuNsPerPixel), y = py(ly(r.relMse));
+    s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"#c0392b\"/>\n", x, y);
+    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{} ({} B, {} cl)</text>\n", x + 6, y - 6, r.label, r.bytes,
+                     r.closures);
+  }
+  s += "</svg>\n";
+  return s;
+}
+
+}  // namespace substratec::sweep

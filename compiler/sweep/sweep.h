@@ -1,0 +1,70 @@
+// `substratec sweep`: what each byte and each instruction buys. The material
+// at its full budget and after each simplification step down to one closure;
+// for each row its cost (bytes, closures, SPIR-V instructions of the forward
+// shader after the performance passes, lavapipe ns per shading point) and its
+// error against the unsimplified tree (relative MSE, max and 99th-percentile
+// absolute error of linear radiance; CIEDE2000 of the packed colours).
+#pragma once
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "gpu/harness.h"
+#include "pipeline/pipeline.h"
+
+namespace substratec::sweep {
+
+/// One material of the sweep: compiled at a budget, and what to call it.
+struct Step {
+  CompileResult result;
+  std::string label;  // "full budget", "step 3", "full simplification"
+  int budget = 0;     // the byte budget it was compiled with
+};
+
+/// The material at its own budget, after each simplification step that
+/// changes its size (compiled with that step's bytes and closures as the
+/// budget: simplification is deterministic, deepest first, so it stops
+/// there), and fully simplified. Also the unsimplified material (`*full`), the
+/// reference of the errors. False with the diagnostics in `*error`.
+bool simplificationSteps(const std::string& path, const std::string& text, const CompileOptions& base,
+                         std::vector<Step>* steps, CompileResult* full, std::string* error);
+
+struct Row {
+  std::string label;
+  int budget = 0, bytes = 0, closures = 0;
+  std::size_t spirvInstructions = 0;  // forward shader (GLSL), after SPIRV-Tools' performance passes
+  double gpuNsPerPixel = 0;           // median of the timed dispatches, lighting one point (1 light + environment)
+  double relMse = 0;                  // mean((x − y)² / (y² + 0.01)) over the probe set, y the unsimplified tree
+  double maxAbs = 0, p99Abs = 0;      // of |x − y|
+  double deltaE2000Mean = 0, deltaE2000Max = 0;  // packed vs exact colours (diffuse albedo, F0, F90, fuzz colour)
+};
+
+struct Options {
+  int pixels = 1 << 20;  // shading points per timed dispatch
+  int timedRuns = 5;     // after one untimed warm-up; the median is reported
+  int diffuseModel = 2;
+};
+
+/// Measures every step. `gpu` runs the timing kernels. False with `*error`.
+bool measure(gpu::Context& gpu, const std::vector<Step>& steps, const CompileResult& full, const Options& options,
+             std::vector<Row>* rows, std::string* error);
+
+/// The cheapest row (fewest bytes, then fewest ns per pixel) whose rel_mse is
+/// at most `maxError`, if any.
+std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double maxError);
+
+/// Outputs: a text table, `{"material": ..., "rows": [...]}`, CSV, and an SVG
+/// plot of error (rel_mse, log scale) against cost (ns per pixel), one
+/// labelled point per row.
+std::string formatTable(const std::string& material, const std::vector<Row>& rows);
+std::string formatJson(const std::string& material, const std::vector<Row>& rows);
+std::string formatCsv(const std::vector<Row>& rows);
+std::string plotSvg(const std::string& material, const std::vector<Row>& rows);
+
+/// CIEDE2000 between two CIELAB colours (Sharma, Wu & Dalal 2005).
+double deltaE2000Lab(const std::array<double, 3>& lab1, const std::array<double, 3>& lab2);
+/// The same between two linear-sRGB colours (through XYZ, D65, and CIELAB).
+double deltaE2000(const std::array<double, 3>& linearA, const std::array<double, 3>& linearB);
+
+}  // namespace substratec::sweep
