@@ -119,6 +119,25 @@ void takeDiscrete(Slab& r, const Slab& a, const Slab& b, bool bWins) {
   r.pin(SlabPin::GlintUv) = pick(aGlint, bGlint) ? b.pin(SlabPin::GlintUv) : a.pin(SlabPin::GlintUv);
 }
 
+/// The plain-lerp baseline (BlendRule::PlainLerp): every pin (the fuzz colour
+/// and the diffuse included, as they are) and the thickness lerped by t,
+/// normals and tangents renormalized; coverage and features are the caller's.
+Slab plainLerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
+  Ex e(m.values);
+  Slab r = a;
+  for (int p = 0; p < kSlabPinCount; ++p) {
+    SlabPin sp = static_cast<SlabPin>(p);
+    ValueId v = e.lerp(pin(a, sp), pin(b, sp), t);
+    if (sp == SlabPin::Normal || sp == SlabPin::Tangent) v = e.normalize(v);
+    r.pin(sp) = v;
+  }
+  if (a.thickness != kNoValue || b.thickness != kNoValue)
+    r.thickness = e.lerp(thicknessOf(m, a), thicknessOf(m, b), t);
+  else
+    r.thickness = kNoValue;
+  return r;
+}
+
 }  // namespace
 
 ValueId coverageOf(Material& m, const Slab& s) { return s.coverage == kNoValue ? m.values.scalar(1) : s.coverage; }
@@ -135,9 +154,16 @@ Slab foldToSingleInterface(Material& m, const Slab& s) {
   return r;
 }
 
-Slab blendHorizontal(Material& m, const Slab& bg, const Slab& fg, ValueId w) {
+Slab blendHorizontal(Material& m, const Slab& bg, const Slab& fg, ValueId w, BlendRule rule) {
   Ex e(m.values);
   ValueId cb = coverageOf(m, bg), cf = coverageOf(m, fg);
+  if (rule == BlendRule::PlainLerp) {
+    Slab r = plainLerpSlabs(m, bg, fg, w);
+    takeDiscrete(r, bg, fg, typicalValue(m, w) > 0.5);
+    r.coverage = e.lerp(cb, cf, w);
+    r.features = bg.features | fg.features;
+    return r;
+  }
   ValueId num = e.mul(cf, w);
   ValueId mix = e.safeDiv(num, e.add(num, e.mul(cb, e.oneMinus(w))));
   Slab r = lerpSlabs(m, bg, fg, mix);
@@ -147,10 +173,10 @@ Slab blendHorizontal(Material& m, const Slab& bg, const Slab& fg, ValueId w) {
   return r;
 }
 
-Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, ValueId threshold) {
+Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, ValueId threshold, BlendRule rule) {
   // a when value <= threshold: the weight of b is 1 - step(value, threshold).
   ValueId pickA = m.values.make(Op::Step, VType::Float, {value, threshold});
-  return blendHorizontal(m, a, b, m.values.make(Op::OneMinus, VType::Float, {pickA}));
+  return blendHorizontal(m, a, b, m.values.make(Op::OneMinus, VType::Float, {pickA}), rule);
 }
 
 Slab blendCoverageWeight(Material& m, const Slab& a, ValueId weight) {
@@ -160,11 +186,18 @@ Slab blendCoverageWeight(Material& m, const Slab& a, ValueId weight) {
   return r;
 }
 
-Slab blendAdd(Material& m, const Slab& a, const Slab& b) {
+Slab blendAdd(Material& m, const Slab& a, const Slab& b, BlendRule rule) {
   Ex e(m.values);
   ValueId ca = coverageOf(m, a), cb = coverageOf(m, b);
   ValueId c = e.sat(e.add(ca, cb));
   ValueId t = e.safeDiv(cb, e.add(ca, cb));
+  if (rule == BlendRule::PlainLerp) {
+    Slab r = plainLerpSlabs(m, a, b, t);
+    takeDiscrete(r, a, b, typicalValue(m, t) > 0.5);
+    r.coverage = c;
+    r.features = a.features | b.features;
+    return r;
+  }
   Slab r = lerpSlabs(m, a, b, t);
   // Colours add: the summed contribution Ca·Xa + Cb·Xb, re-expressed per unit
   // of the new coverage and saturated.
@@ -182,8 +215,17 @@ Slab blendAdd(Material& m, const Slab& a, const Slab& b) {
   return r;
 }
 
-Slab blendVertical(Material& m, const Slab& topIn, const Slab& baseIn, ValueId d) {
+Slab blendVertical(Material& m, const Slab& topIn, const Slab& baseIn, ValueId d, BlendRule rule) {
   Ex e(m.values);
+  if (rule == BlendRule::PlainLerp) {
+    ValueId ctop = coverageOf(m, topIn), cbase = coverageOf(m, baseIn);
+    Slab r = plainLerpSlabs(m, baseIn, topIn, ctop);
+    takeDiscrete(r, baseIn, topIn, true);
+    r.thickness = e.add(d, thicknessOf(m, baseIn));
+    r.coverage = e.sub(e.add(ctop, cbase), e.mul(ctop, cbase));
+    r.features = topIn.features | baseIn.features;
+    return r;
+  }
   const Slab top = foldToSingleInterface(m, topIn);
   const Slab base1 = foldToSingleInterface(m, baseIn);  // the base as seen under the top
   ValueId ct = coverageOf(m, topIn), cb = coverageOf(m, baseIn);
@@ -194,33 +236,30 @@ Slab blendVertical(Material& m, const Slab& topIn, const Slab& baseIn, ValueId d
   ValueId tn2 = e.mul(tn, tn);
   ValueId tn2cb = e.mul(tn2, cb);
 
-  // Region "top present": one interface (the top's) over the base seen through the medium.
-  auto over = [&](SlabPin p) {  // R = Rt + (1-Rt)^2 T^2 Rb / (1 - Rt Rb), the smooth two-interface sum
-    ValueId rt = pin(top, p), rb = pin(base1, p);
-    ValueId omr = e.oneMinus(rt);
-    return e.add(rt, e.safeDiv(e.mul(e.mul(omr, omr), e.mul(tn2cb, rb)), e.oneMinus(e.mul(rt, rb))));
-  };
+  // Region "top present": one interface, the top's (F0, F90, roughness,
+  // normal), over the base seen through the top's medium. The
+  // base's specular lobe is not the top's: putting its reflectance into the
+  // top's (sharper) lobe makes highlights the full stack does not have, so
+  // the whole albedo of the base goes into the diffuse below.
   Slab t = base1;
-  t.pin(SlabPin::F0) = over(SlabPin::F0);
-  t.pin(SlabPin::F90) = over(SlabPin::F90);
+  for (SlabPin p : {SlabPin::F0, SlabPin::F90, SlabPin::Roughness, SlabPin::Normal}) t.pin(p) = pin(top, p);
+  t.pin(SlabPin::Anisotropy) = e.k(0);
+  // Glints (flakes under a clear coat) stay unless the top hides the base:
+  // the glint value is lerped toward the top's by k = 1 - mean(T_n^2 C_B)(1 - mean F0_T).
+  ValueId k = e.oneMinus(e.mul(e.mean(tn2cb), e.oneMinus(e.mean(pin(top, SlabPin::F0)))));
+  t.pin(SlabPin::GlintValue) = e.lerp(pin(base1, SlabPin::GlintValue), pin(top, SlabPin::GlintValue), k);
   // Energy of the stack: the top's interface reflects F_T; what it transmits
-  // meets the medium, which returns its volumetric albedo a_T(1 - T^2) and lets
-  // T^2 reach the base and come back. The diffuse makes the single interface
-  // return exactly that.
+  // meets the medium, which returns its volumetric albedo a_T(1 - T_n^2), and
+  // reaches the base, whose whole albedo (specular included: its lobe is not
+  // the top's) comes back as diffuse through the top twice at the diffuse mean
+  // cosine 0.5 (T_n^2 each way, as the runtime's layer throughput T^(1/mu)).
+  // The diffuse makes the single interface return exactly that.
   ValueId ft = fresnelAverage(m, top);
   ValueId albedoBase = e.add(fresnelAverage(m, base1), diffuseEnergy(m, base1));
   ValueId stack = e.add(ft, e.mul(e.oneMinus(ft), e.add(e.mul(pin(top, SlabPin::DiffuseAlbedo), e.oneMinus(tn2)),
-                                                         e.mul(tn2cb, albedoBase))));
+                                                         e.mul(e.mul(tn2cb, tn2), albedoBase))));
   setDiffuseEnergy(m, t, e.max(e.sub(stack, fresnelAverage(m, t)), e.k(0)));
   t.pin(SlabPin::Emissive) = e.add(pin(top, SlabPin::Emissive), e.mul(e.mul(tn, cb), pin(base1, SlabPin::Emissive)));
-  // Which layer dominates what is seen: the top, unless its medium and
-  // interface let the base through.
-  ValueId baseSeen = e.mul(e.mean(tn2cb), e.oneMinus(e.mean(pin(top, SlabPin::F0))));
-  ValueId k = e.oneMinus(baseSeen);
-  t.pin(SlabPin::Roughness) = e.lerp(pin(base1, SlabPin::Roughness), pin(top, SlabPin::Roughness), k);
-  t.pin(SlabPin::Normal) = e.normalize(e.lerp(pin(base1, SlabPin::Normal), pin(top, SlabPin::Normal), k));
-  t.pin(SlabPin::Anisotropy) = e.k(0);
-  t.pin(SlabPin::GlintValue) = e.lerp(pin(base1, SlabPin::GlintValue), pin(top, SlabPin::GlintValue), k);
 
   // Coverage-weighted: C = Ct + Cb(1-Ct); the top region weighs Ct/C.
   ValueId c = e.sub(e.add(ct, cb), e.mul(ct, cb));

@@ -7,27 +7,40 @@
 
 namespace substratec {
 
+/// Which blending rules a collapse uses. ProjectRules (the default) are the
+/// rules documented in docs/simplification.md. PlainLerp is the naive baseline
+/// the accuracy measurement (docs/accuracy.md) compares them with: every
+/// parameter lerped by one weight — the raw mix weight w for horizontal and
+/// select, the top's coverage for vertical, C_b/(C_a+C_b) for add — normals
+/// and tangents lerped then normalized, no energy, transmittance or albedo
+/// matching; coverage, thickness, discrete choices and feature flags as in
+/// the project rules.
+enum class BlendRule { ProjectRules, PlainLerp };
+
 /// Horizontal mix (w toward the foreground): every parameter is lerped by the
 /// coverage-weighted m = Cf·w / (Cf·w + Cb·(1−w)); normals and tangents are
 /// lerped then normalized; coverage is lerp(Cb, Cf, w); what cannot be blended
 /// (specular profile, SSS type, glint uv) goes to the side with the larger weight.
-Slab blendHorizontal(Material& m, const Slab& background, const Slab& foreground, ValueId mix);
+Slab blendHorizontal(Material& m, const Slab& background, const Slab& foreground, ValueId mix,
+                     BlendRule rule = BlendRule::ProjectRules);
 
 /// Vertical layering: where the top is present (probability Ct/C) the pair is
 /// one interface over the base seen through the top's medium (T = exp(−d/MFP)
 /// along the normal, twice); where it is absent, the base as it is.
-Slab blendVertical(Material& m, const Slab& top, const Slab& base, ValueId thickness);
+Slab blendVertical(Material& m, const Slab& top, const Slab& base, ValueId thickness,
+                   BlendRule rule = BlendRule::ProjectRules);
 
 /// Add: colours add (saturated), everything else is coverage-weighted;
 /// coverage sat(Ca + Cb).
-Slab blendAdd(Material& m, const Slab& a, const Slab& b);
+Slab blendAdd(Material& m, const Slab& a, const Slab& b, BlendRule rule = BlendRule::ProjectRules);
 
 /// Coverage weight: the slab with its coverage scaled by w.
 Slab blendCoverageWeight(Material& m, const Slab& a, ValueId weight);
 
 /// Select (a when value <= threshold): a horizontal mix toward b by the
 /// run-time condition step(threshold < value).
-Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, ValueId threshold);
+Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, ValueId threshold,
+                 BlendRule rule = BlendRule::ProjectRules);
 
 /// The slab's single-interface form: haze folded into the roughness
 /// (lerp(r, r2, w)) and fuzz into the diffuse albedo (lerp(d, fuzz colour,

@@ -77,17 +77,17 @@ int pickOperator(const Material& m, const TreeInfo& t) {
 }
 
 /// Collapses operator `n` (whose children are slabs: it is the deepest).
-void collapse(Material& m, int n) {
+void collapse(Material& m, int n, BlendRule rule) {
   TreeNode node = m.nodes[n];
   const Slab& l = m.slabs[m.nodes[node.left].slab];
   const Slab* r = node.right >= 0 ? &m.slabs[m.nodes[node.right].slab] : nullptr;
   Slab merged;
   switch (node.op) {
-    case TreeOp::Horizontal: merged = blendHorizontal(m, l, *r, node.a); break;
-    case TreeOp::Vertical: merged = blendVertical(m, l, *r, node.a); break;
-    case TreeOp::Add: merged = blendAdd(m, l, *r); break;
+    case TreeOp::Horizontal: merged = blendHorizontal(m, l, *r, node.a, rule); break;
+    case TreeOp::Vertical: merged = blendVertical(m, l, *r, node.a, rule); break;
+    case TreeOp::Add: merged = blendAdd(m, l, *r, rule); break;
     case TreeOp::CoverageWeight: merged = blendCoverageWeight(m, l, node.a); break;
-    case TreeOp::Select: merged = blendSelect(m, l, *r, node.a, node.b); break;
+    case TreeOp::Select: merged = blendSelect(m, l, *r, node.a, node.b, rule); break;
     case TreeOp::Slab: return;
   }
   merged.id = node.id;
@@ -116,7 +116,7 @@ bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& 
     if (n < 0) break;
     SimplifyStep step{"collapse", m.nodes[n].id, std::string(treeOpName(m.nodes[n].op)), t.depth[n],
                       layout.bytes(), 0, static_cast<int>(layout.closures.size()), 0};
-    collapse(m, n);
+    collapse(m, n, budget.rule);
     layout = reprice(m);
     step.bytesAfter = layout.bytes();
     step.closuresAfter = static_cast<int>(layout.closures.size());

@@ -18,6 +18,7 @@
 
 #include "diag/diagnostics.h"
 #include "ir/material.h"
+#include "passes/blend.h"
 #include "storage/layout.h"
 
 namespace substratec {
@@ -35,6 +36,7 @@ struct SimplifyBudget {
   int bytesPerPixel = 80;
   int maxClosures = 8;
   bool full = false;
+  BlendRule rule = BlendRule::ProjectRules;  // blending rules of the collapses
 };
 
 /// The largest packed size of a fully simplified material (ray-tracing payload).

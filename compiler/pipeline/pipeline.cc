@@ -74,7 +74,7 @@ std::optional<CompileResult> compileText(const std::string& displayName, const s
   });
   // 9. simplify to the budget (re-runs 6-8 after each step, so it comes last).
   result.after = result.before;
-  SimplifyBudget budget{result.budgetBytes, result.maxClosures, options.fullSimplification};
+  SimplifyBudget budget{result.budgetBytes, result.maxClosures, options.fullSimplification, options.blendRule};
   if (!pass.run("simplify", [&] { return simplifyToBudget(m, budget, result.after, result.steps, diags); }))
     return std::nullopt;
   result.tree = analyzeTree(m);

@@ -23,6 +23,7 @@ struct CompileOptions {
   std::optional<int> budgetOverride;       // --budget
   std::optional<int> maxClosuresOverride;  // --max-closures
   bool fullSimplification = false;         // --full-simplification
+  BlendRule blendRule = BlendRule::ProjectRules;  // collapse rules (PlainLerp: the accuracy baseline)
   bool printAfterAll = false;              // dump the IR after every pass into debugLog
   bool timePasses = false;                 // record per-pass wall time
 };
