@@ -1,0 +1,187 @@
+// A Monte Carlo ground truth for layered slabs: the position-free random walk
+// through a stack of plane-parallel layers of Guo, Hasan and Zhao 2018
+// ("Position-free Monte Carlo simulation for arbitrary layered BSDFs"), with the
+// estimator structure of pbrt-v4's LayeredBxDF (f() evaluated stochastically:
+// next-event estimation through the interfaces, multiple importance sampling of
+// the exit, Russian roulette), generalized from two interfaces to N. It measures
+// the analytic layering of the runtime (compiler/reference/lighting.cc,
+// substrate_lighting.h): it is not a mirror of any shader.
+//
+// THE MODEL (per colour channel, channels independent)
+//   A stack of layers, top to bottom. Layer k is an interface I_k above a
+//   homogeneous slab of medium M_k; M_k lies between I_k and I_{k+1}.
+//   * Interface: GGX microfacets (isotropic; alpha = max(roughness^2, 1e-3),
+//     roughness the slab's perceptual roughness saturated), height-correlated
+//     Smith shadowing, single scattering on the microsurface (as pbrt's): a
+//     rough interface loses the energy of its inter-microfacet bounces. A white
+//     conductor keeps E(0.5) = 0.89 at roughness 0.45; a dielectric (F0 0.04)
+//     over a white Lambertian keeps 0.998 / 0.93 / 0.79 / 0.63 of the light at
+//     roughness 0.1 / 0.3 / 0.45 / 0.6 (light trapped under the interface meets
+//     it several times). No energy compensation: keep this in mind at
+//     roughness >= 0.3.
+//     - Dielectric: relative IOR (below over above) from the slab's own F0, per
+//       channel (a coloured F0 is a coloured IOR; channels walk apart):
+//       eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) (F0 clamped to 0.99), so each
+//       interface reflects F0 at normal incidence whatever lies above it
+//       (WalkOptions::absoluteIor: the other convention). Exact dielectric
+//       Fresnel; F90 is not used. F0 = 0 is eta = 1: an index-matched boundary,
+//       a pass-through (no reflection, no refraction). The walk carries energy
+//       (pbrt's Importance mode), the light chain radiance; f(wo, wi) of the
+//       stack is the same either way (reciprocity, tested).
+//     - Conductor: a slab whose medium is opaque (MFP 0) and whose diffuse albedo
+//       is 0 in every channel has a conductor interface: GGX reflection with
+//       Schlick's F = F0 + (F90 - F0)(1 - |wo.h|)^5 per channel, nothing below.
+//   * Medium of a layer that is not the bottom: thickness d (the vertical's
+//     thickness), extinction sigma_t = 1 / MFP per channel (MFP clamped to
+//     >= 1e-30), so optical thickness tau = d / MFP; single-scattering albedo
+//     from the diffuse albedo (below); Henyey-Greenstein phase function with
+//     g = the slab's SSS phase anisotropy (clamped to [-0.99, 0.99]).
+//   * Bottom: the last layer's interface sits over a semi-infinite medium of the
+//     same kind (MFP > 0; its thickness is ignored: reflectance of a
+//     semi-infinite medium does not depend on the MFP's scale), or — when the
+//     slab is opaque (MFP 0, WalkLayer::opaqueBase) — directly over a
+//     Lambertian reflector of albedo diffuse_albedo (or is a conductor, above).
+//     An opaque slab hides everything below it: the stack ends there.
+//   * Single-scattering albedo: diffuse_albedo A is the multiple-scattering
+//     albedo the artist sees. For an isotropic semi-infinite index-matched
+//     medium, van de Hulst's approximation gives the spherical albedo
+//       A(w) = (1 - s)(1 - 0.139 s) / (1 + 1.17 s),   s = sqrt(1 - w);
+//     its exact inverse (a quadratic in s; the constants of Kulla & Conty 2017,
+//     alpha = 1 - (4.09712 + 4.20863 A - sqrt(9.59217 + 41.6808 A + 17.7126 A^2))^2)
+//     gives the reduced albedo w' = 1 - s^2, and for g != 0 the similarity
+//     relation w' = w (1 - g) / (1 - w g) gives w = w' / (1 - g + g w').
+//     random_walk_test.cc checks it against this walk (semi-infinite medium
+//     under an index-matched interface: within 0.005). Under a dielectric
+//     interface the slab looks darker than A (the interface reflects light back
+//     in): that is the model, not an error of the inversion
+//     (WalkOptions::albedoSeenThroughInterface: the other convention).
+//
+// THE ESTIMATOR (layeredEval)
+//   Per sample: the top reflection f_0(wo, wi) is exact; a light chain is
+//   sampled once from wi down through the stack (transmission only, a direction
+//   c_k in every layer, weight L_k = product of f|cos|/pdf and of the full-layer
+//   transmittances above); the walk enters from wo (transmission only) and
+//   scatters (medium: distance sampling, HG; interfaces: GGX visible normals;
+//   Lambertian: cosine) with Russian roulette (pbrt's: after 3 events, when the
+//   largest channel of the throughput is below 0.25) up to maxDepth events. At
+//   the top interface from below it samples reflection only: every path that
+//   leaves towards wi is counted at its last vertex v (a medium scattering, a
+//   reflection from above at an interface, the Lambertian base), by
+//     B: connecting v to the light chain of its layer (the unscattered way up
+//        through the interfaces above, sampled from wi), and, when v is in the
+//        top layer,
+//     A: the direction v sampled for the walk, if it leads up, evaluated
+//        through the top interface f_0(-w, wi) with the transmittance to it,
+//   weighted by the power heuristic on the pdfs of the two strategies (for a
+//   vertex below the top layer only B is used: weight 1). Channels whose
+//   interfaces (IORs) and optical thicknesses agree share one walk (throughput
+//   per channel); others get their own walks, each with `samples` walks.
+//   Deterministic: a splitmix64 stream from WalkOptions::seed.
+//   Cost (one core, RelWithDebInfo, 256 samples, maxDepth 64): groundTruth
+//   takes 0.07 .. 1.6 ms per evaluation over examples/*.json (row40_coating
+//   0.57, car_paint 0.68); a stack of coloured IOR or MFP walks per channel.
+//   maxDepth truncates the long walks of bright semi-infinite media: the
+//   albedo of an SSS slab (F0 0.04, roughness 0.5) at A = 0.5 / 0.8 / 0.95 is
+//   short by 0 / 6 / 22 % at maxDepth 64 and converged at 4096 (cost at 256
+//   samples: 0.87 -> 1.5 / 6.5 ms); skin_coated gains 16 % from 64 to 1024
+//   (1.6 -> 4.4 ms). Use maxDepth >= 1024 when an albedo exceeds 0.7.
+//
+// NOT MODELLED: anisotropy, haze (second roughness), fuzz, glints, specular
+//   profiles, emissive, SSS type (wrap / diffusion: only the medium counts),
+//   F90 of dielectrics, thin-surface transmission (the bottom is semi-infinite
+//   or opaque), normal maps (groundTruth uses the geometric frame).
+#pragma once
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/pipeline.h"
+#include "reference/reference.h"
+
+namespace substratec::reference {
+
+/// One layer of a stack (top to bottom). Colours per channel (RGB).
+struct WalkLayer {
+  V3<double> f0{0.04, 0.04, 0.04}, f90{1, 1, 1}, diffuseAlbedo{0, 0, 0}, mfp{0, 0, 0};
+  double roughness = 0.5, phaseAnisotropy = 0, thickness = 0;
+  bool opaqueBase = false;  // MFP 0: a Lambertian of diffuseAlbedo (or a conductor) right under the interface
+};
+
+struct WalkOptions {
+  int samples = 4096;           // walks per channel group
+  int maxDepth = 64;            // events per walk (interfaces, media, base); see the cost note above
+  std::uint32_t seed = 1;
+  /// The albedo convention. false (the default, the model above): diffuse_albedo is
+  /// the albedo of the medium alone (index-matched), the Lambertian's albedo.
+  /// true: it is the albedo seen through the slab's own interface in air — the
+  /// analytic model's meaning (albedo (1 - E_spec) leaves, no darkening by the
+  /// interface's internal reflection): each layer's A is first replaced by
+  /// A' = A / (1 - R21 + R21 A), R21 = internalReflectance(eta of its F0), the
+  /// closed form of a Lambertian under a smooth interface, then inverted as above.
+  bool albedoSeenThroughInterface = false;
+  /// The IOR convention. false (the default, the model above): each slab's F0
+  /// gives the relative IOR of its own interface, so layers' IORs multiply (a
+  /// base of F0 0.04 under a coat of F0 0.04 sits at 2.25 and keeps its 4 %
+  /// specular). true: each slab's F0 gives its absolute IOR (against air) and
+  /// an interface's relative IOR is n_k / n_{k-1} (that base under that coat is
+  /// index-matched: no specular of its own, no extra trapping; eta < 1 allowed).
+  bool absoluteIor = false;
+};
+
+/// f(wo, wi) * |cos(wi)| of the stack (directions in the local frame, z up; wo
+/// the view, wi the light), per channel. Zero unless both are above the surface.
+V3<double> layeredEval(const std::vector<WalkLayer>& stack, const V3<double>& wo, const V3<double>& wi,
+                       const WalkOptions& options);
+
+/// Directional albedo of the stack for view wo: the integral of layeredEval over
+/// wi, estimated with `samples` forward walks (per channel group) that sample wi.
+V3<double> layeredAlbedo(const std::vector<WalkLayer>& stack, const V3<double>& wo, const WalkOptions& options);
+
+/// The ground truth of a compiled material at one shading point: f * cos for
+/// light L and view g.V (world space, around the geometric normal g.N; the
+/// material's normals are not used). The tree of r.material (pass the result of
+/// a compilation that did not simplify: a budget and closure count large enough)
+/// expands into a weighted sum of stacks (groundTruthTerms), each walked by
+/// layeredEval with seed + i * 0x9E3779B9 for term i (term 0: the seed, so a
+/// one-term material is layeredEval of its stack). Inputs at their
+/// defaults; `tex` samples textures (unset: value_eval's constant sample).
+V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
+                       const WalkOptions& options);
+
+/// One term of groundTruth: weight * layeredEval(stack).
+struct WalkTerm {
+  double weight = 1;
+  std::vector<WalkLayer> stack;
+};
+
+/// The tree as a weighted sum of stacks, combined linearly with the tree walk's
+/// weights (tree_walk.cc): a slab is [slab] with its own coverage (1 unless
+/// simplification made one); horizontal: background (1 - mix), foreground mix
+/// (mix saturated); select: background step, foreground 1 - step, step =
+/// threshold >= value; add: both, weight 1 each; coverage weight: times the
+/// weight (saturated); vertical: every top term over every base term (weights
+/// multiplied, stacks concatenated), plus the base terms alone times
+/// 1 - (coverage of the top), plus the top terms alone times 1 - (coverage of the
+/// base). A layer's thickness is that of TreeInfo::layerVertical's vertical
+/// (else settings.surfaceThickness); its MFP is sss_mfp * sss_mfp_scale; it is
+/// opaque when every channel of the MFP is <= 0 and its thickness is > 0 (no
+/// thickness is no matter: the runtime's exp(-0 / 0) is 1). Terms of weight 0
+/// are dropped.
+std::vector<WalkTerm> groundTruthTerms(const CompileResult& r, const Geometry& g, const TextureFn& tex);
+
+/// van de Hulst's spherical albedo of a semi-infinite medium of single-scattering
+/// albedo `omega` and HG anisotropy g (through the similarity relation).
+double multipleScatteringAlbedo(double omega, double g = 0);
+/// Its inverse: the single-scattering albedo for the albedo A the artist sees.
+double singleScatteringAlbedo(double albedo, double g = 0);
+/// The relative IOR of an interface of normal reflectance f0 (1 for f0 <= 0).
+double iorFromF0(double f0);
+/// Cosine-weighted hemispherical reflectance of a smooth interface of relative
+/// IOR eta > 1 seen from the dense side (total internal reflection included),
+/// from the outside one by 1 - R21 = (1 - R12) / eta^2.
+double internalReflectance(double eta);
+/// Unpolarized dielectric Fresnel reflectance for cos(theta_i) (negative: from
+/// the other side) and relative IOR eta (transmitted side over incident side
+/// for cos > 0); 1 under total internal reflection.
+double fresnelDielectric(double cosThetaI, double eta);
+
+}  // namespace substratec::reference
