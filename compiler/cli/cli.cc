@@ -245,6 +245,8 @@ struct SweepArgs {
   int runs = 5;
   std::string diffuse = "chan2024";
   std::size_t maxInputSize = 16u << 20;
+  int groundTruthProbes = 128;
+  int groundTruthSamples = 1024;
 };
 
 /// The material at its full budget and at each simplification step: cost
@@ -279,6 +281,8 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   so.pixels = a.pixels;
   so.timedRuns = a.runs;
   so.diffuseModel = diffuseModelOf(a.diffuse);
+  so.groundTruthProbes = a.groundTruthProbes;
+  so.groundTruthSamples = a.groundTruthSamples;
   std::vector<sweep::Row> rows;
   if (!sweep::measure(*ctx, steps, full, so, &rows, &error)) {
     err << "substratec: internal compiler error: " << error << "\n";
@@ -386,6 +390,11 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
   swp->add_option("--max-input-size", sw.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+  swp->add_option("--ground-truth-probes", sw.groundTruthProbes,
+                  "Shading points walked for rel_mse_vs_ground_truth (0: skip the column)")
+      ->check(CLI::Range(0, 1024));
+  swp->add_option("--ground-truth-samples", sw.groundTruthSamples, "Random walks per shading point and channel group")
+      ->check(CLI::Range(1, 1 << 20));
 
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector

@@ -956,6 +956,16 @@ std::vector<WalkTerm> groundTruthTerms(const CompileResult& r, const Geometry& g
   return out;
 }
 
+Closure<double> layeringOnly(Closure<double> c) {
+  c.features &= ~(kFeatureAnisotropy | kFeatureHaze | kFeatureFuzz | kFeatureGlint | kFeatureSpecularProfile);
+  c.anisotropy = 0;
+  c.secondRoughnessWeight = 0;
+  c.fuzzAmount = 0;
+  c.glintValue = 1;
+  c.specularProfile = 0;
+  return c;
+}
+
 V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
                        const WalkOptions& options) {
   // The geometric frame: N, the tangent made orthogonal to it, B = N x T.

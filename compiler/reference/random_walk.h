@@ -168,6 +168,11 @@ struct WalkTerm {
 /// are dropped.
 std::vector<WalkTerm> groundTruthTerms(const CompileResult& r, const Geometry& g, const TextureFn& tex);
 
+/// The closure without the features the walk does not model (anisotropy, haze,
+/// fuzz, glints, specular profiles: their feature bits cleared, their values
+/// neutral): the part of the analytic model the ground truth can judge.
+Closure<double> layeringOnly(Closure<double> c);
+
 /// van de Hulst's spherical albedo of a semi-infinite medium of single-scattering
 /// albedo `omega` and HG anisotropy g (through the similarity relation).
 double multipleScatteringAlbedo(double omega, double g = 0);

@@ -3,7 +3,8 @@
 // for each row its cost (bytes, closures, SPIR-V instructions of the forward
 // shader after the performance passes, lavapipe ns per shading point) and its
 // error against the unsimplified tree (relative MSE, max and 99th-percentile
-// absolute error of linear radiance; CIEDE2000 of the packed colours).
+// absolute error of linear radiance; CIEDE2000 of the packed colours) and
+// against the Monte Carlo ground truth of layering (reference::groundTruth).
 #pragma once
 #include <array>
 #include <optional>
@@ -12,6 +13,7 @@
 
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
+#include "reference/random_walk.h"
 
 namespace substratec::sweep {
 
@@ -38,13 +40,30 @@ struct Row {
   double relMse = 0;                  // mean((x − y)² / (y² + 0.01)) over the probe set, y the unsimplified tree
   double maxAbs = 0, p99Abs = 0;      // of |x − y|
   double deltaE2000Mean = 0, deltaE2000Max = 0;  // packed vs exact colours (diffuse albedo, F0, F90, fuzz colour)
+  /// The same rel_mse of the direct light alone (no environment, no emissive),
+  /// without the features the walk does not model (anisotropy, haze, fuzz,
+  /// glints, specular profiles), against the random walk through the
+  /// unsimplified tree's stacks
+  /// (reference::groundTruth, in the analytic model's conventions: see
+  /// groundTruthOptions), over the probes where view and light are both above
+  /// the geometric surface. It holds the analytic model's own error (row 1) and
+  /// what simplification adds to it or takes from it.
+  double relMseVsGroundTruth = 0;
 };
 
 struct Options {
   int pixels = 1 << 20;  // shading points per timed dispatch
   int timedRuns = 5;     // after one untimed warm-up; the median is reported
   int diffuseModel = 2;
+  int groundTruthProbes = 128;    // probes walked (the first ones lit from above and seen from above)
+  int groundTruthSamples = 1024;  // walks per probe and channel group
 };
+
+/// The walk's options for the sweep's ground truth: the conventions of the
+/// analytic model (diffuse_albedo is the albedo seen through the slab's own
+/// interface; each F0 is against air, so equal slabs are index-matched), deep
+/// enough walks for bright media (maxDepth 1024), deterministic seeds.
+reference::WalkOptions groundTruthOptions(int samples);
 
 /// Measures every step. `gpu` runs the timing kernels. False with `*error`.
 bool measure(gpu::Context& gpu, const std::vector<Step>& steps, const CompileResult& full, const Options& options,

@@ -63,8 +63,10 @@ TEST(Sweep, RowsGoFromTheFullBudgetDownWithCostAndError) {
   for (std::size_t i = 0; i < rows.size(); ++i) {
     SCOPED_TRACE(i);
     for (const char* key : {"budget", "bytes", "closures", "spirv_instructions", "gpu_ns_per_pixel", "rel_mse",
-                            "max_abs", "p99_abs", "delta_e2000"})
+                            "max_abs", "p99_abs", "delta_e2000", "rel_mse_vs_ground_truth"})
       EXPECT_TRUE(rows[i].contains(key)) << key;
+    const double vsTruth = rows[i]["rel_mse_vs_ground_truth"].get<double>();
+    EXPECT_TRUE(vsTruth > 0 && vsTruth < 1) << vsTruth;
     EXPECT_GT(rows[i]["gpu_ns_per_pixel"].get<double>(), 0.0);
     EXPECT_GT(rows[i]["spirv_instructions"].get<int>(), 0);
     EXPECT_LE(rows[i]["p99_abs"].get<double>(), rows[i]["max_abs"].get<double>());
@@ -74,6 +76,33 @@ TEST(Sweep, RowsGoFromTheFullBudgetDownWithCostAndError) {
     }
   }
   EXPECT_EQ(rows.back()["closures"], 1) << "down to one closure";
+  // The coat's layering, as the analytic model does it, against the random
+  // walk through the same stack (measured 0.028; the one-closure row 0.079).
+  EXPECT_LT(rows[0]["rel_mse_vs_ground_truth"].get<double>(), 0.05);
+  EXPECT_GT(rows.back()["rel_mse_vs_ground_truth"].get<double>(), rows[0]["rel_mse_vs_ground_truth"].get<double>())
+      << "collapsing the coat moves away from the truth";
+}
+
+TEST(Sweep, TheGroundTruthAgreesWhereTheModelIsExact) {
+  // A conductor: one GGX lobe, the same in the walk (single scattering) and in
+  // the runtime, which adds only the energy compensation of the bounces between
+  // microfacets — next to nothing at low roughness, more as it grows.
+  auto vsTruth = [](double roughness) {
+    const fs::path file = fs::temp_directory_path() / "substratec_sweep_conductor.json";
+    std::ofstream(file) << R"({"format": "substrate-material/1", "name": "conductor", "nodes": {"root": {"kind": "slab",
+      "diffuse_albedo": [0, 0, 0], "f0": [0.95, 0.64, 0.54], "roughness": )"
+                        << roughness << R"(}}, "output": "root"})";
+    CliRun r = cli({"sweep", file.string(), "--json", "--pixels", "4096", "--runs", "1"});
+    fs::remove(file);
+    EXPECT_EQ(r.status, 0) << r.err;
+    return r.status == 0 ? nlohmann::json::parse(r.out)["rows"][0]["rel_mse_vs_ground_truth"].get<double>() : 1.0;
+  };
+  const double smooth = vsTruth(0.1), medium = vsTruth(0.35), rough = vsTruth(0.6);
+  EXPECT_LT(smooth, 1e-5);  // measured 2.7e-7
+  EXPECT_LT(medium, 2e-3);  // 3.8e-4
+  EXPECT_LT(rough, 2e-2);   // 9.5e-3: the energy the walk's single-scattering interface loses
+  EXPECT_LT(smooth, medium);
+  EXPECT_LT(medium, rough);
 }
 
 TEST(Sweep, MaxErrorChoosesTheCheapestRowWithinIt) {
