@@ -14,24 +14,39 @@
 #define SUBSTRATE_DIFFUSE_MEAN_COS 0.5
 #endif
 
-// lerp(1, T_N^(1/max(mu, 1e-4)), coverageAbove): the transmittance of the
-// layers above along a direction at cosine mu, blended by their coverage. No
-// transcendental when nothing covers the closure (top layers).
+// The angular part of what an interface transmits, normalized to 1 at normal
+// incidence (where T_N already holds its 1 - F0): 1 - (1 - mu)^5, Schlick's
+// Fresnel with F90 = 1 being F0 + (1 - F0)(1 - mu)^5, so that
+// (1 - F0) * this = 1 - F(mu) exactly. Without it a coat reflects F(mu) at a
+// grazing view and still lets 1 - F0 reach the base: a white base under a
+// clear coat returned 1.21 of the light at NoV 0.1 (docs/stability.md).
+// Conservative for rough coats (their E_spec is below F at grazing).
+float substrate_interface_transmission(float mu) {
+  float x = 1.0 - saturate(mu);
+  float x2 = x * x;
+  return 1.0 - x2 * x2 * x;
+}
+
+// lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5), coverageAbove): the
+// transmittance of the layers above along a direction at cosine mu (their
+// media and their interfaces), blended by their coverage. No transcendental
+// when nothing covers the closure (top layers).
 float3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
-    return lerp(SUBSTRATE_SPLAT3(1.0), substrate_transmittance_at_cosine(c.topTransmittance, mu), cover);
+    float3 through = substrate_transmittance_at_cosine(c.topTransmittance, mu) * substrate_interface_transmission(mu);
+    return lerp(SUBSTRATE_SPLAT3(1.0), through, cover);
   }
   return SUBSTRATE_SPLAT3(1.0);
 }
 
-// Along the view: c.weight * lerp(1, T_N^(1/max(NoV, 1e-4)), c.coverageAbove).
+// Along the view: c.weight * substrate_closure_above_throughput(c, NoV).
 float3 substrate_closure_view_throughput(SubstrateClosure c, float NoV) {
   return max(c.weight, 0.0) * substrate_closure_above_throughput(c, NoV);
 }
 
-// Along the light: lerp(1, T_N^(1/max(NoL, 1e-4)), c.coverageAbove). The
-// closure's weight is counted once, in the view throughput.
+// Along the light: substrate_closure_above_throughput(c, NoL). The closure's
+// weight is counted once, in the view throughput.
 float3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
   return substrate_closure_above_throughput(c, NoL);
 }

@@ -39,4 +39,15 @@ void substrate_layer_above(inout float c, inout float3 t, float cLayer, float3 t
   c = cNew;
 }
 
+// The diffuse albedo a slab layered on top of another scatters back: its
+// medium returns a(1 - T^2) (light crossing it down and up again, T the
+// transmittance along the normal) and lets T^2 reach the base and come back.
+// A coat that lets light through cannot also scatter all of it back: a
+// white coat of thickness 0 (T = 1) over a white base would otherwise return
+// twice the light it receives. An opaque layer (T = 0) keeps its albedo.
+float3 substrate_layer_scattering(float3 albedo, float3 t) {
+  float3 tc = saturate(t);
+  return albedo * (SUBSTRATE_SPLAT3(1.0) - tc * tc);
+}
+
 #endif

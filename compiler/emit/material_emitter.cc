@@ -48,6 +48,7 @@ class Emitter {
   void emitClosures();
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
+  bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
 
   void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
   /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
@@ -171,6 +172,14 @@ std::string Emitter::opExpr(const ValueNode& n) {
 
 int Emitter::verticalOfTop(int node) const { return t_.layerVertical[node]; }
 
+bool Emitter::knownOpaque(int node) const {
+  const Slab& s = m_.slabs[m_.nodes[node].slab];
+  const int v = verticalOfTop(node);
+  const double d = m_.settings.surfaceThickness;
+  return m_.values.isConstEqual(s.pin(SlabPin::SssMfp), 0.0) &&
+         (v < 0 ? d > 0 : m_.values.isConst(m_.nodes[v].a) && m_.values.node(m_.nodes[v].a).c[0] > 0);
+}
+
 /// Marks every value the generated function computes: operator values, the
 /// slabs' media, and for each closure only the pins its features use.
 void Emitter::collectNeeded() {
@@ -278,11 +287,9 @@ void Emitter::emitTree() {
     const Slab& s = m_.slabs[node.slab];
     std::string c = s.coverage == kNoValue ? "1.0" : expr(s.coverage);
     int v = verticalOfTop(n);
-    ValueId mfp = s.pin(SlabPin::SssMfp);
     std::string t;
     double d = m_.settings.surfaceThickness;
-    if (m_.values.isConstEqual(mfp, 0.0) && (v < 0 ? d > 0 : m_.values.isConst(m_.nodes[v].a) &&
-                                                                  m_.values.node(m_.nodes[v].a).c[0] > 0))
+    if (knownOpaque(n))
       t = vec3(0, 0, 0);  // no medium: opaque matter
     else
       t = fmt::format("substrate_transmittance({}, {})", mfpOf(s), v >= 0 ? expr(m_.nodes[v].a) : Syntax::literal(d));
@@ -364,7 +371,12 @@ void Emitter::emitClosures() {
       for (auto it = layerLines.rbegin(); it != layerLines.rend(); ++it) line(*it);  // from the root down
     }
     line(fmt::format("substrate_closure_init({});", c));
-    line(fmt::format("{}.diffuseAlbedo = {};", c, expr(s.pin(SlabPin::DiffuseAlbedo))));
+    const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);
+    if (verticalOfTop(node) >= 0 && !knownOpaque(node) && !m_.values.isConstEqual(albedo, 0.0))
+      // A layer scatters back only what it does not let through (substrate_tree.h).
+      line(fmt::format("{}.diffuseAlbedo = substrate_layer_scattering({}, T_{});", c, expr(albedo), id));
+    else
+      line(fmt::format("{}.diffuseAlbedo = {};", c, expr(albedo)));
     line(fmt::format("{}.f0 = {};", c, expr(s.pin(SlabPin::F0))));
     std::string rough = expr(s.pin(SlabPin::Roughness));
     if (!cl.isTop)  // a rough layer above widens the lobes below (Belcour 2018)

@@ -210,6 +210,17 @@ V3<T> transmittance(const V3<T>& mfp, T d) {
   return r;
 }
 
+// substrate_layer_scattering (substrate_tree.h): albedo * (1 - sat(T)^2).
+template <class T>
+V3<T> layerScattering(const V3<T>& albedo, const V3<T>& t) {
+  V3<T> r;
+  for (int i = 0; i < 3; ++i) {
+    const T tc = clampT(t[i], T(0), T(1));
+    r[i] = albedo[i] * (T(1) - tc * tc);
+  }
+  return r;
+}
+
 // substrate_transmittance_at_cosine: exp(log(clamp(T, 1e-30, 1)) / max(mu, 1e-4)).
 template <class T>
 V3<T> transmittanceAtCosine(const V3<T>& normalTransmittance, T mu) {

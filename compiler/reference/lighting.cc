@@ -19,12 +19,24 @@ namespace {
 template <class T> constexpr T kDiffuseMeanCos = T(0.5);  // SUBSTRATE_DIFFUSE_MEAN_COS
 template <class T> constexpr T kNoVBias = T(1e-3);        // SUBSTRATE_NOV_BIAS
 
-// substrate_closure_above_throughput: lerp(1, T_N^(1/max(mu, 1e-4)), sat(coverageAbove)),
-// and exactly 1 (no transcendental) when nothing covers the closure.
+// substrate_interface_transmission: 1 - (1 - sat(mu))^5.
+template <class T>
+T interfaceTransmission(T mu) {
+  T x = T(1) - saturate(mu);
+  T x2 = x * x;
+  return T(1) - x2 * x2 * x;
+}
+
+// substrate_closure_above_throughput: lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5),
+// sat(coverageAbove)), and exactly 1 (no transcendental) when nothing covers the closure.
 template <class T>
 V3<T> aboveThroughput(const Closure<T>& c, T mu) {
   T cover = saturate(c.coverageAbove);
-  if (cover > T(0)) return lerp(splat3(T(1)), transmittanceAtCosine(c.topTransmittance, mu), cover);
+  if (cover > T(0)) {
+    const V3<T> t = transmittanceAtCosine(c.topTransmittance, mu);
+    const T i = interfaceTransmission(mu);
+    return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
+  }
   return splat3(T(1));
 }
 

@@ -286,6 +286,10 @@ class Walk {
 
     Closure<T> c;  // substrate_closure_init
     c.diffuseAlbedo = vec3(s.pin(SlabPin::DiffuseAlbedo));
+    // A slab layered on top scatters back only what it does not let through
+    // (substrate_layer_scattering; the emitter skips it for a known-opaque
+    // slab, T = 0, and for the constant albedo 0: the same values).
+    if (t_.layerVertical[node] >= 0) c.diffuseAlbedo = layerScattering(c.diffuseAlbedo, Tr_[node]);
     c.f0 = vec3(s.pin(SlabPin::F0));
     T rough = scalar(s.pin(SlabPin::Roughness));
     // Under a layer the roughness always goes through the variance round trip
