@@ -14,6 +14,7 @@
 #include "preview/contact_sheet.h"
 #include "preview/environment.h"
 #include "preview/render.h"
+#include "stability/stability.h"
 #include "sweep/sweep.h"
 
 #include <filesystem>
@@ -315,6 +316,76 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
+struct StabilityArgs {
+  std::string file;
+  bool json = false;
+  long evaluations = 100000;
+  bool noGpu = false;
+  std::optional<int> budget, maxClosures;
+  bool fullSimplification = false;
+  std::size_t maxInputSize = 16u << 20;
+};
+
+/// The material on the hard-case grid (compiler/stability/stability.h): counts
+/// of non-finite values on the CPU reference and on lavapipe, and the white
+/// furnace. Exit 4 when anything is non-finite or the furnace exceeds 1.001.
+int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
+  CompileOptions o;
+  o.read.maxInputBytes = a.maxInputSize;
+  o.budgetOverride = a.budget;
+  o.maxClosuresOverride = a.maxClosures;
+  o.fullSimplification = a.fullSimplification;
+  std::string text;
+  {
+    Diagnostics diags(a.file);
+    auto read = readSourceFile(a.file, o.read, diags);
+    if (!read) {
+      err << diags.formatAll();
+      return kExitBadInput;
+    }
+    text = std::move(*read);
+  }
+  {  // The material as written: its diagnostics name its own lines.
+    Diagnostics diags(a.file);
+    if (!compileText(a.file, text, o, diags)) {
+      err << diags.formatAll();
+      return kExitBadInput;
+    }
+  }
+  std::string forceable, error;
+  std::vector<stability::ForcedKind> kinds;
+  if (!stability::forceableText(text, &forceable, &kinds, &error)) {
+    err << "substratec: error: " << a.file << ": " << error << "\n";
+    return kExitBadInput;
+  }
+  Diagnostics diags(a.file + " (with forcing inputs)");
+  auto r = compileText(a.file + " (with forcing inputs)", forceable, o, diags);
+  if (!r) {
+    err << "substratec: internal compiler error: the material with forcing inputs does not compile\n" << diags.formatAll();
+    return kExitInternal;
+  }
+  std::unique_ptr<gpu::Context> ctx;
+  if (!a.noGpu) {
+    ctx = gpu::Context::create(gpu::Context::Options{}, &error);
+    if (!ctx) {
+      err << "substratec: error: stability runs the generated code on Vulkan (Mesa lavapipe; --no-gpu skips it): "
+          << error << "\n";
+      return kExitBadInput;
+    }
+  }
+  stability::Options so;
+  so.evaluations = a.evaluations;
+  so.gpu = !a.noGpu;
+  stability::Report report;
+  if (!stability::run(*r, kinds, so, ctx.get(), &report, &error)) {
+    err << "substratec: internal compiler error: " << error << "\n";
+    return kExitInternal;
+  }
+  out << (a.json ? stability::formatJson(report) : stability::formatText(report));
+  if (report.nonfinite || report.gpuNonfinite || report.furnaceMax > 1.001) return kExitUnstable;
+  return kExitOk;
+}
+
 }  // namespace
 
 int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -396,6 +467,19 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   swp->add_option("--ground-truth-samples", sw.groundTruthSamples, "Random walks per shading point and channel group")
       ->check(CLI::Range(1, 1 << 20));
 
+  StabilityArgs stab;
+  CLI::App* sta = app.add_subcommand("stability", "Hard cases: non-finite values on the CPU and on lavapipe, white furnace");
+  sta->add_option("file", stab.file, "Material file (substrate-material/1 JSON)")->required();
+  sta->add_flag("--json", stab.json, "Print the counts and the worst cases as JSON");
+  sta->add_option("--evaluations", stab.evaluations, "Shading points to evaluate at least (each path)")
+      ->check(CLI::Range(1L, 100000000L));
+  sta->add_flag("--no-gpu", stab.noGpu, "CPU reference only");
+  sta->add_option("--budget", stab.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
+  sta->add_option("--max-closures", stab.maxClosures, "Closures per pixel")->check(CLI::Range(1, 8));
+  sta->add_flag("--full-simplification", stab.fullSimplification, "Collapse to one closure first");
+  sta->add_option("--max-input-size", stab.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
   try {
@@ -419,6 +503,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (comp->parsed()) return runCompile(compile, out, err);
     if (pre->parsed()) return runPreview(prev, out, err);
     if (swp->parsed()) return runSweep(sw, out, err);
+    if (sta->parsed()) return runStability(stab, out, err);
   } catch (const std::exception& e) {
     err << "substratec: internal compiler error: " << e.what() << "\n";
     return kExitInternal;

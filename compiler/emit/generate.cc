@@ -94,7 +94,7 @@ ShaderValidation compileKernel(const CompileResult& r, Target target, KernelMode
   const std::string materialName = m.name + std::string(syn.materialExtension);
   ShaderSource src;
   src.name = kernelFileName(m, syn, mode);
-  src.text = emitKernel(m, r.after, syn, mode);
+  src.text = emitKernel(m, r.after, syn, mode, emit.inputsPerInvocation);
   src.language = target == Target::Glsl ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
   src.stage = ShaderStage::Compute;
   for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);

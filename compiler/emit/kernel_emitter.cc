@@ -77,7 +77,27 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   return s;
 }
 
-std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax& syn, KernelMode mode) {
+/// With per-sample inputs: binding 8 holds one float4 per non-texture input
+/// (material order) per sample; the material's private input globals
+/// (EmitOptions::inputsPerInvocation) are set from it.
+std::string assignSampleInputs(const Material& m, const Syntax& syn) {
+  const bool glsl = syn.target == Target::Glsl;
+  int count = 0;
+  for (const Input& in : m.inputs) count += in.type != VType::Texture;
+  std::string s;
+  int j = 0;
+  for (const Input& in : m.inputs) {
+    if (in.type == VType::Texture) continue;
+    static const char* swizzle[] = {"", ".x", ".xy", ".xyz", ""};
+    const std::string target = glsl ? fmt::format("{}_inputs.i_{}", m.name, in.name) : fmt::format("{}_i_{}", m.name, in.name);
+    s += fmt::format("  {} = sampleInputs[i * {}u + {}u]{};\n", target, count, j++,
+                     swizzle[componentCount(in.type)]);
+  }
+  return s;
+}
+
+std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax& syn, KernelMode mode,
+                         bool perSampleInputs) {
   const bool glsl = syn.target == Target::Glsl;
   const std::string upper = materialUpper(m);
   const int n = static_cast<int>(L.closures.size());
@@ -89,13 +109,17 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   if (glsl) {
     s += fmt::format("layout(local_size_x = {}) in;\n", kLocalSize);
     s += "layout(set = 0, binding = 6, std430) readonly buffer SubstrateSamples { vec4 samples[]; };\n";
-    s += "layout(set = 0, binding = 7, std430) writeonly buffer SubstrateResults { float results[]; };\n\n";
-    s += "void main() {\n  uint i = gl_GlobalInvocationID.x;\n";
+    s += "layout(set = 0, binding = 7, std430) writeonly buffer SubstrateResults { float results[]; };\n";
+    if (perSampleInputs)
+      s += "layout(set = 0, binding = 8, std430) readonly buffer SubstrateSampleInputs { vec4 sampleInputs[]; };\n";
+    s += "\nvoid main() {\n  uint i = gl_GlobalInvocationID.x;\n";
   } else {
     s += "[[vk::binding(6, 0)]] StructuredBuffer<float4> samples;\n";
-    s += "[[vk::binding(7, 0)]] RWStructuredBuffer<float> results;\n\n";
-    s += fmt::format("[numthreads({}, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID) {{\n  uint i = id.x;\n", kLocalSize);
+    s += "[[vk::binding(7, 0)]] RWStructuredBuffer<float> results;\n";
+    if (perSampleInputs) s += "[[vk::binding(8, 0)]] StructuredBuffer<float4> sampleInputs;\n";
+    s += fmt::format("\n[numthreads({}, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID) {{\n  uint i = id.x;\n", kLocalSize);
   }
+  if (perSampleInputs) s += assignSampleInputs(m, syn);
   auto sample = [&](int k) { return fmt::format("samples[i * {}u + {}u]", kSampleVec4s, k); };
   s += "  SubstrateGeometry g;\n";
   s += fmt::format("  g.N = normalize({}.xyz);\n", sample(kSampleNormal));
@@ -355,10 +379,11 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
 
 }  // namespace
 
-std::string emitKernel(const Material& m, const StorageLayout& layout, const Syntax& syn, KernelMode mode) {
+std::string emitKernel(const Material& m, const StorageLayout& layout, const Syntax& syn, KernelMode mode,
+                       bool perSampleInputs) {
   if (mode == KernelMode::Preview) return previewKernel(m, layout, syn);
   if (mode == KernelMode::Throughput) return throughputKernel(m, layout, syn);
-  return sampleKernel(m, layout, syn, mode);
+  return sampleKernel(m, layout, syn, mode, perSampleInputs);
 }
 
 std::string kernelFileName(const Material& m, const Syntax& syn, KernelMode mode) {

@@ -15,6 +15,9 @@
 //   6     samples: kSampleVec4s float4 per sample (sample kernels only)
 //   (Throughput reads nothing but the material's resources and the tables)
 //   7     results: floats, see below
+//   8     per-sample inputs (sample kernels with perSampleInputs only): one float4
+//         per non-texture material input (material order) per sample; the
+//         material is then emitted with EmitOptions::inputsPerInvocation
 #pragma once
 #include <string>
 
@@ -75,7 +78,9 @@ inline constexpr int kPreviewParamVec4s = 2 + 2 * kPreviewLights;
 }  // namespace kernel
 
 /// The kernel source; it includes "<name>.material.{glsl,hlsl}" and the runtime.
-std::string emitKernel(const Material& m, const StorageLayout& layout, const Syntax& syn, KernelMode mode);
+/// perSampleInputs (Forward and Deferred only): inputs from binding 8, see above.
+std::string emitKernel(const Material& m, const StorageLayout& layout, const Syntax& syn, KernelMode mode,
+                       bool perSampleInputs = false);
 
 /// `<name>.<mode>.comp` / `<name>.<mode>.cs.hlsl` (mode: forward_samples, deferred_samples, preview, throughput).
 std::string kernelFileName(const Material& m, const Syntax& syn, KernelMode mode);

@@ -230,8 +230,20 @@ void Emitter::emitResources() {
   std::vector<const Input*> uniforms;
   for (const auto& in : m_.inputs)
     if (in.type != VType::Texture) uniforms.push_back(&in);
-  line("// Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.");
-  if (!uniforms.empty()) {
+  if (opt_.inputsPerInvocation && !uniforms.empty()) {
+    line("// Material inputs: private globals, set by the kernel for each shading point; textures from binding 1.");
+    if (glsl) {
+      line(fmt::format("struct {}_Inputs {{", m_.name));
+      for (const Input* in : uniforms) line(fmt::format("  {} i_{};", syn_.type(in->type), in->name));
+      line("};");
+      line(fmt::format("{0}_Inputs {0}_inputs;", m_.name));
+    } else {
+      for (const Input* in : uniforms) line(fmt::format("static {} {}_i_{};", syn_.type(in->type), m_.name, in->name));
+    }
+  } else {
+    line("// Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.");
+  }
+  if (!uniforms.empty() && !opt_.inputsPerInvocation) {
     if (glsl) {
       line(fmt::format("layout(set = 1, binding = 0, std140) uniform {}_Inputs {{", m_.name));
       for (const Input* in : uniforms) line(fmt::format("  {} i_{};", syn_.type(in->type), in->name));

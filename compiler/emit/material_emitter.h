@@ -22,6 +22,11 @@ namespace substratec {
 struct EmitOptions {
   int diffuseModel = 2;          // 0 lambert, 1 chan2018, 2 chan2024, 3 eon
   std::string sourceName;        // file name (no directory) for the header comment
+  /// Declare the inputs as private globals instead of the uniform block: a
+  /// kernel that reads one input set per shading point (KernelMode's
+  /// per-sample inputs, `substratec stability`) assigns them before calling
+  /// `<name>_evaluate`. Same names as the block, so the body is unchanged.
+  bool inputsPerInvocation = false;
 };
 
 /// `<name>.material.glsl` / `.hlsl`.

@@ -1,0 +1,95 @@
+// `substratec stability`: the material on a grid of hard cases, on the CPU
+// reference (double and float) and in the generated shaders on lavapipe
+// (forward and packed paths), counting non-finite values; and the largest
+// directional albedo of any forced configuration under a white furnace.
+//
+// THE GRID
+//   Forced parameters. The material is rewritten (forceableText) so that every
+//   slab parameter it has can be forced at run time from two shared inputs per
+//   kind, a flag f in {0, 1} and a value v: the pin p becomes
+//   p * (1 - f) + v * f, exact for either flag (x * 0 = 0, x * 1 = x for finite
+//   x). Kinds and their forced values (docs/stability.md):
+//     roughness {0, 1e-4, 0.02, 0.5, 1} (roughness, second_roughness,
+//       fuzz_roughness), anisotropy {-1, 0, 1} (where the slab has it),
+//     f0 {0, 1}, f90 {0, 1} (where the slab has it), albedo {0, 1}
+//       (diffuse_albedo), coverage {0, 1e-7, 1} (coverage_weight.weight,
+//       horizontal.mix), mfp {0, 1e-9, 1e6} (where the slab has sss_mfp),
+//     thickness {0, 1e-9, 10} (vertical.thickness).
+//   Each kind also has "own" (flag 0). Configurations: the cross product of
+//   every kind's choices with the material's own inputs at their defaults, at
+//   their minima and at their maxima.
+//   Shading points: normals at the octahedral poles and seams (±X, ±Y, ±Z,
+//   diagonals, just off the fold) and a generic one; tangents orthogonal,
+//   parallel to the normal and zero (degenerate frames); NoV and NoL in
+//   {-1e-4, 0, 1e-4, 0.5, 1}, the light in the view's azimuth or the opposite
+//   one (so V = L and V = -L both occur).
+//   Each configuration is evaluated at `perConfiguration` shading points
+//   (rotating through the list: every configuration meets a different slice,
+//   and over the configurations every point meets every value), where
+//   perConfiguration = max(1, evaluations / configurations).
+//
+// WHAT AN EVALUATION CHECKS
+//   CPU (double and float): every closure field, coverage and transmittance,
+//   the direct light, the view throughput, the split-sum environment and
+//   translucency. GPU: the forward kernel (closures lit inline) and the
+//   deferred kernel (packed, unpacked, lit) write the closures and the sums:
+//   every float must be finite.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "gpu/harness.h"
+#include "pipeline/pipeline.h"
+
+namespace substratec::stability {
+
+/// A forceable parameter kind and its forced values.
+struct ForcedKind {
+  std::string name;            // "roughness", "anisotropy", ...
+  std::vector<double> values;  // forced values (the grid adds "own")
+  std::string flagInput, valueInput;  // the inputs forceableText added
+};
+
+/// The material rewritten so that its slab parameters can be forced (see
+/// above), and the kinds it has. False with `*error` if the text is not a
+/// JSON object (the caller compiled it first: its diagnostics come from there).
+bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
+                   std::string* error);
+
+struct Options {
+  long evaluations = 100000;  // at least this many (CPU; the GPU runs the same points in each path)
+  bool gpu = true;
+  int furnaceSamples = 1024;  // importance samples per furnace integral
+};
+
+/// One non-finite (or, for the furnace, the largest) case: where it was found.
+struct Case {
+  std::string where;          // "cpu double", "cpu float", "gpu forward", "gpu deferred", "furnace"
+  std::string quantity;       // "closure 0 f0", "direct", ...
+  std::string configuration;  // "roughness=0 f0=1 inputs=defaults ..."
+  std::string geometry;       // "N=(0,0,1) T=parallel NoV=1e-4 NoL=0 same azimuth"
+  double value = 0;
+};
+
+struct Report {
+  std::string material;
+  std::vector<std::string> forced;  // the kinds
+  long configurations = 0, shadingPoints = 0;
+  long evaluations = 0, nonfinite = 0;        // CPU: points evaluated (each in double and in float), bad ones
+  long gpuEvaluations = 0, gpuNonfinite = 0;  // GPU: points evaluated over both paths, bad ones
+  double furnaceMax = 0;                      // largest directional albedo, white inputs, white furnace
+  Case furnaceWorst;
+  std::vector<Case> worst;                    // the first non-finite cases (at most 16)
+};
+
+/// Runs the grid on `r` (compiled from forceableText's output; `kinds` from it).
+/// `gpu` may be null when options.gpu is false. False with `*error` when a
+/// kernel does not compile or a dispatch fails.
+bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Options& options, gpu::Context* gpu,
+         Report* report, std::string* error);
+
+std::string formatText(const Report& report);
+std::string formatJson(const Report& report);
+
+}  // namespace substratec::stability
