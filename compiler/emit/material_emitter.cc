@@ -49,6 +49,7 @@ class Emitter {
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
   bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
+  bool underOperatorTop(int node) const;  // in (or is) an operator that is the top of a vertical
 
   void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
   /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
@@ -171,6 +172,12 @@ std::string Emitter::opExpr(const ValueNode& n) {
 }
 
 int Emitter::verticalOfTop(int node) const { return t_.layerVertical[node]; }
+
+bool Emitter::underOperatorTop(int node) const {
+  for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p])
+    if (m_.nodes[p].op == TreeOp::Vertical && m_.nodes[p].left == x && m_.nodes[x].op != TreeOp::Slab) return true;
+  return false;
+}
 
 bool Emitter::knownOpaque(int node) const {
   const Slab& s = m_.slabs[m_.nodes[node].slab];
@@ -309,6 +316,8 @@ void Emitter::emitTree() {
                      v >= 0 ? fmt::format(", in the top layer of vertical '{}'", m_.nodes[v].id) : ""));
     line(fmt::format("float C_{} = {};", node.id, c));
     line(fmt::format("{} T_{} = {};", v3, node.id, t));
+    if (underOperatorTop(n))  // what it lets through, its interface included (TI: see emitClosures)
+      line(fmt::format("{} TI_{} = T_{} * (1.0 - {});", v3, node.id, node.id, expr(s.pin(SlabPin::F0))));
   }
   // Operators bottom-up: by distance from leaves, then tree id.
   for (int n : t_.bottomUpOperators) {
@@ -332,6 +341,28 @@ void Emitter::emitTree() {
       case TreeOp::CoverageWeight:
         line(fmt::format("C_{0} = {1} * C_{2}; T_{0} = T_{2};", id, expr(node.a), l));
         break;
+      case TreeOp::Slab: break;
+    }
+    if (!underOperatorTop(n)) continue;
+    // The same operator on what the children let through with their interfaces.
+    line(fmt::format("{} TI_{};", v3, id));
+    switch (node.op) {
+      case TreeOp::Horizontal:
+        line(fmt::format("{{ float c; substrate_op_horizontal(C_{0}, TI_{0}, C_{1}, TI_{1}, {2}, c, TI_{3}); }}", l, r,
+                         expr(node.a), id));
+        break;
+      case TreeOp::Select:
+        line(fmt::format("{{ float c; substrate_op_horizontal(C_{0}, TI_{0}, C_{1}, TI_{1}, 1.0 - step({2}, {3}), c, "
+                         "TI_{4}); }}",
+                         l, r, expr(node.a), expr(node.b), id));
+        break;
+      case TreeOp::Vertical:
+        line(fmt::format("{{ float c; substrate_op_vertical(C_{0}, TI_{0}, C_{1}, TI_{1}, c, TI_{2}); }}", l, r, id));
+        break;
+      case TreeOp::Add:
+        line(fmt::format("{{ float c; substrate_op_add(C_{0}, TI_{0}, C_{1}, TI_{1}, c, TI_{2}); }}", l, r, id));
+        break;
+      case TreeOp::CoverageWeight: line(fmt::format("TI_{} = TI_{};", id, l)); break;
       case TreeOp::Slab: break;
     }
   }
@@ -364,8 +395,10 @@ void Emitter::emitClosures() {
         case TreeOp::Vertical:
           if (op.right == x) {
             const TreeNode& top = m_.nodes[op.left];
-            std::string tTop = fmt::format("T_{}", top.id);
-            if (top.op == TreeOp::Slab)  // the top's interface transmits 1 - F0 at normal incidence
+            // The top's interfaces transmit 1 - F0 at normal incidence: a slab's
+            // inline, an operator's (a partial coat, a mix of coats) through TI.
+            std::string tTop = fmt::format("TI_{}", top.id);
+            if (top.op == TreeOp::Slab)
               tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
             layerLines.push_back(fmt::format("substrate_layer_above(ca_{0}, ta_{0}, C_{1}, {2});  // under '{1}' (vertical '{3}')",
                                              id, top.id, tTop, op.id));

@@ -150,6 +150,7 @@ class Walk {
     const std::size_t n = m_.nodes.size();
     C_.assign(n, T(1));
     Tr_.assign(n, splat3(T(1)));
+    TI_.assign(n, splat3(T(1)));
     slabs();
     operators();
     MaterialResult<T> out;
@@ -203,6 +204,7 @@ class Walk {
         Tr_[n] = splat3(T(0));
       else
         Tr_[n] = transmittance(mfpOf(s), v >= 0 ? scalar(m_.nodes[v].a) : static_cast<T>(d));
+      TI_[n] = Tr_[n] * (splat3(T(1)) - vec3(s.pin(SlabPin::F0)));
     }
   }
 
@@ -224,6 +226,17 @@ class Walk {
           C_[n] = scalar(node.a) * C_[l];
           Tr_[n] = Tr_[l];
           break;
+        case TreeOp::Slab: break;
+      }
+      // The emitter's TI_: the same operator on what the children let through
+      // with their interfaces (used when the node is an operator on top of a vertical).
+      T c;
+      switch (node.op) {
+        case TreeOp::Horizontal: opHorizontal(C_[l], TI_[l], C_[r], TI_[r], scalar(node.a), c, TI_[n]); break;
+        case TreeOp::Select: opHorizontal(C_[l], TI_[l], C_[r], TI_[r], T(1) - step(node), c, TI_[n]); break;
+        case TreeOp::Vertical: opVertical(C_[l], TI_[l], C_[r], TI_[r], c, TI_[n]); break;
+        case TreeOp::Add: opAdd(C_[l], TI_[l], C_[r], TI_[r], c, TI_[n]); break;
+        case TreeOp::CoverageWeight: TI_[n] = TI_[l]; break;
         case TreeOp::Slab: break;
       }
     }
@@ -268,14 +281,16 @@ class Walk {
     }
     // The layers above, from the root down (substrate_layer_above); a slab on
     // top of a vertical transmits T (1 - F0) and widens the roughness below by
-    // C * variance(its roughness). An operator on top: its T, no widening.
+    // C * variance(its roughness). An operator on top: its TI (its slabs'
+    // T (1 - F0) through the operators), no widening.
     T ca = T(0), va = T(0);
     V3<T> ta = splat3(T(1));
     if (!cl.isTop) {
       for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
         const TreeNode& top = m_.nodes[it->top];
-        V3<T> tTop = Tr_[it->top];
+        V3<T> tTop = TI_[it->top];
         if (top.op == TreeOp::Slab) {
+          tTop = Tr_[it->top];
           const Slab& ts = m_.slabs[top.slab];
           va = va + C_[it->top] * roughnessToVariance(scalar(ts.pin(SlabPin::Roughness)));
           tTop = tTop * (splat3(T(1)) - vec3(ts.pin(SlabPin::F0)));
@@ -355,6 +370,7 @@ class Walk {
   V4<T> uvDerivatives_;
   std::vector<T> C_;
   std::vector<V3<T>> Tr_;
+  std::vector<V3<T>> TI_;  // what each node lets through with its interfaces (emitter's TI_)
   std::map<int, int> profileIndex_;
 };
 

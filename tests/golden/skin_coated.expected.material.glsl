@@ -50,12 +50,15 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
   // slab 'sweat_a' (Id=2, BSDF 0), in the top layer of vertical 'root'
   float C_sweat_a = 1.0;
   vec3 T_sweat_a = substrate_transmittance(vec3(10.0, 10.0, 10.0), skin_coated_inputs.i_coat_thickness);
+  vec3 TI_sweat_a = T_sweat_a * (1.0 - vec3(0.0200593122, 0.0200593122, 0.0200593122));
   // slab 'skin' (Id=3, BSDF 1)
   float C_skin = 1.0;
   vec3 T_skin = substrate_transmittance(skin_coated_inputs.i_skin_mfp, 0.0001);
   // WEIGHT 'sweat' (Id=1, DistanceFromLeaves=1)
   float C_sweat; vec3 T_sweat;
   C_sweat = v10 * C_sweat_a; T_sweat = T_sweat_a;
+  vec3 TI_sweat;
+  TI_sweat = TI_sweat_a;
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=2)
   float C_root; vec3 T_root;
   substrate_op_vertical(C_sweat, T_sweat, C_skin, T_skin, C_root, T_root);
@@ -71,7 +74,7 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
 
   // Closure 1: slab 'skin' (BSDF 1, LayerDepth 1, under a layer)
   float ca_skin = 0.0; vec3 ta_skin = vec3(1.0, 1.0, 1.0); float va_skin = 0.0;
-  substrate_layer_above(ca_skin, ta_skin, C_sweat, T_sweat);  // under 'sweat' (vertical 'root')
+  substrate_layer_above(ca_skin, ta_skin, C_sweat, TI_sweat);  // under 'sweat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = skin_coated_inputs.i_skin_albedo;
   closures[1].f0 = vec3(0.028, 0.028, 0.028);

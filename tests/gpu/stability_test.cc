@@ -221,4 +221,22 @@ TEST(LayeringEnergy, ACoatThatLetsLightThroughDoesNotAlsoScatterItAllBack) {
   }
 }
 
+TEST(LayeringEnergy, APartialCoatsInterfaceKeepsWhatItReflects) {
+  // A coat under a coverage weight (an operator on top of the vertical): its
+  // interface's 1 - F0 still reaches the base through the operator (TI). A
+  // mirror coat (F0 1) of full coverage over a white base returned 2.0.
+  for (const char* f0 : {"1", "0.5", "0.04"}) {
+    SCOPED_TRACE(f0);
+    const CompileResult r = compile(fmt::format(R"({{"format": "substrate-material/1", "name": "partial_mirror",
+      "inputs": {{"w": {{"type": "float", "default": 1, "min": 0, "max": 1}}}},
+      "nodes": {{"coat": {{"kind": "slab", "diffuse_albedo": 0, "f0": {}, "roughness": 0.3, "sss_mfp": 1e6}},
+                "partial": {{"kind": "coverage_weight", "a": "coat", "weight": "$w"}},
+                "base": {{"kind": "slab", "diffuse_albedo": 1, "f0": 0, "roughness": 0.5}},
+                "root": {{"kind": "vertical", "top": "partial", "base": "base", "thickness": 0.001}}}},
+      "output": "root"}})",
+                                                f0));
+    for (double mu : {1.0, 0.5, 0.1}) EXPECT_LE(materialAlbedo(r, mu), 1.001) << mu;
+  }
+}
+
 }  // namespace
