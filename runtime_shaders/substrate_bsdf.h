@@ -50,9 +50,14 @@ SUBSTRATE_CONST float SUBSTRATE_FUZZ_MIN_ALPHA = 1e-3;
 // ---------------------------------------------------------------------------
 // Frames.
 
-// Unit shading normal of a closure (falls back to +Z for a zero normal).
+// Unit shading normal of a closure (falls back to +Z for a zero normal); c.N
+// itself when the includer promises unit normals (SUBSTRATE_UNIT_CLOSURE_NORMALS).
 float3 substrate_closure_normal(SubstrateClosure c) {
+#if SUBSTRATE_UNIT_CLOSURE_NORMALS
+  return c.N;
+#else
   return substrate_safe_normalize(c.N, float3(0.0, 0.0, 1.0));
+#endif
 }
 
 // Tangent frame around the unit normal N: c.T made orthogonal to N (one

@@ -103,6 +103,15 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_EMISSIVE
 #define SUBSTRATE_USE_EMISSIVE 1
 #endif
+// 1: every closure the shader lights has a unit N (the generated material
+// function guarantees it for a unit g.N: its normals go through
+// substrate_tangent_to_world, which normalizes, or are g.N itself), so
+// substrate_closure_normal returns N as is instead of re-normalizing it at every
+// use. The forward entries and the kernels that light evaluated closures define
+// it; the default (0) suits closures of any origin (deferred, unpacked).
+#ifndef SUBSTRATE_UNIT_CLOSURE_NORMALS
+#define SUBSTRATE_UNIT_CLOSURE_NORMALS 0
+#endif
 // Diffuse model: 0 Lambert, 1 Chan 2018, 2 Chan 2024, 3 EON (Portsmouth 2025).
 #ifndef SUBSTRATE_DIFFUSE_MODEL
 #define SUBSTRATE_DIFFUSE_MODEL 2

@@ -23,6 +23,8 @@ bool usesEmissive(const Material& m, const StorageLayout& L) {
 std::string includes(const Material& m, const Syntax& syn, bool lighting) {
   std::string s;
   if (syn.target == Target::Glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  // The forward pass lights the closures <name>_evaluate returns: their normals are unit.
+  if (lighting) s += "#define SUBSTRATE_UNIT_CLOSURE_NORMALS 1  // lit as evaluated: unit normals\n";
   s += fmt::format("#include \"{}\"\n", syn.prelude);
   if (!lighting) s += "#include \"substrate_pack.h\"\n";
   s += fmt::format("#include \"{}{}\"\n", m.name, syn.materialExtension);

@@ -28,6 +28,9 @@ std::string includes(const Material& m, const StorageLayout& L, const Syntax& sy
   std::string s;
   if (glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
   s += "#define SUBSTRATE_TEXTURE_LOD0 1  // no implicit derivatives in a compute shader\n";
+  // The closures lit come straight from <name>_evaluate (unit normals), except
+  // in Deferred, which lights what the generic unpacker decoded.
+  if (mode != KernelMode::Deferred) s += "#define SUBSTRATE_UNIT_CLOSURE_NORMALS 1  // lit as evaluated: unit normals\n";
   s += fmt::format("#include \"{}\"\n", syn.prelude);
   if (mode == KernelMode::Deferred) {
     s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", std::max(32, L.words()));
