@@ -54,9 +54,10 @@ std::vector<double> radiance(const CompileResult& r, const std::vector<gpu::Samp
 }
 
 /// The forward shader's SPIR-V instruction count after the performance passes.
-bool forwardInstructions(const CompileResult& r, std::size_t* count, std::string* error) {
+bool forwardInstructions(const CompileResult& r, int diffuseModel, std::size_t* count, std::string* error) {
   GenerateOptions o;
   o.hlsl = false;
+  o.emit.diffuseModel = diffuseModel;
   Generated g = generateFiles(r, o);
   validateGenerated(g, {.optimize = true});
   if (!g.valid) {
@@ -70,7 +71,9 @@ bool forwardInstructions(const CompileResult& r, std::size_t* count, std::string
 
 /// Median lavapipe time per shading point of the throughput kernel.
 bool nsPerPixel(gpu::Context& ctx, const CompileResult& r, const Options& o, double* ns, std::string* error) {
-  ShaderValidation v = compileKernel(r, Target::Glsl, KernelMode::Throughput);
+  EmitOptions emit;
+  emit.diffuseModel = o.diffuseModel;  // the model the errors are measured with
+  ShaderValidation v = compileKernel(r, Target::Glsl, KernelMode::Throughput, emit);
   if (!v.ok) {
     *error = "internal compiler error: the throughput kernel does not validate\n" + v.log;
     return false;
@@ -277,7 +280,7 @@ bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileRes
     row.budget = step.budget;
     row.bytes = r.after.bytes();
     row.closures = static_cast<int>(r.after.closures.size());
-    if (!forwardInstructions(r, &row.spirvInstructions, error)) return false;
+    if (!forwardInstructions(r, o.diffuseModel, &row.spirvInstructions, error)) return false;
     if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, error)) return false;
     std::vector<std::vector<reference::Closure<double>>> closures;
     std::vector<double> direct;
