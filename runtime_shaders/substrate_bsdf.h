@@ -125,10 +125,45 @@ float3 substrate_fresnel(float3 f0, float3 f90, float VoH) {
 
 // Turquin 2019 multiple-scattering compensation W = 1 + F0 (1 - E) / E and the
 // compensated lobe's directional albedo E_spec = (F0 (E - B) + F90 B) W, from
-// the tables at (NoV, r). Returns W; E_spec in `albedo`.
+// the tables at (NoV, r) (upper bounds of E - B and B; E = their sum clamped to
+// [1e-3, 1]). Returns W; E_spec in `albedo`. Both are safe for energy: W E <= 1
+// and E_spec is never below the compensated lobe's true albedo.
 float3 substrate_specular_energy(float3 f0, float3 f90, float NoV, float roughness, out float3 albedo) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
-  float e = max(dfg.x + dfg.y, 1e-3);
+  float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
+  float3 w = SUBSTRATE_SPLAT3(1.0) + f0 * ((1.0 - e) / e);
+  albedo = saturate((f0 * dfg.x + f90 * dfg.y) * w);
+  return w;
+}
+
+// The same for a lobe of anisotropy A. The tables hold isotropic lobes only,
+// and a stretched lobe's albedo leaves that family (seen along its rough axis
+// at NoV 0.1, r 0.5, A 0.5: E = 0.918, above the isotropic E at every alpha in
+// [ay, ax]), so W from the isotropic E overshot (1.74 at r 1, A 1). With
+// t = 1 - (1 - |A|)^2: E and E - B are widened toward 1 and E, bounds for any
+// lobe, by t (measured need: 0.26 at |A| 0.2, 0.68 at 0.5, 0.97 at 1); B, which
+// a stretched lobe seen along its smooth axis raises (its facets tilt
+// sideways: V.H small), is taken as at least the isotropic B at that axis's
+// alpha times 1 + min(0.55 sat(3.3 |A|), 0.2 + 2.33 (1 - |A|)) (measured need:
+// 1.10 at |A| 0.1, 1.45 at 0.5, 1.48 at 0.7, 1.10 at 1), never above E.
+// Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
+// the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
+float3 substrate_specular_energy_aniso(float3 f0, float3 f90, float NoV, float roughness, float anisotropy,
+                                       out float3 albedo) {
+  float2 dfg = substrate_energy_dfg(NoV, roughness);
+  float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
+#if SUBSTRATE_USE_ANISOTROPY
+  float A = min(abs(anisotropy), 1.0);
+  if (A > 0.0) {
+    float t = A * (2.0 - A);
+    e = lerp(e, 1.0, t);
+    float r = saturate(roughness);
+    float smoothAxis = sqrt(max(r * r * (1.0 - A), SUBSTRATE_MIN_ALPHA));
+    float margin = 1.0 + min(0.55 * saturate(3.3 * A), 0.2 + 2.33 * (1.0 - A));
+    float b = min(max(dfg.y, substrate_energy_dfg(NoV, smoothAxis).y * margin), e);
+    dfg = float2(lerp(dfg.x, e, t), b);
+  }
+#endif
   float3 w = SUBSTRATE_SPLAT3(1.0) + f0 * ((1.0 - e) / e);
   albedo = saturate((f0 * dfg.x + f90 * dfg.y) * w);
   return w;
@@ -146,7 +181,11 @@ float3 substrate_diffuse_lambert(float3 albedo, float NoL) {
 // a smooth term (1 - 0.75 (1 - NoV)^5)(1 - 0.75 (1 - NoL)^5) blended by
 // sat(2.2 g - 0.5), and a retro-reflection term
 // ((34.5 g - 59) g + 24.5) VoH 2^(-max(73.2 g - 21.2, 8.9) sqrt(NoH)).
-// As in UE, the lobe (f * pi) / pi is capped at 1.
+// As in UE, the lobe (f * pi) / pi is capped at 1. The model's directional
+// albedo exceeds its albedo when rough and grazing (1.10 at r = 1, NoV -> 0;
+// 1.035 at NoV 0.1): the lobe is divided by a bound of that excess, linear in r
+// and NoV, 1 + max(0, 0.41 (r - 0.74) - 0.59 NoV) (fitted above the measured
+// albedo; docs/stability.md), so it never returns more than `albedo`.
 float3 substrate_diffuse_chan2018(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
   float r = saturate(roughness);
   float a2 = max(r * r * r * r, 1e-7);
@@ -156,14 +195,18 @@ float3 substrate_diffuse_chan2018(float3 albedo, float roughness, float NoV, flo
   float fd = lerp(rough, smoothTerm, saturate(2.2 * g - 0.5));
   float fb = ((34.5 * g - 59.0) * g + 24.5) * VoH * exp2(-max(73.2 * g - 21.2, 8.9) * sqrt(saturate(NoH)));
   float lobe = min(1.0, SUBSTRATE_INV_PI * (fd + fb));
-  return albedo * (lobe * saturate(NoL));
+  float excess = max(0.0, 0.41 * (r - 0.74) - 0.59 * saturate(NoV));
+  return albedo * (lobe * saturate(NoL) / (1.0 + excess));
 }
 
 // Chan 2024, "Multiscattering Diffuse and Specular BRDFs" (as UE ships it, with
 // a Lambertian smooth limit): Scale = max(0.55 - 0.2 r, 1.25 - 1.6 r),
 // Bias = sat(4 a), FRough = Scale (NoH + Bias) / (NoH + 0.025) VoH^2,
-// f = albedo / pi (lerp(1, FRough, r) + 0.38 a).
-float3 substrate_diffuse_chan2024(float3 albedo, float roughness, float NoL, float NoH, float VoH) {
+// f = albedo / pi (lerp(1, FRough, r) + 0.38 a). Its directional albedo
+// exceeds `albedo` by up to 2.4 % at grazing views (NoV < 0.04) for r > 0.43:
+// the lobe is divided by 1 + 0.026 sat(1 - NoV / 0.04) sat(10 (r - 0.42)), a
+// bound of that excess (docs/stability.md).
+float3 substrate_diffuse_chan2024(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
   float r = saturate(roughness);
   float a = r * r;
   float scale = max(0.55 - 0.2 * r, 1.25 - 1.6 * r);
@@ -171,7 +214,8 @@ float3 substrate_diffuse_chan2024(float3 albedo, float roughness, float NoL, flo
   float n = saturate(NoH);
   float fRough = scale * (n + bias) / (n + 0.025) * VoH * VoH;
   float f = lerp(1.0, fRough, r) + 0.38 * a;
-  return albedo * (SUBSTRATE_INV_PI * f * saturate(NoL));
+  float excess = 0.026 * saturate(1.0 - 25.0 * NoV) * saturate(10.0 * (r - 0.42));
+  return albedo * (SUBSTRATE_INV_PI * f * saturate(NoL) / (1.0 + excess));
 }
 
 // E_FON(mu, r): the directional albedo of the Fujii Oren-Nayar lobe, the
@@ -211,7 +255,7 @@ float3 substrate_diffuse(float3 albedo, float roughness, float NoV, float NoL, f
 #if SUBSTRATE_DIFFUSE_MODEL == 1
   return substrate_diffuse_chan2018(albedo, roughness, NoV, NoL, NoH, VoH);
 #elif SUBSTRATE_DIFFUSE_MODEL == 2
-  return substrate_diffuse_chan2024(albedo, roughness, NoL, NoH, VoH);
+  return substrate_diffuse_chan2024(albedo, roughness, NoV, NoL, NoH, VoH);
 #elif SUBSTRATE_DIFFUSE_MODEL == 3
   return substrate_diffuse_eon(albedo, roughness, NoV, NoL, VoL);
 #else
@@ -378,9 +422,16 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 #endif
   float roughness = saturate(c.roughness);
 
+  float anisotropy = 0.0;
+#if SUBSTRATE_USE_ANISOTROPY
+  if ((c.features & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
+    anisotropy = clamp(c.anisotropy, -1.0, 1.0);
+  }
+#endif
+
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
   float3 specAlbedo;
-  float3 w1 = substrate_specular_energy(f0, f90, NoV, roughness, specAlbedo);
+  float3 w1 = substrate_specular_energy_aniso(f0, f90, NoV, roughness, anisotropy, specAlbedo);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -392,18 +443,12 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   float3 w2 = w1;
   if (hazeWeight > 0.0) {
     float3 specAlbedo2;
-    w2 = substrate_specular_energy(f0, f90, NoV, hazeRoughness, specAlbedo2);
+    w2 = substrate_specular_energy_aniso(f0, f90, NoV, hazeRoughness, anisotropy, specAlbedo2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
   }
 
   float3 spec = SUBSTRATE_SPLAT3(0.0);
   if (lightFacing) {
-    float anisotropy = 0.0;
-#if SUBSTRATE_USE_ANISOTROPY
-    if ((c.features & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
-      anisotropy = clamp(c.anisotropy, -1.0, 1.0);
-    }
-#endif
     bool needFrame = anisotropy != 0.0;
 #if SUBSTRATE_USE_GLINT
     needFrame = needFrame || ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u && c.glintValue < 1.0);

@@ -91,6 +91,11 @@ float substrate_energy_albedo(float NoV, float roughness) {
 }
 
 // The split-sum DFG pair (E - B, B): the lobe's albedo is F0 * x + F90 * y.
+// The tables are conservative envelopes of E - B and of B separately
+// (scripts/gen_energy_lut.py): each component bounds its true value from
+// above, so x + y may exceed 1 by the envelope's slack. E is not clamped to 1
+// before the difference is taken (that would cut E - B below its bound); the
+// caller clamps the sum where it needs E itself.
 float2 substrate_energy_dfg(float NoV, float roughness) {
   int4 i;
   float2 f;
@@ -100,9 +105,8 @@ float2 substrate_energy_dfg(float NoV, float roughness) {
   float b = substrate_lut_blend(
       SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.y),
       SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.w), f);
-  e = clamp(e, 1e-3, 1.0);
-  b = clamp(b, 0.0, e);
-  return float2(e - b, b);
+  b = clamp(b, 0.0, 1.0);
+  return float2(clamp(e - b, 0.0, 1.0), b);
 }
 
 // E_fuzz(NoV, r): directional albedo of the Charlie sheen lobe (colour 1,

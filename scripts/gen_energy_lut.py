@@ -21,8 +21,20 @@ centres):
 
 Integration is deterministic: GGX by visible-normal importance sampling
 (Heitz 2018) and the sheen by sampling its NDF, both over a Hammersley set.
+
+The tables are conservative (docs/stability.md, "Energy: the white furnace"):
+every value the runtime's lookup returns (bilinear between cell centres, the
+outer half cells extrapolated linearly, NoV >= 1e-4 as the BSDF clamps it) is
+at least the true albedo. The centre values are integrated first; then, on a
+grid of ENVELOPE_STEPS points per cell and axis over the whole lookup domain,
+the true values are integrated again and any node the lookup leaves below a
+point is raised (by that point's bilinear weights) until none is. E - B and B
+are bounded separately (E = (E - B) + B), so F0 (E - B) + F90 B is an upper
+bound for any F0, F90 in [0, 1]: compensation never adds energy and the
+diffuse below never receives more than 1 - E_spec of the true lobe.
+
 Pure Python 3 (no numpy). Writes the header (default path, or argv[1]) and prints
-nothing; two runs give identical files.
+nothing; two runs give identical files (about 2 minutes).
 """
 
 import math
@@ -34,6 +46,18 @@ GGX_SAMPLES = 4096     # Hammersley points per GGX cell
 FUZZ_SAMPLES = 8192    # Hammersley points per sheen cell
 GGX_MIN_ALPHA = 1e-3   # must match SUBSTRATE_MIN_ALPHA in substrate_bsdf.h
 SHEEN_MIN_ALPHA = 1e-3 # must match SUBSTRATE_FUZZ_MIN_ALPHA in substrate_bsdf.h
+MIN_NOV = 1e-4         # SUBSTRATE_MIN_COS: the BSDF never looks up a smaller NoV
+ENVELOPE_STEPS = 4     # envelope check points per cell and axis
+ENVELOPE_GGX_SAMPLES = 2048
+ENVELOPE_FUZZ_SAMPLES = 4096
+ENVELOPE_MARGIN = 2e-4  # absolute slack over the integrated value (integration noise)
+# More check points in NoV below the first cell centre, where E dips near
+# NoV ~ alpha and a sharp sheen's albedo peaks (6.1 at NoV 6e-4, r 0.03).
+ENVELOPE_EXTRA_NOV = (2e-4, 4e-4, 6e-4, 1e-3, 1.5e-3, 2e-3, 3e-3, 4e-3, 5.5e-3)
+# The sheen's albedo at grazing views integrates to ~0.5 % (1 % where it
+# exceeds 1, sharp fuzz) with ENVELOPE_FUZZ_SAMPLES points: its margin is
+# relative, 1 % of the value.
+ENVELOPE_FUZZ_RELATIVE_MARGIN = 0.01
 
 
 def radical_inverse2(i):
@@ -180,6 +204,8 @@ HEADER_TOP = """\
 //   SUBSTRATE_LUT_E     E(NoV, r): albedo of the single-scattering GGX lobe with
 //                       F = 1 (height-correlated Smith G2, alpha = max(r^2, 1e-3)).
 //                       Turquin 2019 uses it for W = 1 + F0 (1 - E) / E.
+//                       Stored as (E - B) + B of the two upper bounds (below),
+//                       so it may exceed 1 by their slack.
 //   SUBSTRATE_LUT_B     B(NoV, r): the part of E weighted by (1 - VoH)^5; with
 //                       Schlick's Fresnel the lobe's albedo is F0 (E - B) + F90 B
 //                       (the split-sum DFG pair).
@@ -191,6 +217,13 @@ HEADER_TOP = """\
 //
 // Integration: %d (GGX, visible-normal sampling, Heitz 2018) and %d (sheen, NDF
 // sampling) Hammersley points per cell.
+//
+// Conservative: every value the runtime's lookup returns (substrate_lut_coords:
+// bilinear between cell centres, linear extrapolation in the outer half cells,
+// NoV >= 1e-4) is at least the true value (E - B, B and E_fuzz each), checked
+// on %d x %d points over the lookup domain (%d more NoV below the first cell
+// centre) with a margin of %g (E_fuzz: %g of the value more); nodes
+// the lookup left short were raised (docs/stability.md, "Energy: the white furnace").
 //
 // Shaders read these values from a storage buffer by default (see
 // substrate_energy_lut.h); this file is what the host uploads, and what a shader
@@ -215,22 +248,90 @@ SUBSTRATE_ARRAY_END;
 """
 
 
+def lookup_weights(px, py):
+    """substrate_lut_coords: the four (index, weight) pairs of the bilinear
+    lookup at table coordinates p = value * 32 - 0.5 (weights in [-0.5, 1.5]
+    in the outer half cells)."""
+    x0 = min(max(math.floor(px), 0), N - 2)
+    y0 = min(max(math.floor(py), 0), N - 2)
+    fx = px - x0
+    fy = py - y0
+    i = y0 * N + x0
+    return ((i, (1.0 - fx) * (1.0 - fy)), (i + 1, fx * (1.0 - fy)),
+            (i + N, (1.0 - fx) * fy), (i + N + 1, fx * fy))
+
+
+def raise_to_envelope(nodes, points, relative=0.0):
+    """Raises `nodes` until the lookup at every (px, py, value) of `points`
+    is at least value + ENVELOPE_MARGIN + relative * value. A
+    point short by d raises its positive-weight nodes by d w / sum(w^2), which
+    lifts it by exactly d."""
+    for _ in range(200):
+        worst = 0.0
+        for px, py, value in points:
+            ws = lookup_weights(px, py)
+            have = sum(nodes[i] * w for i, w in ws)
+            d = value + ENVELOPE_MARGIN + relative * value - have
+            if d > 1e-9:
+                worst = max(worst, d)
+                s2 = sum(w * w for _, w in ws if w > 0.0)
+                for i, w in ws:
+                    if w > 0.0:
+                        nodes[i] += d * w / s2
+        if worst <= 1e-9:
+            return
+    raise RuntimeError("envelope did not converge")
+
+
+def envelope_points():
+    """(px, py, NoV, r) over the lookup domain: ENVELOPE_STEPS points per cell
+    and axis from p = -0.5 (NoV = 1e-4, r = 0) to 31.5 (NoV = r = 1), and the
+    ENVELOPE_EXTRA_NOV columns."""
+    ps = [-0.5 + k / float(ENVELOPE_STEPS) for k in range(N * ENVELOPE_STEPS + 1)]
+    mus = [min(max((px + 0.5) / N, MIN_NOV), 1.0) for px in ps] + list(ENVELOPE_EXTRA_NOV)
+    out = []
+    for py in ps:
+        r = min(max((py + 0.5) / N, 0.0), 1.0)
+        for mu in mus:
+            out.append((mu * N - 0.5, py, mu, r))
+    return out
+
+
 def main():
     here = os.path.dirname(os.path.abspath(__file__))
     path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
         here, "..", "runtime_shaders", "substrate_energy_lut_data.h")
     pts_ggx = hammersley(GGX_SAMPLES)
     pts_fuzz = hammersley(FUZZ_SAMPLES)
-    e_tab, b_tab, f_tab = [], [], []
+    x_tab, b_tab, f_tab = [], [], []  # E - B, B, E_fuzz at the cell centres
     for j in range(N):
         r = (j + 0.5) / N
         for i in range(N):
             mu = (i + 0.5) / N
             e, b = ggx_cell(mu, r, pts_ggx)
-            e_tab.append(min(e, 1.0))
-            b_tab.append(min(b, e))
+            b = min(b, e)
+            x_tab.append(e - b)
+            b_tab.append(b)
             f_tab.append(fuzz_cell(mu, r, pts_fuzz))  # may exceed 1 (see header)
-    out = [HEADER_TOP % (GGX_SAMPLES, FUZZ_SAMPLES)]
+    # The conservative envelope (see the module docstring).
+    pts_env_ggx = hammersley(ENVELOPE_GGX_SAMPLES)
+    pts_env_fuzz = hammersley(ENVELOPE_FUZZ_SAMPLES)
+    x_pts, b_pts, f_pts = [], [], []
+    for px, py, mu, r in envelope_points():
+        e, b = ggx_cell(mu, r, pts_env_ggx)
+        b = min(b, e)
+        x_pts.append((px, py, e - b))
+        b_pts.append((px, py, b))
+        f_pts.append((px, py, fuzz_cell(mu, r, pts_env_fuzz)))
+    raise_to_envelope(x_tab, x_pts)
+    raise_to_envelope(b_tab, b_pts)
+    raise_to_envelope(f_tab, f_pts, ENVELOPE_FUZZ_RELATIVE_MARGIN)
+    # E is stored as the sum of the two bounds, not clamped to 1: the lookup
+    # takes E - B back from it (substrate_energy_dfg).
+    e_tab = [x + b for x, b in zip(x_tab, b_tab)]
+    steps = N * ENVELOPE_STEPS + 1
+    out = [HEADER_TOP % (GGX_SAMPLES, FUZZ_SAMPLES, steps, steps, len(ENVELOPE_EXTRA_NOV), ENVELOPE_MARGIN,
+                         ENVELOPE_FUZZ_RELATIVE_MARGIN)]
     emit_table(out, "SUBSTRATE_LUT_E", 0, e_tab, "E(NoV, r), F = 1")
     emit_table(out, "SUBSTRATE_LUT_B", 1, b_tab, "B(NoV, r), the (1 - VoH)^5 part of E")
     emit_table(out, "SUBSTRATE_LUT_FUZZ", 2, f_tab, "E_fuzz(NoV, r), Charlie sheen")

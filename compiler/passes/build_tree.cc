@@ -19,7 +19,30 @@ class TreeBuilder {
     for (const auto& in : doc.inputs) used_.insert(in.name);
   }
 
+  /// Instances Substrate node `s` and its subtree (pre-order, left before
+  /// right). Recursive to the tree's depth (at most 512 for the 1024-node
+  /// limit): the frame holds only ints; the node and its slab are built by
+  /// addNode, out of line (docs/stability.md, "Deep and wide trees").
   int instance(int s) {
+    const int index = addNode(s);
+    const SNode& src = doc_.substrate[s];
+    if (src.op == TreeOp::Slab) return index;
+    auto value = [&](const PinRef& p) { return pinToValue(p, VType::Float, table_, m_); };
+    ValueId a = src.op == TreeOp::Add ? kNoValue : value(src.a);
+    ValueId b = src.op == TreeOp::Select ? value(src.b) : kNoValue;
+    int left = src.left >= 0 ? instance(src.left) : -1;
+    int right = src.right >= 0 ? instance(src.right) : -1;
+    TreeNode& n = m_.nodes[index];
+    n.left = left;
+    n.right = right;
+    n.a = a;
+    n.b = b;
+    return index;
+  }
+
+ private:
+  /// The tree node of `s` (and, for a slab, its Slab with every pin); its index.
+  [[gnu::noinline]] int addNode(int s) {
     const SNode& src = doc_.substrate[s];
     TreeNode node;
     node.op = src.op;
@@ -41,22 +64,10 @@ class TreeBuilder {
       slab.sssTypeExplicit = src.sssTypeExplicit;
       m_.nodes[index].slab = static_cast<int>(m_.slabs.size());
       m_.slabs.push_back(std::move(slab));
-      return index;
     }
-    auto value = [&](const PinRef& p) { return pinToValue(p, VType::Float, table_, m_); };
-    ValueId a = src.op == TreeOp::Add ? kNoValue : value(src.a);
-    ValueId b = src.op == TreeOp::Select ? value(src.b) : kNoValue;
-    int left = src.left >= 0 ? instance(src.left) : -1;
-    int right = src.right >= 0 ? instance(src.right) : -1;
-    TreeNode& n = m_.nodes[index];
-    n.left = left;
-    n.right = right;
-    n.a = a;
-    n.b = b;
     return index;
   }
 
- private:
   /// The first instance of an author node keeps its id; every other name
   /// (later instances, inline nodes) takes the first free `base`, `base_2`, ...
   /// that is neither an author id nor already generated.

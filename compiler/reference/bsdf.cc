@@ -101,15 +101,35 @@ V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH) {
   return f0 + (f90 - f0) * pow5(T(1) - VoH);
 }
 
-// substrate_specular_energy: e = max(E - B + B, 1e-3) from the dfg pair (the
-// shader sums the pair back), W = 1 + F0 (1 - e) / e, E_spec = sat((F0 x + F90 y) W).
+// substrate_specular_energy_aniso: e = clamp(E - B + B, 1e-3, 1) from the dfg
+// pair (the shader sums the pair back); an anisotropic lobe, with
+// A = min(|anisotropy|, 1) and t = A (2 - A): e -> lerp(e, 1, t),
+// E - B -> lerp(E - B, e, t), B -> min(max(B, B(NoV, sqrt(max(r^2 (1 - A), 1e-3))) m), e),
+// m = 1 + min(0.55 sat(3.3 A), 0.2 + 2.33 (1 - A));
+// W = 1 + F0 (1 - e) / e, E_spec = sat((F0 x + F90 y) W).
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo) {
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo) {
   V2<T> dfg = energyDfg(NoV, roughness);
-  T e = std::max(dfg[0] + dfg[1], T(1e-3));
+  T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
+  T A = std::min(std::fabs(anisotropy), T(1));
+  if (A > T(0)) {
+    T t = A * (T(2) - A);
+    e = lerp(e, T(1), t);
+    T r = saturate(roughness);
+    T smoothAxis = std::sqrt(std::max(r * r * (T(1) - A), kMinAlpha<T>));
+    T margin = T(1) + std::min(T(0.55) * saturate(T(3.3) * A), T(0.2) + T(2.33) * (T(1) - A));
+    T b = std::max(dfg[1], energyDfg(NoV, smoothAxis)[1] * margin);
+    dfg = {lerp(dfg[0], e, t), std::min(b, e)};
+  }
   V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
   albedo = saturate((f0 * dfg[0] + f90 * dfg[1]) * w);
   return w;
+}
+
+// substrate_specular_energy: the isotropic case.
+template <class T>
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo) {
+  return specularEnergyAniso(f0, f90, NoV, roughness, T(0), albedo);
 }
 
 // ---------------------------------------------------------------------------
@@ -120,7 +140,9 @@ V3<T> diffuseLambert(const V3<T>& albedo, T NoL) {
   return albedo * (K<T>::invPi * saturate(NoL));
 }
 
-// substrate_diffuse_chan2018: a2 = max(r^4, 1e-7); lobe capped at 1 (as UE).
+// substrate_diffuse_chan2018: a2 = max(r^4, 1e-7); lobe capped at 1 (as UE),
+// divided by 1 + max(0, 0.41 (r - 0.74) - 0.59 sat(NoV)), the bound of the
+// model's albedo excess.
 template <class T>
 V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH) {
   T r = saturate(roughness);
@@ -132,12 +154,14 @@ V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T V
   T fb = ((T(34.5) * g - T(59)) * g + T(24.5)) * VoH *
          std::exp2(-std::max(T(73.2) * g - T(21.2), T(8.9)) * std::sqrt(saturate(NoH)));
   T lobe = std::min(T(1), K<T>::invPi * (fd + fb));
-  return albedo * (lobe * saturate(NoL));
+  T excess = std::max(T(0), T(0.41) * (r - T(0.74)) - T(0.59) * saturate(NoV));
+  return albedo * (lobe * saturate(NoL) / (T(1) + excess));
 }
 
-// substrate_diffuse_chan2024 (UE's, Lambertian smooth limit).
+// substrate_diffuse_chan2024 (UE's, Lambertian smooth limit), divided by
+// 1 + 0.026 sat(1 - 25 NoV) sat(10 (r - 0.42)), the bound of its albedo excess.
 template <class T>
-V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoL, T NoH, T VoH) {
+V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH) {
   T r = saturate(roughness);
   T a = r * r;
   T scale = std::max(T(0.55) - T(0.2) * r, T(1.25) - T(1.6) * r);
@@ -145,7 +169,8 @@ V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoL, T NoH, T VoH) {
   T n = saturate(NoH);
   T fRough = scale * (n + bias) / (n + T(0.025)) * VoH * VoH;
   T f = lerp(T(1), fRough, r) + T(0.38) * a;
-  return albedo * (K<T>::invPi * f * saturate(NoL));
+  T excess = T(0.026) * saturate(T(1) - T(25) * NoV) * saturate(T(10) * (r - T(0.42)));
+  return albedo * (K<T>::invPi * f * saturate(NoL) / (T(1) + excess));
 }
 
 // substrate_eon_albedo: Portsmouth et al. 2025's quartic fit of E_FON.
@@ -180,7 +205,7 @@ template <class T>
 V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL) {
   switch (model) {
     case kDiffuseChan2018: return diffuseChan2018(albedo, roughness, NoV, NoL, NoH, VoH);
-    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoL, NoH, VoH);
+    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoV, NoL, NoH, VoH);
     case kDiffuseEon: return diffuseEon(albedo, roughness, NoV, NoL, VoL);
     default: return diffuseLambert(albedo, NoL);
   }
@@ -334,9 +359,13 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   if (c.features & kFeatureF90) f90 = saturate(c.f90);
   T roughness = saturate(c.roughness);
 
-  // Energy terms (needed by the diffuse even when NoL <= 0).
+  T anisotropy = T(0);
+  if (c.features & kFeatureAnisotropy) anisotropy = clampT(c.anisotropy, T(-1), T(1));
+
+  // Energy terms (needed by the diffuse even when NoL <= 0; anisotropic lobes
+  // widen them, substrate_specular_energy_aniso).
   V3<T> specAlbedo;
-  V3<T> w1 = specularEnergy(f0, f90, NoV, roughness, specAlbedo);
+  V3<T> w1 = specularEnergyAniso(f0, f90, NoV, roughness, anisotropy, specAlbedo);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -346,14 +375,12 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   V3<T> w2 = w1;
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
-    w2 = specularEnergy(f0, f90, NoV, hazeRoughness, specAlbedo2);
+    w2 = specularEnergyAniso(f0, f90, NoV, hazeRoughness, anisotropy, specAlbedo2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
   }
 
   V3<T> spec = zero;
   if (lightFacing) {
-    T anisotropy = T(0);
-    if (c.features & kFeatureAnisotropy) anisotropy = clampT(c.anisotropy, T(-1), T(1));
     bool needFrame = anisotropy != T(0);
     needFrame = needFrame || ((c.features & kFeatureGlint) != 0u && c.glintValue < T(1));
     T ToV = T(0), BoV = T(0), ToL = T(0), BoL = T(0), ToH = T(0), BoH = T(0);
@@ -423,9 +450,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T ggxVisAniso<T>(const V2<T>&, T, T, T, T, T, T);                                           \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T);                                            \
   template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, V3<T>&);                          \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, T, T, V3<T>&);                  \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
-  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T);                                         \
+  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \
   template T eonAlbedo<T>(T, T);                                                                       \
   template V3<T> diffuseEon<T>(const V3<T>&, T, T, T, T);                                              \
   template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \

@@ -21,11 +21,14 @@ template <class T> T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL,
 template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH);                 // substrate_fresnel
 /// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`.
 template <class T> V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo);
+/// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
+template <class T>
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo);
 
 // Diffuse models (BRDF * NoL).
 template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);
 template <class T> V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
-template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoL, T NoH, T VoH);
+template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
 template <class T> T eonAlbedo(T mu, T r);
 template <class T> V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL);
 /// substrate_diffuse with SUBSTRATE_DIFFUSE_MODEL = model (anything else than 1..3: Lambert).

@@ -54,11 +54,11 @@ V2<T> energyDfg(T NoV, T roughness) {
   std::array<int, 4> i;
   V2<T> f;
   lutCoords(NoV, roughness, i, f);
+  // The tables bound E - B and B from above separately: E is not clamped
+  // before the difference (substrate_energy_dfg).
   T e = blend(kE, i, f);
-  T b = blend(kB, i, f);
-  e = clampT(e, T(1e-3), T(1));
-  b = clampT(b, T(0), e);
-  return {e - b, b};
+  T b = clampT(blend(kB, i, f), T(0), T(1));
+  return {clampT(e - b, T(0), T(1)), b};
 }
 
 template <class T>

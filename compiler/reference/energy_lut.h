@@ -18,7 +18,8 @@ void lutCoords(T x, T y, std::array<int, 4>& idx, V2<T>& f);
 template <class T>
 T energyAlbedo(T NoV, T roughness);
 
-/// substrate_energy_dfg: (E - B, B), E clamped to [1e-3, 1] and B to [0, E].
+/// substrate_energy_dfg: (E - B, B), each clamped to [0, 1] (the tables are
+/// upper bounds of E - B and of B separately, so E is not clamped first).
 template <class T>
 V2<T> energyDfg(T NoV, T roughness);
 

