@@ -382,7 +382,8 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
     return kExitInternal;
   }
   out << (a.json ? stability::formatJson(report) : stability::formatText(report));
-  if (report.nonfinite || report.gpuNonfinite || report.furnaceMax > 1.001) return kExitUnstable;
+  if (report.nonfinite || report.gpuNonfinite || (report.furnaceJudged && report.furnaceMax > 1.001))
+    return kExitUnstable;
   return kExitOk;
 }
 
