@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
+#include "emit/generate.h"
 #include "gpu/sample_run.h"
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
@@ -140,6 +141,22 @@ TEST(Stability, AdversarialMaterialsAreFiniteOnTheCpuAndOnTheGpu) {
     std::ofstream(file) << text;
     expectFinite(file.string());
     fs::remove(file);
+  }
+}
+
+TEST(Stability, PerSampleInputKernelsValidateInBothLanguages) {
+  // `stability` runs GLSL; the per-invocation inputs are emitted for HLSL too
+  // (static globals, a StructuredBuffer at binding 8): both must validate.
+  EmitOptions emit;
+  emit.inputsPerInvocation = true;
+  for (const std::string& name : exampleNames()) {
+    SCOPED_TRACE(name);
+    const CompileResult r = compile(readFile(example(name)));
+    for (Target target : {Target::Glsl, Target::Hlsl})
+      for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred}) {
+        const ShaderValidation v = compileKernel(r, target, mode, emit);
+        EXPECT_TRUE(v.ok) << v.log;
+      }
   }
 }
 
