@@ -1,8 +1,15 @@
 #include "format/json_document.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
 #include <cmath>
-#include <cstdio>
-#include <fstream>
+#include <cstring>
+#include <deque>
+#include <memory>
 #include <unordered_set>
 #include <vector>
 
@@ -24,33 +31,64 @@ void lineColumnOf(const std::string& text, std::size_t offset, int& line, int& c
   }
 }
 
+namespace {
+
+std::string inputSizeError(std::size_t limit) {
+  return fmt::format("input is larger than the limit of {} bytes (the input-size limit; --max-input-size)", limit);
+}
+
+}  // namespace
+
 std::optional<std::string> readSourceFile(const std::string& path, const ReadLimits& limits,
                                           Diagnostics& diags) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) {
-    diags.errorAt(0, 0, "cannot open file");
+  // O_NONBLOCK only for the open: a FIFO without a writer must not hang it.
+  int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    diags.errorAt(0, 0, fmt::format("cannot open file: {}", std::strerror(errno)));
     return std::nullopt;
   }
+  struct FdCloser {
+    int fd;
+    ~FdCloser() { ::close(fd); }
+  } closer{fd};
+  struct stat st;
+  if (::fstat(fd, &st) != 0) {
+    diags.errorAt(0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
+    return std::nullopt;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    diags.errorAt(0, 0, "cannot read file: it is a directory");
+    return std::nullopt;
+  }
+  // A regular file is judged by its size before anything is read: an 80 MB
+  // file costs one fstat, not 16 MiB of reading.
+  if (S_ISREG(st.st_mode) && static_cast<std::uintmax_t>(st.st_size) > limits.maxInputBytes) {
+    diags.errorAt(1, 1, fmt::format("input of {} bytes is larger than the limit of {} bytes (the input-size limit; "
+                                    "--max-input-size)",
+                                    static_cast<std::uintmax_t>(st.st_size), limits.maxInputBytes));
+    return std::nullopt;
+  }
+  int flags = ::fcntl(fd, F_GETFL);
+  if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  // Read at most maxInputBytes + 1 (a file may grow after the fstat; pipes and
+  // devices have no size), so an oversized input is never read whole.
   std::string text;
-  // Read at most maxInputBytes + 1 so an oversized file is rejected without
-  // being read whole (an 80 MB file costs one chunk, not 80 MB).
+  if (S_ISREG(st.st_mode)) text.reserve(static_cast<std::size_t>(st.st_size));
   const std::size_t cap = limits.maxInputBytes + 1;
   std::vector<char> buf(1 << 16);
   while (text.size() < cap) {
-    std::size_t want = std::min(buf.size(), cap - text.size());
-    std::size_t got = std::fread(buf.data(), 1, want, f);
+    const std::size_t want = std::min(buf.size(), cap - text.size());
+    const ssize_t got = ::read(fd, buf.data(), want);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) {
+      diags.errorAt(0, 0, fmt::format("cannot read file: {}", std::strerror(errno)));
+      return std::nullopt;
+    }
     if (got == 0) break;
-    text.append(buf.data(), got);
-  }
-  bool readError = std::ferror(f) != 0;
-  std::fclose(f);
-  if (readError) {
-    diags.errorAt(0, 0, "cannot read file");
-    return std::nullopt;
+    text.append(buf.data(), static_cast<std::size_t>(got));
   }
   if (text.size() > limits.maxInputBytes) {
-    diags.errorAt(1, 1, fmt::format("input is larger than the limit of {} bytes (--max-input-size)",
-                                    limits.maxInputBytes));
+    diags.errorAt(1, 1, inputSizeError(limits.maxInputBytes));
     return std::nullopt;
   }
   return text;
@@ -88,7 +126,7 @@ bool preScan(const std::string& text, const ReadLimits& limits, Diagnostics& dia
       if (++depth > limits.maxNesting) {
         int line, col;
         lineColumnOf(text, i, line, col);
-        diags.errorAt(line, col, fmt::format("nesting is deeper than the limit of {} levels",
+        diags.errorAt(line, col, fmt::format("nesting is deeper than the limit of {} levels (the nesting-depth limit)",
                                              limits.maxNesting));
         return false;
       }
@@ -100,7 +138,8 @@ bool preScan(const std::string& text, const ReadLimits& limits, Diagnostics& dia
 }
 
 /// SAX handler building an ordered DOM while enforcing what plain JSON allows
-/// but a material file must not contain.
+/// but a material file must not contain. JSON pointers are built only when a
+/// diagnostic needs one (from the stack of open containers).
 class StrictDomBuilder {
  public:
   StrictDomBuilder(const std::string& text, const ReadLimits& limits, Diagnostics& diags)
@@ -124,7 +163,8 @@ class StrictDomBuilder {
   }
   bool string(std::string& v) {
     if (v.size() > limits_.maxStringBytes) {
-      diags_.error(pointerForNext(), fmt::format("string of {} bytes is longer than the limit of {}",
+      diags_.error(pointerForNext(), fmt::format("string of {} bytes is longer than the limit of {} bytes (the "
+                                                 "string-length limit)",
                                                  v.size(), limits_.maxStringBytes));
       failed = true;
       return put(Json(std::string()));
@@ -133,26 +173,27 @@ class StrictDomBuilder {
   }
   bool binary(Json::binary_t&) { return false; }
   bool start_object(std::size_t) {
-    std::string ptr = pointerForNext();
     Json* slot = slotForNext();
     *slot = Json::object();
-    stack_.push_back(Frame{slot, {}, std::move(ptr), {}, false});
+    stack_.push_back(Frame{slot});
     return true;
   }
   bool key(std::string& k) {
     Frame& f = stack_.back();
-    std::string ptr = f.pointer + "/" + pointerToken(k);
-    if (k.size() > limits_.maxStringBytes) {
-      diags_.error(f.pointer, fmt::format("key of {} bytes is longer than the limit of {}", k.size(),
-                                          limits_.maxStringBytes));
+    f.keyTooLong = k.size() > limits_.maxKeyBytes;
+    if (f.keyTooLong) {
+      diags_.error(pointerAt(stack_.size() - 1),
+                   fmt::format("key {} of {} bytes is longer than the limit of {} bytes (the key-length limit; keys "
+                               "are ids, pin and setting names)",
+                               quoteForDiagnostic(k, 32), k.size(), limits_.maxKeyBytes));
       failed = true;
     }
-    f.duplicate = !f.keys.insert(k).second;
+    f.duplicate = !insertKey(f, k);
+    f.key = std::move(k);
     if (f.duplicate) {
-      diags_.error(ptr, fmt::format("duplicate key {}", quoteForDiagnostic(k)));
+      diags_.error(pointerAt(stack_.size()), fmt::format("duplicate key {}", quoteForDiagnostic(f.key)));
       failed = true;
     }
-    f.key = k;
     return true;
   }
   bool end_object() {
@@ -160,10 +201,9 @@ class StrictDomBuilder {
     return true;
   }
   bool start_array(std::size_t) {
-    std::string ptr = pointerForNext();
     Json* slot = slotForNext();
     *slot = Json::array();
-    stack_.push_back(Frame{slot, {}, std::move(ptr), {}, false});
+    stack_.push_back(Frame{slot});
     return true;
   }
   bool end_array() {
@@ -173,8 +213,11 @@ class StrictDomBuilder {
   bool parse_error(std::size_t position, const std::string& lastToken,
                    const nlohmann::detail::exception& ex) {
     // nlohmann reports the byte *after* the offending token; point at its start.
+    // The token as nlohmann shows it spells each control byte as "<U+XXXX>":
+    // count those as the one byte they stand for.
     std::size_t offset = position > 0 ? position - 1 : 0;
-    if (!lastToken.empty() && offset + 1 >= lastToken.size()) offset = offset + 1 - lastToken.size();
+    const std::size_t tokenBytes = rawTokenBytes(lastToken);
+    if (tokenBytes > 0 && offset + 1 >= tokenBytes) offset = offset + 1 - tokenBytes;
     int line, col;
     lineColumnOf(text_, offset, line, col);
     diags_.errorAt(line, col, describe(ex.what(), lastToken));
@@ -183,13 +226,45 @@ class StrictDomBuilder {
   }
 
  private:
+  // Objects with up to this many keys find duplicates by scanning their
+  // (ordered) items; larger ones keep a hash set, so n keys cost O(n).
+  static constexpr std::size_t kLinearKeys = 16;
+
   struct Frame {
     Json* node;
-    std::string key;
-    std::string pointer;
-    std::unordered_set<std::string> keys;  // objects: keys seen (ordered_json lookups are linear)
-    bool duplicate = false;                 // the current key repeats an earlier one
+    std::string key;                                 // objects: the current key
+    std::unique_ptr<std::unordered_set<std::string>> keys;  // objects past kLinearKeys keys
+    bool duplicate = false;                          // the current key repeats an earlier one
+    bool keyTooLong = false;                         // the current key is over the limit
   };
+
+  /// Records `k` in the frame's object; false if it was already there.
+  bool insertKey(Frame& f, const std::string& k) {
+    const auto& items = f.node->get_ref<const Json::object_t&>();
+    if (!f.keys) {
+      for (const auto& [name, value] : items)
+        if (name == k) return false;
+      if (items.size() < kLinearKeys) return true;
+      f.keys = std::make_unique<std::unordered_set<std::string>>();
+      for (const auto& [name, value] : items) f.keys->insert(name);
+    }
+    return f.keys->insert(k).second;
+  }
+
+  /// The length in the file of a token nlohmann returned with control bytes
+  /// spelled "<U+XXXX>" (8 characters for 1 byte).
+  static std::size_t rawTokenBytes(const std::string& token) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < token.size(); ++n) {
+      const bool escaped = i + 8 <= token.size() && token.compare(i, 3, "<U+") == 0 && token[i + 7] == '>' &&
+                           std::isxdigit(static_cast<unsigned char>(token[i + 3])) &&
+                           std::isxdigit(static_cast<unsigned char>(token[i + 4])) &&
+                           std::isxdigit(static_cast<unsigned char>(token[i + 5])) &&
+                           std::isxdigit(static_cast<unsigned char>(token[i + 6]));
+      i += escaped ? 8 : 1;
+    }
+    return n;
+  }
 
   static std::string describe(const std::string& what, const std::string& lastToken) {
     // nlohmann: "[json.exception.parse_error.101] parse error at line 1, column 2:
@@ -197,18 +272,33 @@ class StrictDomBuilder {
     std::string msg = what;
     auto p = msg.find("syntax error while parsing");
     if (p != std::string::npos) msg = msg.substr(p);
-    else if (auto q = msg.find("] "); q != std::string::npos) msg = msg.substr(q + 2);  // drop "[json.exception...]" 
+    else if (auto q = msg.find("] "); q != std::string::npos) msg = msg.substr(q + 2);  // drop "[json.exception...]"
     auto lr = msg.find("; last read:");
     if (lr != std::string::npos) msg = msg.substr(0, lr);
     if (lastToken.empty()) return "JSON " + msg;
     return fmt::format("JSON {} (near {})", msg, quoteForDiagnostic(lastToken, 24));
   }
 
+  /// The reference token of frame i's current child: an array index or the
+  /// current key (an over-long key is shortened: pointers stay bounded).
+  std::string tokenOf(std::size_t i, bool next) const {
+    const Frame& f = stack_[i];
+    if (f.node->is_array()) return std::to_string(next ? f.node->size() : f.node->size() - 1);
+    if (f.keyTooLong) return pointerToken(f.key.substr(0, 32)) + "...";
+    return pointerToken(f.key);
+  }
+
+  /// The pointer of the value open at depth `depth` (0: the document).
+  std::string pointerAt(std::size_t depth) const {
+    std::string p;
+    for (std::size_t i = 0; i < depth && i < stack_.size(); ++i) p += "/" + tokenOf(i, false);
+    return p;
+  }
+
+  /// The pointer of the value about to be added to the innermost container.
   std::string pointerForNext() const {
     if (stack_.empty()) return "";
-    const Frame& f = stack_.back();
-    if (f.node->is_array()) return f.pointer + "/" + std::to_string(f.node->size());
-    return f.pointer + "/" + pointerToken(f.key);
+    return pointerAt(stack_.size() - 1) + "/" + tokenOf(stack_.size() - 1, true);
   }
 
   Json* slotForNext() {
@@ -218,13 +308,13 @@ class StrictDomBuilder {
       f.node->push_back(Json());
       return &f.node->back();
     }
+    // A duplicate (already reported) is parsed into a slot of its own so the
+    // first value is kept. Each duplicate gets a new slot, never a reused
+    // one: a duplicate nested inside a duplicate's value must not free the
+    // container its parser frames still point into.
+    if (f.duplicate) return &scratch_.emplace_back();
     // Append directly to the ordered map's vector: its operator[] searches
-    // linearly, which would make an object of n keys cost O(n^2). A duplicate
-    // (already reported) goes to a scratch slot so the first value is kept.
-    if (f.duplicate) {
-      scratch_ = Json();
-      return &scratch_;
-    }
+    // linearly, which would make an object of n keys cost O(n^2).
     auto& items = static_cast<std::vector<std::pair<const std::string, Json>>&>(f.node->get_ref<Json::object_t&>());
     items.emplace_back(f.key, Json());
     return &items.back().second;
@@ -239,7 +329,7 @@ class StrictDomBuilder {
   const ReadLimits& limits_;
   Diagnostics& diags_;
   std::vector<Frame> stack_;
-  Json scratch_;
+  std::deque<Json> scratch_;  // values of duplicate keys (stable addresses)
 };
 
 }  // namespace

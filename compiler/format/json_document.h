@@ -14,14 +14,19 @@ namespace substratec {
 
 using Json = nlohmann::ordered_json;
 
+/// The reader's limits (docs/robustness.md); each has its own diagnostic.
 struct ReadLimits {
-  std::size_t maxInputBytes = 16u << 20;  // 16 MiB
+  std::size_t maxInputBytes = 16u << 20;  // 16 MiB (--max-input-size)
   std::size_t maxNesting = 128;           // JSON arrays/objects
-  std::size_t maxStringBytes = 1u << 16;  // any single string, in bytes
+  std::size_t maxStringBytes = 1u << 16;  // any single string value, in bytes
+  std::size_t maxKeyBytes = 256;          // any object key (ids are at most 128 bytes)
 };
 
-/// Reads `path` without reading past `limits.maxInputBytes`. Returns nullopt
-/// (with a diagnostic) if the file is missing, unreadable or too large.
+/// Reads `path` without reading past `limits.maxInputBytes`: a regular file
+/// larger than the limit is rejected from its size alone (nothing is read);
+/// pipes and devices are read in chunks up to the limit. A FIFO without a
+/// writer does not block. Returns nullopt (with a diagnostic) if the file is
+/// missing, a directory, unreadable or too large.
 std::optional<std::string> readSourceFile(const std::string& path, const ReadLimits& limits,
                                           Diagnostics& diags);
 

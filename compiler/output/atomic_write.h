@@ -12,9 +12,13 @@ struct OutputFile {
   std::string contents;
 };
 
-/// Writes all files into `dir` (created if missing) or none of them: on any
-/// failure the temporaries are removed and the directory is as it was.
-/// Returns "" on success, else an error message.
+/// Writes all files into `dir` (created if missing) or none of them. Each is
+/// written to a new temporary beside its destination (O_EXCL, never through
+/// an existing name), then all are renamed into place; a file being replaced
+/// is kept as a hard link until every rename succeeded. On any failure the
+/// replaced files are put back, the temporaries and any directory this call
+/// created are removed: the directory is as it was. `name`s must be plain
+/// file names. Returns "" on success, else an error message.
 std::string writeFilesAtomically(const std::string& dir, const std::vector<OutputFile>& files);
 
 }  // namespace substratec

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <iterator>
 #include <cstdlib>
 #include <set>
 #include <unordered_map>
@@ -171,6 +172,14 @@ bool isUsableIdentifier(const std::string& s, std::size_t maxBytes) {
 
 namespace {
 
+/// A node's "kind" if it is an object with a string kind, else "" (never
+/// throws: a fuzzed file gave a node an object for its kind).
+std::string kindOf(const Json& node) {
+  if (!node.is_object()) return "";
+  auto k = node.find("kind");
+  return k != node.end() && k->is_string() ? k->get<std::string>() : "";
+}
+
 std::string kindOfJson(const Json& j) {
   switch (j.type()) {
     case Json::value_t::null: return "null";
@@ -183,6 +192,24 @@ std::string kindOfJson(const Json& j) {
     case Json::value_t::number_float: return fmt::format("{:g}", j.get<double>());
     default: return "a value";
   }
+}
+
+/// "a -> b -> c -> a", with long cycles shortened to their first and last
+/// nodes (a cycle through 20000 nodes must not make a megabyte-long line).
+std::string cycleChain(const std::vector<std::string>& names) {
+  constexpr std::size_t kHead = 6, kTail = 3;
+  std::string chain;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names.size() > kHead + kTail + 1 && i == kHead) {
+      chain += fmt::format("... ({} more) -> ", names.size() - kHead - kTail);
+      i = names.size() - kTail - 1;
+      continue;
+    }
+    chain += quoteForDiagnostic(names[i], 64).substr(1);
+    chain.pop_back();  // the names are identifiers or pointers: shown unquoted
+    if (i + 1 < names.size()) chain += " -> ";
+  }
+  return chain;
 }
 
 std::string typeWord(VType t, bool color) {
@@ -234,15 +261,28 @@ class Resolver {
     auto it = namedKind_.find(id);
     return it != namedKind_.end() && it->second == 2;
   }
-  bool budget() {
+  /// Counts one more node (named or inline); false past the node-count limit,
+  /// which is reported once, at the first node over it.
+  bool budget(const std::string& ptr) {
     if (++nodeCount_ > limits_.maxNodes) {
       if (!nodeLimitReported_) {
-        d_.error("/nodes", fmt::format("material has more than {} nodes (the limit)", limits_.maxNodes));
+        d_.error(ptr, fmt::format("material has more than {} nodes, named and inline (the node-count limit)",
+                                  limits_.maxNodes));
         nodeLimitReported_ = true;
       }
       return false;
     }
     return true;
+  }
+  /// The diagnostic for a name that is not an identifier: the identifier-length
+  /// limit when it is only too long, else what an identifier is.
+  std::string identifierError(const std::string& what, const std::string& name) const {
+    if (name.size() > limits_.maxIdentifierBytes && isIdentifier(name, name.size()))
+      return fmt::format("{} {} of {} bytes is longer than the limit of {} bytes (the identifier-length limit)", what,
+                         quoteForDiagnostic(name), name.size(), limits_.maxIdentifierBytes);
+    return fmt::format("{} {} is not a C identifier of at most {} bytes (letters, digits, '_'; no leading digit, "
+                       "no \"__\")",
+                       what, quoteForDiagnostic(name), limits_.maxIdentifierBytes);
   }
 
   const Json& doc_;
@@ -308,6 +348,9 @@ void Resolver::readTop() {
     d_.error("", "missing required key \"name\"");
   } else if (!nameIt->is_string()) {
     d_.error("/name", fmt::format("expected a C identifier string, got {}", kindOfJson(*nameIt)));
+  } else if (const std::string& name = nameIt->get_ref<const std::string&>();
+             name.size() > limits_.maxIdentifierBytes && isUsableIdentifier(name, name.size())) {
+    d_.error("/name", identifierError("name", name));
   } else if (!isUsableIdentifier(nameIt->get<std::string>(), limits_.maxIdentifierBytes)) {
     d_.error("/name", fmt::format("{} is not usable as a name: it must be a C identifier of at most {} "
                                   "bytes, without \"__\", and not a C/GLSL/HLSL keyword",
@@ -338,6 +381,15 @@ void Resolver::readTop() {
   }
 
   if (!nodes_) return;
+  if (nodes_->size() > limits_.maxNodes) {  // named nodes alone: nothing else is worth reading
+    auto over = nodes_->begin();
+    std::advance(over, limits_.maxNodes);  // the first node over the limit
+    d_.error("/nodes/" + pointerToken(over.key()),
+             fmt::format("material has {} named nodes, more than {} (the node-count limit)", nodes_->size(),
+                         limits_.maxNodes));
+    nodeLimitReported_ = true;
+    return;
+  }
   classifyNodes();
   // Every named node gets its index first, so that references never recurse
   // (a chain of 100k named nodes must not deepen the stack); then each body
@@ -346,13 +398,13 @@ void Resolver::readTop() {
     const std::string& id = it.key();
     std::string p = "/nodes/" + pointerToken(id);
     if (isValueKindName(id)) {
-      if (!budget()) return;
+      if (!budget(p)) return;
       namedValue_[id] = static_cast<int>(out_.values.size());
       out_.values.emplace_back();
       out_.values.back().id = id;
       out_.values.back().pointer = p;
     } else if (isSubstrateName(id)) {
-      if (!budget()) return;
+      if (!budget(p)) return;
       namedSubstrate_[id] = static_cast<int>(out_.substrate.size());
       out_.substrate.emplace_back();
       out_.substrate.back().id = id;
@@ -452,14 +504,22 @@ void Resolver::readInputs(const Json& s, const std::string& ptr) {
     d_.error(ptr, fmt::format("expected an object of inputs keyed by name, got {}", kindOfJson(s)));
     return;
   }
+  std::size_t count = 0;
   for (auto it = s.begin(); it != s.end(); ++it) {
     const std::string& name = it.key();
     std::string p = ptr + "/" + pointerToken(name);
     const Json& v = *it;
+    if (++count > limits_.maxInputs) {
+      // Past the input-count limit: reported once; later names are only
+      // remembered so that references to them stay silent.
+      if (count == limits_.maxInputs + 1)
+        d_.error(p, fmt::format("material has {} inputs, more than {} (the input-count limit)", s.size(),
+                                limits_.maxInputs));
+      badInputs_.insert(name);
+      continue;
+    }
     if (!isIdentifier(name, limits_.maxIdentifierBytes)) {
-      d_.error(p, fmt::format("input name {} is not a C identifier of at most {} bytes (letters, digits, '_'; "
-                              "no leading digit, no \"__\")",
-                              quoteForDiagnostic(name), limits_.maxIdentifierBytes));
+      d_.error(p, identifierError("input name", name));
       badInputs_.insert(name);
       continue;
     }
@@ -588,9 +648,7 @@ void Resolver::classifyNodes() {
     std::string p = "/nodes/" + pointerToken(id);
     namedKind_[id] = 0;
     if (!isIdentifier(id, limits_.maxIdentifierBytes)) {
-      d_.error(p, fmt::format("node id {} is not a C identifier of at most {} bytes (letters, digits, '_'; "
-                              "no leading digit, no \"__\")",
-                              quoteForDiagnostic(id), limits_.maxIdentifierBytes));
+      d_.error(p, identifierError("node id", id));
       continue;
     }
     if (inputIndex_.count(id)) {
@@ -630,7 +688,7 @@ void Resolver::classifyNodes() {
       const std::string& s = j.get_ref<const std::string&>();
       if (isSubstrateName(s)) return true;
       auto f = namedJson_.find(s);
-      if (f != namedJson_.end() && f->second->is_object() && f->second->value("kind", "") == "add")
+      if (f != namedJson_.end() && kindOf(*f->second) == "add")
         referencedBy[s].push_back(owner);
       return false;
     }
@@ -689,7 +747,7 @@ int Resolver::resolveValueNode(const std::string& id) {
 }
 
 int Resolver::makeInlineValueNode(const Json& j, const std::string& ptr) {
-  if (!budget()) return -1;
+  if (!budget(ptr)) return -1;
   const std::string kind = j["kind"].get<std::string>();
   const OpSpec* spec = findOpSpec(kind);
   int index = static_cast<int>(out_.values.size());
@@ -883,7 +941,7 @@ PinRef Resolver::readValuePin(const Json& j, const std::string& ptr, const std::
     if (index < 0) return r;
     r.tag = PinRef::Node;
     r.index = index;
-    const OpSpec* spec = findOpSpec(namedJson_[id]->value("kind", ""));
+    const OpSpec* spec = findOpSpec(kindOf(*namedJson_[id]));
     if (!spec) return r;
     if (output.empty()) {
       if (spec->outputs.size() > 1 && spec->op != Op::Sample) {
@@ -987,7 +1045,7 @@ int Resolver::readSubstratePin(const Json& j, const std::string& ptr, const std:
     std::string kind = k->get<std::string>();
     if (kind == "add" ? isSubstrateValue(j) : substrateKind(kind).has_value())
     {
-      if (!budget()) return -1;
+      if (!budget(ptr)) return -1;
       int index = static_cast<int>(out_.substrate.size());
       out_.substrate.emplace_back();
       out_.substrate[index].id = nameForInline;
@@ -1319,14 +1377,14 @@ void Resolver::typeValueNodes() {
         PinRef& p = v.pins[next++];
         if (p.tag != PinRef::Node) continue;
         if (state[p.index] == 1) {
-          std::string chain;
+          std::vector<std::string> names;
           bool on = false;
           for (auto& [si, sn] : stack) {
             if (si == p.index) on = true;
-            if (on) chain += (out_.values[si].id.empty() ? out_.values[si].pointer : out_.values[si].id) + " -> ";
+            if (on) names.push_back(out_.values[si].id.empty() ? out_.values[si].pointer : out_.values[si].id);
           }
-          chain += out_.values[p.index].id.empty() ? out_.values[p.index].pointer : out_.values[p.index].id;
-          d_.error(v.pointer, fmt::format("cycle in values: {}", chain));
+          names.push_back(out_.values[p.index].id.empty() ? out_.values[p.index].pointer : out_.values[p.index].id);
+          d_.error(v.pointer, fmt::format("cycle in values: {}", cycleChain(names)));
           p.tag = PinRef::Default;
           p.type = VType::Invalid;
           continue;
@@ -1374,14 +1432,14 @@ void Resolver::checkSubstrateCycles() {
         int& child = next++ == 0 ? s.left : s.right;
         if (child < 0) continue;
         if (state[child] == 1) {
-          std::string chain;
+          std::vector<std::string> names;
           bool on = false;
           for (auto& [si, sn] : stack) {
             if (si == child) on = true;
-            if (on) chain += out_.substrate[si].id + " -> ";
+            if (on) names.push_back(out_.substrate[si].id);
           }
-          chain += out_.substrate[child].id;
-          d_.error(s.pointer, fmt::format("cycle in the Substrate graph: {}", chain));
+          names.push_back(out_.substrate[child].id);
+          d_.error(s.pointer, fmt::format("cycle in the Substrate graph: {}", cycleChain(names)));
           child = -1;
           continue;
         }

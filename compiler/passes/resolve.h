@@ -17,8 +17,10 @@
 
 namespace substratec {
 
+/// The resolver's limits (docs/robustness.md); each has its own diagnostic.
 struct ResolveLimits {
   std::size_t maxNodes = 20000;        // named + inline nodes
+  std::size_t maxInputs = 1024;        // inputs (uniform-block members and textures)
   std::size_t maxIdentifierBytes = 128;
 };
 

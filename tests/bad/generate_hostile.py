@@ -154,6 +154,94 @@ def wide_fanout(path):
     ])
 
 
+def many_inputs(path):
+    # 100000 float inputs (5 MB): over the input-count limit (each is a uniform-block member;
+    # SPIR-V caps a struct at 16383 members, so the compiler must stop long before).
+    n = 100_000
+
+    def inputs():
+        for i in range(n):
+            sep = "," if i < n - 1 else ""
+            yield f'    "i{i:06d}": {{ "type": "float", "default": 0.5 }}{sep}\n'
+
+    write_chunks(path, [
+        '{\n  "format": "substrate-material/1",\n  "name": "m",\n  "inputs": {\n',
+        *inputs(),
+        "  },\n",
+        '  "nodes": { "base": { "kind": "slab", "roughness": "$i000005" } },\n',
+        '  "output": "base"\n',
+        "}\n",
+    ])
+
+
+def long_cycle(path):
+    # A value cycle through 19000 named nodes whose ids are 120 characters: the cycle
+    # diagnostic must stay short (a full chain would be a 2.3 MB line).
+    n = 19_000
+
+    def ident(i):
+        return f"v{i:06d}" + "x" * 113
+
+    def nodes():
+        for i in range(n):
+            yield f'    "{ident(i)}": {{ "kind": "saturate", "x": "{ident((i + 1) % n)}" }},\n'
+
+    write_chunks(path, [
+        HEAD,
+        '  "nodes": {\n',
+        *nodes(),
+        f'    "base": {{ "kind": "slab", "diffuse_albedo": "$tint", "roughness": "{ident(0)}" }}\n',
+        "  },\n",
+        '  "output": "base"\n',
+        "}\n",
+    ])
+
+
+def long_string(path):
+    # A 10 MiB "description" (under the 16 MiB input-size limit): the string-length limit.
+    write_chunks(path, [
+        HEAD,
+        '  "description": "', *repeat("d", 10 * MiB), '",\n',
+        '  "nodes": { "base": { "kind": "slab", "diffuse_albedo": "$tint", "roughness": 0.5 } },\n',
+        '  "output": "base"\n',
+        "}\n",
+    ])
+
+
+def long_keys(path):
+    # 60 unknown pins on one slab, each a 60000-byte key: the key-length limit; the
+    # diagnostics (capped at 50 errors) must not echo the keys.
+    keys = [f'"{c * 60_000}": 1, ' for c in ("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ01234567")]
+    write_chunks(path, [
+        HEAD,
+        '  "nodes": { "base": { "kind": "slab", ', *keys, '"roughness": 0.5 } },\n',
+        '  "output": "base"\n',
+        "}\n",
+    ])
+
+
+def many_inline_nodes(path):
+    # 10001 named `add` nodes, each with an inline `abs` node: 10001 named nodes (under the
+    # limit) but 20002 nodes in all, so the node-count limit fires on an inline node.
+    n = 10_001
+
+    def nodes():
+        yield '    "n00000": { "kind": "add", "a": "$mask", "b": { "kind": "abs", "x": 0.5 } },\n'
+        for i in range(1, n):
+            yield f'    "n{i:05d}": {{ "kind": "add", "a": "n{i - 1:05d}", "b": {{ "kind": "abs", "x": 0.5 }} }},\n'
+
+    write_chunks(path, [
+        HEAD,
+        '  "nodes": {\n',
+        *nodes(),
+        '    "base": { "kind": "slab", "diffuse_albedo": "$tint", '
+        f'"roughness": {{ "kind": "saturate", "x": "n{n - 1:05d}" }} }}\n',
+        "  },\n",
+        '  "output": "base"\n',
+        "}\n",
+    ])
+
+
 GENERATORS = {
     "deep_array.json": deep_array,
     "deep_object.json": deep_object,
@@ -163,6 +251,11 @@ GENERATORS = {
     "big_file.json": big_file,
     "long_identifier.json": long_identifier,
     "wide_fanout.json": wide_fanout,
+    "many_inputs.json": many_inputs,
+    "long_cycle.json": long_cycle,
+    "long_string.json": long_string,
+    "long_keys.json": long_keys,
+    "many_inline_nodes.json": many_inline_nodes,
 }
 
 
