@@ -169,7 +169,7 @@ std::unique_ptr<Kernel> generatedKernel(const CompileResult& r, const EmitOption
   if (k->materialText.empty()) die("no material file for " + r.material.name);
   ShaderSource src;
   src.name = kernelFileName(r.material, syn, KernelMode::Throughput);
-  src.text = emitKernel(r.material, r.after, syn, KernelMode::Throughput);
+  src.text = emitKernel(r.material, r.after, syn, KernelMode::Throughput, emit);
   src.language = ShaderLanguage::Glsl;
   src.stage = ShaderStage::Compute;
   for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
