@@ -242,6 +242,21 @@ TEST(Stability, AdversarialMaterialsAreFiniteInHalfPrecision) {
   }
 }
 
+TEST(Stability, AWeightBeyondHalfsRangeStaysFiniteInHalfPrecision) {
+  // A coverage weight from an input (expressions are not range-checked) of
+  // 1e5 to 1e6: float16 ends at 65,504, so the view throughput converts the
+  // weight through SUBSTRATE_M_CLAMPED. Without the clamp: 16,740 of 200,880
+  // evaluations non-finite.
+  const fs::path file = fs::temp_directory_path() / "substratec_heavy_weight_half.json";
+  std::ofstream(file) << R"({"format": "substrate-material/1", "name": "heavy_weight",
+    "inputs": {"w": {"type": "float", "default": 100000, "min": 0, "max": 1000000}},
+    "nodes": {"s": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.5},
+              "root": {"kind": "coverage_weight", "a": "s", "weight": "$w"}},
+    "output": "root"})";
+  expectFiniteInHalf(file.string());
+  fs::remove(file);
+}
+
 TEST(Stability, PerSampleInputKernelsValidateInBothLanguages) {
   // `stability` runs GLSL; the per-invocation inputs are emitted for HLSL too
   // (static globals, a StructuredBuffer at binding 8): both must validate.
