@@ -94,24 +94,23 @@ class EveryExample : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(EveryExample, IsFiniteOnTheHardCaseGridOnTheCpuAndOnTheGpu) { expectFinite(example(GetParam())); }
 
-TEST_P(EveryExample, IsFiniteOnTheHardCaseGridInHalfPrecision) { expectFiniteInHalf(example(GetParam())); }
-
 /// How far half precision may move what the forward pass writes (docs/stability.md, "Half precision").
 constexpr double kHalfAbs = 1e-3, kHalfRel = 5e-3;
 
-TEST_P(EveryExample, HalfPrecisionForwardAgreesWithFloat32) {
-  // The forward kernel in both precisions over the GPU tests' probe set
-  // (material_gpu_test.cc: 1,024 geometries under 4 input sets). The material
-  // function is float32 in both, so every closure field is bit-identical; the
-  // lit sums (direct light, split-sum environment, emissive through the view
-  // throughput) agree within |half - float32| <= kHalfAbs + kHalfRel |float32|.
-  // The HLSL kernel in half (its own msaturate and mlerp) meets the same rule
-  // on the first input set.
+/// The forward kernel of example `name` in both precisions over the GPU tests'
+/// probe set (material_gpu_test.cc: 1,024 geometries under 4 input sets). The
+/// material function is float32 in both, so every closure field is
+/// bit-identical; the lit sums (direct light, split-sum environment, emissive
+/// through the view throughput) agree within |half - float32| <= kHalfAbs +
+/// kHalfRel |float32|. The HLSL kernel in half (its own msaturate and mlerp)
+/// meets the same rule on the first input set.
+void expectHalfAgreesWithFloat32(const std::string& name) {
+  SCOPED_TRACE(name);
   std::string error;
   gpu::Context* ctx = gputest::sharedContext(&error);
   ASSERT_NE(ctx, nullptr) << error;
-  const std::string stem = fs::path(GetParam()).stem().string();
-  const CompileResult r = compile(readFile(example(GetParam())));
+  const std::string stem = fs::path(name).stem().string();
+  const CompileResult r = compile(readFile(example(name)));
   const auto samples =
       gpu::makeSamples(1024, 0x5eed0000u + static_cast<uint32_t>(std::hash<std::string>{}(stem) & 0xffffu));
   const auto inputSets = gputest::makeInputSets(r.material, 4, 0x1a9u);
@@ -173,6 +172,17 @@ std::vector<std::string> exampleNames() {
 
 INSTANTIATE_TEST_SUITE_P(Stability, EveryExample, ::testing::ValuesIn(exampleNames()),
                          [](const auto& info) { return fs::path(info.param).stem().string(); });
+
+// The half-precision tests loop over the examples in one test each: every
+// test is its own process under ctest, and a GPU test process costs seconds
+// before its first kernel (instance, validation layer, lavapipe).
+TEST(Stability, EveryExampleIsFiniteOnTheHardCaseGridInHalfPrecision) {
+  for (const std::string& name : exampleNames()) expectFiniteInHalf(example(name));
+}
+
+TEST(Stability, HalfPrecisionForwardAgreesWithFloat32OnEveryExample) {
+  for (const std::string& name : exampleNames()) expectHalfAgreesWithFloat32(name);
+}
 
 // Adversarial materials: every operator, every opt-in feature, the helpers
 // with their own singularities, thin and translucent surfaces, degenerate
