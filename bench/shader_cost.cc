@@ -23,7 +23,8 @@
 //                 precision (`--precision half`, EmitOptions::precision): ns/pixel
 //                 of both (the two kernels of an example timed in the same
 //                 interleaved rounds), optimized forward-shader instructions, and
-//                 rel_mse / max |Δ| of the half kernel's output against float32's.
+//                 rel_mse, max |Δ| and max |Δ|/|f| of the half kernel's output
+//                 against float32's (docs/stability.md, "Half precision").
 //
 // Timing: the material's Throughput kernel (compiler/emit/kernel_emitter.h:
 // each invocation hashes its own shading point, evaluates the material, lights

@@ -232,24 +232,23 @@ const char* kAdversarial[] = {
         "output": "root"})",
 };
 
+/// `check` on `text` written to a temporary file (ctest may run two tests at
+/// once: `name` keeps their files apart).
+void checkFile(const std::string& name, const std::string& text, void (*check)(const std::string&)) {
+  const fs::path file = fs::temp_directory_path() / ("substratec_" + name + ".json");
+  std::ofstream(file) << text;
+  check(file.string());
+  fs::remove(file);
+}
+
 TEST(Stability, AdversarialMaterialsAreFiniteOnTheCpuAndOnTheGpu) {
   int i = 0;
-  for (const char* text : kAdversarial) {
-    const fs::path file = fs::temp_directory_path() / fmt::format("substratec_adversarial_{}.json", i++);
-    std::ofstream(file) << text;
-    expectFinite(file.string());
-    fs::remove(file);
-  }
+  for (const char* text : kAdversarial) checkFile(fmt::format("adversarial_{}", i++), text, expectFinite);
 }
 
 TEST(Stability, AdversarialMaterialsAreFiniteInHalfPrecision) {
   int i = 0;
-  for (const char* text : kAdversarial) {
-    const fs::path file = fs::temp_directory_path() / fmt::format("substratec_adversarial_half_{}.json", i++);
-    std::ofstream(file) << text;
-    expectFiniteInHalf(file.string());
-    fs::remove(file);
-  }
+  for (const char* text : kAdversarial) checkFile(fmt::format("adversarial_half_{}", i++), text, expectFiniteInHalf);
 }
 
 TEST(Stability, AWeightBeyondHalfsRangeStaysFiniteInHalfPrecision) {
@@ -257,14 +256,12 @@ TEST(Stability, AWeightBeyondHalfsRangeStaysFiniteInHalfPrecision) {
   // 1e5 to 1e6: float16 ends at 65,504, so the view throughput converts the
   // weight through SUBSTRATE_M_CLAMPED. Without the clamp: 16,740 of 200,880
   // evaluations non-finite.
-  const fs::path file = fs::temp_directory_path() / "substratec_heavy_weight_half.json";
-  std::ofstream(file) << R"({"format": "substrate-material/1", "name": "heavy_weight",
+  checkFile("heavy_weight_half", R"({"format": "substrate-material/1", "name": "heavy_weight",
     "inputs": {"w": {"type": "float", "default": 100000, "min": 0, "max": 1000000}},
     "nodes": {"s": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.5},
               "root": {"kind": "coverage_weight", "a": "s", "weight": "$w"}},
-    "output": "root"})";
-  expectFiniteInHalf(file.string());
-  fs::remove(file);
+    "output": "root"})",
+            expectFiniteInHalf);
 }
 
 TEST(Stability, PerSampleInputKernelsValidateInBothLanguages) {
