@@ -53,7 +53,6 @@
 #if SUBSTRATE_PRECISION_HALF
 #extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
 #define mfloat float16_t
-#define mfloat2 f16vec2
 #define mfloat3 f16vec3
 #define SUBSTRATE_M(x) float16_t(x)
 #define SUBSTRATE_M3(x) f16vec3(x)
@@ -65,7 +64,6 @@
 #define msaturate(x) clamp((x), float16_t(0.0), float16_t(1.0))
 #else
 #define mfloat float
-#define mfloat2 vec2
 #define mfloat3 vec3
 #define SUBSTRATE_M(x) (x)
 #define SUBSTRATE_M3(x) (x)

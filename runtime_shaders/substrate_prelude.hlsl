@@ -23,7 +23,6 @@
 #endif
 #if SUBSTRATE_PRECISION_HALF
 #define mfloat half
-#define mfloat2 half2
 #define mfloat3 half3
 #define SUBSTRATE_M(x) ((half)(x))
 #define SUBSTRATE_M3(x) ((half3)(x))
@@ -39,7 +38,6 @@ half mlerp(half a, half b, half t) { return a + (b - a) * t; }
 half3 mlerp(half3 a, half3 b, half t) { return a + (b - a) * t; }
 #else
 #define mfloat float
-#define mfloat2 float2
 #define mfloat3 float3
 #define SUBSTRATE_M(x) (x)
 #define SUBSTRATE_M3(x) (x)
