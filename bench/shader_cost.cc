@@ -19,6 +19,12 @@
 //   3. examples:  every examples/*.json at budgets {own, 80, 48, 20, full
 //                 simplification}: bytes, closures, forward instructions, ns/pixel.
 //   4. diffuse:   one material under each diffuse model: instructions, ns/pixel.
+//   5. half:      every example at its own budget in float32 and in half
+//                 precision (`--precision half`, EmitOptions::precision): ns/pixel
+//                 of both (the two kernels of an example timed in the same
+//                 interleaved rounds), optimized forward-shader instructions, and
+//                 rel_mse, max |Δ| and max |Δ|/|f| of the half kernel's output
+//                 against float32's (docs/stability.md, "Half precision").
 //
 // Timing: the material's Throughput kernel (compiler/emit/kernel_emitter.h:
 // each invocation hashes its own shading point, evaluates the material, lights
@@ -37,12 +43,12 @@
 // Forward-shader instructions: the GLSL forward entry (`<name>.forward.frag`)
 // after SPIRV-Tools' performance passes, as `substratec report --spirv` counts it.
 //
-// Usage: shader_cost [--pixels N] [--runs N] [--parts 1234] [--dump DIR] [--extra DIR] [--callgrind]
+// Usage: shader_cost [--pixels N] [--runs N] [--parts 12345] [--dump DIR] [--extra DIR] [--callgrind]
 //   --dump DIR   writes the timed kernels' sources and the synthetic materials to DIR.
 //   --extra DIR  also times every DIR/*.comp in part 1's group (row12_simple's
 //                resources; includes found in DIR first, then in the embedded
 //                runtime), e.g. a variant of the runtime or of a generated kernel.
-//   --callgrind  parts 1, 2 and 4, no timing: one instrumented dispatch per kernel
+//   --callgrind  parts 1, 2, 4 and 5, no timing: one instrumented dispatch per kernel
 //                for callgrind (x86 instructions executed per pixel, deterministic);
 //                SHADER_COST_CALLGRIND=1 bench/shader_cost.sh runs and sums it.
 #include <algorithm>
@@ -73,6 +79,7 @@
 #include "gpu/harness.h"
 #include "gpu/sample_run.h"
 #include "pipeline/pipeline.h"
+#include "sweep/sweep.h"
 #include "validate/runtime_files.h"
 #include "validate/shader_validate.h"
 
@@ -84,7 +91,7 @@ namespace {
 struct Args {
   int pixels = 1 << 20;
   int runs = 5;
-  std::string parts = "1234";
+  std::string parts = "12345";
   std::string dump;
   std::string extra;  // a directory of extra kernels (*.comp) timed with part 1
   bool callgrind = false;
@@ -169,7 +176,7 @@ std::unique_ptr<Kernel> generatedKernel(const CompileResult& r, const EmitOption
   if (k->materialText.empty()) die("no material file for " + r.material.name);
   ShaderSource src;
   src.name = kernelFileName(r.material, syn, KernelMode::Throughput);
-  src.text = emitKernel(r.material, r.after, syn, KernelMode::Throughput);
+  src.text = emitKernel(r.material, r.after, syn, KernelMode::Throughput, emit);
   src.language = ShaderLanguage::Glsl;
   src.stage = ShaderStage::Compute;
   for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
@@ -641,6 +648,62 @@ void partDiffuse(gpu::Context& ctx, const Args& a) {
   fmt::print("\n");
 }
 
+// ---------------------------------------------------------------------------
+// 5. Half precision.
+
+void partHalf(gpu::Context& ctx, const Args& a) {
+  if (!ctx.shaderFloat16()) die("part 5 needs shaderFloat16 (" + ctx.deviceName() + " has none)");
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(a.source + "/examples"))
+    if (e.path().extension() == ".json") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  EmitOptions full, half;
+  half.precision = Precision::Half;
+  if (!a.callgrind) {
+    fmt::print("## 5. Half precision (`--precision half`)\n\n");
+    fmt::print("Every example at its own budget: the throughput kernel in float32 and in half, the two of an example "
+               "timed in the same interleaved rounds ({} pixels, {} timed rounds; median, min–max ns per pixel); "
+               "optimized forward-shader instructions; the half kernel's output (rgb per pixel) against float32's: "
+               "rel_mse = mean((h − f)² / (f² + 0.01)), max |h − f|, and max |h − f| / |f| where |f| ≥ 0.01.\n\n",
+               paddedPixels(a.pixels), a.runs);
+    fmt::print("| example | float32 ns/pixel | half ns/pixel | half ÷ float32 | forward instr. float32 / half | "
+               "rel_mse | max abs | max rel |\n|---|---:|---:|---:|---:|---:|---:|---:|\n");
+  }
+  for (const std::string& path : files) {
+    const CompileResult r = compileOrDie(stemOf(path) + ".json", readAll(path), {});
+    auto f = generatedKernel(r, full, stemOf(path) + " float32");
+    auto h = generatedKernel(r, half, stemOf(path) + " half");
+    prepare(ctx, *f, r.material, a.pixels);
+    prepare(ctx, *h, r.material, a.pixels);
+    dumpKernel(a, *h, stemOf(path) + ".half.throughput.comp");
+    std::vector<Kernel*> group = {f.get(), h.get()};
+    if (a.callgrind) {
+      countInstructions(ctx, group, a.pixels);
+      continue;
+    }
+    timeGroup(ctx, group, a.pixels, a.runs);
+    // rgb of every pixel (each result is a float4: colour, coverage).
+    auto rgb = [](const Kernel& k) {
+      const std::vector<float> out = gpu::floatsOf(k.resources, 0, 7);
+      std::vector<double> v;
+      for (std::size_t i = 0; i < out.size(); ++i)
+        if (i % 4 != 3) v.push_back(out[i]);
+      return v;
+    };
+    const std::vector<double> x = rgb(*h), y = rgb(*f);
+    double maxAbs = 0, maxRel = 0;
+    for (std::size_t i = 0; i < y.size(); ++i) {
+      maxAbs = std::max(maxAbs, std::abs(x[i] - y[i]));
+      if (std::abs(y[i]) >= 0.01) maxRel = std::max(maxRel, std::abs(x[i] - y[i]) / std::abs(y[i]));
+    }
+    fmt::print("| {} | {:.2f} ({}) | {:.2f} ({}) | {:.3f} | {} / {} | {:.2e} | {:.2e} | {:.2e} |\n", stemOf(path),
+               f->median(), spread(*f), h->median(), spread(*h), h->median() / f->median(), forwardInstructions(r, full),
+               forwardInstructions(r, half), sweep::relMse(x, y), maxAbs, maxRel);
+    std::fflush(stdout);
+  }
+  if (!a.callgrind) fmt::print("\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -659,7 +722,7 @@ int main(int argc, char** argv) {
     else if (arg == "--callgrind") a.callgrind = true;
     else if (arg == "--source") a.source = value();
     else if (arg == "-h" || arg == "--help") {
-      std::printf("usage: shader_cost [--pixels N] [--runs N] [--parts 1234] [--dump DIR] [--extra DIR] [--callgrind] [--source DIR]\n");
+      std::printf("usage: shader_cost [--pixels N] [--runs N] [--parts 12345] [--dump DIR] [--extra DIR] [--callgrind] [--source DIR]\n");
       return 0;
     } else die("unknown argument " + arg);
   }
@@ -684,6 +747,7 @@ int main(int argc, char** argv) {
   part('2', partClosures);
   part('3', partExamples);
   part('4', partDiffuse);
+  part('5', partHalf);
   fmt::print("(total {:.0f} s)\n",
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   return 0;

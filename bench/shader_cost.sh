@@ -4,23 +4,24 @@
 #
 #   1. builds the shader_cost target (configuring the build directory if needed),
 #   2. prints the machine (nproc, cpu, load average, git revision),
-#   3. runs build/bin/shader_cost, which prints four markdown tables:
+#   3. runs build/bin/shader_cost, which prints five markdown tables:
 #        1. the simple layout (row12_simple) against a hand-written minimal
 #           GGX + Lambert kernel (bench/shaders/minimal_ggx_lambert.comp): the floor;
 #        2. cost against the number of closures (synthetic 1–8 closure materials),
 #           with least-squares lines and R²;
 #        3. every example at budgets own / 80 / 48 / 20 / full simplification;
-#        4. row12_simple under each diffuse model.
+#        4. row12_simple under each diffuse model;
+#        5. every example in float32 and in half precision (`--precision half`, issue 7).
 #
 # Environment knobs (defaults in brackets):
 #   SHADER_COST_PIXELS [1048576]  shading points per timed dispatch
 #   SHADER_COST_RUNS   [5]        timed dispatches per kernel, after 1 warm-up (median reported)
-#   SHADER_COST_PARTS  [1234]     which tables
+#   SHADER_COST_PARTS  [12345]    which tables
 #   SHADER_COST_BUILD  [build]    build directory (relative to the source root, or absolute);
 #                                 configured RelWithDebInfo with Ninja when it has no build.ninja
 #   SHADER_COST_CALLGRIND [0]     1: instead of timing, count the x86 instructions lavapipe's
 #                                 JIT-compiled code executes per pixel for the kernels of
-#                                 tables 1, 2 and 4 (valgrind --tool=callgrind, one dispatch of
+#                                 tables 1, 2, 4 and 5 (valgrind --tool=callgrind, one dispatch of
 #                                 65,536 pixels each; deterministic, unlike the timings on a
 #                                 shared machine)
 #
@@ -33,7 +34,7 @@ BUILD="${SHADER_COST_BUILD:-build}"
 case "$BUILD" in /*) ;; *) BUILD="$ROOT/$BUILD" ;; esac
 PIXELS="${SHADER_COST_PIXELS:-1048576}"
 RUNS="${SHADER_COST_RUNS:-5}"
-PARTS="${SHADER_COST_PARTS:-1234}"
+PARTS="${SHADER_COST_PARTS:-12345}"
 
 cd "$ROOT"
 if [ ! -f "$BUILD/build.ninja" ]; then

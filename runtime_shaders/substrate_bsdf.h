@@ -118,21 +118,23 @@ float substrate_ggx_vis_aniso(float2 alpha, float ToV, float BoV, float NoV, flo
   return 0.5 / max(gv + gl, 1e-30);
 }
 
-// Schlick's Fresnel with an F90: F0 + (F90 - F0) (1 - VoH)^5.
-float3 substrate_fresnel(float3 f0, float3 f90, float VoH) {
-  return f0 + (f90 - f0) * substrate_pow5(1.0 - VoH);
+// Schlick's Fresnel with an F90: F0 + (F90 - F0) (1 - VoH)^5 (the weight from
+// the half vector in float, the blend of the colours in mfloat).
+mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float VoH) {
+  return f0 + (f90 - f0) * SUBSTRATE_M(substrate_pow5(1.0 - VoH));
 }
 
 // Turquin 2019 multiple-scattering compensation W = 1 + F0 (1 - E) / E and the
 // compensated lobe's directional albedo E_spec = (F0 (E - B) + F90 B) W, from
 // the tables at (NoV, r) (upper bounds of E - B and B; E = their sum clamped to
 // [1e-3, 1]). Returns W; E_spec in `albedo`. Both are safe for energy: W E <= 1
-// and E_spec is never below the compensated lobe's true albedo.
-float3 substrate_specular_energy(float3 f0, float3 f90, float NoV, float roughness, out float3 albedo) {
+// and E_spec is never below the compensated lobe's true albedo. The table
+// lookup and E are float; W (<= 1000) and E_spec are colours (mfloat).
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float NoV, float roughness, out mfloat3 albedo) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
-  float3 w = SUBSTRATE_SPLAT3(1.0) + f0 * ((1.0 - e) / e);
-  albedo = saturate((f0 * dfg.x + f90 * dfg.y) * w);
+  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
+  albedo = msaturate((f0 * SUBSTRATE_M(dfg.x) + f90 * SUBSTRATE_M(dfg.y)) * w);
   return w;
 }
 
@@ -148,8 +150,8 @@ float3 substrate_specular_energy(float3 f0, float3 f90, float NoV, float roughne
 // 1.10 at |A| 0.1, 1.45 at 0.5, 1.48 at 0.7, 1.10 at 1), never above E.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-float3 substrate_specular_energy_aniso(float3 f0, float3 f90, float NoV, float roughness, float anisotropy,
-                                       out float3 albedo) {
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float NoV, float roughness, float anisotropy,
+                                        out mfloat3 albedo) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
 #if SUBSTRATE_USE_ANISOTROPY
@@ -164,16 +166,16 @@ float3 substrate_specular_energy_aniso(float3 f0, float3 f90, float NoV, float r
     dfg = float2(lerp(dfg.x, e, t), b);
   }
 #endif
-  float3 w = SUBSTRATE_SPLAT3(1.0) + f0 * ((1.0 - e) / e);
-  albedo = saturate((f0 * dfg.x + f90 * dfg.y) * w);
+  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
+  albedo = msaturate((f0 * SUBSTRATE_M(dfg.x) + f90 * SUBSTRATE_M(dfg.y)) * w);
   return w;
 }
 
 // ---------------------------------------------------------------------------
 // Diffuse models (each returns BRDF * NoL for albedo `albedo`).
 
-float3 substrate_diffuse_lambert(float3 albedo, float NoL) {
-  return albedo * (SUBSTRATE_INV_PI * saturate(NoL));
+mfloat3 substrate_diffuse_lambert(mfloat3 albedo, float NoL) {
+  return albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * saturate(NoL));
 }
 
 // Chan 2018, "Material Advances in Call of Duty: WWII": GGX-rough diffuse with
@@ -186,7 +188,7 @@ float3 substrate_diffuse_lambert(float3 albedo, float NoL) {
 // 1.035 at NoV 0.1): the lobe is divided by a bound of that excess, linear in r
 // and NoV, 1 + max(0, 0.41 (r - 0.74) - 0.59 NoV) (fitted above the measured
 // albedo; docs/stability.md), so it never returns more than `albedo`.
-float3 substrate_diffuse_chan2018(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
+mfloat3 substrate_diffuse_chan2018(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
   float r = saturate(roughness);
   float a2 = max(r * r * r * r, 1e-7);
   float g = saturate((1.0 / 18.0) * log2(2.0 / a2 - 1.0));
@@ -196,7 +198,7 @@ float3 substrate_diffuse_chan2018(float3 albedo, float roughness, float NoV, flo
   float fb = ((34.5 * g - 59.0) * g + 24.5) * VoH * exp2(-max(73.2 * g - 21.2, 8.9) * sqrt(saturate(NoH)));
   float lobe = min(1.0, SUBSTRATE_INV_PI * (fd + fb));
   float excess = max(0.0, 0.41 * (r - 0.74) - 0.59 * saturate(NoV));
-  return albedo * (lobe * saturate(NoL) / (1.0 + excess));
+  return albedo * SUBSTRATE_M(lobe * saturate(NoL) / (1.0 + excess));
 }
 
 // Chan 2024, "Multiscattering Diffuse and Specular BRDFs" (as UE ships it, with
@@ -206,7 +208,7 @@ float3 substrate_diffuse_chan2018(float3 albedo, float roughness, float NoV, flo
 // exceeds `albedo` by up to 2.4 % at grazing views (NoV < 0.04) for r > 0.43:
 // the lobe is divided by 1 + 0.026 sat(1 - NoV / 0.04) sat(10 (r - 0.42)), a
 // bound of that excess (docs/stability.md).
-float3 substrate_diffuse_chan2024(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
+mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
   float r = saturate(roughness);
   float a = r * r;
   float scale = max(0.55 - 0.2 * r, 1.25 - 1.6 * r);
@@ -215,7 +217,7 @@ float3 substrate_diffuse_chan2024(float3 albedo, float roughness, float NoV, flo
   float fRough = scale * (n + bias) / (n + 0.025) * VoH * VoH;
   float f = lerp(1.0, fRough, r) + 0.38 * a;
   float excess = 0.026 * saturate(1.0 - 25.0 * NoV) * saturate(10.0 * (r - 0.42));
-  return albedo * (SUBSTRATE_INV_PI * f * saturate(NoL) / (1.0 + excess));
+  return albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * f * saturate(NoL) / (1.0 + excess));
 }
 
 // E_FON(mu, r): the directional albedo of the Fujii Oren-Nayar lobe, the
@@ -234,7 +236,9 @@ float substrate_eon_albedo(float mu, float r) {
 // The albedo is inverted exactly for the model's hemispherical mean: with
 // A = rho E_avg / (1 - rho (1 - E_avg)), rho = A / (E_avg + A (1 - E_avg)), so the
 // mean albedo equals the closure's diffuseAlbedo (post multiple scattering).
-float3 substrate_diffuse_eon(float3 albedo, float roughness, float NoV, float NoL, float VoL) {
+// The angular terms are float, the albedo inversion per channel mfloat: with
+// NoV >= 1e-4 (substrate_eval_closure's clamp) f_ss <= 1 + 0.4e4, within half.
+mfloat3 substrate_diffuse_eon(mfloat3 albedo, float roughness, float NoV, float NoL, float VoL) {
   float r = 0.4 * saturate(roughness);
   float mo = saturate(NoV);
   float mi = saturate(NoL);
@@ -242,16 +246,16 @@ float3 substrate_diffuse_eon(float3 albedo, float roughness, float NoV, float No
   float sOverT = s > 0.0 ? s / max(max(mo, mi), 1e-6) : s;
   float af = 1.0 / (1.0 + 0.287793409 * r);
   float eAvg = af * (1.0 + 0.0724882125 * r);
-  float3 rho = albedo / (SUBSTRATE_SPLAT3(eAvg) + albedo * (1.0 - eAvg));
-  float3 rhoMs = rho * rho * eAvg / (SUBSTRATE_SPLAT3(1.0) - rho * (1.0 - eAvg));
+  mfloat3 rho = albedo / (SUBSTRATE_MSPLAT3(eAvg) + albedo * SUBSTRATE_M(1.0 - eAvg));
+  mfloat3 rhoMs = rho * rho * SUBSTRATE_M(eAvg) / (SUBSTRATE_MSPLAT3(1.0) - rho * SUBSTRATE_M(1.0 - eAvg));
   float fss = af * (1.0 + r * sOverT);
   float ms = max(1e-7, 1.0 - substrate_eon_albedo(mo, r)) * max(1e-7, 1.0 - substrate_eon_albedo(mi, r)) /
              max(1e-7, 1.0 - eAvg);
-  return (rho * fss + rhoMs * ms) * (SUBSTRATE_INV_PI * mi);
+  return (rho * SUBSTRATE_M(fss) + rhoMs * SUBSTRATE_M(ms)) * SUBSTRATE_M(SUBSTRATE_INV_PI * mi);
 }
 
 // The diffuse model selected by SUBSTRATE_DIFFUSE_MODEL.
-float3 substrate_diffuse(float3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL) {
+mfloat3 substrate_diffuse(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL) {
 #if SUBSTRATE_DIFFUSE_MODEL == 1
   return substrate_diffuse_chan2018(albedo, roughness, NoV, NoL, NoH, VoH);
 #elif SUBSTRATE_DIFFUSE_MODEL == 2
@@ -275,11 +279,12 @@ float3 substrate_sss_wrap_amount(float3 mfp) {
 }
 
 // Energy-conserving wrap lighting: albedo / pi * max(NoL + w, 0) / (1 + w)^2
-// (its integral over the sphere equals Lambert's over the hemisphere).
-float3 substrate_diffuse_wrap(float3 albedo, float3 wrap, float NoL) {
+// (its integral over the sphere equals Lambert's over the hemisphere). The
+// wrap factor (NoL + w cancels near the terminator) is float.
+mfloat3 substrate_diffuse_wrap(mfloat3 albedo, float3 wrap, float NoL) {
   float3 w = saturate(wrap);
   float3 onePlus = SUBSTRATE_SPLAT3(1.0) + w;
-  return albedo * SUBSTRATE_INV_PI * max(SUBSTRATE_SPLAT3(NoL) + w, SUBSTRATE_SPLAT3(0.0)) / (onePlus * onePlus);
+  return albedo * SUBSTRATE_M3(SUBSTRATE_INV_PI * max(SUBSTRATE_SPLAT3(NoL) + w, SUBSTRATE_SPLAT3(0.0)) / (onePlus * onePlus));
 }
 
 // ---------------------------------------------------------------------------
@@ -413,11 +418,11 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   float VoH = saturate(dot(V, H));
   float VoL = clamp(dot(V, L), -1.0, 1.0);
 
-  float3 f0 = saturate(c.f0);
-  float3 f90 = SUBSTRATE_SPLAT3(1.0);
+  mfloat3 f0 = SUBSTRATE_M3(saturate(c.f0));
+  mfloat3 f90 = SUBSTRATE_MSPLAT3(1.0);
 #if SUBSTRATE_USE_F90
   if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90 = saturate(c.f90);
+    f90 = SUBSTRATE_M3(saturate(c.f90));
   }
 #endif
   float roughness = saturate(c.roughness);
@@ -430,8 +435,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 #endif
 
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
-  float3 specAlbedo;
-  float3 w1 = substrate_specular_energy_aniso(f0, f90, NoV, roughness, anisotropy, specAlbedo);
+  mfloat3 specAlbedo;
+  mfloat3 w1 = substrate_specular_energy_aniso(f0, f90, NoV, roughness, anisotropy, specAlbedo);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -440,11 +445,11 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     hazeRoughness = saturate(c.secondRoughness);
   }
 #endif
-  float3 w2 = w1;
+  mfloat3 w2 = w1;
   if (hazeWeight > 0.0) {
-    float3 specAlbedo2;
+    mfloat3 specAlbedo2;
     w2 = substrate_specular_energy_aniso(f0, f90, NoV, hazeRoughness, anisotropy, specAlbedo2);
-    specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
+    specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
   }
 
   float3 spec = SUBSTRATE_SPLAT3(0.0);
@@ -480,7 +485,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
       d1 = substrate_ggx_d(alpha1.x, NoH);
       vis1 = substrate_ggx_vis(alpha1.x, NoV, NoLc);
     }
-    float3 lobe = w1 * (d1 * vis1 * NoLc);
+    // The lobe in float: D reaches 1 / (pi 1e-6) = 3.2e5 at the smallest alpha.
+    float3 lobe = SUBSTRATE_F3(w1) * (d1 * vis1 * NoLc);
     if (hazeWeight > 0.0) {
       float2 alpha2 = substrate_ggx_alpha(hazeRoughness, anisotropy);
       float d2;
@@ -492,9 +498,9 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
         d2 = substrate_ggx_d(alpha2.x, NoH);
         vis2 = substrate_ggx_vis(alpha2.x, NoV, NoLc);
       }
-      lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
+      lobe = lerp(lobe, SUBSTRATE_F3(w2) * (d2 * vis2 * NoLc), hazeWeight);
     }
-    spec = substrate_fresnel(f0, f90, VoH) * lobe;
+    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, VoH)) * lobe;
 #if SUBSTRATE_USE_GLINT
     if ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u) {
       spec *= substrate_glint_factor(c, d1, ToH, BoH, NoH);
@@ -508,14 +514,14 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   }
 
   // Diffuse, below the specular interface.
-  float3 albedo = saturate(c.diffuseAlbedo);
-  float3 diffuse;
+  mfloat3 albedo = SUBSTRATE_M3(saturate(c.diffuseAlbedo));
+  mfloat3 diffuse;
   if (isWrap) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
     diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
   }
-  float3 result = spec + diffuse * (SUBSTRATE_SPLAT3(1.0) - specAlbedo);
+  float3 result = spec + SUBSTRATE_F3(diffuse * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
 
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {

@@ -30,24 +30,27 @@ float substrate_interface_transmission(float mu) {
 // lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5), coverageAbove): the
 // transmittance of the layers above along a direction at cosine mu (their
 // media and their interfaces), blended by their coverage. No transcendental
-// when nothing covers the closure (top layers).
-float3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
+// when nothing covers the closure (top layers). The remap (exp, log) and the
+// interface term (1 - (1 - mu)^5 cancels at grazing) are float; the
+// throughput, in [0, 1], is mfloat.
+mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
     float3 through = substrate_transmittance_at_cosine(c.topTransmittance, mu) * substrate_interface_transmission(mu);
-    return lerp(SUBSTRATE_SPLAT3(1.0), through, cover);
+    return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
   }
-  return SUBSTRATE_SPLAT3(1.0);
+  return SUBSTRATE_MSPLAT3(1.0);
 }
 
-// Along the view: c.weight * substrate_closure_above_throughput(c, NoV).
-float3 substrate_closure_view_throughput(SubstrateClosure c, float NoV) {
-  return max(c.weight, 0.0) * substrate_closure_above_throughput(c, NoV);
+// Along the view: c.weight * substrate_closure_above_throughput(c, NoV) (the
+// weight clamped to half's range in half precision).
+mfloat3 substrate_closure_view_throughput(SubstrateClosure c, float NoV) {
+  return SUBSTRATE_M_CLAMPED(max(c.weight, 0.0)) * substrate_closure_above_throughput(c, NoV);
 }
 
 // Along the light: substrate_closure_above_throughput(c, NoL). The closure's
 // weight is counted once, in the view throughput.
-float3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
+mfloat3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
   return substrate_closure_above_throughput(c, NoL);
 }
 
@@ -58,8 +61,8 @@ float3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
 float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 radiance) {
   float3 N = substrate_closure_normal(c);
   float3 f = substrate_eval_closure(c, V, L);
-  float3 throughput = substrate_closure_view_throughput(c, dot(N, V)) * substrate_closure_light_throughput(c, dot(N, L));
-  return throughput * f * radiance;
+  mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V)) * substrate_closure_light_throughput(c, dot(N, L));
+  return SUBSTRATE_F3(throughput) * f * radiance;
 }
 
 // The deferred light loop over the unpacked closures of a pixel. The optional
@@ -152,38 +155,39 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
     return SUBSTRATE_SPLAT3(0.0);
   }
   float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
-  float3 f0 = saturate(c.f0);
-  float3 f90 = SUBSTRATE_SPLAT3(1.0);
+  mfloat3 f0 = SUBSTRATE_M3(saturate(c.f0));
+  mfloat3 f90 = SUBSTRATE_MSPLAT3(1.0);
 #if SUBSTRATE_USE_F90
   if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90 = saturate(c.f90);
+    f90 = SUBSTRATE_M3(saturate(c.f90));
   }
 #endif
-  float3 specAlbedo;
+  mfloat3 specAlbedo;
   substrate_specular_energy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
-    float3 specAlbedo2;
+    mfloat3 specAlbedo2;
     substrate_specular_energy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
-    specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
+    specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
   }
 #endif
-  float3 spec = specAlbedo * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
+  // Radiance (HDR) is float; the weights that multiply it are mfloat.
+  float3 spec = SUBSTRATE_F3(specAlbedo) * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE
   if ((c.features & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u && c.specularProfile > 0u) {
     spec *= SUBSTRATE_SPECULAR_PROFILE_SAMPLE(c.specularProfile - 1u, float2(NoV, NoV));
   }
 #endif
   float3 irr = max(irradiance, SUBSTRATE_SPLAT3(0.0)) * SUBSTRATE_INV_PI;
-  float3 diffuse = saturate(c.diffuseAlbedo) * (SUBSTRATE_SPLAT3(1.0) - specAlbedo) * irr;
-  float3 specLight = substrate_closure_light_throughput(c, NoV);
-  float3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
-  float3 result = spec * specLight + diffuse * diffuseLight;
+  float3 diffuse = SUBSTRATE_F3(SUBSTRATE_M3(saturate(c.diffuseAlbedo)) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo)) * irr;
+  mfloat3 specLight = substrate_closure_light_throughput(c, NoV);
+  mfloat3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
+  float3 result = spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight);
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
     float amount = saturate(c.fuzzAmount);
     float eFuzz = min(substrate_fuzz_albedo(NoV, c.fuzzRoughness), 1.0);
-    result = result * (1.0 - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
+    result = result * (1.0 - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * SUBSTRATE_F3(diffuseLight);
   }
 #endif
   return result;
@@ -204,23 +208,23 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 void substrate_translucency(SubstrateClosure c, float NoV, out float coverage, out float3 transmittance) {
   coverage = saturate(c.weight);
   float mu = clamp(NoV, SUBSTRATE_MIN_COS, 1.0);
-  float3 f0 = saturate(c.f0);
-  float3 f90 = SUBSTRATE_SPLAT3(1.0);
+  mfloat3 f0 = SUBSTRATE_M3(saturate(c.f0));
+  mfloat3 f90 = SUBSTRATE_MSPLAT3(1.0);
 #if SUBSTRATE_USE_F90
   if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90 = saturate(c.f90);
+    f90 = SUBSTRATE_M3(saturate(c.f90));
   }
 #endif
-  float3 specAlbedo;
+  mfloat3 specAlbedo;
   substrate_specular_energy(f0, f90, mu, saturate(c.roughness), specAlbedo);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
-    float3 specAlbedo2;
+    mfloat3 specAlbedo2;
     substrate_specular_energy(f0, f90, mu, saturate(c.secondRoughness), specAlbedo2);
-    specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
+    specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
   }
 #endif
-  transmittance = substrate_closure_above_throughput(c, mu) * (SUBSTRATE_SPLAT3(1.0) - specAlbedo);
+  transmittance = SUBSTRATE_F3(substrate_closure_above_throughput(c, mu) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
     transmittance *= 1.0 - saturate(c.fuzzAmount) * min(substrate_fuzz_albedo(mu, c.fuzzRoughness), 1.0);

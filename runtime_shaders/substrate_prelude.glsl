@@ -41,4 +41,38 @@
 #define SUBSTRATE_ARRAY_BEGIN(T, N) T[N](
 #define SUBSTRATE_ARRAY_END )
 
+// Medium precision (docs/stability.md, "Half precision"): the runtime keeps
+// colours, albedos, Fresnel, energy weights and throughputs in mfloat types,
+// float unless the includer defines SUBSTRATE_PRECISION_HALF 1 before this
+// file (float16_t then: the device needs shaderFloat16). Conversions are
+// explicit (SUBSTRATE_M*: to mfloat, SUBSTRATE_F*: back to float) and vanish
+// in float, so the float32 SPIR-V is the same as without this block.
+#ifndef SUBSTRATE_PRECISION_HALF
+#define SUBSTRATE_PRECISION_HALF 0
+#endif
+#if SUBSTRATE_PRECISION_HALF
+#extension GL_EXT_shader_explicit_arithmetic_types_float16 : require
+#define mfloat float16_t
+#define mfloat3 f16vec3
+#define SUBSTRATE_M(x) float16_t(x)
+#define SUBSTRATE_M3(x) f16vec3(x)
+#define SUBSTRATE_F(x) float(x)
+#define SUBSTRATE_F3(x) vec3(x)
+// A float of any magnitude to mfloat: clamped to half's finite range (+-65504)
+// first, where the conversion would give +-inf.
+#define SUBSTRATE_M_CLAMPED(x) float16_t(clamp((x), -65504.0, 65504.0))
+#define msaturate(x) clamp((x), float16_t(0.0), float16_t(1.0))
+#else
+#define mfloat float
+#define mfloat3 vec3
+#define SUBSTRATE_M(x) (x)
+#define SUBSTRATE_M3(x) (x)
+#define SUBSTRATE_F(x) (x)
+#define SUBSTRATE_F3(x) (x)
+#define SUBSTRATE_M_CLAMPED(x) (x)
+#define msaturate saturate
+#endif
+#define mlerp mix
+#define SUBSTRATE_MSPLAT3(x) mfloat3(x)
+
 #endif

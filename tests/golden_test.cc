@@ -292,6 +292,44 @@ TEST(Golden, EveryExampleKernelValidates) {
   }
 }
 
+// `--precision half`: every entry still validates in both languages (HLSL with
+// 16-bit types), the preview and throughput kernels too (the forward and
+// deferred ones: tests/gpu/stability_test.cc); the material files, the base
+// passes and the layout are the float32 ones byte for byte, and a forward entry
+// differs only by the line that asks for half.
+TEST(Golden, HalfPrecisionChangesOnlyTheForwardEntries) {
+  for (const auto& e : filesIn(kSource / "examples", ".json")) {
+    SCOPED_TRACE(e.filename().string());
+    auto [r, diags] = compileAs(e, e.filename().string());
+    ASSERT_TRUE(r) << diags;
+    GenerateOptions half;
+    half.emit.precision = Precision::Half;
+    Generated h = generateFiles(*r, half);
+    validateGenerated(h);
+    ASSERT_TRUE(h.valid) << h.failure;
+    const Generated f = generateFiles(*r, GenerateOptions{});
+    ASSERT_EQ(h.files.size(), f.files.size());
+    for (std::size_t i = 0; i < f.files.size(); ++i) {
+      SCOPED_TRACE(f.files[i].name);
+      ASSERT_EQ(h.files[i].name, f.files[i].name);
+      std::string expected = f.files[i].contents;
+      if (f.files[i].name.find(".forward.") != std::string::npos) {
+        const std::string prelude = "#include \"substrate_prelude.";
+        ASSERT_NE(expected.find(prelude), std::string::npos);
+        expected.insert(expected.find(prelude), precisionDefine(Precision::Half));
+      }
+      EXPECT_EQ(h.files[i].contents, expected);
+    }
+    EmitOptions emit;
+    emit.precision = Precision::Half;
+    for (Target t : {Target::Glsl, Target::Hlsl})
+      for (KernelMode mode : {KernelMode::Preview, KernelMode::Throughput}) {
+        ShaderValidation v = compileKernel(*r, t, mode, emit);
+        EXPECT_TRUE(v.ok) << v.log;
+      }
+  }
+}
+
 TEST(Golden, SameInputTwiceGivesIdenticalOutput) {
   for (const auto& e : filesIn(kSource / "examples", ".json")) {
     SCOPED_TRACE(e.filename().string());

@@ -11,6 +11,7 @@
 #include "emit/generate.h"
 #include "output/atomic_write.h"
 #include "gpu/harness.h"
+#include "gpu/sample_run.h"
 #include "preview/contact_sheet.h"
 #include "preview/environment.h"
 #include "preview/render.h"
@@ -104,6 +105,15 @@ int diffuseModelOf(const std::string& name) {
   return 2;
 }
 
+/// --precision (compile, preview, sweep, stability): the runtime's lighting in float32 or half.
+void addPrecisionOption(CLI::App* command, std::string& precision) {
+  command->add_option("--precision", precision,
+                      "Lighting precision: float, or half (float16 colours, weights and throughputs; "
+                      "docs/stability.md)")
+      ->check(CLI::IsMember({"float", "half"}));
+}
+Precision precisionOf(const std::string& name) { return name == "half" ? Precision::Half : Precision::Float; }
+
 struct CompileArgs {
   std::string file;
   std::string outDir;
@@ -114,6 +124,7 @@ struct CompileArgs {
   bool fullSimplification = false;
   bool skipValidation = false;
   std::size_t maxInputSize = 16u << 20;
+  std::string precision = "float";
 };
 
 int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
@@ -131,6 +142,7 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
   go.hlsl = a.target != "glsl";
   go.emit.sourceName = std::filesystem::path(a.file).filename().string();
   go.emit.diffuseModel = diffuseModelOf(a.diffuse);
+  go.emit.precision = precisionOf(a.precision);
   Generated gen = generateFiles(*result, go);
   // Validate in-process before anything is written: a shader that does not
   // compile is the compiler's bug (exit 3), and the output folder stays as it was.
@@ -162,6 +174,7 @@ struct PreviewArgs {
   std::string diffuse = "chan2024";
   double exposure = 0;
   std::size_t maxInputSize = 16u << 20;
+  std::string precision = "float";
 };
 
 /// Renders the material (or, with --sweep, a labelled contact sheet of its
@@ -199,7 +212,7 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   }
   gpu::Context::Options go;
   auto ctx = gpu::Context::create(go, &error);
-  if (!ctx) {
+  if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
     err << "substratec: error: preview renders on Vulkan (Mesa lavapipe): " << error << "\n";
     return kExitBadInput;
   }
@@ -208,6 +221,7 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   ro.environment = a.environment;
   ro.target = a.target == "hlsl" ? Target::Hlsl : Target::Glsl;
   ro.diffuseModel = diffuseModelOf(a.diffuse);
+  ro.precision = precisionOf(a.precision);
   ro.exposure = a.exposure;
   std::vector<preview::Image> tiles;
   std::vector<std::string> labels;
@@ -248,6 +262,7 @@ struct SweepArgs {
   std::size_t maxInputSize = 16u << 20;
   int groundTruthProbes = 128;
   int groundTruthSamples = 1024;
+  std::string precision = "float";
 };
 
 /// The material at its full budget and at each simplification step: cost
@@ -274,7 +289,7 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
     return kExitBadInput;
   }
   auto ctx = gpu::Context::create(gpu::Context::Options{}, &error);
-  if (!ctx) {
+  if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
     err << "substratec: error: sweep times the generated code on Vulkan (Mesa lavapipe): " << error << "\n";
     return kExitBadInput;
   }
@@ -284,6 +299,7 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   so.diffuseModel = diffuseModelOf(a.diffuse);
   so.groundTruthProbes = a.groundTruthProbes;
   so.groundTruthSamples = a.groundTruthSamples;
+  so.precision = precisionOf(a.precision);
   std::vector<sweep::Row> rows;
   if (!sweep::measure(*ctx, steps, full, so, &rows, &error)) {
     err << "substratec: internal compiler error: " << error << "\n";
@@ -321,9 +337,11 @@ struct StabilityArgs {
   bool json = false;
   long evaluations = 100000;
   bool noGpu = false;
+  bool gpuOnly = false;
   std::optional<int> budget, maxClosures;
   bool fullSimplification = false;
   std::size_t maxInputSize = 16u << 20;
+  std::string precision = "float";
 };
 
 /// The material on the hard-case grid (compiler/stability/stability.h): counts
@@ -367,7 +385,7 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   std::unique_ptr<gpu::Context> ctx;
   if (!a.noGpu) {
     ctx = gpu::Context::create(gpu::Context::Options{}, &error);
-    if (!ctx) {
+    if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
       err << "substratec: error: stability runs the generated code on Vulkan (Mesa lavapipe; --no-gpu skips it): "
           << error << "\n";
       return kExitBadInput;
@@ -376,6 +394,8 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   stability::Options so;
   so.evaluations = a.evaluations;
   so.gpu = !a.noGpu;
+  so.cpu = !a.gpuOnly;
+  so.precision = precisionOf(a.precision);
   stability::Report report;
   if (!stability::run(*r, kinds, so, ctx.get(), &report, &error)) {
     err << "substratec: internal compiler error: " << error << "\n";
@@ -427,6 +447,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                  "Write the outputs without compiling them with glslang (debugging the generator)");
   comp->add_option("--max-input-size", compile.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+  addPrecisionOption(comp, compile.precision);
 
   PreviewArgs prev;
   CLI::App* pre = app.add_subcommand("preview", "Render the material on a sphere (Vulkan, Mesa lavapipe) into a PNG");
@@ -446,6 +467,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   pre->add_option("--exposure", prev.exposure, "Exposure in stops before the tone curve")->check(CLI::Range(-16.0, 16.0));
   pre->add_option("--max-input-size", prev.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+  addPrecisionOption(pre, prev.precision);
 
   SweepArgs sw;
   CLI::App* swp = app.add_subcommand("sweep", "Cost against error at the full budget and at each simplification step");
@@ -467,6 +489,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       ->check(CLI::Range(0, 1024));
   swp->add_option("--ground-truth-samples", sw.groundTruthSamples, "Random walks per shading point and channel group")
       ->check(CLI::Range(1, 1 << 20));
+  addPrecisionOption(swp, sw.precision);
 
   StabilityArgs stab;
   CLI::App* sta = app.add_subcommand("stability", "Hard cases: non-finite values on the CPU and on lavapipe, white furnace");
@@ -475,11 +498,14 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   sta->add_option("--evaluations", stab.evaluations, "Shading points to evaluate at least (each path)")
       ->check(CLI::Range(1L, 100000000L));
   sta->add_flag("--no-gpu", stab.noGpu, "CPU reference only");
+  sta->add_flag("--gpu-only", stab.gpuOnly, "The generated shaders only (no CPU reference, no furnace)")
+      ->excludes("--no-gpu");
   sta->add_option("--budget", stab.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
   sta->add_option("--max-closures", stab.maxClosures, "Closures per pixel")->check(CLI::Range(1, 8));
   sta->add_flag("--full-simplification", stab.fullSimplification, "Collapse to one closure first");
   sta->add_option("--max-input-size", stab.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+  addPrecisionOption(sta, stab.precision);
 
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector

@@ -11,7 +11,9 @@
 
 namespace substratec {
 
-std::string emitForwardEntry(const Material& m, const StorageLayout& layout, const Syntax& syn);
+/// The forward pass lights closures: `precision` selects the runtime's (the base pass only packs, in float32).
+std::string emitForwardEntry(const Material& m, const StorageLayout& layout, const Syntax& syn,
+                             Precision precision = Precision::Float);
 std::string emitBasePassEntry(const Material& m, const StorageLayout& layout, const Syntax& syn);
 
 /// The packing function `<name>_pack(closures, dither, words, topLayer)`,

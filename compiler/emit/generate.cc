@@ -29,13 +29,14 @@ std::string materialFile(const CompileResult& r, const Syntax& syn, const EmitOp
 
 Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
   Generated g;
+  g.precision = o.emit.precision;
   const Material& m = r.material;
   for (Target t : {Target::Glsl, Target::Hlsl}) {
     if ((t == Target::Glsl && !o.glsl) || (t == Target::Hlsl && !o.hlsl)) continue;
     const Syntax& syn = syntaxFor(t);
     g.files.push_back({m.name + std::string(syn.materialExtension), materialFile(r, syn, o.emit)});
     g.files.push_back({basePassFileName(m, syn), emitBasePassEntry(m, r.after, syn)});
-    g.files.push_back({forwardFileName(m, syn), emitForwardEntry(m, r.after, syn)});
+    g.files.push_back({forwardFileName(m, syn), emitForwardEntry(m, r.after, syn, o.emit.precision)});
   }
   g.files.push_back({m.name + ".layout.json", layoutJson(m, r.after).dump(2) + "\n"});
   return g;
@@ -66,6 +67,7 @@ void validateGenerated(Generated& g, const ValidateOptions& options) {
       src.language = f.name.ends_with(".frag") ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
       src.stage = ShaderStage::Fragment;
       src.memoryFiles = files;
+      src.hlsl16BitTypes = g.precision == Precision::Half;
       results[i] = compileAndValidate(src, options);
     }
   };
@@ -94,9 +96,10 @@ ShaderValidation compileKernel(const CompileResult& r, Target target, KernelMode
   const std::string materialName = m.name + std::string(syn.materialExtension);
   ShaderSource src;
   src.name = kernelFileName(m, syn, mode);
-  src.text = emitKernel(m, r.after, syn, mode, emit.inputsPerInvocation);
+  src.text = emitKernel(m, r.after, syn, mode, emit);
   src.language = target == Target::Glsl ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
   src.stage = ShaderStage::Compute;
+  src.hlsl16BitTypes = emit.precision == Precision::Half;
   for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
   src.memoryFiles[materialName] = material;
   ShaderValidation v = compileAndValidate(src);

@@ -29,6 +29,7 @@ struct EntryReport {
 struct Generated {
   std::vector<OutputFile> files;   // materials, entries, layout.json
   std::vector<EntryReport> entries;
+  Precision precision = Precision::Float;  // of the forward entries (GenerateOptions::emit)
   bool valid = true;               // every entry compiled and validated
   std::string failure;             // the numbered source and the log of the first failure
 };

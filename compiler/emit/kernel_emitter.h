@@ -78,9 +78,10 @@ inline constexpr int kPreviewParamVec4s = 2 + 2 * kPreviewLights;
 }  // namespace kernel
 
 /// The kernel source; it includes "<name>.material.{glsl,hlsl}" and the runtime.
-/// perSampleInputs (Forward and Deferred only): inputs from binding 8, see above.
+/// emit.inputsPerInvocation (Forward and Deferred only): inputs from binding 8,
+/// see above; emit.precision: the runtime's (every mode lights closures).
 std::string emitKernel(const Material& m, const StorageLayout& layout, const Syntax& syn, KernelMode mode,
-                       bool perSampleInputs = false);
+                       const EmitOptions& emit = {});
 
 /// `<name>.<mode>.comp` / `<name>.<mode>.cs.hlsl` (mode: forward_samples, deferred_samples, preview, throughput).
 std::string kernelFileName(const Material& m, const Syntax& syn, KernelMode mode);

@@ -17,6 +17,12 @@ std::string materialUpper(const Material& m) {
   return s;
 }
 
+const char* precisionName(Precision p) { return p == Precision::Half ? "half" : "float"; }
+
+std::string precisionDefine(Precision p) {
+  return p == Precision::Half ? "#define SUBSTRATE_PRECISION_HALF 1  // colours, weights, throughputs in float16\n" : "";
+}
+
 namespace {
 
 // Closure feature bits (runtime_shaders/substrate_closure.h, docs/storage.md).

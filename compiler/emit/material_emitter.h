@@ -19,8 +19,15 @@
 
 namespace substratec {
 
+/// Precision of the runtime's lighting (docs/stability.md, "Half precision"):
+/// Half compiles the "medium" quantities of runtime_shaders/ (colours,
+/// albedos, Fresnel, energy weights, throughputs) as float16. The material
+/// function and the base pass are float32 in both.
+enum class Precision { Float, Half };
+
 struct EmitOptions {
   int diffuseModel = 2;          // 0 lambert, 1 chan2018, 2 chan2024, 3 eon
+  Precision precision = Precision::Float;  // of the entries and kernels that light closures
   std::string sourceName;        // file name (no directory) for the header comment
   /// Declare the inputs as private globals instead of the uniform block: a
   /// kernel that reads one input set per shading point (KernelMode's
@@ -35,5 +42,11 @@ std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayo
 
 /// Names used across emitted files.
 std::string materialUpper(const Material& m);  // NAME in macros
+
+/// "float" / "half" (the CLI's --precision).
+const char* precisionName(Precision p);
+/// What an entry or kernel that lights closures writes before the prelude:
+/// `#define SUBSTRATE_PRECISION_HALF 1` for Half, nothing for Float.
+std::string precisionDefine(Precision p);
 
 }  // namespace substratec

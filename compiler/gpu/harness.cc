@@ -149,6 +149,7 @@ struct Context::Impl {
   VkCommandPool commandPool = VK_NULL_HANDLE;
   std::string deviceName, driverInfo;
   double timestampPeriodNs = 1;  // VkPhysicalDeviceLimits::timestampPeriod
+  bool shaderFloat16 = false;    // enabled on the device (VkPhysicalDeviceVulkan12Features)
   bool lost = false;  // a fence wait timed out or the device was lost: leak, never wait
 
   ~Impl() {
@@ -184,7 +185,8 @@ struct Context::Impl {
 
   /// Loads libvulkan, pins lavapipe, creates the instance with the validation layer and the messenger.
   bool createInstance(std::string* error);
-  /// Picks lavapipe, creates the device with one compute queue and the command pool.
+  /// Picks lavapipe, creates the device with one compute queue (and shaderFloat16 when it has it) and the
+  /// command pool.
   bool createDevice(std::string* error);
   /// Allocates memory for `req` (host-visible + coherent and mapped when `hostVisible`), owned by `objs`.
   bool allocate(const VkMemoryRequirements& req, bool hostVisible, DispatchObjects& objs, VkDeviceMemory* out,
@@ -325,8 +327,22 @@ bool Context::Impl::createDevice(std::string* error) {
   queueInfo.queueFamilyIndex = queueFamily;
   queueInfo.queueCount = 1;
   queueInfo.pQueuePriorities = &priority;
+  // Half-precision arithmetic (`--precision half`: the Float16 capability) when the device has it;
+  // nothing else of Vulkan 1.2 is enabled (the shaders keep 16-bit values out of buffers, so no
+  // 16-bit storage feature is needed).
+  VkPhysicalDeviceVulkan12Features has12{};
+  has12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  VkPhysicalDeviceFeatures2 features{};
+  features.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  features.pNext = &has12;
+  vk.vkGetPhysicalDeviceFeatures2(physical, &features);
+  shaderFloat16 = has12.shaderFloat16 == VK_TRUE;
+  VkPhysicalDeviceVulkan12Features enable12{};
+  enable12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
+  enable12.shaderFloat16 = shaderFloat16 ? VK_TRUE : VK_FALSE;
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
+  info.pNext = &enable12;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queueInfo;
   if (!succeeded(vk.vkCreateDevice(physical, &info, nullptr, &device), "vkCreateDevice (lavapipe)", error)) return false;
@@ -468,6 +484,7 @@ std::unique_ptr<Context> Context::create(const Options& options, std::string* er
 
 std::string Context::deviceName() const { return impl_->deviceName; }
 std::string Context::driverInfo() const { return impl_->driverInfo; }
+bool Context::shaderFloat16() const { return impl_->shaderFloat16; }
 
 std::vector<std::string> Context::takeMessages() {
   std::lock_guard<std::mutex> lock(impl_->log->mutex);

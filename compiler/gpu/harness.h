@@ -95,8 +95,9 @@ class Context {
   /// Loads libvulkan.so.1, creates an instance (Vulkan 1.2, VK_LAYER_KHRONOS_validation with
   /// synchronization validation, and a VK_EXT_debug_utils messenger recording warnings and errors;
   /// the messenger also watches vkCreateInstance itself) and a device on lavapipe with one
-  /// compute queue. Sets VK_DRIVER_FILES to lavapipe's ICD unless VK_DRIVER_FILES or VK_ICD_FILENAMES
-  /// is set non-empty (setenv: call before starting threads). Null with `*error` set when anything is missing.
+  /// compute queue (and shaderFloat16 when the device has it). Sets VK_DRIVER_FILES to lavapipe's ICD
+  /// unless VK_DRIVER_FILES or VK_ICD_FILENAMES is set non-empty (setenv: call before starting threads).
+  /// Null with `*error` set when anything is missing.
   static std::unique_ptr<Context> create(const Options& options, std::string* error);
   ~Context();
   Context(const Context&) = delete;
@@ -104,6 +105,9 @@ class Context {
 
   std::string deviceName() const;  // "llvmpipe (LLVM 15.0.6, 256 bits)"
   std::string driverInfo() const;  // "Mesa 22.3.6 (LLVM 15.0.6)"
+  /// Whether the device has (and so the Context enabled) shaderFloat16: half-precision arithmetic in
+  /// shaders (SPIR-V capability Float16, `--precision half`). Lavapipe has it.
+  bool shaderFloat16() const;
 
   /// Reflects `spirv` (a GLCompute entry point is required) and builds its pipeline. Null with
   /// `*error` set on a reflection or Vulkan failure, or when the validation layer reported anything.

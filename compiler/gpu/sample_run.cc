@@ -7,6 +7,7 @@
 #include <mutex>
 #include <random>
 
+#include "emit/generate.h"
 #include "gpu/block_layout.h"
 #include "validate/runtime_files.h"
 
@@ -211,6 +212,30 @@ std::vector<float> floatsOf(const Resources& resources, uint32_t set, uint32_t b
   std::vector<float> f(buf.data.size() / sizeof(float));
   std::memcpy(f.data(), buf.data.data(), f.size() * sizeof(float));
   return f;
+}
+
+bool canRun(const Context& ctx, Precision precision, std::string* error) {
+  if (precision == Precision::Float || ctx.shaderFloat16()) return true;
+  *error = "half precision needs a Vulkan device with shaderFloat16 (" + ctx.deviceName() + " has none)";
+  return false;
+}
+
+bool runSampleKernel(Context& ctx, const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit,
+                     const std::vector<Sample>& samples, const std::vector<std::array<double, 4>>& inputValues,
+                     std::vector<float>* results, std::string* error) {
+  if (!canRun(ctx, emit.precision, error)) return false;
+  const ShaderValidation v = compileKernel(r, target, mode, emit);
+  if (!v.ok) {
+    *error = "internal compiler error: the sample kernel does not validate\n" + v.log;
+    return false;
+  }
+  auto pipeline = ctx.createPipeline(v.spirv, error);
+  if (!pipeline) return false;
+  Resources res = kernelResources(r.material, pipeline->reflection(), v.spirv, inputValues, sampleBuffer(samples),
+                                  samples.size() * static_cast<std::size_t>(resultStride(r)));
+  if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(samples.size() / kLocalSize), 1, 1, error)) return false;
+  *results = floatsOf(res, 0, 7);
+  return true;
 }
 
 }  // namespace substratec::gpu

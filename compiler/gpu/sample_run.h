@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "emit/kernel_emitter.h"
@@ -54,5 +55,18 @@ int resultStride(const CompileResult& r);
 
 /// Reads a float result buffer back from a BufferResource.
 std::vector<float> floatsOf(const Resources& resources, uint32_t set, uint32_t binding);
+
+/// False with `*error` when kernels of `precision` cannot run on `ctx`: Half
+/// needs shaderFloat16.
+bool canRun(const Context& ctx, Precision precision, std::string* error);
+
+/// Compiles the material's `mode` sample kernel (Forward or Deferred) for
+/// `target` with `emit` (compileKernel) and runs it once over `samples` (a
+/// multiple of kernel::kLocalSize) with `inputValues` (empty: defaults):
+/// `*results` holds resultStride(r) floats per sample. False with `*error` when
+/// the kernel does not validate (a compiler bug) or the dispatch fails.
+bool runSampleKernel(Context& ctx, const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit,
+                     const std::vector<Sample>& samples, const std::vector<std::array<double, 4>>& inputValues,
+                     std::vector<float>* results, std::string* error);
 
 }  // namespace substratec::gpu

@@ -25,6 +25,7 @@ namespace substratec::gpu {
   X(vkDestroyInstance)                       \
   X(vkEnumeratePhysicalDevices)              \
   X(vkGetPhysicalDeviceProperties2)          \
+  X(vkGetPhysicalDeviceFeatures2)            \
   X(vkGetPhysicalDeviceQueueFamilyProperties) \
   X(vkGetPhysicalDeviceMemoryProperties)     \
   X(vkCreateDevice)                          \

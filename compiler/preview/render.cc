@@ -10,6 +10,7 @@
 #include "emit/generate.h"
 #include "emit/kernel_emitter.h"
 #include "gpu/block_layout.h"
+#include "gpu/sample_run.h"
 #include "preview/cubemap.h"
 #include "preview/environment.h"
 #include "validate/runtime_files.h"
@@ -91,6 +92,8 @@ std::vector<float> previewTexture(int size) {
 bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions& o, Image* out, std::string* error) {
   EmitOptions emit;
   emit.diffuseModel = o.diffuseModel;
+  emit.precision = o.precision;
+  if (!gpu::canRun(ctx, o.precision, error)) return false;
   ShaderValidation v = compileKernel(r, o.target, KernelMode::Preview, emit);
   if (!v.ok) {
     *error = "internal compiler error: the preview kernel does not validate\n" + v.log;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "emit/material_emitter.h"
 #include "emit/syntax.h"
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
@@ -20,6 +21,7 @@ struct RenderOptions {
   std::string environment = "studio";        // preview/environment.h
   Target target = Target::Glsl;              // which generated language runs
   int diffuseModel = 2;                      // SUBSTRATE_DIFFUSE_MODEL
+  Precision precision = Precision::Float;    // of the runtime's lighting (needs shaderFloat16 for Half)
   double exposure = 0;                       // stops, for the tone map
 };
 

@@ -298,6 +298,8 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
             const std::vector<std::pair<long, int>>& work, gpu::Context& ctx, Report* report, std::string* error) {
   EmitOptions emit;
   emit.inputsPerInvocation = true;
+  emit.precision = report->precision;
+  if (!gpu::canRun(ctx, emit.precision, error)) return false;
   int inputCount = 0;
   for (const Input& in : r.material.inputs) inputCount += in.type != VType::Texture;
   const int stride = gpu::resultStride(r);
@@ -458,6 +460,7 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
   for (const ForcedKind& k : kinds) grid.count *= static_cast<long>(k.values.size()) + 1;
   const std::vector<Point> points = shadingPoints();
   report->material = r.material.name;
+  report->precision = o.precision;
   for (const ForcedKind& k : kinds) report->forced.push_back(k.name);
   report->configurations = grid.count;
   report->shadingPoints = static_cast<long>(points.size());
@@ -470,24 +473,28 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
   for (long c = 0; c < grid.count; ++c)
     for (long k = 0; k < per; ++k) work.emplace_back(c, static_cast<int>(next++ % static_cast<long>(points.size())));
 
-  for (const auto& [config, point] : work) {
-    const Configuration cfg = grid.at(config);
-    const reference::InputValues in = inputsOf(r.material, grid, cfg);
-    ++report->evaluations;
-    double value = 0;
-    std::string bad = evaluate<double>(r, points[point], in, &value);
-    const char* where = "cpu double";
-    if (bad.empty()) {
-      bad = evaluate<float>(r, points[point], in, &value);
-      where = "cpu float";
+  report->cpu = o.cpu;
+  if (o.cpu) {
+    for (const auto& [config, point] : work) {
+      const Configuration cfg = grid.at(config);
+      const reference::InputValues in = inputsOf(r.material, grid, cfg);
+      ++report->evaluations;
+      double value = 0;
+      std::string bad = evaluate<double>(r, points[point], in, &value);
+      const char* where = "cpu double";
+      if (bad.empty()) {
+        bad = evaluate<float>(r, points[point], in, &value);
+        where = "cpu float";
+      }
+      if (bad.empty()) continue;
+      ++report->nonfinite;
+      if (report->worst.size() < kMaxCases)
+        report->worst.push_back({where, bad, grid.describe(cfg), points[point].label, value});
     }
-    if (bad.empty()) continue;
-    ++report->nonfinite;
-    if (report->worst.size() < kMaxCases)
-      report->worst.push_back({where, bad, grid.describe(cfg), points[point].label, value});
   }
   if (o.gpu && !runGpu(r, grid, points, work, *gpu, report, error)) return false;
-  furnace(r, grid, o.furnaceSamples, report);
+  if (o.cpu) furnace(r, grid, o.furnaceSamples, report);
+  report->furnaceJudged = o.cpu;
   // `add` sums two pieces of matter: more light than arrives, by construction.
   for (const TreeNode& n : r.material.nodes)
     if (n.op == TreeOp::Add) report->furnaceJudged = false;
@@ -498,10 +505,17 @@ std::string formatText(const Report& r) {
   std::string s = fmt::format("----- STABILITY - {} -----\n", r.material);
   s += fmt::format("forced parameters: {}\n", r.forced.empty() ? std::string("none") : fmt::format("{}", fmt::join(r.forced, ", ")));
   s += fmt::format("configurations:    {} x {} shading points\n", r.configurations, r.shadingPoints);
-  s += fmt::format("cpu evaluations:   {} (double and float), non-finite: {}\n", r.evaluations, r.nonfinite);
-  s += fmt::format("gpu evaluations:   {} (forward and deferred), non-finite: {}\n", r.gpuEvaluations, r.gpuNonfinite);
-  s += fmt::format("furnace max:       {:.5f}  ({}; {}){}\n", r.furnaceMax, r.furnaceWorst.configuration,
-                   r.furnaceWorst.geometry, r.furnaceJudged ? "" : "  [not judged: `add` sums matter]");
+  if (r.cpu)
+    s += fmt::format("cpu evaluations:   {} (double and float), non-finite: {}\n", r.evaluations, r.nonfinite);
+  else
+    s += "cpu evaluations:   not run (--gpu-only)\n";
+  s += fmt::format("gpu evaluations:   {} (forward and deferred, {} precision), non-finite: {}\n", r.gpuEvaluations,
+                   precisionName(r.precision), r.gpuNonfinite);
+  if (r.cpu)
+    s += fmt::format("furnace max:       {:.5f}  ({}; {}){}\n", r.furnaceMax, r.furnaceWorst.configuration,
+                     r.furnaceWorst.geometry, r.furnaceJudged ? "" : "  [not judged: `add` sums matter]");
+  else
+    s += "furnace max:       not run (--gpu-only)\n";
   for (const Case& c : r.worst)
     s += fmt::format("non-finite: {} {} = {} at {}; {}\n", c.where, c.quantity, c.value, c.configuration, c.geometry);
   return s;
@@ -522,10 +536,12 @@ std::string formatJson(const Report& r) {
   j["forced"] = r.forced;
   j["configurations"] = r.configurations;
   j["shading_points"] = r.shadingPoints;
+  j["cpu"] = r.cpu;
   j["evaluations"] = r.evaluations;
   j["nonfinite"] = r.nonfinite;
   j["gpu_evaluations"] = r.gpuEvaluations;
   j["gpu_nonfinite"] = r.gpuNonfinite;
+  j["gpu_precision"] = precisionName(r.precision);
   j["furnace_max"] = r.furnaceMax;
   j["furnace_judged"] = r.furnaceJudged;
   j["furnace_worst"] = caseJson(r.furnaceWorst);

@@ -33,7 +33,9 @@
 //   the direct light, the view throughput, the split-sum environment and
 //   translucency. GPU: the forward kernel (closures lit inline) and the
 //   deferred kernel (packed, unpacked, lit) write the closures and the sums:
-//   every float must be finite.
+//   every float must be finite. With Options::precision Half the GPU kernels
+//   light in half precision (EmitOptions::precision; the CPU reference has one
+//   precision for both).
 //
 // THE FURNACE
 //   Up to 128 configurations with albedo 1 and white colour inputs (a
@@ -47,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "emit/material_emitter.h"
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
 
@@ -68,7 +71,9 @@ bool forceableText(const std::string& text, std::string* rewritten, std::vector<
 struct Options {
   long evaluations = 100000;  // at least this many (CPU; the GPU runs the same points in each path)
   bool gpu = true;
+  bool cpu = true;  // the CPU reference's grid and the furnace (neither depends on `precision`)
   int furnaceSamples = 4096;  // importance samples per furnace integral (noise well under 1e-3)
+  Precision precision = Precision::Float;  // of the GPU kernels' lighting
 };
 
 /// One non-finite (or, for the furnace, the largest) case: where it was found.
@@ -82,12 +87,15 @@ struct Case {
 
 struct Report {
   std::string material;
+  Precision precision = Precision::Float;  // of the GPU kernels
   std::vector<std::string> forced;  // the kinds
   long configurations = 0, shadingPoints = 0;
   long evaluations = 0, nonfinite = 0;        // CPU: points evaluated (each in double and in float), bad ones
   long gpuEvaluations = 0, gpuNonfinite = 0;  // GPU: points evaluated over both paths, bad ones
   double furnaceMax = 0;                      // largest directional albedo, white inputs, white furnace (glints off)
+  bool cpu = true;                            // Options::cpu: the CPU grid and the furnace ran
   bool furnaceJudged = true;                  // false when the tree has an `add` (it sums matter: > 1 by design)
+                                              // or without the CPU part
   Case furnaceWorst;
   std::vector<Case> worst;                    // the first non-finite cases (at most 16)
 };

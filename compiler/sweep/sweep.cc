@@ -12,6 +12,7 @@
 #include "gpu/sample_run.h"
 #include "reference/reference.h"
 #include "storage/pack.h"
+#include "sweep/precision.h"
 
 namespace substratec::sweep {
 
@@ -54,10 +55,11 @@ std::vector<double> radiance(const CompileResult& r, const std::vector<gpu::Samp
 }
 
 /// The forward shader's SPIR-V instruction count after the performance passes.
-bool forwardInstructions(const CompileResult& r, int diffuseModel, std::size_t* count, std::string* error) {
+bool forwardInstructions(const CompileResult& r, const Options& options, std::size_t* count, std::string* error) {
   GenerateOptions o;
   o.hlsl = false;
-  o.emit.diffuseModel = diffuseModel;
+  o.emit.diffuseModel = options.diffuseModel;
+  o.emit.precision = options.precision;
   Generated g = generateFiles(r, o);
   validateGenerated(g, {.optimize = true});
   if (!g.valid) {
@@ -73,6 +75,7 @@ bool forwardInstructions(const CompileResult& r, int diffuseModel, std::size_t* 
 bool nsPerPixel(gpu::Context& ctx, const CompileResult& r, const Options& o, double* ns, std::string* error) {
   EmitOptions emit;
   emit.diffuseModel = o.diffuseModel;  // the model the errors are measured with
+  emit.precision = o.precision;
   ShaderValidation v = compileKernel(r, Target::Glsl, KernelMode::Throughput, emit);
   if (!v.ok) {
     *error = "internal compiler error: the throughput kernel does not validate\n" + v.log;
@@ -155,12 +158,6 @@ std::vector<double> groundTruthDirect(const CompileResult& full, const std::vect
   return out;
 }
 
-double relMse(const std::vector<double>& x, const std::vector<double>& y) {
-  double sum = 0;
-  for (std::size_t i = 0; i < x.size(); ++i) sum += (x[i] - y[i]) * (x[i] - y[i]) / (y[i] * y[i] + 0.01);
-  return x.empty() ? 0 : sum / static_cast<double>(x.size());
-}
-
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -168,6 +165,12 @@ double percentile(std::vector<double> v, double p) {
 }
 
 }  // namespace
+
+double relMse(const std::vector<double>& x, const std::vector<double>& y) {
+  double sum = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) sum += (x[i] - y[i]) * (x[i] - y[i]) / (y[i] * y[i] + 0.01);
+  return x.empty() ? 0 : sum / static_cast<double>(x.size());
+}
 
 reference::WalkOptions groundTruthOptions(int samples) {
   reference::WalkOptions o;
@@ -280,8 +283,15 @@ bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileRes
     row.budget = step.budget;
     row.bytes = r.after.bytes();
     row.closures = static_cast<int>(r.after.closures.size());
-    if (!forwardInstructions(r, o.diffuseModel, &row.spirvInstructions, error)) return false;
+    if (!forwardInstructions(r, o, &row.spirvInstructions, error)) return false;
     if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, error)) return false;
+    if (o.precision == Precision::Half) {
+      BothPrecisions both;
+      if (!runBothPrecisions(ctx, r, Target::Glsl, probes, {}, &both, error)) return false;
+      const PrecisionError e = precisionError(both, gpu::resultStride(r));
+      row.relMseVsFloat32 = e.relMse;
+      row.maxAbsVsFloat32 = e.maxAbs;
+    }
     std::vector<std::vector<reference::Closure<double>>> closures;
     std::vector<double> direct;
     const std::vector<double> x = radiance(r, probes, o.diffuseModel, &closures, &direct);
@@ -326,22 +336,33 @@ std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double m
   return best;
 }
 
+namespace {
+/// Whether the rows carry the half-vs-float32 columns (Options::precision Half).
+bool halfColumns(const std::vector<Row>& rows) { return !rows.empty() && rows.front().relMseVsFloat32.has_value(); }
+}  // namespace
+
 std::string formatTable(const std::string& material, const std::vector<Row>& rows) {
-  std::string s = fmt::format("----- SWEEP - {} -----\n", material);
-  s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>10}\n", "row", "budget",
+  const bool half = halfColumns(rows);
+  std::string s = fmt::format("----- SWEEP - {}{} -----\n", material, half ? " (half precision)" : "");
+  s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>10}", "row", "budget",
                    "bytes", "closures", "spirv_instr", "ns/pixel", "rel_mse", "max_abs", "p99_abs", "dE00_avg",
                    "dE00_max", "mse_vs_gt");
-  for (const Row& r : rows)
+  s += half ? fmt::format(" {:>10} {:>10}\n", "mse_vs_f32", "abs_vs_f32") : "\n";
+  for (const Row& r : rows) {
     s += fmt::format(
-        "{:<20} {:>6} {:>5} {:>8} {:>11} {:>10.1f} {:>10.3e} {:>10.3e} {:>10.3e} {:>8.3f} {:>8.3f} {:>10.3e}\n",
+        "{:<20} {:>6} {:>5} {:>8} {:>11} {:>10.1f} {:>10.3e} {:>10.3e} {:>10.3e} {:>8.3f} {:>8.3f} {:>10.3e}",
         r.label, r.budget, r.bytes, r.closures, r.spirvInstructions, r.gpuNsPerPixel, r.relMse, r.maxAbs, r.p99Abs,
         r.deltaE2000Mean, r.deltaE2000Max, r.relMseVsGroundTruth);
+    s += half ? fmt::format(" {:>10.3e} {:>10.3e}\n", r.relMseVsFloat32.value_or(0), r.maxAbsVsFloat32.value_or(0))
+              : "\n";
+  }
   return s;
 }
 
 std::string formatJson(const std::string& material, const std::vector<Row>& rows) {
   nlohmann::ordered_json j;
   j["material"] = material;
+  if (halfColumns(rows)) j["precision"] = "half";
   j["rows"] = nlohmann::ordered_json::array();
   for (const Row& r : rows) {
     nlohmann::ordered_json row;
@@ -356,19 +377,25 @@ std::string formatJson(const std::string& material, const std::vector<Row>& rows
     row["p99_abs"] = r.p99Abs;
     row["delta_e2000"] = {{"mean", r.deltaE2000Mean}, {"max", r.deltaE2000Max}};
     row["rel_mse_vs_ground_truth"] = r.relMseVsGroundTruth;
+    if (r.relMseVsFloat32) row["rel_mse_vs_float32"] = *r.relMseVsFloat32;
+    if (r.maxAbsVsFloat32) row["max_abs_vs_float32"] = *r.maxAbsVsFloat32;
     j["rows"].push_back(row);
   }
   return j.dump(2) + "\n";
 }
 
 std::string formatCsv(const std::vector<Row>& rows) {
+  const bool half = halfColumns(rows);
   std::string s =
       "label,budget,bytes,closures,spirv_instructions,gpu_ns_per_pixel,rel_mse,max_abs,p99_abs,delta_e2000_mean,"
-      "delta_e2000_max,rel_mse_vs_ground_truth\n";
-  for (const Row& r : rows)
-    s += fmt::format("{},{},{},{},{},{:.3f},{:.6e},{:.6e},{:.6e},{:.4f},{:.4f},{:.6e}\n", r.label, r.budget, r.bytes,
+      "delta_e2000_max,rel_mse_vs_ground_truth";
+  s += half ? ",rel_mse_vs_float32,max_abs_vs_float32\n" : "\n";
+  for (const Row& r : rows) {
+    s += fmt::format("{},{},{},{},{},{:.3f},{:.6e},{:.6e},{:.6e},{:.4f},{:.4f},{:.6e}", r.label, r.budget, r.bytes,
                      r.closures, r.spirvInstructions, r.gpuNsPerPixel, r.relMse, r.maxAbs, r.p99Abs, r.deltaE2000Mean,
                      r.deltaE2000Max, r.relMseVsGroundTruth);
+    s += half ? fmt::format(",{:.6e},{:.6e}\n", r.relMseVsFloat32.value_or(0), r.maxAbsVsFloat32.value_or(0)) : "\n";
+  }
   return s;
 }
 

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "emit/material_emitter.h"
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
 #include "reference/random_walk.h"
@@ -49,6 +50,10 @@ struct Row {
   /// the geometric surface. It holds the analytic model's own error (row 1) and
   /// what simplification adds to it or takes from it.
   double relMseVsGroundTruth = 0;
+  /// Options::precision Half only: the half-precision forward kernel's lit
+  /// radiance (direct + environment + emissive) against the float32 one's on
+  /// lavapipe over the same probes (sweep/precision.h).
+  std::optional<double> relMseVsFloat32, maxAbsVsFloat32;
 };
 
 struct Options {
@@ -57,6 +62,7 @@ struct Options {
   int diffuseModel = 2;
   int groundTruthProbes = 128;    // probes walked (the first ones lit from above and seen from above)
   int groundTruthSamples = 1024;  // walks per probe and channel group
+  Precision precision = Precision::Float;  // of the timed kernels and the counted forward shader
 };
 
 /// The walk's options for the sweep's ground truth: the conventions of the
@@ -80,6 +86,9 @@ std::string formatTable(const std::string& material, const std::vector<Row>& row
 std::string formatJson(const std::string& material, const std::vector<Row>& rows);
 std::string formatCsv(const std::vector<Row>& rows);
 std::string plotSvg(const std::string& material, const std::vector<Row>& rows);
+
+/// mean((x − y)² / (y² + 0.01)): the sweep's rel_mse of x against the reference y.
+double relMse(const std::vector<double>& x, const std::vector<double>& y);
 
 /// CIEDE2000 between two CIELAB colours (Sharma, Wu & Dalal 2005).
 double deltaE2000Lab(const std::array<double, 3>& lab1, const std::array<double, 3>& lab2);

@@ -223,6 +223,7 @@ ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptio
 
   int messages = EShMsgSpvRules | EShMsgVulkanRules;
   if (hlsl) messages |= EShMsgReadHlsl | EShMsgHlslOffsets;
+  if (hlsl && src.hlsl16BitTypes) messages |= EShMsgHlslEnable16BitTypes;
   const auto msgs = static_cast<EShMessages>(messages);
 
   FileIncluder includer(src.includeDirs, src.memoryFiles);

@@ -39,6 +39,9 @@ struct ShaderSource {
   // Files #include finds by name before searching any directory (name -> text;
   // the texts must outlive the call). Diagnostics name them as given.
   std::map<std::string, std::string_view> memoryFiles;
+  // HLSL: `half` is a 16-bit float (EShMsgHlslEnable16BitTypes, DXC's -enable-16bit-types), for the
+  // runtime's SUBSTRATE_PRECISION_HALF; otherwise a 32-bit one. GLSL asks for float16 by #extension.
+  bool hlsl16BitTypes = false;
 };
 
 struct ValidateOptions {
@@ -62,10 +65,10 @@ struct ShaderValidation {
 /// the performance passes (validating it too). Link warnings are errors, and the module must contain exactly one OpEntryPoint,
 /// named `entryPoint`. Thread-safe to call from several threads (glslang::InitializeProcess once,
 /// guarded). GLSL sources without #version get 450.
-/// HLSL: EShMsgReadHlsl | EShMsgHlslOffsets; `half` is 32-bit (no EShMsgHlslEnable16BitTypes, as
-/// DXC without -enable-16bit-types); glslang's legalization passes run on HLSL output when spirv-val
-/// rejects the raw module (e.g. structs holding resources need them), and `spirv` is then the legalized
-/// module.
+/// HLSL: EShMsgReadHlsl | EShMsgHlslOffsets; `half` is 32-bit unless ShaderSource::hlsl16BitTypes
+/// (EShMsgHlslEnable16BitTypes, as DXC with -enable-16bit-types); glslang's legalization passes run on
+/// HLSL output when spirv-val rejects the raw module (e.g. structs holding resources need them), and
+/// `spirv` is then the legalized module.
 ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptions& options = {});
 
 /// Counts the instructions of a SPIR-V module (0 if the header is missing or a word count is bad).

@@ -2,6 +2,8 @@
 // generated shaders on lavapipe (`substratec stability`), and layering does
 // not make energy from nowhere.
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -15,9 +17,11 @@
 #include "cli/cli.h"
 #include "emit/generate.h"
 #include "gpu/sample_run.h"
+#include "material_fixture.h"
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
 #include "stability/stability.h"
+#include "sweep/precision.h"
 
 namespace {
 
@@ -71,9 +75,92 @@ void expectFinite(const std::string& file) {
   EXPECT_FALSE(j["forced"].empty());
 }
 
+/// The same grid with the shaders lighting in half precision (`--precision
+/// half`): at least 1e5 points on the GPU over the two paths (5e4 each: the
+/// CPU reference and the furnace do not depend on the shaders' precision and
+/// are checked above), none of them non-finite.
+void expectFiniteInHalf(const std::string& file) {
+  SCOPED_TRACE(file);
+  CliRun r = cli({"stability", file, "--precision", "half", "--gpu-only", "--evaluations", "50000", "--json"});
+  ASSERT_TRUE(r.status == 0 || r.status == 4) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_EQ(j["gpu_precision"], "half");
+  EXPECT_GE(j["gpu_evaluations"].get<long>(), 100000) << "forward and deferred";
+  EXPECT_EQ(j["gpu_nonfinite"], 0) << j["worst"].dump(1);
+}
+
 class EveryExample : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(EveryExample, IsFiniteOnTheHardCaseGridOnTheCpuAndOnTheGpu) { expectFinite(example(GetParam())); }
+
+/// How far half precision may move what the forward pass writes (docs/stability.md, "Half precision").
+constexpr double kHalfAbs = 1e-3, kHalfRel = 5e-3;
+
+/// The forward kernel of example `name` in both precisions over the GPU tests'
+/// probe set (material_gpu_test.cc: 1,024 geometries under 4 input sets). The
+/// material function is float32 in both, so every closure field is
+/// bit-identical; the lit sums (direct light, split-sum environment, emissive
+/// through the view throughput) agree within |half - float32| <= kHalfAbs +
+/// kHalfRel |float32|. The HLSL kernel in half (its own msaturate and mlerp)
+/// meets the same rule on the first input set.
+void expectHalfAgreesWithFloat32(const std::string& name) {
+  SCOPED_TRACE(name);
+  std::string error;
+  gpu::Context* ctx = gputest::sharedContext(&error);
+  ASSERT_NE(ctx, nullptr) << error;
+  const std::string stem = fs::path(name).stem().string();
+  const CompileResult r = compile(readFile(example(name)));
+  const auto samples =
+      gpu::makeSamples(1024, 0x5eed0000u + static_cast<uint32_t>(std::hash<std::string>{}(stem) & 0xffffu));
+  const auto inputSets = gputest::makeInputSets(r.material, 4, 0x1a9u);
+  const int stride = gpu::resultStride(r);
+  double margin = 0, relMseSum = 0, maxAbs = 0;
+  long failed = 0, checked = 0;
+  std::string first;
+  auto checkLit = [&](const std::vector<float>& float32, const std::vector<float>& half, const char* what) {
+    for (std::size_t i = 0; i < samples.size(); ++i)
+      for (int at : {kernel::kResultDirect, kernel::kResultEnvironment, kernel::kResultEmissive})
+        for (int c = 0; c < 3; ++c) {
+          const float f = float32[i * stride + at + c], h = half[i * stride + at + c];
+          const double allowed = kHalfAbs + kHalfRel * std::abs(f), d = std::abs(static_cast<double>(h) - f);
+          ++checked;
+          margin = std::max(margin, d / allowed);
+          if (!(d <= allowed) && failed++ == 0)
+            first = fmt::format("{}: sample {} float {}: half {} float32 {}", what, i, at + c, h, f);
+        }
+  };
+  for (std::size_t set = 0; set < inputSets.size(); ++set) {
+    sweep::BothPrecisions both;
+    ASSERT_TRUE(sweep::runBothPrecisions(*ctx, r, Target::Glsl, samples, inputSets[set].values, &both, &error)) << error;
+    ASSERT_EQ(both.float32.size(), both.half.size());
+    const sweep::PrecisionError e = sweep::precisionError(both, stride);
+    relMseSum += e.relMse;
+    maxAbs = std::max(maxAbs, e.maxAbs);
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+      const float* f = &both.float32[i * stride];
+      const float* h = &both.half[i * stride];
+      ASSERT_EQ(0, std::memcmp(f + kernel::kResultHeaderFloats, h + kernel::kResultHeaderFloats,
+                               sizeof(float) * (stride - kernel::kResultHeaderFloats)))
+          << "input set " << set << ", sample " << i << ": the closures differ";
+      ASSERT_EQ(f[kernel::kResultCoverage], h[kernel::kResultCoverage]);
+    }
+    checkLit(both.float32, both.half, "GLSL");
+    if (set == 0) {
+      EmitOptions half;
+      half.precision = Precision::Half;
+      std::vector<float> hlsl;
+      ASSERT_TRUE(gpu::runSampleKernel(*ctx, r, Target::Hlsl, KernelMode::Forward, half, samples, inputSets[0].values,
+                                       &hlsl, &error))
+          << error;
+      checkLit(both.float32, hlsl, "HLSL");
+    }
+  }
+  std::printf("[ half     ] %s: rel_mse %.3e (mean of %zu input sets), max abs %.3e; margin %.3f of |d| <= %g + %g |f|\n",
+              stem.c_str(), relMseSum / static_cast<double>(inputSets.size()), inputSets.size(), maxAbs, margin,
+              kHalfAbs, kHalfRel);
+  EXPECT_EQ(failed, 0) << failed << " of " << checked << " lit values outside the tolerance; first: " << first;
+}
 
 std::vector<std::string> exampleNames() {
   std::vector<std::string> names;
@@ -85,6 +172,17 @@ std::vector<std::string> exampleNames() {
 
 INSTANTIATE_TEST_SUITE_P(Stability, EveryExample, ::testing::ValuesIn(exampleNames()),
                          [](const auto& info) { return fs::path(info.param).stem().string(); });
+
+// The half-precision tests loop over the examples in one test each: every
+// test is its own process under ctest, and a GPU test process costs seconds
+// before its first kernel (instance, validation layer, lavapipe).
+TEST(Stability, EveryExampleIsFiniteOnTheHardCaseGridInHalfPrecision) {
+  for (const std::string& name : exampleNames()) expectFiniteInHalf(example(name));
+}
+
+TEST(Stability, HalfPrecisionForwardAgreesWithFloat32OnEveryExample) {
+  for (const std::string& name : exampleNames()) expectHalfAgreesWithFloat32(name);
+}
 
 // Adversarial materials: every operator, every opt-in feature, the helpers
 // with their own singularities, thin and translucent surfaces, degenerate
@@ -134,29 +232,54 @@ const char* kAdversarial[] = {
         "output": "root"})",
 };
 
+/// `check` on `text` written to a temporary file (ctest may run two tests at
+/// once: `name` keeps their files apart).
+void checkFile(const std::string& name, const std::string& text, void (*check)(const std::string&)) {
+  const fs::path file = fs::temp_directory_path() / ("substratec_" + name + ".json");
+  std::ofstream(file) << text;
+  check(file.string());
+  fs::remove(file);
+}
+
 TEST(Stability, AdversarialMaterialsAreFiniteOnTheCpuAndOnTheGpu) {
   int i = 0;
-  for (const char* text : kAdversarial) {
-    const fs::path file = fs::temp_directory_path() / fmt::format("substratec_adversarial_{}.json", i++);
-    std::ofstream(file) << text;
-    expectFinite(file.string());
-    fs::remove(file);
-  }
+  for (const char* text : kAdversarial) checkFile(fmt::format("adversarial_{}", i++), text, expectFinite);
+}
+
+TEST(Stability, AdversarialMaterialsAreFiniteInHalfPrecision) {
+  int i = 0;
+  for (const char* text : kAdversarial) checkFile(fmt::format("adversarial_half_{}", i++), text, expectFiniteInHalf);
+}
+
+TEST(Stability, AWeightBeyondHalfsRangeStaysFiniteInHalfPrecision) {
+  // A coverage weight from an input (expressions are not range-checked) of
+  // 1e5 to 1e6: float16 ends at 65,504, so the view throughput converts the
+  // weight through SUBSTRATE_M_CLAMPED. Without the clamp: 16,740 of 200,880
+  // evaluations non-finite.
+  checkFile("heavy_weight_half", R"({"format": "substrate-material/1", "name": "heavy_weight",
+    "inputs": {"w": {"type": "float", "default": 100000, "min": 0, "max": 1000000}},
+    "nodes": {"s": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.5},
+              "root": {"kind": "coverage_weight", "a": "s", "weight": "$w"}},
+    "output": "root"})",
+            expectFiniteInHalf);
 }
 
 TEST(Stability, PerSampleInputKernelsValidateInBothLanguages) {
   // `stability` runs GLSL; the per-invocation inputs are emitted for HLSL too
   // (static globals, a StructuredBuffer at binding 8): both must validate.
+  // In half precision too (HLSL with glslang's 16-bit types).
   EmitOptions emit;
   emit.inputsPerInvocation = true;
   for (const std::string& name : exampleNames()) {
     SCOPED_TRACE(name);
     const CompileResult r = compile(readFile(example(name)));
-    for (Target target : {Target::Glsl, Target::Hlsl})
-      for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred}) {
-        const ShaderValidation v = compileKernel(r, target, mode, emit);
-        EXPECT_TRUE(v.ok) << v.log;
-      }
+    for (Precision precision : {Precision::Float, Precision::Half})
+      for (Target target : {Target::Glsl, Target::Hlsl})
+        for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred}) {
+          emit.precision = precision;
+          const ShaderValidation v = compileKernel(r, target, mode, emit);
+          EXPECT_TRUE(v.ok) << precisionName(precision) << "\n" << v.log;
+        }
   }
 }
 

@@ -4,7 +4,9 @@
 // tables from their uniform buffer or inlined (SUBSTRATE_LUT_INLINE). The
 // shader is a deferred lighting pass: unpack a pixel's closures from its words
 // (substrate_unpack.h), light them (substrate_lighting.h) and add the split-sum
-// environment, so every public entry of the library is reached.
+// environment, so every public entry of the library is reached. Each also in
+// half precision (SUBSTRATE_PRECISION_HALF: float16 colours, weights and
+// throughputs; HLSL with glslang's 16-bit types).
 #include <gtest/gtest.h>
 
 #include <map>
@@ -94,12 +96,13 @@ struct Config {
   int diffuseModel;
   bool features;
   bool inlineLut;
+  bool half = false;
 };
 
 std::string describe(const Config& c) {
   return std::string(c.language == ShaderLanguage::Glsl ? "GLSL" : "HLSL") + ", diffuse model " +
          std::to_string(c.diffuseModel) + ", features " + (c.features ? "on" : "off") + ", tables " +
-         (c.inlineLut ? "inline" : "in a uniform buffer");
+         (c.inlineLut ? "inline" : "in a uniform buffer") + (c.half ? ", half precision" : "");
 }
 
 ShaderValidation compileLighting(const Config& c) {
@@ -111,18 +114,21 @@ ShaderValidation compileLighting(const Config& c) {
   src.defines.push_back({"SUBSTRATE_DIFFUSE_MODEL", std::to_string(c.diffuseModel)});
   for (const char* use : kUseSwitches) src.defines.push_back({use, c.features ? "1" : "0"});
   if (c.inlineLut) src.defines.push_back({"SUBSTRATE_LUT_INLINE", "1"});
+  if (c.half) src.defines.push_back({"SUBSTRATE_PRECISION_HALF", "1"});
+  src.hlsl16BitTypes = c.half;
   return compileAndValidate(src);
 }
 
 TEST(RuntimeShaders, EveryConfigurationCompilesAndValidates) {
   for (ShaderLanguage language : {ShaderLanguage::Glsl, ShaderLanguage::Hlsl})
     for (int model = 0; model < 4; ++model)
-      for (bool features : {false, true}) {
-        Config c{language, model, features, false};
-        SCOPED_TRACE(describe(c));
-        ShaderValidation v = compileLighting(c);
-        EXPECT_TRUE(v.ok) << v.log;
-      }
+      for (bool features : {false, true})
+        for (bool half : {false, true}) {
+          Config c{language, model, features, false, half};
+          SCOPED_TRACE(describe(c));
+          ShaderValidation v = compileLighting(c);
+          EXPECT_TRUE(v.ok) << v.log;
+        }
 }
 
 TEST(RuntimeShaders, InlineTablesCompileAndValidate) {
@@ -139,6 +145,31 @@ std::size_t countOpcode(const std::vector<uint32_t>& w, uint32_t op) {
   std::size_t n = 0;
   for (std::size_t i = 5; i < w.size() && (w[i] >> 16) != 0; i += w[i] >> 16) n += (w[i] & 0xffffu) == op;
   return n;
+}
+
+/// Whether the module declares a 16-bit float type (OpTypeFloat 16).
+bool hasFloat16Type(const std::vector<uint32_t>& w) {
+  constexpr uint32_t kOpTypeFloat = 22;
+  for (std::size_t i = 5; i < w.size() && (w[i] >> 16) != 0; i += w[i] >> 16)
+    if ((w[i] & 0xffffu) == kOpTypeFloat && w[i + 2] == 16) return true;
+  return false;
+}
+
+TEST(RuntimeShaders, HalfPrecisionComputesInFloat16AndFloatDoesNot) {
+  // SUBSTRATE_PRECISION_HALF turns the medium types into float16 in both
+  // languages (HLSL: only with 16-bit types; without them `half` is 32-bit and
+  // the module has no Float16); the float build declares no 16-bit float.
+  constexpr uint32_t kOpCapability = 17, kOpFConvert = 115;
+  for (ShaderLanguage language : {ShaderLanguage::Glsl, ShaderLanguage::Hlsl}) {
+    Config half{language, 2, true, false, true}, full{language, 2, true, false, false};
+    SCOPED_TRACE(describe(half));
+    ShaderValidation h = compileLighting(half), f = compileLighting(full);
+    ASSERT_TRUE(h.ok && f.ok) << h.log << f.log;
+    EXPECT_TRUE(hasFloat16Type(h.spirv));
+    EXPECT_GT(countOpcode(h.spirv, kOpFConvert), countOpcode(f.spirv, kOpFConvert));
+    EXPECT_EQ(countOpcode(h.spirv, kOpCapability), countOpcode(f.spirv, kOpCapability) + 1) << "Float16";
+    EXPECT_FALSE(hasFloat16Type(f.spirv));
+  }
 }
 
 TEST(RuntimeShaders, TablesInAUniformBufferAreNotConstants) {
