@@ -93,7 +93,21 @@ std::string MaterialWriter::text() const {
   doc["name"] = name_;
   if (!description_.empty()) doc["description"] = description_;
   if (!settings_.empty()) doc["settings"] = settings_;
-  if (!inputs_.empty()) doc["inputs"] = inputs_;
+  // Inputs no node reads are left out (a parameter the mapping did not need
+  // would still cost a uniform).
+  std::set<std::string> read;
+  std::vector<const Json*> stack = {&nodes_};
+  while (!stack.empty()) {
+    const Json* j = stack.back();
+    stack.pop_back();
+    if (j->is_string() && j->get_ref<const std::string&>().rfind('$', 0) == 0) read.insert(j->get<std::string>().substr(1));
+    if (j->is_structured())
+      for (const auto& c : *j) stack.push_back(&c);
+  }
+  Json inputs = Json::object();
+  for (const auto& [name, body] : inputs_.items())
+    if (read.count(name)) inputs[name] = body;
+  if (!inputs.empty()) doc["inputs"] = inputs;
   doc["nodes"] = nodes_;
   doc["output"] = output_;
   return doc.dump(2) + "\n";

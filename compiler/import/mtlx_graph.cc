@@ -398,16 +398,20 @@ MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind
   if (uv.is_null()) uv = Value();  // uv0
   auto uvOr0 = [&]() { return uv.is_null() ? geometry("uv0") : uv; };
   if (kind == "tiledimage" || kind == "hextiledimage") {
-    const Value tiling = in(kind == "tiledimage" ? "uvtiling" : "tiling", "vector2", {1, 1});
-    Value t = mul(uvOr0(), tiling);
+    // uv = (texcoord · uvtiling − uvoffset) / realworldimagesize · realworldtilesize (identities skipped).
+    auto apply = [](Value x, const Value& by, double identity, Value (*op)(const Value&, const Value&)) {
+      return isLiteral(by, identity) ? x : op(x, by);
+    };
+    Value t = apply(uvOr0(), in(kind == "tiledimage" ? "uvtiling" : "tiling", "vector2", {1, 1}), 1, mul);
     if (kind == "tiledimage") {
-      t = sub(t, in("uvoffset", "vector2", {0, 0}));
-      t = mul(divide(t, in("realworldimagesize", "vector2", {1, 1})), in("realworldtilesize", "vector2", {1, 1}));
+      t = apply(t, in("uvoffset", "vector2", {0, 0}), 0, sub);
+      t = apply(t, in("realworldimagesize", "vector2", {1, 1}), 1, divide);
+      t = apply(t, in("realworldtilesize", "vector2", {1, 1}), 1, mul);
     } else {
       warn(node, "hexagonal tiling (random rotation, scale and offset per tile, blended) is not represented: "
                  "sampled as a plain tiled image");
     }
-    uv = t;
+    uv = t == geometry("uv0") ? Value() : t;
   } else if (kind == "gltf_image" || kind == "gltf_colorimage" || kind == "gltf_normalmap") {
     const Value scale = in("scale", "vector2", {1, 1}), offset = in("offset", "vector2", {0, 0});
     const double rotate = literalOf(in("rotate", "float", {0})).value_or(std::vector<double>{0})[0];

@@ -61,7 +61,7 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   const Value tint = namedValue(w, "specular_tint", mul(specularWeight, P("specular_color", "color3", {1, 1, 1})));
   const Value ior = P("specular_ior", "float", {1.5});
   if (!isLiteral(tint, 1) || !isLiteral(ior, 1.5)) {
-    s.specularF0 = mul(iorToF0Value(ior), tint);
+    s.specularF0 = isLiteral(tint, 1) ? iorToF0Value(ior) : mul(iorToF0Value(ior), tint);
     if (!isLiteral(tint, 1)) s.specularF90 = tint;
   }
   if (!off(s.metallic, 0) && !isLiteral(tint, 1)) s.metalF90 = tint;

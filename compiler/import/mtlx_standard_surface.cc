@@ -65,7 +65,7 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
   const Value tint = namedValue(w, "specular_tint", mul(specular, specularColor));
   const Value ior = P("specular_IOR", "float", {1.5});
   if (!isLiteral(tint, 1) || !isLiteral(ior, 1.5)) {
-    s.specularF0 = mul(iorToF0Value(ior), tint);
+    s.specularF0 = isLiteral(tint, 1) ? iorToF0Value(ior) : mul(iorToF0Value(ior), tint);
     if (!isLiteral(tint, 1)) s.specularF90 = tint;
   }
   if (!off(metalness, 0) && !isLiteral(tint, 1)) s.metalF90 = tint;
