@@ -12,6 +12,7 @@ namespace substratec::reference {
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kMinAlpha = 1e-3;
 
 double dot(const Rgb& a, const Rgb& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 Rgb normalized(const Rgb& a) {
@@ -103,7 +104,9 @@ Rgb gltfReflectance(const GltfMaterial& m, const Rgb& V, const Rgb& L) {
   if (NoV <= 0 || NoL <= 0 || m.unlit) return {0, 0, 0};
   const Rgb H = normalized({V[0] + L[0], V[1] + L[1], V[2] + L[2]});
   const double NoH = H[2], VoH = std::fabs(dot(V, H));
-  const double alpha = m.roughness * m.roughness;
+  // alpha = roughness², kept >= 1e-3 (Substrate's GGX floor): at 0 the
+  // specification's lobe is a delta, with no value to compare at a probe.
+  const double alpha = std::max(m.roughness * m.roughness, kMinAlpha);
 
   // specular_brdf: V·D, isotropic or along the rotated tangent.
   double vd;
@@ -137,7 +140,7 @@ Rgb gltfReflectance(const GltfMaterial& m, const Rgb& V, const Rgb& L) {
   }
   // Clearcoat on top: fresnel_coat(N, 1.5, clearcoat, base, layer) = mix(base, layer, clearcoat · Fc(NoV)).
   if (m.clearcoat > 0) {
-    const double ac = m.clearcoatRoughness * m.clearcoatRoughness;
+    const double ac = std::max(m.clearcoatRoughness * m.clearcoatRoughness, kMinAlpha);
     const double layer = ggxD(ac, NoH) * smithV(ac, NoV, NoL);
     const double w = m.clearcoat * schlick(0.04, NoV);
     for (int k = 0; k < 3; ++k) f[k] = f[k] * (1 - w) + layer * w;
