@@ -44,6 +44,17 @@ int compileFailure(const import::MaterialSource& s, std::ostream& err) {
   return kExitInternal;
 }
 
+/// Writes `files` into `dir` (all or none) and prints their paths.
+int writeOutputs(const std::string& dir, const std::vector<OutputFile>& files, std::ostream& out, std::ostream& err) {
+  std::string error = writeFilesAtomically(dir, files);
+  if (!error.empty()) {
+    err << "substratec: error: " << error << "\n";
+    return kExitBadInput;
+  }
+  for (const auto& f : files) out << (std::filesystem::path(dir) / f.name).string() << "\n";
+  return kExitOk;
+}
+
 struct ReportArgs {
   std::vector<std::string> files;
   std::string material;
@@ -173,14 +184,7 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
     err << "substratec: internal compiler error: generated code does not validate\n" << gen.failure << "\n";
     return kExitInternal;
   }
-  const std::vector<OutputFile>& files = gen.files;
-  std::string error = writeFilesAtomically(a.outDir, files);
-  if (!error.empty()) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
-  }
-  for (const auto& f : files) out << (std::filesystem::path(a.outDir) / f.name).string() << "\n";
-  return kExitOk;
+  return writeOutputs(a.outDir, gen.files, out, err);
 }
 
 struct PreviewArgs {
@@ -439,13 +443,7 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     }
     files.push_back({m.name + ".json", m.text});
   }
-  std::string error = writeFilesAtomically(a.outDir, files);
-  if (!error.empty()) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
-  }
-  for (const auto& f : files) out << (std::filesystem::path(a.outDir) / f.name).string() << "\n";
-  return kExitOk;
+  return writeOutputs(a.outDir, files, out, err);
 }
 
 }  // namespace

@@ -348,8 +348,7 @@ bool MaterialReader::read(GltfPbr& g) {
         if (const Value t = sample(ext, "transmissionTexture", xp, false); !t.is_null())
           g.transmission = times(g.transmission, outputOf(t, "r"));
         if (!isLiteral(g.transmission, 0))
-          warn(xp, name + ": refraction and the blur of rough transmission are not represented; the background is "
-                          "seen through the slab's transmittance (blend mode translucent_colored)");
+          warn(xp, name + ": " + kTransmissionNote);
       } else if (name == "KHR_materials_volume") {
         g.thickness = scalar(ext, "thicknessFactor", xp, 0, 0, kBig, Kind::Plain, name + ".thicknessFactor (metres)");
         if (const Value t = sample(ext, "thicknessTexture", xp, false); !t.is_null()) g.thickness = times(g.thickness, outputOf(t, "g"));

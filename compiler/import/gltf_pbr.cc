@@ -9,6 +9,18 @@ namespace {
 
 bool off(const Value& v, double neutral) { return v.is_null() || isLiteral(v, neutral); }
 
+/// KHR_materials_anisotropy's lobe: alpha_t = mix(alpha, 1, strength²) along
+/// the direction, alpha_b = alpha, as the slab's (roughness, anisotropy).
+RoughnessAnisotropy anisotropic(MaterialWriter& w, const std::string& prefix, const Value& roughness,
+                                const Value& strength) {
+  const Value r = namedValue(w, prefix + "roughness", roughness);
+  const Value alpha = namedValue(w, prefix + "alpha", mul(r, r));
+  const Value alphaT = namedValue(w, prefix + "alpha_t", vlerp(alpha, 1.0, mul(strength, strength)));
+  RoughnessAnisotropy ra = fromAlphas(alphaT, alpha);
+  ra.roughness = namedValue(w, prefix + "anisotropic_roughness", ra.roughness);
+  return ra;
+}
+
 }  // namespace
 
 LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
@@ -49,12 +61,8 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
 
   // Anisotropy: alpha_t = mix(alpha, 1, strength²) along the direction, alpha_b = alpha.
   if (!off(g.anisotropyStrength, 0)) {
-    const Value roughness = namedValue(w, "roughness", s.roughness);
-    const Value alpha = namedValue(w, "alpha", mul(roughness, roughness));
-    const Value strength = g.anisotropyStrength;
-    const Value alphaT = namedValue(w, "alpha_t", vlerp(alpha, 1.0, mul(strength, strength)));
-    const RoughnessAnisotropy ra = fromAlphas(alphaT, alpha);
-    s.roughness = namedValue(w, "anisotropic_roughness", ra.roughness);
+    const RoughnessAnisotropy ra = anisotropic(w, "", s.roughness, g.anisotropyStrength);
+    s.roughness = ra.roughness;
     s.anisotropy = ra.anisotropy;
     if (g.anisotropyDirection.is_null()) {
       s.tangent = rotatedTangent(g.anisotropyRotation);
@@ -136,12 +144,8 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
     s.coatNormal = g.coatNormal;
     if (!off(g.coatColor, 1)) s.coatTransmittance = vsqrt(g.coatColor);
     if (!off(g.coatAnisotropyStrength, 0)) {
-      const Value roughness = namedValue(w, "coat_roughness", s.coatRoughness);
-      const Value alpha = namedValue(w, "coat_alpha", mul(roughness, roughness));
-      const Value strength = g.coatAnisotropyStrength;
-      const Value alphaT = namedValue(w, "coat_alpha_t", vlerp(alpha, 1.0, mul(strength, strength)));
-      const RoughnessAnisotropy ra = fromAlphas(alphaT, alpha);
-      s.coatRoughness = namedValue(w, "coat_anisotropic_roughness", ra.roughness);
+      const RoughnessAnisotropy ra = anisotropic(w, "coat_", s.coatRoughness, g.coatAnisotropyStrength);
+      s.coatRoughness = ra.roughness;
       s.coatAnisotropy = ra.anisotropy;
       s.coatTangent = rotatedTangent(g.coatAnisotropyRotation);
     }

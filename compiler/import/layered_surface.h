@@ -27,6 +27,11 @@ namespace substratec::import {
 
 enum class AlphaMode { Opaque, Mask, Blend };
 
+/// What every importer says of a transmitting material (a warning).
+inline constexpr const char* kTransmissionNote =
+    "refraction and the blur of rough transmission are not represented; the background is seen through the "
+    "slab's transmittance (blend mode translucent_colored)";
+
 struct LayeredSurface {
   // Base.
   Value baseColor;      // color: the dielectric's diffuse colour and the metal's F0 (required)

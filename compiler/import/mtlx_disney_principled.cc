@@ -50,8 +50,7 @@ LayeredSurface disneyPrincipled(pugi::xml_node n, MtlxValues& v, MaterialWriter&
     s.transmittance = baseColor;
     const Value ior = P("ior", "float", {1.5});
     if (!isLiteral(ior, 1.5) && s.specularF0.is_null()) s.specularF0 = iorToF0Value(ior);
-    v.warn(n, "specTrans: refraction is not represented; the background is seen through the slab's transmittance "
-              "(blend mode translucent_colored)");
+    v.warn(n, std::string("specTrans: ") + kTransmissionNote);
   }
   const Value subsurface = P("subsurface", "float", {0}, ParamKind::Switch);
   if (!isLiteral(subsurface, 0)) s.sssMfp = mul(P("subsurfaceDistance", "color3", {1, 1, 1}), subsurface);

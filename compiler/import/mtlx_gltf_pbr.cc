@@ -30,8 +30,7 @@ LayeredSurface mtlxGltfPbr(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
   g.specularColor = P("specular_color", "color3", {1, 1, 1});
   g.transmission = P("transmission", "float", {0}, ParamKind::Switch);
   if (!isLiteral(g.transmission, 0))
-    v.warn(n, "transmission: refraction and the blur of rough transmission are not represented; the background is "
-              "seen through the slab's transmittance (blend mode translucent_colored)");
+    v.warn(n, std::string("transmission: ") + kTransmissionNote);
   g.thickness = P("thickness", "float", {0});
   g.attenuationDistance = C("attenuation_distance", "float", {0})[0];
   if (g.attenuationDistance >= 1e30) g.attenuationDistance = 0;

@@ -19,6 +19,23 @@ RoughnessAnisotropy mtlxRoughnessAnisotropy(const Value& roughness, const Value&
   return fromAlphas(at, ab);
 }
 
+void mtlxTransmission(pugi::xml_node n, MtlxValues& v, const Value& weight, const char* dispersion,
+                      LayeredSurface& s) {
+  auto C = [&](const char* name, const char* type, std::vector<double> def) {
+    return v.constant(n, name, type, def).value_or(def);
+  };
+  s.transmission = weight;
+  s.transmittance = v.param(n, "transmission_color", "color3", {1, 1, 1});
+  v.warn(n, std::string("transmission: ") + kTransmissionNote);
+  if (C("transmission_depth", "float", {0})[0] > 0)
+    v.warn(n, "transmission_depth: a surface material does not know the object's thickness; transmission_color "
+              "is applied once, as if the light crossed one depth");
+  const auto scatter = C("transmission_scatter", "color3", {0, 0, 0});
+  if (scatter[0] != 0 || scatter[1] != 0 || scatter[2] != 0)
+    v.warn(n, "transmission_scatter: volume scattering inside the transmitting medium is not represented");
+  if (C(dispersion, "float", {0})[0] != 0) v.warn(n, std::string(dispersion) + ": one IOR for every colour; dispersion ignored");
+}
+
 namespace {
 
 using SurfaceFn = LayeredSurface (*)(pugi::xml_node, MtlxValues&, MaterialWriter&);

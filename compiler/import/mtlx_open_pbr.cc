@@ -104,20 +104,7 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   if (!off(luminance, 0)) s.emissive = mul(luminance, P("emission_color", "color3", {1, 1, 1}));
 
   const Value transmission = P("transmission_weight", "float", {0}, ParamKind::Switch);
-  if (!off(transmission, 0)) {
-    s.transmission = transmission;
-    s.transmittance = P("transmission_color", "color3", {1, 1, 1});
-    v.warn(n, "transmission: refraction and the blur of rough transmission are not represented; the background is "
-              "seen through the slab's transmittance (blend mode translucent_colored)");
-    if (C("transmission_depth", "float", {0})[0] > 0)
-      v.warn(n, "transmission_depth: a surface material does not know the object's thickness; transmission_color "
-                "is applied once, as if the light crossed one depth");
-    const auto scatter = C("transmission_scatter", "color3", {0, 0, 0});
-    if (scatter[0] != 0 || scatter[1] != 0 || scatter[2] != 0)
-      v.warn(n, "transmission_scatter: volume scattering inside the transmitting medium is not represented");
-    if (C("transmission_dispersion_scale", "float", {0})[0] != 0)
-      v.warn(n, "transmission_dispersion_scale: one IOR for every colour; dispersion ignored");
-  }
+  if (!off(transmission, 0)) mtlxTransmission(n, v, transmission, "transmission_dispersion_scale", s);
 
   if (!off(coat, 0)) {
     s.coatWeight = coat;

@@ -23,6 +23,13 @@ LayeredSurface disneyPrincipled(pugi::xml_node shader, MtlxValues& v, MaterialWr
 // Shared by the units: MaterialX's roughness_anisotropy (Standard Surface):
 // a = max(r², ε), aspect = sqrt(1 − min(A, 0.98)), at = min(a / aspect, 1),
 // ab = a · aspect, as the slab's (roughness, anisotropy).
+/// Transmission of Standard Surface and OpenPBR (`weight` not 0): the
+/// transmitting dielectric tinted by transmission_color, and a warning for
+/// each of what is not represented (refraction; transmission_depth, whose
+/// tint is applied once; scatter; the model's dispersion input `dispersion`).
+void mtlxTransmission(pugi::xml_node shader, MtlxValues& v, const Value& weight, const char* dispersion,
+                      LayeredSurface& s);
+
 RoughnessAnisotropy mtlxRoughnessAnisotropy(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
                                             const std::string& prefix);
 
