@@ -162,7 +162,12 @@ std::string MaterialReader::imageDescription(int texture, const std::string& ptr
         out += " (" + name + ")";
       }
   const Json images = doc_.value("images", Json::array());
-  if (source >= 0 && images.is_array() && source < static_cast<int>(images.size()) && images[source].is_object()) {
+  if (source < 0 || !images.is_array() || source >= static_cast<int>(images.size()) || !images[source].is_object()) {
+    error(fmt::format("/textures/{}/source", texture),
+          fmt::format("expected the index of one of the document's {} images", images.is_array() ? images.size() : 0));
+    return out;
+  }
+  {
     const Json& img = images[source];
     std::string label;
     if (img.contains("uri") && img["uri"].is_string()) {

@@ -75,7 +75,7 @@ bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName,
       const std::string name = std::filesystem::path(href).filename().string();
       if (std::find(loading_.begin(), loading_.end(), path.lexically_normal().string()) != loading_.end() ||
           name == fileName) {
-        fail(fmt::format("xi:include '{}' includes itself", href));
+        fail(fmt::format("xi:include '{}': a file that is already being read (a cycle of includes)", href));
         continue;
       }
       Diagnostics readDiags(href);

@@ -11,7 +11,8 @@ namespace substratec::import {
 
 namespace {
 
-constexpr int kMaxDepth = 256;
+constexpr int kMaxNodes = 256;            // nodes along one chain of connections
+constexpr int kMaxDepth = 2 * kMaxNodes;  // each node is two calls deep (its input, then itself)
 constexpr double kPi = 3.14159265358979323846;
 
 double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
@@ -141,14 +142,13 @@ std::optional<MtlxValues::Binding> MtlxValues::implementation(pugi::xml_node ins
   return std::nullopt;
 }
 
-Value MtlxValues::valueInput(pugi::xml_node owner, const std::string& name, const std::string& type,
-                             const std::vector<double>& v, const std::string& what) {
+Value MtlxValues::valueInput(const std::string& name, const std::string& type, const std::vector<double>& v,
+                             const std::string& what) {
   const Value lit = mtlxLiteral(v, type, "");
   if (type == "float") return w_.floatInput(name, literalOf(lit)->at(0), std::nullopt, std::nullopt, what);
   if (type == "color3") return w_.colorInput(name, *literalOf(lit), what);
   if (type == "vector2") return w_.vec2Input(name, literalOf(lit)->at(0), literalOf(lit)->at(1), what);
   if (type == "vector3") return w_.vec3Input(name, *literalOf(lit), what);
-  (void)owner;
   return lit;  // integer, boolean, 4-vectors: static
 }
 
@@ -163,7 +163,7 @@ Value MtlxValues::interfaceInput(pugi::xml_node graphInput, const std::string& n
   }
   std::vector<double> c = *v;
   if (isColor(type) && str(graphInput, "colorspace") == "srgb_texture") c = *literalOf(mtlxLiteral(c, type, "srgb_texture"));
-  Value r = valueInput(graphInput, name, type, c,
+  Value r = valueInput(name, type, c,
                        fmt::format("{}", doc_.describe(graphInput)));
   interface_[key] = r;
   return r;
@@ -173,7 +173,7 @@ MtlxValues::Typed MtlxValues::connection(pugi::xml_node input, const std::string
                                          bool* connected) {
   *connected = true;
   if (depth > kMaxDepth) {
-    error(input, fmt::format("the graph is deeper than {} nodes", kMaxDepth));
+    error(input, fmt::format("the graph is deeper than {} nodes", kMaxNodes));
     return {Value(), type};
   }
   const std::string output = str(input, "output");
@@ -218,7 +218,7 @@ MtlxValues::Typed MtlxValues::connection(pugi::xml_node input, const std::string
         if (frozen && instIn) ++frozenReads_;
         if (!v) error(input, fmt::format("interface input '{}' has no value", iname));
         else r = {frozen || !instIn ? mtlxLiteral(*v, type, str(src, "colorspace"))
-                                    : valueInput(instIn, iname, type, *v, doc_.describe(instIn)),
+                                    : valueInput(iname, type, *v, doc_.describe(instIn)),
                   type};
       }
       bindings_.push_back(b);
@@ -296,7 +296,7 @@ Value MtlxValues::param(pugi::xml_node shader, const std::string& name, const st
   }
   const Value lit = mtlxLiteral(*v, type, str(in, "colorspace"));
   if (kind == ParamKind::Switch && (isLiteral(lit, 0) || isLiteral(lit, 1))) return lit;
-  return valueInput(in, name, type, *literalOf(lit), fmt::format("{} input {}", str(shader, "name"), name));
+  return valueInput(name, type, *literalOf(lit), fmt::format("{} input {}", str(shader, "name"), name));
 }
 
 std::optional<std::vector<double>> MtlxValues::constant(pugi::xml_node shader, const std::string& name,
@@ -307,7 +307,7 @@ std::optional<std::vector<double>> MtlxValues::constant(pugi::xml_node shader, c
 
 MtlxValues::Typed MtlxValues::nodeValue(pugi::xml_node node, const std::string& output, bool frozen, int depth) {
   if (depth > kMaxDepth) {
-    error(node, fmt::format("the graph is deeper than {} nodes", kMaxDepth));
+    error(node, fmt::format("the graph is deeper than {} nodes", kMaxNodes));
     return {Value(), str(node, "type")};
   }
   const std::string binding = bindings_.empty() ? "" : std::to_string(bindings_.back().instance.hash_value());

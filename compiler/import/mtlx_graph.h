@@ -86,8 +86,8 @@ class MtlxValues {
   Value textureOf(pugi::xml_node node, const std::string& file, bool srgb);
   Value sampleOf(const Value& texture, const Value& uv);
   Value interfaceInput(pugi::xml_node graphInput, const std::string& name, const std::string& type);
-  Value valueInput(pugi::xml_node owner, const std::string& name, const std::string& type,
-                   const std::vector<double>& v, const std::string& what);
+  Value valueInput(const std::string& name, const std::string& type, const std::vector<double>& v,
+                   const std::string& what);
 
   const MtlxDocument& doc_;
   MaterialWriter& w_;

@@ -4,6 +4,9 @@
 // reference evaluates from the imported material at its inputs' defaults.
 #include <cmath>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 #include <string>
 #include <vector>
 
@@ -403,4 +406,38 @@ TEST(MaterialXImport, AMissingIncludeIsAnErrorAtTheInclude) {
   Imported r = mtlx("  <xi:include href=\"nowhere.mtlx\" />\n");
   EXPECT_FALSE(r.materials);
   EXPECT_NE(r.diags.find("t.mtlx:3:4: error: xi:include 'nowhere.mtlx':"), std::string::npos) << r.diags;
+}
+
+TEST(MaterialXImport, DeepGraphsAndIncludeCyclesAreErrorsNotCrashes) {
+  std::string graph = "  <nodegraph name=\"NG\">\n";
+  for (int i = 0; i < 2000; ++i)
+    graph += "    <multiply name=\"m" + std::to_string(i) + "\" type=\"float\"><input name=\"in1\" type=\"float\" " +
+             (i + 1 < 2000 ? "nodename=\"m" + std::to_string(i + 1) + "\"" : std::string("value=\"1\"")) + " /></multiply>\n";
+  graph += "    <output name=\"out\" type=\"float\" nodename=\"m0\" />\n  </nodegraph>\n";
+  Imported deep = mtlx(graph + R"(  <standard_surface name="SR" type="surfaceshader">
+    <input name="specular_roughness" type="float" nodegraph="NG" output="out" />
+  </standard_surface>
+  <surfacematerial name="M" type="material"><input name="surfaceshader" type="surfaceshader" nodename="SR" /></surfacematerial>
+)");
+  EXPECT_FALSE(deep.materials);
+  EXPECT_NE(deep.diags.find("the graph is deeper than 256 nodes"), std::string::npos) << deep.diags.substr(0, 400);
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("substratec_include_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const char* head = "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
+  std::ofstream(dir / "a.mtlx") << head << "  <xi:include href=\"b.mtlx\" />\n</materialx>\n";
+  std::ofstream(dir / "b.mtlx") << head << "  <xi:include href=\"a.mtlx\" />\n</materialx>\n";
+  Diagnostics d("a.mtlx");
+  auto r = importFile((dir / "a.mtlx").string(), ReadLimits{}, d);
+  EXPECT_FALSE(r);
+  EXPECT_NE(d.formatAll().find("a.mtlx:3:4: error: xi:include 'b.mtlx': a file that is already being read (a cycle of includes)"),
+            std::string::npos) << d.formatAll();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GltfImport, ATextureWithoutAnImageIsAnError) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])", R"(, "textures": [{"source": 2}], "images": [])");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("t.gltf: /textures/0/source: error: expected the index of one of the document's 0 images"),
+            std::string::npos) << r.diags;
 }
