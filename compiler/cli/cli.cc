@@ -17,6 +17,7 @@
 #include "preview/render.h"
 #include "stability/stability.h"
 #include "sweep/sweep.h"
+#include "import/import.h"
 
 #include <filesystem>
 
@@ -24,8 +25,40 @@ namespace substratec {
 
 namespace {
 
+/// The one material `file` holds (a substrate-material/1 file, or the
+/// --material of an importable one), diagnostics printed; nullopt on error.
+std::optional<import::MaterialSource> loadMaterial(const std::string& file, const std::string& material,
+                                                   const ReadLimits& read, std::ostream& err) {
+  Diagnostics diags(file);
+  auto sources = import::loadMaterialSources(file, material, false, read, diags);
+  err << diags.formatAll();
+  if (!sources) return std::nullopt;
+  return std::move(sources->front());
+}
+
+/// The exit status of a material that does not compile: the user's input, or
+/// (for an imported one) the importer's bug.
+int compileFailure(const import::MaterialSource& s, std::ostream& err) {
+  if (!s.imported) return kExitBadInput;
+  err << "substratec: internal compiler error: the material imported from " << s.displayName
+      << " does not compile\n";
+  return kExitInternal;
+}
+
+/// Writes `files` into `dir` (all or none) and prints their paths.
+int writeOutputs(const std::string& dir, const std::vector<OutputFile>& files, std::ostream& out, std::ostream& err) {
+  std::string error = writeFilesAtomically(dir, files);
+  if (!error.empty()) {
+    err << "substratec: error: " << error << "\n";
+    return kExitBadInput;
+  }
+  for (const auto& f : files) out << (std::filesystem::path(dir) / f.name).string() << "\n";
+  return kExitOk;
+}
+
 struct ReportArgs {
   std::vector<std::string> files;
+  std::string material;
   int budget = 0;
   int maxClosures = 0;
   bool fullSimplification = false;
@@ -51,12 +84,21 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
   int status = kExitOk;
   nlohmann::ordered_json all = nlohmann::ordered_json::array();
   bool first = true;
+  std::vector<import::MaterialSource> sources;
   for (const auto& file : a.files) {
     Diagnostics diags(file);
-    auto result = compileFile(file, optionsFrom(a), diags);
+    auto loaded = import::loadMaterialSources(file, a.material, true, optionsFrom(a).read, diags);
+    err << diags.formatAll();
+    if (!loaded) status = kExitBadInput;
+    else for (auto& s : *loaded) sources.push_back(std::move(s));
+  }
+  for (const auto& source : sources) {
+    const std::string& file = source.displayName;
+    Diagnostics diags(file);
+    auto result = compileText(file, source.text, optionsFrom(a), diags);
     err << diags.formatAll();
     if (!result) {
-      status = kExitBadInput;
+      status = std::max(status, compileFailure(source, err));
       continue;
     }
     if (a.printAfterAll) err << result->debugLog;
@@ -93,7 +135,7 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
     }
     first = false;
   }
-  if (a.json) out << (a.files.size() == 1 && !all.empty() ? all[0] : all).dump(2) << "\n";
+  if (a.json) out << (a.files.size() == 1 && all.size() == 1 ? all[0] : all).dump(2) << "\n";
   return status;
 }
 
@@ -116,6 +158,7 @@ Precision precisionOf(const std::string& name) { return name == "half" ? Precisi
 
 struct CompileArgs {
   std::string file;
+  std::string material;
   std::string outDir;
   std::string target = "all";
   std::string diffuse = "chan2024";
@@ -128,15 +171,17 @@ struct CompileArgs {
 };
 
 int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
-  Diagnostics diags(a.file);
   CompileOptions o;
   if (a.budget > 0) o.budgetOverride = a.budget;
   if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
   o.fullSimplification = a.fullSimplification;
   o.read.maxInputBytes = a.maxInputSize;
-  auto result = compileFile(a.file, o, diags);
+  auto source = loadMaterial(a.file, a.material, o.read, err);
+  if (!source) return kExitBadInput;
+  Diagnostics diags(source->displayName);
+  auto result = compileText(source->displayName, source->text, o, diags);
   err << diags.formatAll();
-  if (!result) return kExitBadInput;
+  if (!result) return compileFailure(*source, err);
   GenerateOptions go;
   go.glsl = a.target != "hlsl";
   go.hlsl = a.target != "glsl";
@@ -151,18 +196,12 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
     err << "substratec: internal compiler error: generated code does not validate\n" << gen.failure << "\n";
     return kExitInternal;
   }
-  const std::vector<OutputFile>& files = gen.files;
-  std::string error = writeFilesAtomically(a.outDir, files);
-  if (!error.empty()) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
-  }
-  for (const auto& f : files) out << (std::filesystem::path(a.outDir) / f.name).string() << "\n";
-  return kExitOk;
+  return writeOutputs(a.outDir, gen.files, out, err);
 }
 
 struct PreviewArgs {
   std::string file;
+  std::string material;
   std::string output;
   int budget = 0;
   int maxClosures = 0;
@@ -185,29 +224,22 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
   o.fullSimplification = a.fullSimplification;
   o.read.maxInputBytes = a.maxInputSize;
-  std::string text;
-  {
-    Diagnostics diags(a.file);
-    auto read = readSourceFile(a.file, o.read, diags);
-    if (!read) {
-      err << diags.formatAll();
-      return kExitBadInput;
-    }
-    text = std::move(*read);
-  }
+  auto source = loadMaterial(a.file, a.material, o.read, err);
+  if (!source) return kExitBadInput;
+  const std::string& text = source->text;
   std::vector<sweep::Step> entries;
   std::string error;
   if (a.sweep) {
     CompileResult full;
-    if (!sweep::simplificationSteps(a.file, text, o, &entries, &full, &error)) {
+    if (!sweep::simplificationSteps(source->displayName, text, o, &entries, &full, &error)) {
       err << error;
-      return kExitBadInput;
+      return compileFailure(*source, err);
     }
   } else {
-    Diagnostics diags(a.file);
-    auto r = compileText(a.file, text, o, diags);
+    Diagnostics diags(source->displayName);
+    auto r = compileText(source->displayName, text, o, diags);
     err << diags.formatAll();
-    if (!r) return kExitBadInput;
+    if (!r) return compileFailure(*source, err);
     entries.push_back({std::move(*r), "", 0});
   }
   gpu::Context::Options go;
@@ -252,6 +284,7 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
 
 struct SweepArgs {
   std::string file;
+  std::string material;
   bool json = false;
   bool csv = false;
   std::string plot;
@@ -271,22 +304,14 @@ struct SweepArgs {
 int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   CompileOptions o;
   o.read.maxInputBytes = a.maxInputSize;
-  std::string text;
-  {
-    Diagnostics diags(a.file);
-    auto read = readSourceFile(a.file, o.read, diags);
-    if (!read) {
-      err << diags.formatAll();
-      return kExitBadInput;
-    }
-    text = std::move(*read);
-  }
+  auto source = loadMaterial(a.file, a.material, o.read, err);
+  if (!source) return kExitBadInput;
   std::vector<sweep::Step> steps;
   CompileResult full;
   std::string error;
-  if (!sweep::simplificationSteps(a.file, text, o, &steps, &full, &error)) {
+  if (!sweep::simplificationSteps(source->displayName, source->text, o, &steps, &full, &error)) {
     err << error;
-    return kExitBadInput;
+    return compileFailure(*source, err);
   }
   auto ctx = gpu::Context::create(gpu::Context::Options{}, &error);
   if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
@@ -334,6 +359,7 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
 
 struct StabilityArgs {
   std::string file;
+  std::string material;
   bool json = false;
   long evaluations = 100000;
   bool noGpu = false;
@@ -353,21 +379,14 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   o.budgetOverride = a.budget;
   o.maxClosuresOverride = a.maxClosures;
   o.fullSimplification = a.fullSimplification;
-  std::string text;
-  {
-    Diagnostics diags(a.file);
-    auto read = readSourceFile(a.file, o.read, diags);
-    if (!read) {
-      err << diags.formatAll();
-      return kExitBadInput;
-    }
-    text = std::move(*read);
-  }
+  auto source = loadMaterial(a.file, a.material, o.read, err);
+  if (!source) return kExitBadInput;
+  const std::string& text = source->text;
   {  // The material as written: its diagnostics name its own lines.
-    Diagnostics diags(a.file);
-    if (!compileText(a.file, text, o, diags)) {
+    Diagnostics diags(source->displayName);
+    if (!compileText(source->displayName, text, o, diags)) {
       err << diags.formatAll();
-      return kExitBadInput;
+      return compileFailure(*source, err);
     }
   }
   std::string forceable, error;
@@ -407,6 +426,46 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
+struct ImportArgs {
+  std::string file;
+  std::string outDir;
+  std::string material;
+  std::size_t maxInputSize = 16u << 20;
+};
+
+/// `import`: every material of a glTF / MaterialX file (or the --material one)
+/// as substrate-material/1 files in the output directory, all or none; each is
+/// compiled first, so what is written is known to compile.
+int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
+  ReadLimits read;
+  read.maxInputBytes = a.maxInputSize;
+  if (import::sourceKindOf(a.file) == import::SourceKind::Substrate) {
+    err << "substratec: error: " << a.file
+        << ": import reads .gltf, .glb, .materials.json and .mtlx files (this is a substrate-material/1 file)\n";
+    return kExitBadInput;
+  }
+  Diagnostics diags(a.file);
+  auto materials = import::importFile(a.file, read, diags);
+  if (materials && !a.material.empty()) {
+    const import::ImportedMaterial* m = import::pickMaterial(*materials, a.material, diags);
+    if (m) materials = std::vector<import::ImportedMaterial>{*m};
+    else materials.reset();
+  }
+  err << diags.formatAll();
+  if (!materials) return kExitBadInput;
+  std::vector<OutputFile> files;
+  for (const auto& m : *materials) {
+    const import::MaterialSource source{a.file + "[" + m.name + "]", m.text, true};
+    Diagnostics compileDiags(source.displayName);
+    if (!compileText(source.displayName, m.text, CompileOptions{}, compileDiags)) {
+      err << compileDiags.formatAll();
+      return compileFailure(source, err);
+    }
+    files.push_back({m.name + ".json", m.text});
+  }
+  return writeOutputs(a.outDir, files, out, err);
+}
+
 }  // namespace
 
 int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
@@ -418,7 +477,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   ReportArgs report;
   CLI::App* rep = app.add_subcommand("report", "Print the tree, features, byte budget and layout of materials");
-  rep->add_option("files", report.files, "Material files (substrate-material/1 JSON)")->required();
+  rep->add_option("files", report.files, "Material files (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx: every material)")->required();
+  rep->add_option("--material", report.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   rep->add_option("--budget", report.budget, "Bytes per pixel budget (overrides settings.bytes_per_pixel)")
       ->check(CLI::Range(8, 1024));
   rep->add_option("--max-closures", report.maxClosures, "Closure budget (overrides settings.max_closures)")
@@ -435,7 +495,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   CompileArgs compile;
   CLI::App* comp = app.add_subcommand("compile", "Generate flattened GLSL/HLSL, the packing layout and entry shaders");
-  comp->add_option("file", compile.file, "Material file (substrate-material/1 JSON)")->required();
+  comp->add_option("file", compile.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
+  comp->add_option("--material", compile.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   comp->add_option("-o,--output", compile.outDir, "Output directory")->required();
   comp->add_option("--target", compile.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}));
   comp->add_option("--diffuse", compile.diffuse, "Diffuse model")
@@ -451,7 +512,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   PreviewArgs prev;
   CLI::App* pre = app.add_subcommand("preview", "Render the material on a sphere (Vulkan, Mesa lavapipe) into a PNG");
-  pre->add_option("file", prev.file, "Material file (substrate-material/1 JSON)")->required();
+  pre->add_option("file", prev.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
+  pre->add_option("--material", prev.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   pre->add_option("-o,--output", prev.output, "PNG file to write")->required();
   pre->add_option("--budget", prev.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
   pre->add_option("--max-closures", prev.maxClosures, "Closure budget")->check(CLI::Range(1, 8));
@@ -471,7 +533,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   SweepArgs sw;
   CLI::App* swp = app.add_subcommand("sweep", "Cost against error at the full budget and at each simplification step");
-  swp->add_option("file", sw.file, "Material file (substrate-material/1 JSON)")->required();
+  swp->add_option("file", sw.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
+  swp->add_option("--material", sw.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   swp->add_flag("--json", sw.json, "Print {\"material\": ..., \"rows\": [...]}");
   swp->add_flag("--csv", sw.csv, "Print the rows as CSV");
   swp->add_option("--plot", sw.plot, "Also write an SVG plot of error against cost");
@@ -493,7 +556,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   StabilityArgs stab;
   CLI::App* sta = app.add_subcommand("stability", "Hard cases: non-finite values on the CPU and on lavapipe, white furnace");
-  sta->add_option("file", stab.file, "Material file (substrate-material/1 JSON)")->required();
+  sta->add_option("file", stab.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
+  sta->add_option("--material", stab.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   sta->add_flag("--json", stab.json, "Print the counts and the worst cases as JSON");
   sta->add_option("--evaluations", stab.evaluations, "Shading points to evaluate at least (each path)")
       ->check(CLI::Range(1L, 100000000L));
@@ -506,6 +570,15 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   sta->add_option("--max-input-size", stab.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
   addPrecisionOption(sta, stab.precision);
+
+  ImportArgs imp;
+  CLI::App* impc = app.add_subcommand("import", "Import glTF 2.0 (.gltf, .glb, .materials.json) or MaterialX (.mtlx) "
+                                                 "materials as substrate-material/1 files (docs/import.md)");
+  impc->add_option("file", imp.file, "A .gltf, .glb, .materials.json or .mtlx file")->required();
+  impc->add_option("-o,--output", imp.outDir, "Output directory (one <material>.json per material)")->required();
+  impc->add_option("--material", imp.material, "Import only this material (by name)");
+  impc->add_option("--max-input-size", imp.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
 
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
@@ -531,6 +604,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (pre->parsed()) return runPreview(prev, out, err);
     if (swp->parsed()) return runSweep(sw, out, err);
     if (sta->parsed()) return runStability(stab, out, err);
+    if (impc->parsed()) return runImport(imp, out, err);
   } catch (const std::exception& e) {
     err << "substratec: internal compiler error: " << e.what() << "\n";
     return kExitInternal;

@@ -52,6 +52,16 @@ void Diagnostics::error(std::string pointer, std::string message) {
   push(std::move(d));
 }
 
+void Diagnostics::warningAt(int line, int column, std::string message) {
+  Diagnostic d;
+  d.severity = Severity::Warning;
+  d.file = file_;
+  d.line = line;
+  d.column = column;
+  d.message = std::move(message);
+  push(std::move(d));
+}
+
 void Diagnostics::warning(std::string pointer, std::string message) {
   Diagnostic d;
   d.severity = Severity::Warning;

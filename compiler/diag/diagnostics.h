@@ -32,6 +32,7 @@ class Diagnostics {
   void errorAt(int line, int column, std::string message);
   void error(std::string pointer, std::string message);
   void warning(std::string pointer, std::string message);
+  void warningAt(int line, int column, std::string message);
 
   bool hasErrors() const { return errorCount_ > 0; }
   std::size_t errorCount() const { return errorCount_; }

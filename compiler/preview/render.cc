@@ -89,6 +89,14 @@ std::vector<float> previewTexture(int size) {
   return t;
 }
 
+gpu::ComputePipeline* PipelineCache::get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, std::string* error) {
+  auto it = pipelines_.find(spirv);
+  if (it != pipelines_.end()) return it->second.get();
+  auto pipeline = gpu.createPipeline(spirv, error);
+  if (!pipeline) return nullptr;
+  return pipelines_.emplace(spirv, std::move(pipeline)).first->second.get();
+}
+
 bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions& o, Image* out, std::string* error) {
   EmitOptions emit;
   emit.diffuseModel = o.diffuseModel;
@@ -99,7 +107,14 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
     *error = "internal compiler error: the preview kernel does not validate\n" + v.log;
     return false;
   }
-  auto pipeline = ctx.createPipeline(v.spirv, error);
+  std::unique_ptr<gpu::ComputePipeline> own;
+  gpu::ComputePipeline* pipeline = nullptr;
+  if (o.pipelines) {
+    pipeline = o.pipelines->get(ctx, v.spirv, error);
+  } else {
+    own = ctx.createPipeline(v.spirv, error);
+    pipeline = own.get();
+  }
   if (!pipeline) return false;
   const EnvironmentMaps& maps = environmentMaps(o.environment);
 

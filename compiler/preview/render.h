@@ -4,6 +4,7 @@
 // preview/cubemap.h), tone-mapped and written as an 8-bit sRGB PNG; and the
 // contact sheet of a material at each step of its simplification.
 #pragma once
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -16,6 +17,18 @@
 
 namespace substratec::preview {
 
+/// Preview pipelines by their SPIR-V, so that rendering many materials in one
+/// context builds each distinct kernel once (materials that differ only in
+/// their inputs' values, compiled under one name, share a kernel).
+class PipelineCache {
+ public:
+  /// The pipeline of `spirv`, built on first use. Null with `*error` on failure.
+  gpu::ComputePipeline* get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, std::string* error);
+
+ private:
+  std::map<std::vector<uint32_t>, std::unique_ptr<gpu::ComputePipeline>> pipelines_;
+};
+
 struct RenderOptions {
   int size = 256;                            // pixels, square
   std::string environment = "studio";        // preview/environment.h
@@ -23,6 +36,7 @@ struct RenderOptions {
   int diffuseModel = 2;                      // SUBSTRATE_DIFFUSE_MODEL
   Precision precision = Precision::Float;    // of the runtime's lighting (needs shaderFloat16 for Half)
   double exposure = 0;                       // stops, for the tone map
+  PipelineCache* pipelines = nullptr;        // reuse pipelines across calls (null: build one per call)
 };
 
 /// Renders `r` (linear HDR, background = the environment). False with `*error`

@@ -1,0 +1,484 @@
+#include "import/gltf_import.h"
+
+#include <cmath>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "import/gltf_pbr.h"
+
+namespace substratec::import {
+
+namespace {
+
+constexpr int kRepeat = 10497;
+
+std::string wrapName(int mode) {
+  switch (mode) {
+    case 10497: return "REPEAT";
+    case 33071: return "CLAMP_TO_EDGE";
+    case 33648: return "MIRRORED_REPEAT";
+  }
+  return std::to_string(mode);
+}
+
+/// How a factor becomes a value: always an input when given (Plain), or a
+/// literal at the values that switch its feature off or fully on (Switch:
+/// 0 and 1 for a weight; the neutral colour for a colour), so the compiler can
+/// cull what the switch turns off.
+enum class Kind { Plain, Switch };
+
+/// factor · texture channel, without the product when the factor is the literal 1 or 0.
+Value times(const Value& factor, const Value& texture) {
+  if (isLiteral(factor, 1)) return texture;
+  if (isLiteral(factor, 0) && literalOf(factor)->size() == 1) return 0.0;
+  return mul(factor, texture);
+}
+
+/// Reads one material into GltfPbr, writing its inputs and value nodes.
+class MaterialReader {
+ public:
+  MaterialReader(const Json& doc, const Json& material, std::string pointer, std::string label, Diagnostics& d,
+                 MaterialWriter& w)
+      : doc_(doc), m_(material), ptr_(std::move(pointer)), label_(std::move(label)), d_(d), w_(w) {}
+
+  bool read(GltfPbr& g);
+
+ private:
+  void warn(const std::string& pointer, const std::string& what) {
+    d_.warning(pointer, fmt::format("material {}: {}", label_, what));
+  }
+  void error(const std::string& pointer, const std::string& what) {
+    d_.error(pointer, what);
+    ok_ = false;
+  }
+
+  const Json* object(const Json& parent, const char* key, const std::string& ptr);
+  std::optional<double> number(const Json& parent, const char* key, const std::string& ptr, double lo, double hi);
+  std::optional<std::vector<double>> numbers(const Json& parent, const char* key, const std::string& ptr,
+                                             std::size_t n, double lo, double hi);
+  Value scalar(const Json& parent, const char* key, const std::string& ptr, double def, double lo, double hi,
+               Kind kind, const std::string& what);
+  Value color(const Json& parent, const char* key, const std::string& ptr, std::vector<double> def, double neutral,
+              Kind kind, const std::string& what, double hi = 1);
+  /// The sample node of the textureInfo `parent[key]` (null when absent).
+  Value sample(const Json& parent, const char* key, const std::string& ptr, bool srgb);
+  /// A tangent-space normal from a normal textureInfo (its `scale` an input).
+  Value normalFrom(const Json& parent, const char* key, const std::string& ptr);
+  Value uvOf(const Json& info, const std::string& ptr);
+  std::string imageDescription(int texture, const std::string& ptr);
+
+  const Json& doc_;
+  const Json& m_;
+  std::string ptr_, label_;
+  Diagnostics& d_;
+  MaterialWriter& w_;
+  bool ok_ = true;
+  std::map<std::pair<int, bool>, Value> inputs_;  // (texture index, sRGB) -> "$input"
+  std::map<std::string, Value> samples_;          // input + uv -> sample node
+};
+
+const Json* MaterialReader::object(const Json& parent, const char* key, const std::string& ptr) {
+  auto it = parent.find(key);
+  if (it == parent.end()) return nullptr;
+  if (!it->is_object()) {
+    error(ptr + "/" + key, "expected an object");
+    return nullptr;
+  }
+  return &*it;
+}
+
+std::optional<double> MaterialReader::number(const Json& parent, const char* key, const std::string& ptr, double lo,
+                                             double hi) {
+  auto it = parent.find(key);
+  if (it == parent.end()) return std::nullopt;
+  const std::string p = ptr + "/" + key;
+  if (!it->is_number()) {
+    error(p, "expected a number");
+    return std::nullopt;
+  }
+  double v = it->get<double>();
+  if (v < lo || v > hi) {
+    const double c = std::clamp(v, lo, hi);
+    warn(p, fmt::format("{} is {}, outside [{}, {}]: clamped to {}", key, v, lo, hi, c));
+    v = c;
+  }
+  return v;
+}
+
+std::optional<std::vector<double>> MaterialReader::numbers(const Json& parent, const char* key,
+                                                           const std::string& ptr, std::size_t n, double lo,
+                                                           double hi) {
+  auto it = parent.find(key);
+  if (it == parent.end()) return std::nullopt;
+  const std::string p = ptr + "/" + key;
+  if (!it->is_array() || it->size() != n) {
+    error(p, fmt::format("expected an array of {} numbers", n));
+    return std::nullopt;
+  }
+  std::vector<double> v;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(*it)[i].is_number()) {
+      error(p + "/" + std::to_string(i), "expected a number");
+      return std::nullopt;
+    }
+    double x = (*it)[i].get<double>();
+    if (x < lo || x > hi) {
+      const double c = std::clamp(x, lo, hi);
+      warn(p + "/" + std::to_string(i), fmt::format("{}[{}] is {}, outside [{}, {}]: clamped to {}", key, i, x, lo, hi, c));
+      x = c;
+    }
+    v.push_back(x);
+  }
+  return v;
+}
+
+Value MaterialReader::scalar(const Json& parent, const char* key, const std::string& ptr, double def, double lo,
+                             double hi, Kind kind, const std::string& what) {
+  const auto v = number(parent, key, ptr, lo, hi);
+  if (!v) return def;
+  if (kind == Kind::Switch && (*v == 0 || *v == 1)) return *v;
+  return w_.floatInput(key, *v, lo, hi >= 1e300 ? std::optional<double>() : std::optional<double>(hi), what);
+}
+
+Value MaterialReader::color(const Json& parent, const char* key, const std::string& ptr, std::vector<double> def,
+                            double neutral, Kind kind, const std::string& what, double hi) {
+  const auto v = numbers(parent, key, ptr, 3, 0, hi);
+  if (!v) return literal(def);
+  if (kind == Kind::Switch && std::all_of(v->begin(), v->end(), [neutral](double x) { return x == neutral; }))
+    return literal(*v);
+  return w_.colorInput(key, *v, what);
+}
+
+std::string MaterialReader::imageDescription(int texture, const std::string& ptr) {
+  const Json& t = doc_["textures"][texture];
+  std::string out = fmt::format("textures[{}]", texture);
+  int source = -1;
+  if (auto s = t.find("source"); s != t.end() && s->is_number_integer()) source = s->get<int>();
+  if (auto e = t.find("extensions"); e != t.end() && e->is_object())
+    for (const auto& [name, ext] : e->items())
+      if (ext.is_object() && ext.contains("source") && ext["source"].is_number_integer()) {
+        source = ext["source"].get<int>();
+        out += " (" + name + ")";
+      }
+  const Json images = doc_.value("images", Json::array());
+  if (source < 0 || !images.is_array() || source >= static_cast<int>(images.size()) || !images[source].is_object()) {
+    error(fmt::format("/textures/{}/source", texture),
+          fmt::format("expected the index of one of the document's {} images", images.is_array() ? images.size() : 0));
+    return out;
+  }
+  {
+    const Json& img = images[source];
+    std::string label;
+    if (img.contains("uri") && img["uri"].is_string()) {
+      std::string uri = img["uri"].get<std::string>();
+      if (uri.rfind("data:", 0) == 0 || uri == "<embedded>") label = "embedded";
+      else label = uri.substr(uri.find_last_of('/') == std::string::npos ? 0 : uri.find_last_of('/') + 1);
+    } else if (img.contains("name") && img["name"].is_string()) {
+      label = img["name"].get<std::string>();
+    } else {
+      label = "bufferView";
+    }
+    out += fmt::format(", images[{}] '{}'", source, label);
+  }
+  if (auto s = t.find("sampler"); s != t.end() && s->is_number_integer()) {
+    const Json samplers = doc_.value("samplers", Json::array());
+    const int si = s->get<int>();
+    if (samplers.is_array() && si >= 0 && si < static_cast<int>(samplers.size()) && samplers[si].is_object()) {
+      const int ws = samplers[si].value("wrapS", kRepeat), wt = samplers[si].value("wrapT", kRepeat);
+      if (ws != kRepeat || wt != kRepeat) {
+        warn(ptr, fmt::format("textures[{}] samples with wrap {}/{}: a material does not choose its sampler "
+                              "(the renderer binds one); recorded in the input's description",
+                              texture, wrapName(ws), wrapName(wt)));
+        out += fmt::format(", wrap {}/{}", wrapName(ws), wrapName(wt));
+      }
+    }
+  }
+  return out;
+}
+
+Value MaterialReader::uvOf(const Json& info, const std::string& ptr) {
+  int set = 0;
+  if (auto v = number(info, "texCoord", ptr, 0, 1e9)) set = static_cast<int>(*v);
+  const Json* ext = info.contains("extensions") && info["extensions"].is_object() ? &info["extensions"] : nullptr;
+  const Json* tt = nullptr;
+  if (ext) tt = object(*ext, "KHR_texture_transform", ptr + "/extensions");
+  const std::string tptr = ptr + "/extensions/KHR_texture_transform";
+  if (tt)
+    if (auto v = number(*tt, "texCoord", tptr, 0, 1e9)) set = static_cast<int>(*v);
+  if (set > 1) {
+    warn(ptr, fmt::format("texCoord {} : a material reads uv0 and uv1 only; uv1 is used", set));
+    set = 1;
+  }
+  Value uv = set == 0 ? Value() : geometry("uv1");
+  if (!tt) return uv;
+  const auto offset = numbers(*tt, "offset", tptr, 2, -1e30, 1e30).value_or(std::vector<double>{0, 0});
+  const auto scale = numbers(*tt, "scale", tptr, 2, -1e30, 1e30).value_or(std::vector<double>{1, 1});
+  const double rotation = number(*tt, "rotation", tptr, -1e30, 1e30).value_or(0);
+  const Value base = uv.is_null() ? geometry("uv0") : uv;
+  if (rotation == 0) {
+    // uv' = uv · scale + offset
+    return add(mul(base, literal(scale)), literal(offset));
+  }
+  // uv' = T · R · S · uv with R = [cos sin; −sin cos] (KHR_texture_transform).
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  const Value u = Json{{"kind", "dot"}, {"a", base}, {"b", literal({c * scale[0], s * scale[1]})}};
+  const Value v = Json{{"kind", "dot"}, {"a", base}, {"b", literal({-s * scale[0], c * scale[1]})}};
+  return combine({add(u, offset[0]), add(v, offset[1])});
+}
+
+Value MaterialReader::sample(const Json& parent, const char* key, const std::string& parentPtr, bool srgb) {
+  const std::string ptr = parentPtr + "/" + key;
+  const Json* info = object(parent, key, parentPtr);
+  if (!info) return Value();
+  const auto idx = info->find("index");
+  const int count = doc_.contains("textures") && doc_["textures"].is_array() ? static_cast<int>(doc_["textures"].size()) : 0;
+  if (idx == info->end() || !idx->is_number_integer() || idx->get<long long>() < 0 || idx->get<long long>() >= count) {
+    error(ptr + "/index", fmt::format("expected the index of one of the document's {} textures", count));
+    return Value();
+  }
+  const int texture = idx->get<int>();
+  if (!doc_["textures"][texture].is_object()) {
+    error(fmt::format("/textures/{}", texture), "expected an object");
+    return Value();
+  }
+  Value& input = inputs_[{texture, srgb}];
+  if (input.is_null()) input = w_.textureInput(key, srgb, imageDescription(texture, ptr));
+  const Value uv = uvOf(*info, ptr);
+  Value& node = samples_[input.get<std::string>() + "|" + uv.dump()];
+  if (node.is_null()) node = w_.node(input.get<std::string>().substr(1) + "_sample", textureSample(input, uv));
+  return node;
+}
+
+Value MaterialReader::normalFrom(const Json& parent, const char* key, const std::string& ptr) {
+  const Value tex = sample(parent, key, ptr, false);
+  if (tex.is_null()) return Value();
+  // n = vnormalize((2·rgb − 1) · (scale, scale, 1))
+  Value n = sub(mul(outputOf(tex, "rgb"), 2.0), 1.0);
+  const Json& info = parent[key];
+  const std::string what = fmt::format("{}.scale: the normal map's strength", key);
+  const std::string name = std::string(key) + "_scale";
+  if (auto s = number(info, "scale", ptr + "/" + key, -1e30, 1e30); s && *s != 1) {
+    const Value scale = w_.floatInput(name, *s, std::nullopt, std::nullopt, what);
+    n = mul(n, combine({scale, scale, 1.0}));
+  }
+  return vnormalize(n);
+}
+
+bool MaterialReader::read(GltfPbr& g) {
+  static const double kBig = 1e30;
+  const Json empty = Json::object();
+  const Json* pbr = object(m_, "pbrMetallicRoughness", ptr_);
+  const std::string pp = ptr_ + "/pbrMetallicRoughness";
+  const Json& p = pbr ? *pbr : empty;
+
+  std::string alphaMode = "OPAQUE";
+  if (auto a = m_.find("alphaMode"); a != m_.end()) {
+    if (!a->is_string() || (*a != "OPAQUE" && *a != "MASK" && *a != "BLEND"))
+      error(ptr_ + "/alphaMode", "expected \"OPAQUE\", \"MASK\" or \"BLEND\"");
+    else alphaMode = a->get<std::string>();
+  }
+  g.alphaMode = alphaMode == "MASK" ? AlphaMode::Mask : alphaMode == "BLEND" ? AlphaMode::Blend : AlphaMode::Opaque;
+  g.alphaCutoff = number(m_, "alphaCutoff", ptr_, 0, kBig).value_or(0.5);
+  if (g.alphaMode != AlphaMode::Mask && m_.contains("alphaCutoff"))
+    warn(ptr_ + "/alphaCutoff", "alphaCutoff applies to alphaMode MASK only; ignored");
+
+  // Base colour and alpha.
+  const auto bc = numbers(p, "baseColorFactor", pp, 4, 0, 1);
+  Value baseFactor = literal3(1, 1, 1), alphaFactor = 1.0;
+  if (bc) {
+    baseFactor = w_.colorInput("baseColorFactor", {(*bc)[0], (*bc)[1], (*bc)[2]}, "pbrMetallicRoughness.baseColorFactor (rgb)");
+    if (g.alphaMode != AlphaMode::Opaque)
+      alphaFactor = w_.floatInput("baseColorFactor_alpha", (*bc)[3], 0.0, 1.0, "pbrMetallicRoughness.baseColorFactor (alpha)");
+  }
+  const Value baseTex = sample(p, "baseColorTexture", pp, true);
+  g.baseColor = baseTex.is_null() ? baseFactor : times(baseFactor, outputOf(baseTex, "rgb"));
+  g.alpha = baseTex.is_null() ? alphaFactor : times(alphaFactor, outputOf(baseTex, "a"));
+  if (g.alphaMode == AlphaMode::Opaque) g.alpha = Value();
+
+  g.metallic = scalar(p, "metallicFactor", pp, 1, 0, 1, Kind::Switch, "pbrMetallicRoughness.metallicFactor");
+  g.roughness = scalar(p, "roughnessFactor", pp, 1, 0, 1, Kind::Plain, "pbrMetallicRoughness.roughnessFactor");
+  if (const Value mr = sample(p, "metallicRoughnessTexture", pp, false); !mr.is_null()) {
+    g.metallic = times(g.metallic, outputOf(mr, "b"));
+    g.roughness = times(g.roughness, outputOf(mr, "g"));
+  }
+  g.normal = normalFrom(m_, "normalTexture", ptr_);
+  if (m_.contains("occlusionTexture"))
+    warn(ptr_ + "/occlusionTexture", "occlusionTexture: ambient occlusion is the renderer's (a Substrate material "
+                                     "has no occlusion pin); ignored");
+
+  Value emissive = color(m_, "emissiveFactor", ptr_, {0, 0, 0}, 0, Kind::Switch, "emissiveFactor", kBig);
+  const Value emissiveTex = sample(m_, "emissiveTexture", ptr_, true);
+  if (!isLiteral(emissive, 0) && !emissiveTex.is_null()) {
+    emissive = times(emissive, outputOf(emissiveTex, "rgb"));
+  }
+
+  const Json* exts = object(m_, "extensions", ptr_);
+  const std::string ep = ptr_ + "/extensions";
+  if (exts) {
+    for (const auto& [name, ext] : exts->items()) {
+      const std::string xp = ep + "/" + pointerToken(name);
+      if (!ext.is_object()) {
+        error(xp, "expected an object");
+        continue;
+      }
+      if (name == "KHR_materials_emissive_strength") {
+        const Value strength = scalar(ext, "emissiveStrength", xp, 1, 0, kBig, Kind::Plain, name + ".emissiveStrength");
+        if (!isLiteral(emissive, 0)) emissive = mul(emissive, strength);
+      } else if (name == "KHR_materials_ior") {
+        g.ior = scalar(ext, "ior", xp, 1.5, 0, kBig, Kind::Plain, name + ".ior: index of refraction of the dielectric");
+        if (g.ior.is_number() && g.ior.get<double>() == 1.5 && !ext.contains("ior")) g.ior = Value();
+      } else if (name == "KHR_materials_specular") {
+        g.specular = scalar(ext, "specularFactor", xp, 1, 0, 1, Kind::Switch, name + ".specularFactor");
+        if (const Value t = sample(ext, "specularTexture", xp, false); !t.is_null()) g.specular = times(g.specular, outputOf(t, "a"));
+        g.specularColor = color(ext, "specularColorFactor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".specularColorFactor", kBig);
+        if (const Value t = sample(ext, "specularColorTexture", xp, true); !t.is_null())
+          g.specularColor = times(g.specularColor, outputOf(t, "rgb"));
+      } else if (name == "KHR_materials_clearcoat") {
+        g.clearcoat = scalar(ext, "clearcoatFactor", xp, 0, 0, 1, Kind::Switch, name + ".clearcoatFactor");
+        if (const Value t = sample(ext, "clearcoatTexture", xp, false); !t.is_null()) g.clearcoat = times(g.clearcoat, outputOf(t, "r"));
+        g.clearcoatRoughness = scalar(ext, "clearcoatRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".clearcoatRoughnessFactor");
+        if (const Value t = sample(ext, "clearcoatRoughnessTexture", xp, false); !t.is_null())
+          g.clearcoatRoughness = times(g.clearcoatRoughness, outputOf(t, "g"));
+        g.clearcoatNormal = normalFrom(ext, "clearcoatNormalTexture", xp);
+      } else if (name == "KHR_materials_sheen") {
+        g.sheenColor = color(ext, "sheenColorFactor", xp, {0, 0, 0}, 0, Kind::Switch, name + ".sheenColorFactor");
+        if (const Value t = sample(ext, "sheenColorTexture", xp, true); !t.is_null())
+          g.sheenColor = times(g.sheenColor, outputOf(t, "rgb"));
+        g.sheenRoughness = scalar(ext, "sheenRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".sheenRoughnessFactor");
+        if (const Value t = sample(ext, "sheenRoughnessTexture", xp, false); !t.is_null())
+          g.sheenRoughness = times(g.sheenRoughness, outputOf(t, "a"));
+      } else if (name == "KHR_materials_transmission") {
+        g.transmission = scalar(ext, "transmissionFactor", xp, 0, 0, 1, Kind::Switch, name + ".transmissionFactor");
+        if (const Value t = sample(ext, "transmissionTexture", xp, false); !t.is_null())
+          g.transmission = times(g.transmission, outputOf(t, "r"));
+        if (!isLiteral(g.transmission, 0))
+          warn(xp, name + ": " + kTransmissionNote);
+      } else if (name == "KHR_materials_volume") {
+        g.thickness = scalar(ext, "thicknessFactor", xp, 0, 0, kBig, Kind::Plain, name + ".thicknessFactor (metres)");
+        if (const Value t = sample(ext, "thicknessTexture", xp, false); !t.is_null()) g.thickness = times(g.thickness, outputOf(t, "g"));
+        g.attenuationDistance = number(ext, "attenuationDistance", xp, 0, kBig).value_or(0);
+        g.attenuationColor = color(ext, "attenuationColor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".attenuationColor");
+      } else if (name == "KHR_materials_iridescence") {
+        g.iridescence = scalar(ext, "iridescenceFactor", xp, 0, 0, 1, Kind::Switch, name + ".iridescenceFactor");
+        if (const Value t = sample(ext, "iridescenceTexture", xp, false); !t.is_null()) g.iridescence = times(g.iridescence, outputOf(t, "r"));
+        g.iridescenceIor = scalar(ext, "iridescenceIor", xp, 1.3, 1, 5, Kind::Plain, name + ".iridescenceIor");
+        const Value hi = scalar(ext, "iridescenceThicknessMaximum", xp, 400, 0, kBig, Kind::Plain,
+                                name + ".iridescenceThicknessMaximum (nanometres)");
+        if (const Value t = sample(ext, "iridescenceThicknessTexture", xp, false); !t.is_null()) {
+          const Value lo = scalar(ext, "iridescenceThicknessMinimum", xp, 100, 0, kBig, Kind::Plain,
+                                  name + ".iridescenceThicknessMinimum (nanometres)");
+          g.iridescenceThickness = vlerp(lo, hi, outputOf(t, "g"));
+        } else {
+          g.iridescenceThickness = hi;
+        }
+      } else if (name == "KHR_materials_anisotropy") {
+        g.anisotropyStrength = scalar(ext, "anisotropyStrength", xp, 0, 0, 1, Kind::Switch, name + ".anisotropyStrength");
+        g.anisotropyRotation = number(ext, "anisotropyRotation", xp, -kBig, kBig).value_or(0);
+        if (const Value t = sample(ext, "anisotropyTexture", xp, false); !t.is_null()) {
+          g.anisotropyStrength = times(g.anisotropyStrength, outputOf(t, "b"));
+          g.anisotropyDirection = sub(mul(swizzle(outputOf(t, "rgb"), "xy"), 2.0), 1.0);
+        }
+      } else if (name == "KHR_materials_dispersion") {
+        if (number(ext, "dispersion", xp, 0, kBig).value_or(0) > 0)
+          warn(xp, name + ": dispersion (an IOR per wavelength) is not represented; one IOR for every colour");
+      } else if (name == "KHR_materials_diffuse_transmission") {
+        g.diffuseTransmission = scalar(ext, "diffuseTransmissionFactor", xp, 0, 0, 1, Kind::Switch, name + ".diffuseTransmissionFactor");
+        if (const Value t = sample(ext, "diffuseTransmissionTexture", xp, false); !t.is_null())
+          g.diffuseTransmission = times(g.diffuseTransmission, outputOf(t, "a"));
+        g.diffuseTransmissionColor = color(ext, "diffuseTransmissionColorFactor", xp, {1, 1, 1}, 1, Kind::Switch,
+                                           name + ".diffuseTransmissionColorFactor");
+        if (const Value t = sample(ext, "diffuseTransmissionColorTexture", xp, true); !t.is_null())
+          g.diffuseTransmissionColor =
+              times(g.diffuseTransmissionColor, outputOf(t, "rgb"));
+        if (!isLiteral(g.diffuseTransmission, 0))
+          warn(xp, name + ": light diffusely transmitted through a thin surface is approximated by wrap lighting "
+                          "(sss_type wrap, light reaching past the horizon)");
+      } else if (name == "KHR_materials_unlit") {
+        g.unlit = true;
+      } else if (name == "KHR_materials_coat") {
+        g.coat = scalar(ext, "coatFactor", xp, 0, 0, 1, Kind::Switch, name + ".coatFactor");
+        if (const Value t = sample(ext, "coatTexture", xp, false); !t.is_null()) g.coat = times(g.coat, outputOf(t, "r"));
+        g.coatRoughness = scalar(ext, "coatRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".coatRoughnessFactor");
+        if (const Value t = sample(ext, "coatRoughnessTexture", xp, false); !t.is_null()) g.coatRoughness = times(g.coatRoughness, outputOf(t, "g"));
+        g.coatIor = scalar(ext, "coatIor", xp, 1.5, 0, kBig, Kind::Plain, name + ".coatIor");
+        g.coatColor = color(ext, "coatColorFactor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".coatColorFactor");
+        if (const Value t = sample(ext, "coatColorTexture", xp, true); !t.is_null())
+          g.coatColor = times(g.coatColor, outputOf(t, "rgb"));
+        g.coatNormal = normalFrom(ext, "coatNormalTexture", xp);
+        g.coatAnisotropyStrength = scalar(ext, "coatAnisotropyStrength", xp, 0, 0, 1, Kind::Switch, name + ".coatAnisotropyStrength");
+        g.coatAnisotropyRotation = number(ext, "coatAnisotropyRotation", xp, -kBig, kBig).value_or(0);
+        if (ext.contains("coatAnisotropyTexture"))
+          warn(xp + "/coatAnisotropyTexture", name + ": a textured coat anisotropy direction is not imported; the "
+                                                     "factors alone are used");
+        if (number(ext, "coatDarkeningFactor", xp, 0, 1).value_or(1) > 0 && !isLiteral(g.coat, 0))
+          warn(xp, name + ": coat darkening (light trapped under the coat by internal reflection) is not modelled; "
+                          "the base is seen through the coat's transmittance only");
+      } else if (name == "KHR_materials_fuzz") {
+        g.fuzz = scalar(ext, "fuzzFactor", xp, 0, 0, 1, Kind::Switch, name + ".fuzzFactor");
+        if (const Value t = sample(ext, "fuzzTexture", xp, false); !t.is_null()) g.fuzz = times(g.fuzz, outputOf(t, "r"));
+        g.fuzzColor = color(ext, "fuzzColorFactor", xp, {1, 1, 1}, 1, Kind::Plain, name + ".fuzzColorFactor");
+        if (const Value t = sample(ext, "fuzzColorTexture", xp, true); !t.is_null()) g.fuzzColor = times(g.fuzzColor, outputOf(t, "rgb"));
+        g.fuzzRoughness = scalar(ext, "fuzzRoughnessFactor", xp, 0.5, 0, 1, Kind::Plain, name + ".fuzzRoughnessFactor");
+        if (const Value t = sample(ext, "fuzzRoughnessTexture", xp, false); !t.is_null()) g.fuzzRoughness = times(g.fuzzRoughness, outputOf(t, "a"));
+      } else if (name == "KHR_materials_diffuse_roughness") {
+        if (number(ext, "diffuseRoughnessFactor", xp, 0, 1).value_or(0) > 0 || ext.contains("diffuseRoughnessTexture"))
+          warn(xp, name + ": a slab's diffuse roughness is its specular roughness; the diffuse roughness is ignored");
+      } else {
+        warn(xp, fmt::format("extension {} is not imported; ignored", name));
+      }
+    }
+  }
+  g.emissive = isLiteral(emissive, 0) ? Value() : emissive;
+  if (g.unlit && exts && exts->size() > 1)
+    warn(ep, "KHR_materials_unlit: the material is its base colour, unlit; its other extensions are ignored");
+  return ok_;
+}
+
+}  // namespace
+
+bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostics& diags,
+                        std::vector<ImportedMaterial>* out) {
+  if (!doc.is_object()) {
+    diags.error("", "expected a glTF document (a JSON object)");
+    return false;
+  }
+  auto mats = doc.find("materials");
+  if (mats == doc.end() || !mats->is_array()) {
+    diags.error(mats == doc.end() ? "" : "/materials", "expected a \"materials\" array");
+    return false;
+  }
+  for (const char* key : {"textures", "samplers", "images"})
+    if (doc.contains(key) && !doc[key].is_array()) {
+      diags.error(std::string("/") + key, "expected an array");
+      return false;
+    }
+  bool ok = true;
+  std::set<std::string> used;
+  for (std::size_t i = 0; i < mats->size(); ++i) {
+    const std::string ptr = "/materials/" + std::to_string(i);
+    const Json& m = (*mats)[i];
+    if (!m.is_object()) {
+      diags.error(ptr, "expected an object");
+      ok = false;
+      continue;
+    }
+    std::string sourceName = m.contains("name") && m["name"].is_string() ? m["name"].get<std::string>() : "";
+    const std::string name = uniqueMaterialName(used, sourceName, "material_" + std::to_string(i));
+    const std::string label = sourceName.empty() ? fmt::format("materials[{}]", i) : quoteForDiagnostic(sourceName);
+    MaterialWriter w(name);
+    w.setDescription(fmt::format("Imported from {} materials[{}]{} (glTF 2.0 PBR).", fileName, i,
+                                 sourceName.empty() ? "" : " " + quoteForDiagnostic(sourceName)));
+    GltfPbr g;
+    MaterialReader reader(doc, m, ptr, label, diags, w);
+    if (!reader.read(g)) {
+      ok = false;
+      continue;
+    }
+    writeLayeredSurface(gltfPbrSurface(g, w), w);
+    out->push_back({sourceName, name, ptr, w.text()});
+  }
+  return ok;
+}
+
+}  // namespace substratec::import

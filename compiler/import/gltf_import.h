@@ -1,0 +1,24 @@
+// Reading glTF 2.0 materials: the `materials`, `textures`, `samplers` and
+// `images` of a glTF JSON document (a .gltf file, the JSON chunk of a .glb, or
+// a corpus `<Model>.materials.json` extract, which holds the same arrays),
+// each material turned into glTF parameters (factors as material inputs named
+// after them, textures as texture2d inputs named after their slot, sampled
+// with their texcoord set and KHR_texture_transform) and then into Substrate
+// through gltf_pbr.h. Problems are located by JSON pointer: errors for values
+// of the wrong type or out of the document, warnings (naming the material)
+// for everything the mapping cannot represent and what was done instead.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "import/material_writer.h"
+
+namespace substratec::import {
+
+/// Appends every material of `doc` to `out`. `fileName` (a file name, no
+/// directories) goes into each material's description. False on any error.
+bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostics& diags,
+                        std::vector<ImportedMaterial>* out);
+
+}  // namespace substratec::import

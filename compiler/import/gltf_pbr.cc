@@ -1,0 +1,161 @@
+#include "import/gltf_pbr.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace substratec::import {
+
+namespace {
+
+bool off(const Value& v, double neutral) { return v.is_null() || isLiteral(v, neutral); }
+
+/// KHR_materials_anisotropy's lobe: alpha_t = mix(alpha, 1, strength²) along
+/// the direction, alpha_b = alpha, as the slab's (roughness, anisotropy).
+RoughnessAnisotropy anisotropic(MaterialWriter& w, const std::string& prefix, const Value& roughness,
+                                const Value& strength) {
+  const Value r = namedValue(w, prefix + "roughness", roughness);
+  const Value alpha = namedValue(w, prefix + "alpha", mul(r, r));
+  const Value alphaT = namedValue(w, prefix + "alpha_t", vlerp(alpha, 1.0, mul(strength, strength)));
+  RoughnessAnisotropy ra = fromAlphas(alphaT, alpha);
+  ra.roughness = namedValue(w, prefix + "anisotropic_roughness", ra.roughness);
+  return ra;
+}
+
+}  // namespace
+
+LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
+  LayeredSurface s;
+  const Value baseColor = namedValue(w, "base_color", g.baseColor.is_null() ? literal3(1, 1, 1) : g.baseColor);
+  s.baseColor = baseColor;
+  s.metallic = g.metallic.is_null() ? Value(1.0) : g.metallic;
+  s.roughness = g.roughness.is_null() ? Value(1.0) : g.roughness;
+  s.normal = g.normal;
+
+  if (g.unlit) {
+    // KHR_materials_unlit: the base colour is the radiance; nothing reflects.
+    s.metallic = Value();
+    s.diffuseColor = 0.0;
+    s.specularF0 = 0.0;
+    s.specularF90 = 0.0;
+    s.roughness = 1.0;
+    s.normal = Value();
+    s.emissive = baseColor;
+    s.opacity = g.alpha;
+    s.alphaMode = g.alphaMode;
+    s.alphaCutoff = g.alphaCutoff;
+    return s;
+  }
+
+  // Dielectric Fresnel (KHR_materials_ior, KHR_materials_specular):
+  //   F0 = min(((ior − 1)/(ior + 1))² · specularColor, 1) · specular,  F90 = specular.
+  if (!g.ior.is_null() || !off(g.specular, 1) || !off(g.specularColor, 1)) {
+    Value f0 = iorToF0Value(g.ior.is_null() ? Value(1.5) : g.ior);
+    if (!off(g.specularColor, 1)) f0 = vmin(mul(f0, g.specularColor), 1.0);
+    if (!off(g.specular, 1)) {
+      const Value specular = namedValue(w, "specular", g.specular);
+      f0 = mul(f0, specular);
+      s.specularF90 = specular;
+    }
+    s.specularF0 = f0;
+  }
+
+  // Anisotropy: alpha_t = mix(alpha, 1, strength²) along the direction, alpha_b = alpha.
+  if (!off(g.anisotropyStrength, 0)) {
+    const RoughnessAnisotropy ra = anisotropic(w, "", s.roughness, g.anisotropyStrength);
+    s.roughness = ra.roughness;
+    s.anisotropy = ra.anisotropy;
+    if (g.anisotropyDirection.is_null()) {
+      s.tangent = rotatedTangent(g.anisotropyRotation);
+    } else {
+      const double c = std::cos(g.anisotropyRotation), sn = std::sin(g.anisotropyRotation);
+      const Value d = namedValue(w, "anisotropy_direction", g.anisotropyDirection);
+      const Value x = swizzle(d, "x"), y = swizzle(d, "y");
+      Value tx = x, ty = y;
+      if (g.anisotropyRotation != 0) {
+        tx = sub(mul(x, c), mul(y, sn));
+        ty = add(mul(x, sn), mul(y, c));
+      }
+      s.tangent = vnormalize(combine({tx, ty, 0.0}));
+    }
+  }
+
+  // Sheen: Charlie lobe over the base with albedo scaling
+  //   fuzz_amount = max(sheenColor), fuzz_color = sheenColor / fuzz_amount.
+  if (!off(g.sheenColor, 0)) {
+    if (auto c = literalOf(g.sheenColor)) {
+      const double m = c->size() == 1 ? (*c)[0] : std::max({(*c)[0], (*c)[1], (*c)[2]});
+      s.fuzzAmount = m;
+      s.fuzzColor = divide(g.sheenColor, m);
+    } else {
+      const Value color = namedValue(w, "sheen_color", g.sheenColor);
+      const Value amount = namedValue(w, "sheen_amount", max3(color));
+      s.fuzzAmount = amount;
+      s.fuzzColor = divide(color, amount);
+    }
+    s.fuzzRoughness = g.sheenRoughness.is_null() ? Value(0.0) : g.sheenRoughness;
+  }
+  if (!off(g.fuzz, 0)) {  // KHR_materials_fuzz: weight, colour, roughness as they are
+    s.fuzzAmount = g.fuzz;
+    s.fuzzColor = g.fuzzColor.is_null() ? Value(1.0) : g.fuzzColor;
+    s.fuzzRoughness = g.fuzzRoughness.is_null() ? Value(0.5) : g.fuzzRoughness;
+  }
+
+  // Thin-film iridescence: F0 = vlerp(F0, thin_film(F0, F90, d, ior).f0, factor), d in metres.
+  if (!off(g.iridescence, 0)) {
+    s.filmWeight = g.iridescence;
+    s.filmThickness = mul(g.iridescenceThickness.is_null() ? Value(400.0) : g.iridescenceThickness, 1e-9);
+    s.filmIor = g.iridescenceIor.is_null() ? Value(1.3) : g.iridescenceIor;
+  }
+
+  // Transmission: the dielectric transmits, tinted by the base colour, and the
+  // volume attenuates over its thickness: T = baseColor · attenuationColor^(thickness / distance).
+  if (!off(g.transmission, 0)) {
+    s.transmission = g.transmission;
+    Value t = baseColor;
+    if (g.attenuationDistance > 0 && !off(g.thickness, 0) && !off(g.attenuationColor, 1))
+      t = mul(t, vpow(g.attenuationColor, divide(g.thickness, g.attenuationDistance)));
+    s.transmittance = t;
+  }
+
+  // Diffuse transmission: the closest slab medium is wrap lighting (light from
+  // below the horizon): per-channel wrap w = factor · colour (at most 0.95),
+  // mfp = scale · w / (1 − w); the diffuse colour leans to the transmission colour.
+  if (!off(g.diffuseTransmission, 0)) {
+    const Value color = g.diffuseTransmissionColor.is_null() ? literal3(1, 1, 1) : g.diffuseTransmissionColor;
+    const Value wrap = namedValue(w, "diffuse_transmission_wrap", vmin(mul(g.diffuseTransmission, color), 0.95));
+    s.sssMfp = divide(mul(wrap, kWrapMfpScale), oneMinus(wrap));
+    s.sssType = "wrap";
+    s.diffuseColor = vlerp(baseColor, color, mul(g.diffuseTransmission, 0.5));
+  }
+
+  // Clearcoat: a colourless dielectric (IOR 1.5) on top, its own roughness and normal.
+  if (!off(g.clearcoat, 0)) {
+    s.coatWeight = g.clearcoat;
+    s.coatF0 = 0.04;
+    s.coatRoughness = g.clearcoatRoughness.is_null() ? Value(0.0) : g.clearcoatRoughness;
+    s.coatNormal = g.clearcoatNormal;
+  }
+  // KHR_materials_coat: the same with its IOR, an absorbing colour (one pass
+  // each way: per-pass transmittance sqrt(coatColor)) and anisotropy.
+  if (!off(g.coat, 0)) {
+    s.coatWeight = g.coat;
+    s.coatF0 = iorToF0Value(g.coatIor.is_null() ? Value(1.5) : g.coatIor);
+    s.coatRoughness = g.coatRoughness.is_null() ? Value(0.0) : g.coatRoughness;
+    s.coatNormal = g.coatNormal;
+    if (!off(g.coatColor, 1)) s.coatTransmittance = vsqrt(g.coatColor);
+    if (!off(g.coatAnisotropyStrength, 0)) {
+      const RoughnessAnisotropy ra = anisotropic(w, "coat_", s.coatRoughness, g.coatAnisotropyStrength);
+      s.coatRoughness = ra.roughness;
+      s.coatAnisotropy = ra.anisotropy;
+      s.coatTangent = rotatedTangent(g.coatAnisotropyRotation);
+    }
+  }
+
+  s.emissive = g.emissive;
+  s.opacity = g.alpha;
+  s.alphaMode = g.alphaMode;
+  s.alphaCutoff = g.alphaCutoff;
+  return s;
+}
+
+}  // namespace substratec::import

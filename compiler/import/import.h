@@ -1,0 +1,54 @@
+// `substratec import` and the on-the-fly import of report/compile/preview/
+// sweep: recognises a source by its name (.gltf, .glb, .mtlx, and the corpus'
+// <Model>.materials.json extracts), reads it within the input-size limit, and
+// turns each of its materials into substrate-material/1 text (gltf_import.h,
+// mtlx_import.h). The text is then compiled like any hand-written material
+// (compileText): the importer never builds IR itself.
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "format/json_document.h"
+#include "import/material_writer.h"
+
+namespace substratec::import {
+
+enum class SourceKind { Substrate, Gltf, Glb, GltfMaterials, MaterialX };
+
+/// What `path`'s name says it is (".materials.json" before ".json").
+SourceKind sourceKindOf(const std::string& path);
+
+/// Imports every material of the file at `path` (warnings and errors into
+/// `diags`, which should name the file as the user gave it). nullopt on any
+/// error: nothing is returned half-imported.
+std::optional<std::vector<ImportedMaterial>> importFile(const std::string& path, const ReadLimits& limits,
+                                                        Diagnostics& diags);
+
+/// Imports `text` read from a file named `fileName` (no directories; it goes
+/// into the descriptions). MaterialX includes are read relative to `baseDir`.
+std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const std::string& fileName,
+                                                        const std::string& text, const std::string& baseDir,
+                                                        const ReadLimits& limits, Diagnostics& diags);
+
+/// The material called `wanted` (its source name or its identifier), or the
+/// only one when `wanted` is empty; otherwise an error listing the materials.
+const ImportedMaterial* pickMaterial(const std::vector<ImportedMaterial>& all, const std::string& wanted,
+                                     Diagnostics& diags);
+
+/// One material to compile: the text and how diagnostics call it.
+struct MaterialSource {
+  std::string displayName;  // the file, or "file[material]" for an imported one
+  std::string text;
+  bool imported = false;    // a compile error in it is the importer's (an internal error)
+};
+
+/// The material(s) `path` holds: a substrate-material/1 file as it is, or its
+/// imported materials — the one called `material`, the only one, or (with
+/// `all`) every one of them. nullopt with diagnostics in `diags`.
+std::optional<std::vector<MaterialSource>> loadMaterialSources(const std::string& path, const std::string& material,
+                                                               bool all, const ReadLimits& limits,
+                                                               Diagnostics& diags);
+
+}  // namespace substratec::import

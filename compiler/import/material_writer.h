@@ -1,0 +1,126 @@
+// Writing a substrate-material/1 document from an importer: unique C
+// identifiers for inputs and nodes (one namespace, as the format wants),
+// inputs with their source's names and values, named value and Substrate
+// nodes, settings, the output; and small constructors for value expressions
+// that fold the identities an importer produces all the time (x * 1, x + 0,
+// lerp by a literal 0 or 1, literal arithmetic) so that the JSON stays
+// readable. The result is text: it goes through the normal parser and
+// pipeline (compileText) like any hand-written material.
+#pragma once
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace substratec::import {
+
+using Json = nlohmann::ordered_json;
+
+/// A pin's value: a literal (number or array), a reference ("$input",
+/// "node", "node.output") or an inline value node (an object with "kind").
+/// A null Json means "not given" wherever a Value is optional.
+using Value = Json;
+
+/// `s` made a usable identifier of at most 120 bytes: characters other than
+/// [A-Za-z0-9_] become '_', runs of '_' collapse, a leading digit gets
+/// `prefix` in front; empty stays empty.
+std::string sanitizeIdentifier(std::string_view s, std::string_view prefix = "m");
+
+/// One imported material: what its source calls it, its identifier (the
+/// material's `name`, unique within its source) and its text.
+struct ImportedMaterial {
+  std::string sourceName;  // as written in the source ("" when unnamed)
+  std::string name;        // a usable identifier, unique among the source's materials
+  std::string location;    // where the source defines it (JSON pointer or "line N")
+  std::string text;        // substrate-material/1 JSON
+};
+
+/// A material identifier for `wanted` (sanitized; `fallback` when that is
+/// empty) not yet in `used`, which it joins.
+std::string uniqueMaterialName(std::set<std::string>& used, std::string_view wanted, const std::string& fallback);
+
+class MaterialWriter {
+ public:
+  /// `name` is the material's name (sanitized; made unique by the caller).
+  explicit MaterialWriter(const std::string& name);
+
+  /// A fresh identifier like `wanted` (sanitized), not yet used by an input or
+  /// a node, and usable as a material name too (no keyword, no "gl_").
+  std::string uniqueId(std::string_view wanted);
+
+  /// Inputs; each returns the reference "$name" (the name made unique).
+  Value floatInput(std::string_view name, double value, std::optional<double> lo, std::optional<double> hi,
+                   const std::string& description);
+  Value colorInput(std::string_view name, const std::vector<double>& rgb, const std::string& description);
+  Value vec2Input(std::string_view name, double x, double y, const std::string& description);
+  Value vec3Input(std::string_view name, const std::vector<double>& xyz, const std::string& description);
+  Value textureInput(std::string_view name, bool srgb, const std::string& description);
+
+  /// A named node (value or Substrate); returns its id as a reference.
+  Value node(std::string_view wantedId, Json body);
+
+  void setDescription(const std::string& text) { description_ = text; }
+  void setSetting(const std::string& key, Json value) { settings_[key] = std::move(value); }
+  void setOutput(const Value& root) { output_ = root.get<std::string>(); }
+
+  const std::string& name() const { return name_; }
+  /// The document as text (2-space indented JSON, '\n'-terminated).
+  std::string text() const;
+
+ private:
+  Value addInput(std::string_view name, Json body);
+  std::string name_, description_, output_;
+  Json settings_ = Json::object(), inputs_ = Json::object(), nodes_ = Json::object();
+  std::set<std::string> used_;
+};
+
+// ---------------------------------------------------------------------------
+// Value expressions. Literals are numbers or arrays of numbers; every
+// constructor folds what it can and otherwise returns an inline node.
+
+bool isNull(const Value& v);
+/// The literal's components (1 for a number), or nullopt for anything else.
+std::optional<std::vector<double>> literalOf(const Value& v);
+/// True when `v` is a literal whose every component equals `x`.
+bool isLiteral(const Value& v, double x);
+/// A number (one component) or an array.
+Value literal(const std::vector<double>& c);
+Value literal3(double r, double g, double b);
+
+Value mul(const Value& a, const Value& b);
+Value add(const Value& a, const Value& b);
+Value sub(const Value& a, const Value& b);
+Value divide(const Value& a, const Value& b);
+Value vmin(const Value& a, const Value& b);
+Value vmax(const Value& a, const Value& b);
+Value vlerp(const Value& a, const Value& b, const Value& t);
+Value oneMinus(const Value& x);
+Value saturate(const Value& x);
+Value vabs(const Value& x);
+Value vsqrt(const Value& x);
+Value vpow(const Value& x, const Value& y);
+Value vnormalize(const Value& x);
+Value vdot(const Value& a, const Value& b);
+Value vclamp(const Value& x, const Value& lo, const Value& hi);
+Value vlength(const Value& x);
+Value swizzle(const Value& x, const std::string& channels);
+/// The largest of a colour's three channels (max(max(r, g), b)).
+Value max3(const Value& rgb);
+Value combine(const std::vector<Value>& components);
+Value unaryNode(const std::string& kind, const Value& x);
+Value binaryNode(const std::string& kind, const Value& a, const Value& b);
+Value geometry(const std::string& attribute);
+/// `{"kind": "texture", "texture": tex, "uv": uv}` (uv omitted when null).
+Value textureSample(const Value& textureInput, const Value& uv);
+/// `node.output` for a named node reference or an inline node's output.
+Value outputOf(const Value& nodeRef, const std::string& name);
+/// An inline expression as a named node of `w` (an expression used more than
+/// once is then written once); references and literals as they are.
+Value namedValue(MaterialWriter& w, const std::string& id, const Value& v);
+/// ((ior − 1) / (ior + 1))² (the ior_to_f0 helper), folded for a literal.
+Value iorToF0Value(const Value& ior);
+
+}  // namespace substratec::import

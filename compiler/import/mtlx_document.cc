@@ -1,0 +1,178 @@
+#include "import/mtlx_document.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+namespace substratec::import {
+
+namespace {
+
+constexpr int kMaxIncludeDepth = 8;
+constexpr std::size_t kMaxDocuments = 64;
+
+bool isInclude(pugi::xml_node n) {
+  const std::string name = n.name();
+  return name == "xi:include" || (name.size() > 8 && name.substr(name.size() - 8) == ":include");
+}
+
+}  // namespace
+
+bool MtlxDocument::load(const std::string& text, const std::string& fileName, const std::string& baseDir,
+                        const ReadLimits& limits, Diagnostics& diags) {
+  return loadOne(text, fileName, baseDir, 0, 0, 0, limits, diags);
+}
+
+bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName, const std::string& dir, int depth,
+                           int includeLine, int includeColumn, const ReadLimits& limits, Diagnostics& diags) {
+  auto loaded = std::make_unique<Loaded>();
+  loaded->fileName = fileName;
+  loaded->text = text;
+  loaded->includeLine = includeLine;
+  loaded->includeColumn = includeColumn;
+  const pugi::xml_parse_result r = loaded->doc.load_buffer(loaded->text.data(), loaded->text.size(), pugi::parse_default);
+  auto at = [&](std::size_t offset, const std::string& message) {
+    int line = includeLine, column = includeColumn;
+    if (depth == 0) lineColumnOf(loaded->text, offset, line, column);
+    diags.errorAt(line, column, depth == 0 ? message : fmt::format("in included {}: {}", fileName, message));
+  };
+  if (!r) {
+    at(static_cast<std::size_t>(std::max<std::ptrdiff_t>(r.offset, 0)), fmt::format("XML: {}", r.description()));
+    return false;
+  }
+  const pugi::xml_node root = loaded->doc.child("materialx");
+  if (!root) {
+    at(0, "expected a <materialx> root element");
+    return false;
+  }
+  Loaded* self = loaded.get();
+  docs_.push_back(std::move(loaded));
+  loading_.push_back(fileName);
+  bool ok = true;
+  for (pugi::xml_node n : root.children()) {
+    if (n.type() != pugi::node_element) continue;
+    if (isInclude(n)) {
+      const std::string href = n.attribute("href").as_string();
+      int line = includeLine, column = includeColumn;
+      if (depth == 0) lineColumnOf(self->text, static_cast<std::size_t>(n.offset_debug()), line, column);
+      auto fail = [&](const std::string& m) {
+        diags.errorAt(line, column, m);
+        ok = false;
+      };
+      if (href.empty()) {
+        fail("xi:include without an href");
+        continue;
+      }
+      if (depth + 1 > kMaxIncludeDepth || docs_.size() >= kMaxDocuments) {
+        fail(fmt::format("xi:include '{}': more than {} levels or {} files of includes", href, kMaxIncludeDepth,
+                         kMaxDocuments));
+        continue;
+      }
+      const std::filesystem::path path = std::filesystem::path(dir) / href;
+      const std::string name = std::filesystem::path(href).filename().string();
+      if (std::find(loading_.begin(), loading_.end(), path.lexically_normal().string()) != loading_.end() ||
+          name == fileName) {
+        fail(fmt::format("xi:include '{}': a file that is already being read (a cycle of includes)", href));
+        continue;
+      }
+      Diagnostics readDiags(href);
+      auto included = readSourceFile(path.string(), limits, readDiags);
+      if (!included) {
+        fail(fmt::format("xi:include '{}': {}", href,
+                         readDiags.all().empty() ? std::string("cannot read it") : readDiags.all().front().message));
+        continue;
+      }
+      loading_.push_back(path.lexically_normal().string());
+      if (!loadOne(*included, name, path.parent_path().string(), depth + 1, line, column, limits, diags)) ok = false;
+      loading_.pop_back();
+      continue;
+    }
+    const std::string name = n.attribute("name").as_string();
+    top_.push_back(n);
+    if (!name.empty() && !byName_.count(name)) byName_[name] = n;
+  }
+  loading_.pop_back();
+  return ok;
+}
+
+pugi::xml_node MtlxDocument::find(const std::string& name) const {
+  auto it = byName_.find(name);
+  return it == byName_.end() ? pugi::xml_node() : it->second;
+}
+
+const MtlxDocument::Loaded* MtlxDocument::owner(pugi::xml_node n) const {
+  const pugi::xml_node root = n.root();
+  for (const auto& d : docs_)
+    if (d->doc == root) return d.get();
+  return nullptr;
+}
+
+std::string MtlxDocument::filePrefix(pugi::xml_node n) const {
+  std::string prefix;
+  for (pugi::xml_node p = n; p; p = p.parent()) {
+    if (p.type() != pugi::node_element) continue;
+    if (auto a = p.attribute("fileprefix")) prefix = std::string(a.as_string()) + prefix;
+  }
+  return prefix;
+}
+
+void MtlxDocument::lineColumn(pugi::xml_node n, int& line, int& column) const {
+  line = column = 0;
+  const Loaded* d = owner(n);
+  if (!d) return;
+  if (d->includeLine > 0) {
+    line = d->includeLine;
+    column = d->includeColumn;
+    return;
+  }
+  const std::ptrdiff_t off = n.offset_debug();
+  if (off >= 0) lineColumnOf(d->text, static_cast<std::size_t>(off), line, column);
+}
+
+std::string MtlxDocument::describe(pugi::xml_node n) const {
+  std::vector<std::string> parts;
+  for (pugi::xml_node p = n; p && p.type() == pugi::node_element && std::string(p.name()) != "materialx";
+       p = p.parent())
+    parts.push_back(fmt::format("{} '{}'", p.name(), p.attribute("name").as_string()));
+  std::string out;
+  for (std::size_t i = 0; i < parts.size(); ++i) out += (i ? " in " : "") + parts[i];
+  const Loaded* d = owner(n);
+  if (d && d->includeLine > 0) {
+    int line = 0, column = 0;
+    const std::ptrdiff_t off = n.offset_debug();
+    if (off >= 0) lineColumnOf(d->text, static_cast<std::size_t>(off), line, column);
+    out += fmt::format(" (included {} line {})", d->fileName, line);
+  }
+  return out;
+}
+
+std::optional<std::vector<double>> parseMtlxNumbers(const std::string& s) {
+  if (s == "true") return std::vector<double>{1};
+  if (s == "false") return std::vector<double>{0};
+  std::vector<double> out;
+  const char* p = s.c_str();
+  while (*p) {
+    while (*p == ' ' || *p == '\t' || *p == ',' || *p == '\n' || *p == '\r') ++p;
+    if (!*p) break;
+    char* end = nullptr;
+    const double v = std::strtod(p, &end);
+    if (end == p || !std::isfinite(v)) return std::nullopt;
+    out.push_back(v);
+    p = end;
+  }
+  if (out.empty()) return std::nullopt;
+  return out;
+}
+
+int mtlxComponents(const std::string& type) {
+  if (type == "float" || type == "integer" || type == "boolean") return 1;
+  if (type == "vector2") return 2;
+  if (type == "color3" || type == "vector3") return 3;
+  if (type == "color4" || type == "vector4") return 4;
+  return 0;
+}
+
+}  // namespace substratec::import

@@ -1,0 +1,766 @@
+#include "import/mtlx_graph.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+namespace substratec::import {
+
+namespace {
+
+constexpr int kMaxNodes = 256;            // nodes along one chain of connections
+constexpr int kMaxDepth = 2 * kMaxNodes;  // each node is two calls deep (its input, then itself)
+constexpr double kPi = 3.14159265358979323846;
+
+double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
+std::string str(pugi::xml_node n, const char* attr) { return n.attribute(attr).as_string(); }
+
+bool isColor(const std::string& type) { return type == "color3" || type == "color4"; }
+
+/// Procedural nodes: no value node and no constant to fold; baked into a texture.
+bool isProcedural(const std::string& kind) {
+  static const char* const kinds[] = {"noise2d", "noise3d", "fractal2d", "fractal3d", "cellnoise2d", "cellnoise3d",
+                                      "worleynoise2d", "worleynoise3d", "unifiednoise2d", "unifiednoise3d",
+                                      "checkerboard", "randomfloat", "randomcolor", "circle", "cloverleaf",
+                                      "hexagon", "grid", "crosshatch", "tiledcircles", "tiledcloverleafs",
+                                      "tiledhexagons", "ramp4", "splitlr", "splittb", "ramplr", "ramptb"};
+  return std::find(std::begin(kinds), std::end(kinds), kind) != std::end(kinds);
+}
+
+/// Nodes without a value node that are evaluated at import when constant.
+bool isFoldable(const std::string& kind) {
+  static const char* const kinds[] = {"rgbtohsv", "hsvtorgb", "sin", "cos", "tan", "asin", "acos", "atan2", "floor",
+                                      "ceil", "round", "modulo", "fract", "exp", "ln", "sign", "smoothstep",
+                                      "ifgreater", "ifgreatereq", "ifequal", "rotate2d"};
+  return std::find(std::begin(kinds), std::end(kinds), kind) != std::end(kinds);
+}
+
+std::array<double, 3> rgbToHsv(double r, double g, double b) {
+  const double mx = std::max({r, g, b}), mn = std::min({r, g, b}), delta = mx - mn;
+  double h = 0;
+  const double s = mx > 0 ? delta / mx : 0;
+  if (delta > 0) {
+    if (r >= mx) h = (g - b) / delta;
+    else if (g >= mx) h = 2 + (b - r) / delta;
+    else h = 4 + (r - g) / delta;
+    h /= 6;
+    if (h < 0) h += 1;
+  }
+  return {h, s, mx};
+}
+
+std::array<double, 3> hsvToRgb(double h, double s, double v) {
+  std::array<double, 3> rgb;
+  const double k[3] = {1.0, 2.0 / 3.0, 1.0 / 3.0};
+  for (int i = 0; i < 3; ++i) {
+    const double x = h + k[i];
+    const double p = std::fabs((x - std::floor(x)) * 6 - 3);
+    rgb[i] = v * (1 + (std::clamp(p - 1, 0.0, 1.0) - 1) * s);
+  }
+  return rgb;
+}
+
+}  // namespace
+
+Value mtlxLiteral(const std::vector<double>& v, const std::string& type, const std::string& colorspace) {
+  const int n = std::max(1, mtlxComponents(type));
+  std::vector<double> c = v;
+  if (c.size() == 1 && n > 1) c.assign(n, v[0]);
+  c.resize(n, c.empty() ? 0.0 : c.back());
+  if (isColor(type) && colorspace == "srgb_texture")
+    for (int i = 0; i < std::min(n, 3); ++i) c[i] = srgbToLinear(c[i]);
+  return literal(c);
+}
+
+void MtlxValues::warn(pugi::xml_node at, const std::string& what) {
+  int line = 0, column = 0;
+  doc_.lineColumn(at, line, column);
+  const std::string m = fmt::format("material {}: {}: {}", label_, doc_.describe(at), what);
+  if (!warned_.insert(m).second) return;
+  d_.warningAt(line, column, m);
+}
+
+void MtlxValues::error(pugi::xml_node at, const std::string& what) {
+  int line = 0, column = 0;
+  doc_.lineColumn(at, line, column);
+  d_.errorAt(line, column, fmt::format("{}: {}", doc_.describe(at), what));
+  ok_ = false;
+}
+
+bool MtlxValues::given(pugi::xml_node shader, const std::string& name) const {
+  return static_cast<bool>(shader.find_child_by_attribute("input", "name", name.c_str()));
+}
+
+pugi::xml_node MtlxValues::resolveNodeName(pugi::xml_node user, const std::string& name) const {
+  // A node's inputs name siblings: inside a node graph, the graph's nodes; at
+  // the top level, the document's.
+  pugi::xml_node scope = user.parent();
+  if (scope && std::string(scope.name()) != "materialx") {
+    for (pugi::xml_node c : scope.children())
+      if (c.type() == pugi::node_element && name == c.attribute("name").as_string() && std::string(c.name()) != "input" &&
+          std::string(c.name()) != "output")
+        return c;
+    return {};
+  }
+  return doc_.find(name);
+}
+
+std::pair<pugi::xml_node, std::string> MtlxValues::resolveGraphOutput(pugi::xml_node graph, const std::string& output,
+                                                                      pugi::xml_node at) {
+  pugi::xml_node out = output.empty() ? graph.child("output") : graph.find_child_by_attribute("output", "name", output.c_str());
+  if (!out) {
+    error(at, fmt::format("node graph '{}' has no output '{}'", str(graph, "name"), output));
+    return {};
+  }
+  const std::string nodename = str(out, "nodename");
+  pugi::xml_node node;
+  for (pugi::xml_node c : graph.children())
+    if (c.type() == pugi::node_element && nodename == c.attribute("name").as_string() && std::string(c.name()) != "output" &&
+        std::string(c.name()) != "input")
+      node = c;
+  if (!node) {
+    error(out, nodename.empty() ? std::string("the output connects to no node")
+                                : fmt::format("the output reads node '{}', which the graph does not have", nodename));
+    return {};
+  }
+  return {node, str(out, "output")};
+}
+
+std::optional<MtlxValues::Binding> MtlxValues::implementation(pugi::xml_node instance) const {
+  const std::string kind = instance.name();
+  for (pugi::xml_node def : doc_.topLevel()) {
+    if (std::string(def.name()) != "nodedef" || kind != def.attribute("node").as_string()) continue;
+    const std::string defName = str(def, "name");
+    for (pugi::xml_node g : doc_.topLevel())
+      if (std::string(g.name()) == "nodegraph" && defName == g.attribute("nodedef").as_string())
+        return Binding{instance, def, g};
+  }
+  return std::nullopt;
+}
+
+Value MtlxValues::valueInput(const std::string& name, const std::string& type, const std::vector<double>& v,
+                             const std::string& what) {
+  const Value lit = mtlxLiteral(v, type, "");
+  if (type == "float") return w_.floatInput(name, literalOf(lit)->at(0), std::nullopt, std::nullopt, what);
+  if (type == "color3") return w_.colorInput(name, *literalOf(lit), what);
+  if (type == "vector2") return w_.vec2Input(name, literalOf(lit)->at(0), literalOf(lit)->at(1), what);
+  if (type == "vector3") return w_.vec3Input(name, *literalOf(lit), what);
+  return lit;  // integer, boolean, 4-vectors: static
+}
+
+Value MtlxValues::interfaceInput(pugi::xml_node graphInput, const std::string& name, const std::string& type) {
+  const std::string key = std::to_string(graphInput.hash_value());
+  auto it = interface_.find(key);
+  if (it != interface_.end()) return it->second;
+  const auto v = parseMtlxNumbers(str(graphInput, "value"));
+  if (!v) {
+    error(graphInput, fmt::format("interface input '{}' has no value of type {}", name, type));
+    return Value();
+  }
+  std::vector<double> c = *v;
+  if (isColor(type) && str(graphInput, "colorspace") == "srgb_texture") c = *literalOf(mtlxLiteral(c, type, "srgb_texture"));
+  Value r = valueInput(name, type, c,
+                       fmt::format("{}", doc_.describe(graphInput)));
+  interface_[key] = r;
+  return r;
+}
+
+MtlxValues::Typed MtlxValues::connection(pugi::xml_node input, const std::string& type, bool frozen, int depth,
+                                         bool* connected) {
+  *connected = true;
+  if (depth > kMaxDepth) {
+    error(input, fmt::format("the graph is deeper than {} nodes", kMaxNodes));
+    return {Value(), type};
+  }
+  const std::string output = str(input, "output");
+  if (input.attribute("nodename")) {
+    pugi::xml_node node = resolveNodeName(input.parent(), str(input, "nodename"));
+    if (!node) {
+      error(input, fmt::format("input '{}' reads node '{}', which is not in its scope", str(input, "name"), str(input, "nodename")));
+      return {Value(), type};
+    }
+    if (std::string(node.name()) == "nodegraph") {
+      auto [n, o] = resolveGraphOutput(node, output, input);
+      if (!n) return {Value(), type};
+      return nodeValue(n, o, frozen, depth + 1);
+    }
+    return nodeValue(node, output, frozen, depth + 1);
+  }
+  if (input.attribute("nodegraph")) {
+    pugi::xml_node graph = doc_.find(str(input, "nodegraph"));
+    if (!graph || std::string(graph.name()) != "nodegraph") {
+      error(input, fmt::format("input '{}' reads node graph '{}', which the document does not have", str(input, "name"),
+                               str(input, "nodegraph")));
+      return {Value(), type};
+    }
+    auto [n, o] = resolveGraphOutput(graph, output, input);
+    if (!n) return {Value(), type};
+    return nodeValue(n, o, frozen, depth + 1);
+  }
+  if (input.attribute("interfacename")) {
+    const std::string iname = str(input, "interfacename");
+    pugi::xml_node graph = input.parent().parent();
+    if (!bindings_.empty() && bindings_.back().graph == graph) {
+      const Binding b = bindings_.back();
+      pugi::xml_node instIn = b.instance.find_child_by_attribute("input", "name", iname.c_str());
+      pugi::xml_node defIn = b.nodedef.find_child_by_attribute("input", "name", iname.c_str());
+      bindings_.pop_back();
+      Typed r{Value(), type};
+      bool c = false;
+      if (instIn) r = connection(instIn, type, frozen, depth + 1, &c);
+      if (!c) {
+        pugi::xml_node src = instIn ? instIn : defIn;
+        const auto v = src ? parseMtlxNumbers(str(src, "value")) : std::nullopt;
+        if (frozen && instIn) ++frozenReads_;
+        if (!v) error(input, fmt::format("interface input '{}' has no value", iname));
+        else r = {frozen || !instIn ? mtlxLiteral(*v, type, str(src, "colorspace"))
+                                    : valueInput(iname, type, *v, doc_.describe(instIn)),
+                  type};
+      }
+      bindings_.push_back(b);
+      return r;
+    }
+    pugi::xml_node gi = graph.find_child_by_attribute("input", "name", iname.c_str());
+    if (!gi) {
+      error(input, fmt::format("interface name '{}' is not an input of the node graph", iname));
+      return {Value(), type};
+    }
+    bool c = false;
+    Typed r = connection(gi, type, frozen, depth + 1, &c);
+    if (c) return r;
+    if (frozen) {
+      ++frozenReads_;
+      const auto v = parseMtlxNumbers(str(gi, "value"));
+      if (!v) {
+        error(gi, fmt::format("interface input '{}' has no value", iname));
+        return {Value(), type};
+      }
+      return {mtlxLiteral(*v, type, str(gi, "colorspace")), type};
+    }
+    return {interfaceInput(gi, iname, type), type};
+  }
+  *connected = false;
+  return {Value(), type};
+}
+
+namespace {
+
+/// A value of MaterialX type `from` as type `to` (convert's rules).
+Value convertValue(const Value& v, const std::string& from, const std::string& to) {
+  const int a = mtlxComponents(from), b = mtlxComponents(to);
+  if (a == b || v.is_null() || a == 0 || b == 0) return v;
+  if (a == 1) return swizzle(v, std::string(b, 'x'));
+  if (b == 1) return swizzle(v, "x");
+  if (b < a) return swizzle(v, std::string("xyzw").substr(0, b));
+  if (a == 2 && b == 3) return combine({swizzle(v, "x"), swizzle(v, "y"), 0.0});
+  if (a == 2 && b == 4) return combine({swizzle(v, "x"), swizzle(v, "y"), 0.0, 1.0});
+  return combine({swizzle(v, "x"), swizzle(v, "y"), swizzle(v, "z"), 1.0});  // 3 -> 4
+}
+
+}  // namespace
+
+MtlxValues::Typed MtlxValues::inputOf(pugi::xml_node node, const std::string& name, const std::string& type,
+                                      const std::vector<double>& def, bool frozen, int depth) {
+  pugi::xml_node in = node.find_child_by_attribute("input", "name", name.c_str());
+  const std::string itype = in && in.attribute("type") ? str(in, "type") : type;
+  if (!in) return {def.empty() ? Value() : mtlxLiteral(def, itype, ""), itype};
+  bool connected = false;
+  Typed t = connection(in, itype, frozen, depth, &connected);
+  if (connected) return {convertValue(t.v, t.type, itype), itype};
+  if (in.attribute("value")) {
+    const auto v = parseMtlxNumbers(str(in, "value"));
+    if (!v) {
+      error(in, fmt::format("input '{}': value '{}' is not a {}", name, str(in, "value"), itype));
+      return {Value(), itype};
+    }
+    return {mtlxLiteral(*v, itype, str(in, "colorspace")), itype};
+  }
+  return {def.empty() ? Value() : mtlxLiteral(def, itype, ""), itype};
+}
+
+Value MtlxValues::param(pugi::xml_node shader, const std::string& name, const std::string& type,
+                        const std::vector<double>& def, ParamKind kind) {
+  pugi::xml_node in = shader.find_child_by_attribute("input", "name", name.c_str());
+  if (!in) return mtlxLiteral(def, type, "");
+  bool connected = false;
+  Typed t = connection(in, type, false, 0, &connected);
+  if (connected) return convertValue(t.v, t.type, type);
+  const auto v = parseMtlxNumbers(str(in, "value"));
+  if (!v) {
+    if (in.attribute("value")) error(in, fmt::format("input '{}': value '{}' is not a {}", name, str(in, "value"), type));
+    return mtlxLiteral(def, type, "");
+  }
+  const Value lit = mtlxLiteral(*v, type, str(in, "colorspace"));
+  if (kind == ParamKind::Switch && (isLiteral(lit, 0) || isLiteral(lit, 1))) return lit;
+  return valueInput(name, type, *literalOf(lit), fmt::format("{} input {}", str(shader, "name"), name));
+}
+
+std::optional<std::vector<double>> MtlxValues::constant(pugi::xml_node shader, const std::string& name,
+                                                        const std::string& type, const std::vector<double>& def) {
+  Typed t = inputOf(shader, name, type, def, true, 0);
+  return literalOf(t.v);
+}
+
+MtlxValues::Typed MtlxValues::nodeValue(pugi::xml_node node, const std::string& output, bool frozen, int depth) {
+  if (depth > kMaxDepth) {
+    error(node, fmt::format("the graph is deeper than {} nodes", kMaxNodes));
+    return {Value(), str(node, "type")};
+  }
+  const std::string binding = bindings_.empty() ? "" : std::to_string(bindings_.back().instance.hash_value());
+  const std::string key = fmt::format("{}|{}|{}|{}", node.hash_value(), output, frozen, binding);
+  if (auto it = memo_.find(key); it != memo_.end()) return it->second;
+  if (!active_.insert(key).second) {
+    error(node, "the node depends on itself (a cycle)");
+    return {Value(), str(node, "type")};
+  }
+  const std::string kind = node.name();
+  std::string type = str(node, "type");
+  if (type == "multioutput") {
+    pugi::xml_node o = node.find_child_by_attribute("output", "name", output.c_str());
+    if (o) type = str(o, "type");
+  }
+  Typed t;
+  if (auto impl = implementation(node); impl && !isProcedural(kind)) {
+    // A node the document defines itself: its implementation graph.
+    auto [n, o] = resolveGraphOutput(impl->graph, output, node);
+    if (n) {
+      pushBinding(*impl);
+      t = nodeValue(n, o, frozen, depth + 1);
+      popBinding();
+    }
+  } else {
+    t = compute(node, kind, type, output, frozen, depth);
+  }
+  active_.erase(key);
+  if (!frozen && t.v.is_object()) t.v = w_.node(str(node, "name"), t.v);
+  memo_[key] = t;
+  return t;
+}
+
+Value MtlxValues::textureOf(pugi::xml_node node, const std::string& file, bool srgb) {
+  const std::string key = file + (srgb ? "|srgb" : "|linear");
+  auto it = textures_.find(key);
+  if (it != textures_.end()) return it->second;
+  std::string stem = std::filesystem::path(file).stem().string();
+  if (stem.empty()) stem = str(node, "name");
+  const Value t = w_.textureInput(stem, srgb, fmt::format("{}: file '{}{}'", doc_.describe(node), doc_.filePrefix(node), file));
+  textures_[key] = t;
+  return t;
+}
+
+Value MtlxValues::sampleOf(const Value& texture, const Value& uv) {
+  const std::string key = texture.get<std::string>() + "|" + uv.dump();
+  auto it = samples_.find(key);
+  if (it != samples_.end()) return it->second;
+  const Value n = w_.node(texture.get<std::string>().substr(1) + "_sample", textureSample(texture, uv));
+  samples_[key] = n;
+  return n;
+}
+
+MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind, const std::string& type,
+                                    const std::string& output, bool frozen, int depth) {
+  if (frozen) return {Value(), type};
+  auto in = [&](const char* name, const std::string& t, std::vector<double> def) {
+    return inputOf(node, name, t, def, false, depth + 1).v;
+  };
+  pugi::xml_node fileIn = node.find_child_by_attribute("input", "name", "file");
+  // The file may come through an interface name.
+  for (int guard = 0; fileIn && fileIn.attribute("interfacename") && guard < 8; ++guard) {
+    pugi::xml_node graph = fileIn.parent().parent();
+    pugi::xml_node next = graph.find_child_by_attribute("input", "name", str(fileIn, "interfacename").c_str());
+    if (!bindings_.empty() && bindings_.back().graph == graph)
+      next = bindings_.back().instance.find_child_by_attribute("input", "name", str(fileIn, "interfacename").c_str());
+    fileIn = next;
+  }
+  const std::string file = fileIn ? str(fileIn, "value") : "";
+  if (file.empty()) {
+    error(node, "an image node without a file");
+    return {Value(), type};
+  }
+  const std::string cs = fileIn.attribute("colorspace") ? str(fileIn, "colorspace") : "";
+  const bool srgb = cs == "srgb_texture" || cs == "srgb_displayp3";
+  if (!cs.empty() && !srgb && cs != "lin_rec709" && cs != "raw" && cs != "none")
+    warn(node, fmt::format("colour space '{}' of the file is read as linear Rec.709", cs));
+  for (const char* mode : {"uaddressmode", "vaddressmode"})
+    if (auto a = node.find_child_by_attribute("input", "name", mode)) {
+      const std::string m = str(a, "value");
+      if (!m.empty() && m != "periodic")
+        warn(node, fmt::format("{} '{}': a material does not choose its sampler (the renderer binds one)", mode, m));
+    }
+  const Value tex = textureOf(node, file, srgb && (type != "float"));
+
+  // Texture coordinates.
+  Value uv = in("texcoord", "vector2", {});
+  if (uv.is_null()) uv = Value();  // uv0
+  auto uvOr0 = [&]() { return uv.is_null() ? geometry("uv0") : uv; };
+  if (kind == "tiledimage" || kind == "hextiledimage") {
+    // uv = (texcoord · uvtiling − uvoffset) / realworldimagesize · realworldtilesize (identities skipped).
+    auto apply = [](Value x, const Value& by, double identity, Value (*op)(const Value&, const Value&)) {
+      return isLiteral(by, identity) ? x : op(x, by);
+    };
+    Value t = apply(uvOr0(), in(kind == "tiledimage" ? "uvtiling" : "tiling", "vector2", {1, 1}), 1, mul);
+    if (kind == "tiledimage") {
+      t = apply(t, in("uvoffset", "vector2", {0, 0}), 0, sub);
+      t = apply(t, in("realworldimagesize", "vector2", {1, 1}), 1, divide);
+      t = apply(t, in("realworldtilesize", "vector2", {1, 1}), 1, mul);
+    } else {
+      warn(node, "hexagonal tiling (random rotation, scale and offset per tile, blended) is not represented: "
+                 "sampled as a plain tiled image");
+    }
+    uv = t == geometry("uv0") ? Value() : t;
+  } else if (kind == "gltf_image" || kind == "gltf_colorimage" || kind == "gltf_normalmap") {
+    const Value scale = in("scale", "vector2", {1, 1}), offset = in("offset", "vector2", {0, 0});
+    const double rotate = literalOf(in("rotate", "float", {0})).value_or(std::vector<double>{0})[0];
+    if (!isLiteral(scale, 1) || !isLiteral(offset, 0) || rotate != 0) {
+      // KHR_texture_transform as MaterialX's gltf nodes apply it (about the pivot (0, 1)).
+      const Value pivot = in("pivot", "vector2", {0, 1});
+      Value p = mul(sub(uvOr0(), pivot), scale);
+      if (rotate != 0) {
+        const double a = rotate * kPi / 180, c = std::cos(a), s = std::sin(a);
+        p = combine({sub(mul(swizzle(p, "x"), c), mul(swizzle(p, "y"), s)), add(mul(swizzle(p, "x"), s), mul(swizzle(p, "y"), c))});
+      }
+      uv = add(add(p, pivot), offset);
+    }
+  }
+  const Value sample = sampleOf(tex, uv);
+  const Value rgb = outputOf(sample, "rgb");
+  if (kind == "gltf_normalmap") {
+    const Value s = in("scale", "float", {1});
+    Value n = sub(mul(rgb, 2.0), 1.0);
+    if (!isLiteral(s, 1)) n = mul(n, combine({s, s, 1.0}));
+    return {vnormalize(n), "vector3"};
+  }
+  if (kind == "gltf_colorimage") {
+    const Value factor = in("color", "color4", {1, 1, 1, 1});
+    const Value geom = in("geomcolor", "color4", {1, 1, 1, 1});
+    if (output == "outa") {
+      Value a = outputOf(sample, "a");
+      a = mul(mul(a, swizzle(factor, "w")), swizzle(geom, "w"));
+      return {a, "float"};
+    }
+    Value c = rgb;
+    if (!isLiteral(factor, 1)) c = mul(c, swizzle(factor, "xyz"));
+    if (!isLiteral(geom, 1)) c = mul(c, swizzle(geom, "xyz"));
+    return {c, "color3"};
+  }
+  Value v;
+  const int n = mtlxComponents(type);
+  if (n == 1) v = outputOf(sample, "r");
+  else if (n == 2) v = swizzle(rgb, "xy");
+  else if (n == 3) v = rgb;
+  else v = combine({outputOf(sample, "r"), outputOf(sample, "g"), outputOf(sample, "b"), outputOf(sample, "a")});
+  if (kind == "gltf_image") {
+    const Value factor = in("factor", type, {1, 1, 1, 1});
+    if (!isLiteral(factor, 1)) v = mul(v, factor);
+  }
+  return {v, type};
+}
+
+MtlxValues::Typed MtlxValues::bake(pugi::xml_node node, const std::string& kind, const std::string& type,
+                                   const std::string& why) {
+  const Value tex = w_.textureInput(std::string(str(node, "name")) + "_baked", false,
+                                    fmt::format("bake of {} ({})", doc_.describe(node), kind));
+  warn(node, fmt::format("{}: replaced by the texture input '{}' sampled at uv0 (bake the node into it)", why,
+                         tex.get<std::string>().substr(1)));
+  const Value sample = sampleOf(tex, Value());
+  const int n = mtlxComponents(type);
+  if (n == 1) return {outputOf(sample, "r"), type};
+  if (n == 2) return {swizzle(outputOf(sample, "rgb"), "xy"), type};
+  if (n == 3) return {outputOf(sample, "rgb"), type};
+  return {combine({outputOf(sample, "r"), outputOf(sample, "g"), outputOf(sample, "b"), outputOf(sample, "a")}), type};
+}
+
+MtlxValues::Typed MtlxValues::bakeOrFold(pugi::xml_node node, const std::string& kind, const std::string& type,
+                                         bool frozen, int depth) {
+  // Every input at its constant value (interface inputs at their defaults).
+  auto c = [&](const char* name, const std::string& t, std::vector<double> def) {
+    return literalOf(inputOf(node, name, t, def, true, depth + 1).v);
+  };
+  const int readsBefore = frozenReads_;
+  const int n = std::max(1, mtlxComponents(type));
+  std::optional<std::vector<double>> r;
+  auto unary = [&](const char* name, auto f) {
+    if (auto x = c(name, type, {0})) {
+      r = *x;
+      for (double& v : *r) v = f(v);
+    }
+  };
+  if (kind == "sin") unary("in", [](double x) { return std::sin(x); });
+  else if (kind == "cos") unary("in", [](double x) { return std::cos(x); });
+  else if (kind == "tan") unary("in", [](double x) { return std::tan(x); });
+  else if (kind == "asin") unary("in", [](double x) { return std::asin(std::clamp(x, -1.0, 1.0)); });
+  else if (kind == "acos") unary("in", [](double x) { return std::acos(std::clamp(x, -1.0, 1.0)); });
+  else if (kind == "floor") unary("in", [](double x) { return std::floor(x); });
+  else if (kind == "ceil") unary("in", [](double x) { return std::ceil(x); });
+  else if (kind == "round") unary("in", [](double x) { return std::round(x); });
+  else if (kind == "fract") unary("in", [](double x) { return x - std::floor(x); });
+  else if (kind == "exp") unary("in", [](double x) { return std::exp(x); });
+  else if (kind == "ln") unary("in", [](double x) { return x > 0 ? std::log(x) : 0.0; });
+  else if (kind == "sign") unary("in", [](double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; });
+  else if (kind == "rgbtohsv" || kind == "hsvtorgb") {
+    if (auto x = c("in", type, {0, 0, 0})) {
+      const auto h = kind == "rgbtohsv" ? rgbToHsv((*x)[0], (*x)[1], (*x)[2]) : hsvToRgb((*x)[0], (*x)[1], (*x)[2]);
+      r = std::vector<double>(h.begin(), h.end());
+      if (n == 4) r->push_back(x->size() > 3 ? (*x)[3] : 1);
+    }
+  } else if (kind == "modulo" || kind == "atan2") {
+    auto a = c("in1", type, {0}), b = c("in2", type, {kind == "modulo" ? 1.0 : 1.0});
+    if (a && b) {
+      r = std::vector<double>(n);
+      for (int i = 0; i < n; ++i) {
+        const double x = (*a)[std::min<std::size_t>(i, a->size() - 1)], y = (*b)[std::min<std::size_t>(i, b->size() - 1)];
+        (*r)[i] = kind == "atan2" ? std::atan2(x, y) : (y == 0 ? 0.0 : x - y * std::floor(x / y));
+      }
+    }
+  } else if (kind == "smoothstep") {
+    auto x = c("in", type, {0}), lo = c("low", type, {0}), hi = c("high", type, {1});
+    if (x && lo && hi) {
+      r = std::vector<double>(n);
+      for (int i = 0; i < n; ++i) {
+        const double a = (*lo)[std::min<std::size_t>(i, lo->size() - 1)], b = (*hi)[std::min<std::size_t>(i, hi->size() - 1)];
+        const double t = b == a ? ((*x)[i] >= b ? 1.0 : 0.0) : std::clamp(((*x)[i] - a) / (b - a), 0.0, 1.0);
+        (*r)[i] = t * t * (3 - 2 * t);
+      }
+    }
+  } else if (kind == "ifgreater" || kind == "ifgreatereq" || kind == "ifequal") {
+    auto a = c("value1", "float", {1}), b = c("value2", "float", {0});
+    auto x = c("in1", type, {0}), y = c("in2", type, {0});
+    if (a && b && x && y) {
+      const bool take = kind == "ifgreater" ? (*a)[0] > (*b)[0] : kind == "ifgreatereq" ? (*a)[0] >= (*b)[0] : (*a)[0] == (*b)[0];
+      r = take ? *x : *y;
+    }
+  } else if (kind == "rotate2d") {
+    auto x = c("in", "vector2", {0, 0}), a = c("amount", "float", {0});
+    if (x && a) {
+      const double t = (*a)[0] * kPi / 180, cs = std::cos(t), sn = std::sin(t);
+      r = std::vector<double>{(*x)[0] * cs - (*x)[1] * sn, (*x)[0] * sn + (*x)[1] * cs};
+    }
+  }
+  if (r && std::all_of(r->begin(), r->end(), [](double v) { return std::isfinite(v); })) {
+    if (!frozen && frozenReads_ > readsBefore)
+      warn(node, fmt::format("{} has no value node: evaluated at import with the material inputs it reads at "
+                             "their values (changing them at run time does not change this)", kind));
+    return {mtlxLiteral(*r, type, ""), type};
+  }
+  if (frozen) return {Value(), type};
+  if (kind == "hsvtorgb") {
+    // rgb = v · vlerp(1, saturate(|x − 6| − 3| − 1), s) with x = 6h + (6, 4, 2): the triangle wave
+    // |fract(h + k)·6 − 3| folded with abs, exact for h in [−1/3, 1] (h is clamped there).
+    const Value hsv = namedValue(w_, std::string(str(node, "name")) + "_hsv", inputOf(node, "in", "color3", {0, 0, 0}, false, depth + 1).v);
+    const Value h = vclamp(swizzle(hsv, "x"), -1.0 / 3.0, 1.0);
+    const Value x = add(mul(swizzle(h, "xxx"), 6.0), literal3(6, 4, 2));
+    const Value tri = vabs(sub(vabs(sub(x, 6.0)), 3.0));
+    const Value rgb = mul(vlerp(literal3(1, 1, 1), saturate(sub(tri, 1.0)), swizzle(hsv, "y")), swizzle(hsv, "z"));
+    warn(node, "hsvtorgb: written with abs and clamp (exact for hue in [-1/3, 1]; hue is clamped to it)");
+    return {rgb, "color3"};
+  }
+  return bake(node, kind, type, fmt::format("{} has no value node and its inputs vary", kind));
+}
+
+MtlxValues::Typed MtlxValues::compute(pugi::xml_node node, const std::string& kind, const std::string& type,
+                                      const std::string& output, bool frozen, int depth) {
+  auto in = [&](const char* name, const std::string& t, std::vector<double> def) {
+    return inputOf(node, name, t, def, frozen, depth + 1).v;
+  };
+  auto varies = [&](std::initializer_list<Value> vs) {
+    if (!frozen) return false;
+    for (const auto& v : vs)
+      if (!literalOf(v)) return true;
+    return false;
+  };
+  const std::string T = type;
+  if (kind == "image" || kind == "tiledimage" || kind == "hextiledimage" || kind == "gltf_image" ||
+      kind == "gltf_colorimage" || kind == "gltf_normalmap")
+    return image(node, kind, type, output, frozen, depth);
+  if (isProcedural(kind)) {
+    if (frozen) return {Value(), type};
+    return bake(node, kind, type, fmt::format("the procedural {} has no value node", kind));
+  }
+  if (isFoldable(kind)) return bakeOrFold(node, kind, type, frozen, depth);
+  if (kind == "constant" || kind == "dot") {
+    const Value v = in(kind == "constant" ? "value" : "in", T, std::vector<double>(std::max(1, mtlxComponents(T)), 0.0));
+    return {v, T};
+  }
+  if (kind == "convert") {
+    pugi::xml_node i = node.find_child_by_attribute("input", "name", "in");
+    const std::string from = i ? str(i, "type") : T;
+    return {convertValue(in("in", from, {0}), from, T), T};
+  }
+  static const std::map<std::string, std::pair<std::string, double>> kBinary = {
+      {"add", {"add", 0}}, {"subtract", {"subtract", 0}}, {"multiply", {"multiply", 1}}, {"divide", {"divide", 1}},
+      {"min", {"min", 0}}, {"max", {"max", 0}}, {"power", {"pow", 1}}};
+  if (auto b = kBinary.find(kind); b != kBinary.end()) {
+    const Value a = in("in1", T, {0}), c = in("in2", T, {b->second.second});
+    if (varies({a, c})) return {Value(), T};
+    const std::string& op = b->second.first;
+    Value v = op == "add" ? add(a, c) : op == "subtract" ? sub(a, c) : op == "multiply" ? mul(a, c)
+              : op == "divide" ? divide(a, c) : op == "min" ? vmin(a, c) : op == "max" ? vmax(a, c) : vpow(a, c);
+    return {v, T};
+  }
+  if (kind == "mix") {
+    const Value fg = in("fg", T, {0}), bg = in("bg", T, {0}), m = in("mix", "float", {0});
+    if (varies({fg, bg, m})) return {Value(), T};
+    return {vlerp(bg, fg, m), T};
+  }
+  if (kind == "clamp") {
+    const Value x = in("in", T, {0}), lo = in("low", T, {0}), hi = in("high", T, {1});
+    if (varies({x, lo, hi})) return {Value(), T};
+    return {vclamp(x, lo, hi), T};
+  }
+  if (kind == "invert") {
+    const Value x = in("in", T, {0}), amount = in("amount", T, {1});
+    if (varies({x, amount})) return {Value(), T};
+    return {sub(amount, x), T};
+  }
+  if (kind == "absval" || kind == "sqrt" || kind == "normalize" || kind == "magnitude") {
+    pugi::xml_node i = node.find_child_by_attribute("input", "name", "in");
+    const Value x = in("in", i ? str(i, "type") : T, {0});
+    if (varies({x})) return {Value(), T};
+    if (kind == "absval") return {vabs(x), T};
+    if (kind == "sqrt") return {vsqrt(x), T};
+    if (kind == "normalize") return {vnormalize(x), T};
+    return {vlength(x), "float"};
+  }
+  if (kind == "dotproduct") {
+    pugi::xml_node i = node.find_child_by_attribute("input", "name", "in1");
+    const std::string it = i ? str(i, "type") : "vector3";
+    const Value a = in("in1", it, {0}), b = in("in2", it, {0});
+    if (varies({a, b})) return {Value(), "float"};
+    return {vdot(a, b), "float"};
+  }
+  if (kind == "remap") {
+    const Value x = in("in", T, {0}), il = in("inlow", T, {0}), ih = in("inhigh", T, {1}), ol = in("outlow", T, {0}),
+                oh = in("outhigh", T, {1});
+    if (varies({x, il, ih, ol, oh})) return {Value(), T};
+    return {add(ol, mul(divide(sub(x, il), sub(ih, il)), sub(oh, ol))), T};
+  }
+  if (kind == "luminance") {
+    const Value x = in("in", T, {0}), k = in("lumacoeffs", "color3", {0.2126, 0.7152, 0.0722});
+    if (varies({x, k})) return {Value(), T};
+    const Value y = vdot(mtlxComponents(T) == 4 ? swizzle(x, "xyz") : x, k);
+    return {mtlxComponents(T) == 4 ? combine({y, y, y, swizzle(x, "w")}) : swizzle(y, "xxx"), T};
+  }
+  if (kind == "combine2" || kind == "combine3" || kind == "combine4") {
+    const int n = kind.back() - '0';
+    std::vector<Value> parts;
+    for (int i = 0; i < n; ++i) {
+      const std::string name = "in" + std::to_string(i + 1);
+      pugi::xml_node ie = node.find_child_by_attribute("input", "name", name.c_str());
+      const std::string it = ie ? str(ie, "type") : "float";
+      const Value v = in(name.c_str(), it, {0});
+      if (mtlxComponents(it) == 1) {
+        parts.push_back(v);
+      } else {
+        for (int k = 0; k < mtlxComponents(it); ++k) parts.push_back(swizzle(v, std::string(1, "xyzw"[k])));
+      }
+    }
+    for (const auto& v : parts)
+      if (varies({v})) return {Value(), T};
+    if (static_cast<int>(parts.size()) != mtlxComponents(T)) {
+      error(node, fmt::format("{} builds {} components for a {}", kind, parts.size(), T));
+      return {Value(), T};
+    }
+    return {combine(parts), T};
+  }
+  if (kind == "extract" || kind == "separate2" || kind == "separate3" || kind == "separate4") {
+    pugi::xml_node ie = node.find_child_by_attribute("input", "name", "in");
+    const std::string it = ie ? str(ie, "type") : "vector3";
+    const Value x = in("in", it, {0});
+    if (varies({x})) return {Value(), "float"};
+    int index = 0;
+    if (kind == "extract") {
+      const auto k = literalOf(in("index", "integer", {0}));
+      index = k ? static_cast<int>((*k)[0]) : -1;
+    } else {
+      static const std::string names = "xyzwrgba";
+      const std::size_t at = output.size() == 4 ? names.find(output[3]) : std::string::npos;
+      index = at == std::string::npos ? -1 : static_cast<int>(at % 4);
+    }
+    if (index < 0 || index >= mtlxComponents(it)) {
+      error(node, fmt::format("{}: no channel {} of a {}", kind, kind == "extract" ? std::to_string(index) : output, it));
+      return {Value(), "float"};
+    }
+    return {swizzle(x, std::string(1, "xyzw"[index])), "float"};
+  }
+  if (kind == "swizzle") {  // MaterialX 1.38
+    pugi::xml_node ie = node.find_child_by_attribute("input", "name", "in");
+    const std::string it = ie ? str(ie, "type") : "color3";
+    const Value x = in("in", it, {0});
+    pugi::xml_node ch = node.find_child_by_attribute("input", "name", "channels");
+    std::string channels = ch ? str(ch, "value") : "";
+    if (channels.empty() || channels.find_first_not_of("xyzwrgba") != std::string::npos) {
+      error(node, fmt::format("swizzle channels '{}' (constant channels are not supported)", channels));
+      return {Value(), T};
+    }
+    if (varies({x})) return {Value(), T};
+    return {swizzle(x, channels), T};
+  }
+  if (kind == "normalmap") {
+    const Value x = in("in", "vector3", {0.5, 0.5, 1});
+    const Value s = in("scale", "float", {1});
+    if (varies({x, s})) return {Value(), "vector3"};
+    if (auto space = node.find_child_by_attribute("input", "name", "space"); space && str(space, "value") == "object")
+      warn(node, "an object-space normal map is read as a tangent-space one");
+    Value n = sub(mul(x, 2.0), 1.0);
+    if (!isLiteral(s, 1)) n = mul(n, combine({s, s, 1.0}));
+    return {vnormalize(n), "vector3"};
+  }
+  if (kind == "texcoord") {
+    if (frozen) return {Value(), T};
+    const auto k = literalOf(in("index", "integer", {0}));
+    int index = k ? static_cast<int>((*k)[0]) : 0;
+    if (index > 1) {
+      warn(node, fmt::format("texcoord index {}: a material reads uv0 and uv1 only; uv1 is used", index));
+      index = 1;
+    }
+    return {convertValue(geometry(index == 0 ? "uv0" : "uv1"), "vector2", T), T};
+  }
+  if (kind == "place2d") {
+    const Value uv = in("texcoord", "vector2", {});
+    const Value pivot = in("pivot", "vector2", {0, 0}), scale = in("scale", "vector2", {1, 1}),
+                offset = in("offset", "vector2", {0, 0});
+    const auto rotate = literalOf(in("rotate", "float", {0}));
+    if (frozen) return {Value(), T};
+    if (!rotate) {
+      error(node, "place2d: a varying rotation is not supported (the rotation must be a constant)");
+      return {Value(), T};
+    }
+    if (auto order = literalOf(in("operationorder", "integer", {0})); order && (*order)[0] != 0)
+      warn(node, "place2d operationorder TRS is applied as SRT");
+    // uv' = R(rotate) · ((uv − pivot) / scale) + pivot − offset, R counter-clockwise in degrees.
+    Value p = divide(sub(uv.is_null() ? geometry("uv0") : uv, pivot), scale);
+    if ((*rotate)[0] != 0) {
+      const double a = (*rotate)[0] * kPi / 180, c = std::cos(a), s = std::sin(a);
+      const Value pn = namedValue(w_, std::string(str(node, "name")) + "_scaled", p);
+      p = combine({sub(mul(swizzle(pn, "x"), c), mul(swizzle(pn, "y"), s)), add(mul(swizzle(pn, "x"), s), mul(swizzle(pn, "y"), c))});
+    }
+    return {sub(add(p, pivot), offset), T};
+  }
+  if (kind == "position" || kind == "normal" || kind == "tangent" || kind == "bitangent" || kind == "geomcolor") {
+    if (frozen) return {Value(), T};
+    const std::string space = str(node.find_child_by_attribute("input", "name", "space"), "value");
+    if (kind == "position") {
+      if (space != "world") warn(node, fmt::format("position in {} space: the world-space position is used", space.empty() ? "object" : space));
+      return {geometry("position"), T};
+    }
+    if (kind == "geomcolor") return {convertValue(geometry("vertex_color"), "vector4", T), T};
+    if (kind == "bitangent") return {Json::array({0.0, 1.0, 0.0}), T};
+    warn(node, fmt::format("the geometric {} is read in tangent space", kind));
+    return {geometry(kind), T};
+  }
+  static const char* const kShading[] = {"surface", "surfacematerial", "standard_surface", "open_pbr_surface",
+                                         "gltf_pbr", "UsdPreviewSurface", "disney_principled"};
+  if (std::find(std::begin(kShading), std::end(kShading), kind) != std::end(kShading) || type == "BSDF" ||
+      type == "EDF" || type == "VDF" || type == "surfaceshader") {
+    error(node, fmt::format("unsupported node '{}': a shader where a value is expected", kind));
+    return {Value(), T};
+  }
+  error(node, fmt::format("unsupported node '{}' (no Substrate value node or import rule for it)", kind));
+  return {Value(), T};
+}
+
+}  // namespace substratec::import

@@ -1,0 +1,23 @@
+// Importing a MaterialX document: every `surfacematerial` (after includes)
+// whose surface shader is one of the shading models below, mapped to
+// Substrate by that model's unit (mtlx_surfaces.h) and written as one
+// substrate-material/1 text. A shader node the document defines itself (a
+// `nodedef` with a node graph implementation) is followed into its graph. A
+// shading model, node or connection that cannot be imported is an error at
+// its line naming it; approximations are warnings naming the material.
+#pragma once
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "format/json_document.h"
+#include "import/material_writer.h"
+
+namespace substratec::import {
+
+/// Appends the materials of the MaterialX document `text` (from `fileName`;
+/// includes read from `baseDir`). False on any error.
+bool importMaterialXDocument(const std::string& text, const std::string& fileName, const std::string& baseDir,
+                             const ReadLimits& limits, Diagnostics& diags, std::vector<ImportedMaterial>* out);
+
+}  // namespace substratec::import

@@ -1,0 +1,443 @@
+// The importers (compiler/import/), read like their specification
+// (docs/import.md): the .glb container, the glTF and MaterialX errors (each
+// located), and the mapping formulas, checked on the closures the CPU
+// reference evaluates from the imported material at its inputs' defaults.
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "import/glb_container.h"
+#include "import/import.h"
+#include "pipeline/pipeline.h"
+#include "reference/reference.h"
+
+using namespace substratec;
+using namespace substratec::import;
+
+namespace {
+
+struct Imported {
+  std::optional<std::vector<ImportedMaterial>> materials;
+  std::string diags;
+};
+
+Imported importAs(SourceKind kind, const std::string& text, const std::string& file = "test") {
+  Diagnostics d(file);
+  Imported r;
+  r.materials = importText(kind, file, text, ".", ReadLimits{}, d);
+  r.diags = d.formatAll();
+  return r;
+}
+
+Imported gltf(const std::string& materialsJson, const std::string& rest = "") {
+  return importAs(SourceKind::Gltf, "{\"materials\": " + materialsJson + rest + "}", "t.gltf");
+}
+
+Imported mtlx(const std::string& body) {
+  return importAs(SourceKind::MaterialX, "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\">\n" + body + "</materialx>\n",
+                  "t.mtlx");
+}
+
+CompileResult compiled(const ImportedMaterial& m) {
+  Diagnostics d(m.name);
+  auto r = compileText(m.name, m.text, CompileOptions{}, d);
+  EXPECT_TRUE(r.has_value()) << d.formatAll() << m.text;
+  return r ? std::move(*r) : CompileResult{};
+}
+
+/// The closures of the material, evaluated by the CPU reference at a view
+/// along the normal, inputs at their defaults, textures at the constant 0.5.
+std::vector<reference::Closure<double>> closures(const ImportedMaterial& m, const CompileResult& r) {
+  (void)m;
+  reference::Geometry g;
+  const reference::TextureFn tex = [](int, double, double) { return std::array<double, 4>{0.5, 0.5, 0.5, 0.5}; };
+  return reference::evaluateMaterial<double>(r, g, {}, tex).closures;
+}
+
+void expectNear3(const std::array<double, 3>& a, double x, double y, double z, double tol = 1e-6) {
+  EXPECT_NEAR(a[0], x, tol);
+  EXPECT_NEAR(a[1], y, tol);
+  EXPECT_NEAR(a[2], z, tol);
+}
+
+std::string glb(const std::string& json, bool pad = true, std::uint32_t version = 2, int lengthDelta = 0) {
+  std::string chunk = json;
+  while (pad && chunk.size() % 4) chunk += ' ';
+  auto le = [](std::uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    return s;
+  };
+  std::string body = le(static_cast<std::uint32_t>(chunk.size())) + "JSON" + chunk;
+  return "glTF" + le(version) + le(static_cast<std::uint32_t>(12 + body.size() + lengthDelta)) + body;
+}
+
+}  // namespace
+
+// --- .glb -------------------------------------------------------------------
+
+TEST(Glb, TheJsonChunkOfAWellFormedContainerIsImported) {
+  const std::string json = R"({"asset": {"version": "2.0"}, "materials": [{"name": "red", "pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0, 1]}}]})";
+  Imported r = importAs(SourceKind::Glb, glb(json), "m.glb");
+  ASSERT_TRUE(r.materials) << r.diags;
+  ASSERT_EQ(r.materials->size(), 1u);
+  EXPECT_EQ((*r.materials)[0].name, "red");
+}
+
+TEST(Glb, EveryMalformedHeaderIsAnErrorAtItsByte) {
+  const std::string json = R"({"materials": [{}]})";
+  struct Case {
+    std::string bytes, message;
+  } cases[] = {
+      {"glTF", "byte 0: error: malformed .glb container: 4 bytes, shorter than the 12-byte header"},
+      {"glTX" + glb(json).substr(4), "byte 0: error: malformed .glb container: the magic is not \"glTF\""},
+      {glb(json, true, 1), "byte 4: error: malformed .glb container: version 1"},
+      {glb(json, true, 2, 4), "byte 8: error: malformed .glb container: the header says"},
+      {glb(json, false), "byte 12: error: malformed .glb container: chunk 0 is 19 bytes, not a multiple of 4"},
+  };
+  for (const auto& c : cases) {
+    Imported r = importAs(SourceKind::Glb, c.bytes, "m.glb");
+    EXPECT_FALSE(r.materials);
+    EXPECT_NE(r.diags.find(c.message), std::string::npos) << r.diags;
+  }
+  std::string truncated = glb(json);
+  truncated[12] = '\x7f';  // the chunk claims more than the file holds
+  Imported r = importAs(SourceKind::Glb, truncated, "m.glb");
+  EXPECT_NE(r.diags.find("chunk 0 claims 127 bytes"), std::string::npos) << r.diags;
+}
+
+// --- glTF errors and warnings ---------------------------------------------
+
+TEST(GltfImport, WrongValuesAreErrorsAtTheirPointer) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorFactor": [1, 0, 0]}},
+                   {"pbrMetallicRoughness": {"baseColorTexture": {"index": 3}}},
+                   {"alphaMode": "CUTOUT"}])");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("t.gltf: /materials/0/pbrMetallicRoughness/baseColorFactor: error: expected an array of 4 numbers"),
+            std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("/materials/1/pbrMetallicRoughness/baseColorTexture/index: error: expected the index of one of "
+                         "the document's 0 textures"), std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("/materials/2/alphaMode: error: expected \"OPAQUE\", \"MASK\" or \"BLEND\""), std::string::npos);
+  EXPECT_NE(gltf("3").diags.find("/materials: error: expected a \"materials\" array"), std::string::npos);
+}
+
+TEST(GltfImport, WhatCannotBeRepresentedIsAWarningNamingTheMaterial) {
+  Imported r = gltf(R"([{"name": "glass", "occlusionTexture": {"index": 0},
+                    "pbrMetallicRoughness": {"roughnessFactor": 1.5},
+                    "extensions": {"KHR_materials_dispersion": {"dispersion": 0.1}, "EXT_custom": {}}}])",
+               R"(, "textures": [{"source": 0}], "images": [{"uri": "ao.png"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  EXPECT_NE(r.diags.find("/materials/0/occlusionTexture: warning: material \"glass\": occlusionTexture: ambient occlusion"),
+            std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("/materials/0/pbrMetallicRoughness/roughnessFactor: warning: material \"glass\": roughnessFactor "
+                         "is 1.5, outside [0, 1]: clamped to 1"), std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("/materials/0/extensions/KHR_materials_dispersion: warning: material \"glass\": "
+                         "KHR_materials_dispersion: dispersion"), std::string::npos);
+  EXPECT_NE(r.diags.find("extension EXT_custom is not imported; ignored"), std::string::npos);
+}
+
+TEST(GltfImport, NamesBecomeUniqueIdentifiers) {
+  Imported r = gltf(R"([{"name": "Car Paint"}, {"name": "Car Paint"}, {}, {"name": "01 rust"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  EXPECT_EQ((*r.materials)[0].name, "Car_Paint");
+  EXPECT_EQ((*r.materials)[1].name, "Car_Paint_2");
+  EXPECT_EQ((*r.materials)[2].name, "material_2");
+  EXPECT_EQ((*r.materials)[3].name, "m_01_rust");
+  Diagnostics d("t.gltf");
+  EXPECT_EQ(pickMaterial(*r.materials, "Car Paint", d), &(*r.materials)[0]);  // by its source name
+  EXPECT_EQ(pickMaterial(*r.materials, "m_01_rust", d), &(*r.materials)[3]);  // or its identifier
+  EXPECT_EQ(pickMaterial(*r.materials, "", d), nullptr);
+  EXPECT_NE(d.formatAll().find("the file holds 4 materials; choose one with --material NAME:\n  Car_Paint (\"Car Paint\")"),
+            std::string::npos) << d.formatAll();
+}
+
+// --- glTF mapping -----------------------------------------------------------
+
+TEST(GltfImport, MetallicRoughnessGoesThroughTheMetalnessHelper) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.4, 0.2, 1], "metallicFactor": 0.25,
+                                             "roughnessFactor": 0.6}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  EXPECT_NE(m.text.find("\"metalness_to_diffuse_f0\""), std::string::npos);
+  EXPECT_NE(m.text.find("\"baseColorFactor\": {\n      \"type\": \"color\""), std::string::npos) << m.text;
+  const auto c = closures(m, compiled(m));
+  ASSERT_EQ(c.size(), 1u);
+  // diffuse = base (1 − m), F0 = lerp(0.04, base, m)
+  expectNear3(c[0].diffuseAlbedo, 0.8 * 0.75, 0.4 * 0.75, 0.2 * 0.75);
+  expectNear3(c[0].f0, 0.04 + (0.8 - 0.04) * 0.25, 0.04 + (0.4 - 0.04) * 0.25, 0.04 + (0.2 - 0.04) * 0.25);
+  EXPECT_NEAR(c[0].roughness, 0.6, 1e-6);
+}
+
+TEST(GltfImport, SpecularAndIorSetF0AndF90) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"metallicFactor": 0, "baseColorFactor": [0.5, 0.5, 0.5, 1]},
+                    "extensions": {"KHR_materials_ior": {"ior": 2.0},
+                                   "KHR_materials_specular": {"specularFactor": 0.5, "specularColorFactor": [1, 0.5, 4]}}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto c = closures((*r.materials)[0], compiled((*r.materials)[0]));
+  const double f0 = 1.0 / 9.0;  // ((2 − 1) / (2 + 1))²
+  // F0 = min(f0 · specularColor, 1) · specular; F90 = specular
+  expectNear3(c[0].f0, f0 * 0.5, f0 * 0.5 * 0.5, std::min(f0 * 4, 1.0) * 0.5);
+  expectNear3(c[0].f90, 0.5, 0.5, 0.5);
+}
+
+TEST(GltfImport, ClearcoatIsAVerticalCoatWithItsOwnNormal) {
+  Imported r = gltf(R"([{"normalTexture": {"index": 0}, "extensions": {"KHR_materials_clearcoat": {"clearcoatFactor": 0.5,
+                    "clearcoatRoughnessFactor": 0.1, "clearcoatNormalTexture": {"index": 1}}}}])",
+               R"(, "textures": [{"source": 0}, {"source": 1}], "images": [{"uri": "n.png"}, {"uri": "cn.png"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  const CompileResult res = compiled(m);
+  ASSERT_EQ(res.after.closures.size(), 2u);
+  EXPECT_NE(m.text.find("\"kind\": \"vertical\""), std::string::npos);
+  EXPECT_NE(m.text.find("\"kind\": \"coverage_weight\""), std::string::npos);  // weight 0.5 on the coat
+  EXPECT_NE(m.text.find("\"clearcoatNormalTexture\""), std::string::npos);
+  const auto c = closures(m, res);
+  // The coat: colourless dielectric, IOR 1.5 (F0 0.04), its own roughness.
+  bool coat = false;
+  for (const auto& k : c)
+    if (k.isTop && k.diffuseAlbedo[0] == 0) {
+      coat = true;
+      expectNear3(k.f0, 0.04, 0.04, 0.04);
+      EXPECT_NEAR(k.roughness, 0.1, 1e-6);
+    }
+  EXPECT_TRUE(coat);
+}
+
+TEST(GltfImport, SheenIsFuzzWithItsLargestChannelAsAmount) {
+  Imported r = gltf(R"([{"extensions": {"KHR_materials_sheen": {"sheenColorFactor": [0.8, 0.4, 0.2], "sheenRoughnessFactor": 0.3}}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto c = closures((*r.materials)[0], compiled((*r.materials)[0]));
+  EXPECT_NEAR(c[0].fuzzAmount, 0.8, 1e-6);
+  expectNear3(c[0].fuzzColor, 1.0, 0.5, 0.25);
+  EXPECT_NEAR(c[0].fuzzRoughness, 0.3, 1e-6);
+}
+
+TEST(GltfImport, TransmissionAndVolumeAreATranslucentSlabWithTheirTransmittance) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.9, 0.9, 0.9, 1], "metallicFactor": 0},
+                    "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                                   "KHR_materials_volume": {"thicknessFactor": 0.02, "attenuationDistance": 0.01,
+                                                            "attenuationColor": [0.5, 0.8, 1.0]}}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const CompileResult res = compiled((*r.materials)[0]);
+  EXPECT_EQ(res.material.settings.blendMode, BlendMode::TranslucentColored);
+  ASSERT_EQ(res.after.closures.size(), 1u);  // transmission 1 and no metal: the transmitting slab alone
+  reference::Geometry g;
+  const auto m = reference::evaluateMaterial<double>(res, g, {}, {});
+  // T = baseColor · attenuationColor^(thickness / distance), along the normal.
+  expectNear3(m.transmittance, 0.9 * 0.25, 0.9 * 0.64, 0.9, 1e-5);
+}
+
+TEST(GltfImport, AlphaModesChooseTheBlendModeAndCoverage) {
+  Imported r = gltf(R"([{"alphaMode": "MASK", "alphaCutoff": 0.3, "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.4]}},
+                   {"alphaMode": "MASK", "alphaCutoff": 0.3, "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.2]}},
+                   {"alphaMode": "BLEND", "pbrMetallicRoughness": {"baseColorFactor": [1, 1, 1, 0.25]}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const double expected[] = {1.0, 0.0, 0.25};
+  const BlendMode modes[] = {BlendMode::Masked, BlendMode::Masked, BlendMode::TranslucentGrey};
+  for (int i = 0; i < 3; ++i) {
+    const CompileResult res = compiled((*r.materials)[i]);
+    EXPECT_EQ(res.material.settings.blendMode, modes[i]);
+    reference::Geometry g;
+    EXPECT_NEAR(reference::evaluateMaterial<double>(res, g, {}, {}).coverage, expected[i], 1e-9) << i;
+  }
+}
+
+TEST(GltfImport, TextureTransformAndTexcoordSetsBecomeUvArithmetic) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0, "texCoord": 1,
+                    "extensions": {"KHR_texture_transform": {"offset": [0.5, 0.25], "scale": [2, 3]}}}}}])",
+               R"(, "textures": [{"source": 0}], "images": [{"uri": "c.png"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const CompileResult res = compiled((*r.materials)[0]);
+  reference::Geometry g;
+  g.uv1 = {0.1, 0.2};
+  double u = -1, v = -1;
+  const reference::TextureFn tex = [&](int, double a, double b) {
+    u = a;
+    v = b;
+    return std::array<double, 4>{0.5, 0.5, 0.5, 1};
+  };
+  reference::evaluateMaterial<double>(res, g, {}, tex);
+  EXPECT_NEAR(u, 0.1 * 2 + 0.5, 1e-12);  // uv1 · scale + offset
+  EXPECT_NEAR(v, 0.2 * 3 + 0.25, 1e-12);
+}
+
+TEST(GltfImport, AnisotropyMatchesGltfAlphasAlongTheRotatedTangent) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"roughnessFactor": 0.5},
+                    "extensions": {"KHR_materials_anisotropy": {"anisotropyStrength": 0.6, "anisotropyRotation": 1.5707963267948966}}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto c = closures((*r.materials)[0], compiled((*r.materials)[0]));
+  const double a = 0.25, at = a + (1 - a) * 0.36;  // alpha_t = mix(alpha, 1, strength²), alpha_b = alpha
+  const double r2 = c[0].roughness * c[0].roughness;
+  EXPECT_NEAR(r2 * (1 + c[0].anisotropy), at, 1e-9);
+  EXPECT_NEAR(r2 * (1 - c[0].anisotropy), a, 1e-9);
+  expectNear3(c[0].T_, 0, 1, 0, 1e-9);  // the tangent turned by 90 degrees
+}
+
+TEST(GltfImport, UnlitIsItsBaseColourEmitted) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1]}, "extensions": {"KHR_materials_unlit": {}}}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto c = closures((*r.materials)[0], compiled((*r.materials)[0]));
+  expectNear3(c[0].emissive, 0.2, 0.4, 0.6);
+  expectNear3(c[0].diffuseAlbedo, 0, 0, 0);
+  expectNear3(c[0].f0, 0, 0, 0);
+  expectNear3(c[0].f90, 0, 0, 0);
+}
+
+// --- MaterialX ----------------------------------------------------------------
+
+TEST(MaterialXImport, SyntaxErrorsAreAtTheirLineAndColumn) {
+  Imported r = importAs(SourceKind::MaterialX, "<?xml version=\"1.0\"?>\n<materialx>\n  <nodegraph name=\"a\">\n</materialx>\n", "t.mtlx");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("t.mtlx:4:"), std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("error: XML: "), std::string::npos) << r.diags;
+}
+
+TEST(MaterialXImport, AnUnsupportedNodeIsAnErrorNamingItAndItsLine) {
+  Imported r = mtlx(R"(  <nodegraph name="NG">
+    <my_custom_noise name="n1" type="float" />
+    <output name="out" type="float" nodename="n1" />
+  </nodegraph>
+  <standard_surface name="SR" type="surfaceshader">
+    <input name="specular_roughness" type="float" nodegraph="NG" output="out" />
+  </standard_surface>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR" />
+  </surfacematerial>
+)");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("t.mtlx:4:6: error: my_custom_noise 'n1' in nodegraph 'NG': unsupported node 'my_custom_noise'"),
+            std::string::npos) << r.diags;
+}
+
+TEST(MaterialXImport, BrokenConnectionsAndCyclesAreErrors) {
+  Imported r = mtlx(R"(  <nodegraph name="NG">
+    <multiply name="a" type="float"><input name="in1" type="float" nodename="b" /></multiply>
+    <multiply name="b" type="float"><input name="in1" type="float" nodename="a" /></multiply>
+    <output name="out" type="float" nodename="a" />
+  </nodegraph>
+  <standard_surface name="SR" type="surfaceshader">
+    <input name="specular_roughness" type="float" nodegraph="NG" output="out" />
+    <input name="base" type="float" nodegraph="NG" output="missing" />
+  </standard_surface>
+  <surfacematerial name="M" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR" />
+  </surfacematerial>
+  <surfacematerial name="N" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="nowhere" />
+  </surfacematerial>
+)");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("the node depends on itself (a cycle)"), std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("node graph 'NG' has no output 'missing'"), std::string::npos) << r.diags;
+  EXPECT_NE(r.diags.find("its surfaceshader 'nowhere' is not in the document"), std::string::npos) << r.diags;
+}
+
+TEST(MaterialXImport, StandardSurfaceParametersBecomeInputsNamedAfterThem) {
+  Imported r = mtlx(R"(  <standard_surface name="SR" type="surfaceshader">
+    <input name="base" type="float" value="0.5" />
+    <input name="base_color" type="color3" value="0.8, 0.6, 0.4" />
+    <input name="metalness" type="float" value="0" />
+    <input name="specular_roughness" type="float" value="0.3" />
+  </standard_surface>
+  <surfacematerial name="Paint" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR" />
+  </surfacematerial>
+)");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  for (const char* input : {"\"base\": {", "\"base_color\": {", "\"specular_roughness\": {"})
+    EXPECT_NE(m.text.find(input), std::string::npos) << input << "\n" << m.text;
+  EXPECT_EQ(m.text.find("\"metalness\": {"), std::string::npos);  // 0: a static switch, no metal
+  const auto c = closures(m, compiled(m));
+  expectNear3(c[0].diffuseAlbedo, 0.4, 0.3, 0.2);  // base · base_color
+  expectNear3(c[0].f0, 0.04, 0.04, 0.04);
+  EXPECT_NEAR(c[0].roughness, 0.3, 1e-6);
+}
+
+TEST(MaterialXImport, ImagesAreTextureInputsAndProceduralsAreBaked) {
+  Imported r = mtlx(R"(  <nodegraph name="NG">
+    <tiledimage name="img" type="color3">
+      <input name="file" type="filename" value="tex/wood_color.png" colorspace="srgb_texture" />
+      <input name="uvtiling" type="vector2" value="4, 2" />
+    </tiledimage>
+    <noise2d name="grain" type="float" />
+    <multiply name="m" type="color3">
+      <input name="in1" type="color3" nodename="img" />
+      <input name="in2" type="float" nodename="grain" />
+    </multiply>
+    <output name="out" type="color3" nodename="m" />
+  </nodegraph>
+  <standard_surface name="SR" type="surfaceshader">
+    <input name="base_color" type="color3" nodegraph="NG" output="out" />
+  </standard_surface>
+  <surfacematerial name="Wood" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR" />
+  </surfacematerial>
+)");
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  EXPECT_NE(m.text.find("\"wood_color\": {\n      \"type\": \"texture2d\",\n      \"colorspace\": \"srgb\""),
+            std::string::npos) << m.text;
+  EXPECT_NE(m.text.find("\"grain_baked\""), std::string::npos);
+  EXPECT_NE(r.diags.find("t.mtlx:8:6: warning: material \"Wood\": noise2d 'grain' in nodegraph 'NG': the procedural noise2d "
+                         "has no value node: replaced by the texture input 'grain_baked'"),
+            std::string::npos) << r.diags;
+  const CompileResult res = compiled(m);
+  reference::Geometry g;
+  g.uv0 = {0.1, 0.3};
+  std::vector<std::array<double, 2>> uvs;
+  const reference::TextureFn tex = [&](int, double u, double v) {
+    uvs.push_back({u, v});
+    return std::array<double, 4>{0.5, 0.5, 0.5, 1};
+  };
+  reference::evaluateMaterial<double>(res, g, {}, tex);
+  bool tiled = false;
+  for (const auto& uv : uvs) tiled |= std::fabs(uv[0] - 0.4) < 1e-12 && std::fabs(uv[1] - 0.6) < 1e-12;
+  EXPECT_TRUE(tiled);  // uv · uvtiling
+}
+
+TEST(MaterialXImport, AMissingIncludeIsAnErrorAtTheInclude) {
+  Imported r = mtlx("  <xi:include href=\"nowhere.mtlx\" />\n");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("t.mtlx:3:4: error: xi:include 'nowhere.mtlx':"), std::string::npos) << r.diags;
+}
+
+TEST(MaterialXImport, DeepGraphsAndIncludeCyclesAreErrorsNotCrashes) {
+  std::string graph = "  <nodegraph name=\"NG\">\n";
+  for (int i = 0; i < 2000; ++i)
+    graph += "    <multiply name=\"m" + std::to_string(i) + "\" type=\"float\"><input name=\"in1\" type=\"float\" " +
+             (i + 1 < 2000 ? "nodename=\"m" + std::to_string(i + 1) + "\"" : std::string("value=\"1\"")) + " /></multiply>\n";
+  graph += "    <output name=\"out\" type=\"float\" nodename=\"m0\" />\n  </nodegraph>\n";
+  Imported deep = mtlx(graph + R"(  <standard_surface name="SR" type="surfaceshader">
+    <input name="specular_roughness" type="float" nodegraph="NG" output="out" />
+  </standard_surface>
+  <surfacematerial name="M" type="material"><input name="surfaceshader" type="surfaceshader" nodename="SR" /></surfacematerial>
+)");
+  EXPECT_FALSE(deep.materials);
+  EXPECT_NE(deep.diags.find("the graph is deeper than 256 nodes"), std::string::npos) << deep.diags.substr(0, 400);
+
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("substratec_include_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const char* head = "<?xml version=\"1.0\"?>\n<materialx version=\"1.39\" xmlns:xi=\"http://www.w3.org/2001/XInclude\">\n";
+  std::ofstream(dir / "a.mtlx") << head << "  <xi:include href=\"b.mtlx\" />\n</materialx>\n";
+  std::ofstream(dir / "b.mtlx") << head << "  <xi:include href=\"a.mtlx\" />\n</materialx>\n";
+  Diagnostics d("a.mtlx");
+  auto r = importFile((dir / "a.mtlx").string(), ReadLimits{}, d);
+  EXPECT_FALSE(r);
+  EXPECT_NE(d.formatAll().find("a.mtlx:3:4: error: xi:include 'b.mtlx': a file that is already being read (a cycle of includes)"),
+            std::string::npos) << d.formatAll();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GltfImport, ATextureWithoutAnImageIsAnError) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])", R"(, "textures": [{"source": 2}], "images": [])");
+  EXPECT_FALSE(r.materials);
+  EXPECT_NE(r.diags.find("t.gltf: /textures/0/source: error: expected the index of one of the document's 0 images"),
+            std::string::npos) << r.diags;
+}
