@@ -27,6 +27,10 @@ struct EmitOptions {
   /// per-sample inputs, `substratec stability`) assigns them before calling
   /// `<name>_evaluate`. Same names as the block, so the body is unchanged.
   bool inputsPerInvocation = false;
+  /// The pack function stores a pixel where one plain closure is left in the
+  /// SIMPLE layout (storage/layout.h, runtimeSimpleClosures). Off only to
+  /// compare with the static layout (tests).
+  bool dynamicSimplification = true;
 };
 
 /// `<name>.material.glsl` / `.hlsl`.
