@@ -8,6 +8,7 @@ PACKAGES=(
   nlohmann-json3-dev libfmt-dev libcli11-dev libgtest-dev libbenchmark-dev
   glslang-dev glslang-tools spirv-tools
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools libpng-dev
+  libxxhash-dev
 )
 
 missing=()

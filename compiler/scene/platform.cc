@@ -72,6 +72,17 @@ std::optional<std::uint16_t> parseFeatureList(const Json& list, const std::strin
   return mask;
 }
 
+std::optional<PlatformTable> loadPlatformTable(const std::string& platformsFile, const ReadLimits& limits,
+                                               std::string& messages) {
+  PlatformTable t = PlatformTable::builtin();
+  if (platformsFile.empty()) return t;
+  Diagnostics d(platformsFile);
+  const bool ok = t.applyFile(platformsFile, limits, d);
+  messages += d.formatAll();
+  if (!ok) return std::nullopt;
+  return t;
+}
+
 bool PlatformTable::applyFile(const std::string& path, const ReadLimits& limits, Diagnostics& diags) {
   auto text = readSourceFile(path, limits, diags);
   return text && applyText(*text, limits, diags);

@@ -58,6 +58,11 @@ class PlatformTable {
   std::vector<Platform> platforms_;
 };
 
+/// The built-in table extended by `platformsFile` ("" for none). nullopt when
+/// the file has errors; its diagnostics are appended to `messages`.
+std::optional<PlatformTable> loadPlatformTable(const std::string& platformsFile, const ReadLimits& limits,
+                                               std::string& messages);
+
 /// Parses a list of feature names (a JSON array of strings) at `pointer`
 /// into feature bits; unknown names are errors listing the known ones.
 std::optional<std::uint16_t> parseFeatureList(const Json& list, const std::string& pointer, Diagnostics& diags);
