@@ -14,46 +14,25 @@
 
 #include "batch/cache.h"
 #include "cli/cli.h"
+#include "cli_util.h"
 
 namespace fs = std::filesystem;
 using substratec::runCli;
+using substratec::clitest::cli;
+using substratec::clitest::CliResult;
+using substratec::clitest::filesOf;
+using substratec::clitest::slurp;
 
 namespace {
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
-struct CliResult {
-  int status;
-  std::string out, err;
-};
-
-CliResult cli(std::vector<std::string> args) {
-  std::ostringstream out, err;
-  int status = runCli(args, out, err);
-  return {status, out.str(), err.str()};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 void spit(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
 fs::path freshDir(const std::string& name) {
-  fs::path d = fs::path(SUBSTRATEC_WORK_DIR) / "pipeline" / name;
-  fs::remove_all(d);
+  fs::path d = substratec::clitest::freshDir("pipeline", name);
   fs::create_directories(d);
   return d;
-}
-
-std::map<std::string, std::string> filesOf(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::directory_iterator(dir))
-    if (e.is_regular_file()) files[e.path().filename().string()] = slurp(e.path());
-  return files;
 }
 
 std::vector<fs::path> cacheEntries(const fs::path& cache) {

@@ -10,37 +10,23 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
+#include "cli_util.h"
 #include "validate/runtime_files.h"
 #include "validate/shader_validate.h"
 
 namespace fs = std::filesystem;
 using substratec::runCli;
+using substratec::clitest::cli;
+using substratec::clitest::CliResult;
+using substratec::clitest::filesOf;
+using substratec::clitest::slurp;
 
 namespace {
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
-struct CliResult {
-  int status;
-  std::string out, err;
-};
-
-CliResult cli(std::vector<std::string> args) {
-  std::ostringstream out, err;
-  int status = runCli(args, out, err);
-  return {status, out.str(), err.str()};
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 fs::path freshDir(const std::string& name) {
-  fs::path d = fs::path(SUBSTRATEC_WORK_DIR) / "scene" / name;
-  fs::remove_all(d);
+  fs::path d = substratec::clitest::freshDir("scene", name);
   return d;
 }
 
@@ -48,11 +34,6 @@ std::string scene(const char* name) { return (kSource / "examples" / "scenes" / 
 
 nlohmann::json sceneJson(const fs::path& dir) { return nlohmann::json::parse(slurp(dir / "scene.json")); }
 
-std::map<std::string, std::string> filesOf(const fs::path& dir) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : fs::directory_iterator(dir)) files[e.path().filename().string()] = slurp(e.path());
-  return files;
-}
 
 /// OpLoopMerge (246) instructions in a SPIR-V module.
 std::size_t loops(const std::vector<uint32_t>& w) {

@@ -37,6 +37,10 @@ struct EmitOptions {
 std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayout& layout, const Syntax& syn,
                          const EmitOptions& options);
 
+/// `#define SUBSTRATE_USE_<FEATURE> 0|1` for each runtime switch
+/// (runtime_shaders/substrate_closure.h), 1 for the kFeat* bits of `features`.
+std::string useDefines(std::uint16_t features);
+
 /// Names used across emitted files.
 std::string materialUpper(const Material& m);  // NAME in macros
 

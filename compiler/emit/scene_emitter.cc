@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "emit/material_emitter.h"
+
 namespace substratec {
 
 namespace {
@@ -20,20 +22,6 @@ const SceneLightingClass& targetOf(const SceneShape& s, LayoutClass c) {
   for (const SceneLightingClass& k : s.classes)
     if (rank(k.cls) >= rank(c)) return k;
   return s.classes.back();
-}
-
-std::string useDefines(std::uint16_t features) {
-  std::string s;
-  auto use = [&](const char* macro, bool on) { s += fmt::format("#define {} {}\n", macro, on ? 1 : 0); };
-  use("SUBSTRATE_USE_F90", features & kFeatF90);
-  use("SUBSTRATE_USE_ANISOTROPY", features & kFeatAnisotropy);
-  use("SUBSTRATE_USE_HAZE", features & kFeatHaze);
-  use("SUBSTRATE_USE_FUZZ", features & kFeatFuzz);
-  use("SUBSTRATE_USE_SSS", features & kFeatSss);
-  use("SUBSTRATE_USE_GLINT", features & kFeatGlint);
-  use("SUBSTRATE_USE_SPECULAR_PROFILE", features & kFeatSpecularProfile);
-  s += "#define SUBSTRATE_USE_EMISSIVE 0  // the base pass adds emissive\n";
-  return s;
 }
 
 std::string featureNames(std::uint16_t mask) {
@@ -206,7 +194,7 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
       "// Stored features: {}; at most {} closure(s) and {} word(s) a pixel. Bindings: compiler/emit/scene_emitter.h.\n",
       scene.name, layoutClassName(k.cls), layoutClassName(k.cls), materialList(k.materials), featureNames(k.features),
       k.maxClosures, k.maxWords);
-  s += useDefines(k.features);
+  s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
   s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", scene.diffuseModel);
   s += fmt::format("#define SUBSTRATE_MAX_CLOSURES {}\n", k.maxClosures);
   s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", k.maxWords);
