@@ -133,8 +133,9 @@ TEST(Scene, EveryExampleGivesTheUnionOfFeaturesAndTheLargestMaterialBuffer) {
 }
 
 TEST(Scene, APlatformSimplifiesEveryMaterialForIt) {
-  const fs::path dir = freshDir("mobile");
-  CliResult r = cli({"scene", scene("all_examples.json"), "-o", dir.string(), "--platform", "mobile", "--target", "glsl"});
+  const fs::path dir = freshDir("mobile"), cache = freshDir("mobile_cache");
+  CliResult r = cli({"scene", scene("all_examples.json"), "-o", dir.string(), "--platform", "mobile", "--target", "glsl",
+                     "--cache", cache.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   const auto j = sceneJson(dir);
   EXPECT_EQ(j["platform"]["name"], "mobile");
@@ -147,14 +148,19 @@ TEST(Scene, APlatformSimplifiesEveryMaterialForIt) {
   }
   // The manifest's own platform gives the same materials.
   const fs::path own = freshDir("mobile_examples");
-  ASSERT_EQ(cli({"scene", scene("mobile_examples.json"), "-o", own.string(), "--target", "glsl"}).status, 0);
+  ASSERT_EQ(cli({"scene", scene("mobile_examples.json"), "-o", own.string(), "--target", "glsl", "--cache",
+                 cache.string()}).status,
+            0);
   EXPECT_EQ(sceneJson(own)["materials"].dump(), j["materials"].dump());
   // A project's platforms file adds one.
   const fs::path handheld = freshDir("handheld");
-  r = cli({"scene", scene("all_examples.json"), "-o", handheld.string(), "--platform", "handheld", "--platforms",
+  r = cli({"scene", scene("street.json"), "-o", handheld.string(), "--platform", "handheld", "--platforms",
            (kSource / "examples" / "platforms" / "studio.json").string(), "--target", "glsl"});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_LE(sceneJson(handheld)["max_bytes_per_pixel"].get<int>(), 28);
+  const auto h = sceneJson(handheld);
+  EXPECT_EQ(h["platform"]["bytes_per_pixel"], 28);
+  EXPECT_LE(h["max_bytes_per_pixel"].get<int>(), 28);
+  EXPECT_EQ(h["max_closures"], 1);
 }
 
 TEST(Scene, TheOutputIsTheSameWhateverJobsCompileIt) {
