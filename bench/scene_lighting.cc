@@ -23,7 +23,11 @@
 //   floor (Karis), floor (tables)       bench/shaders/minimal_ggx_lambert.comp over as many
 //                                       invocations (its shading point is hashed, no G-buffer)
 //
-// Usage: scene_lighting [--size N] [--runs N] [--source DIR]
+// Usage: scene_lighting [--size N] [--runs N] [--source DIR] [--dump DIR] [--extra DIR]
+//   --dump DIR   writes the timed scene shaders to DIR
+//   --extra DIR  also times every DIR/*.comp as a lighting shader over the
+//                simple scene's G-buffer (every tile listed under every class),
+//                e.g. a dumped shader edited by hand
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -184,13 +188,15 @@ gpu::TileLists everyTileAs(const gpu::SceneFrame& f, LayoutClass cls) {
 int main(int argc, char** argv) {
   uint32_t size = 1024;
   int runs = 9;
-  std::string source = SUBSTRATEC_SOURCE_DIR;
+  std::string source = SUBSTRATEC_SOURCE_DIR, dump, extra;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--size" && i + 1 < argc) size = static_cast<uint32_t>(std::atoi(argv[++i]));
+    if (a == "--dump" && i + 1 < argc) dump = argv[++i];
+    else if (a == "--extra" && i + 1 < argc) extra = argv[++i];
+    else if (a == "--size" && i + 1 < argc) size = static_cast<uint32_t>(std::atoi(argv[++i]));
     else if (a == "--runs" && i + 1 < argc) runs = std::atoi(argv[++i]);
     else if (a == "--source" && i + 1 < argc) source = argv[++i];
-    else die("usage: scene_lighting [--size N] [--runs N] [--source DIR]");
+    else die("usage: scene_lighting [--size N] [--runs N] [--source DIR] [--dump DIR] [--extra DIR]");
   }
   if (size < 8 || size > 4096 || runs < 1) die("--size in [8, 4096], --runs >= 1");
   std::string error;
@@ -219,6 +225,12 @@ int main(int argc, char** argv) {
   for (const SceneLightingClass& k : all.shape.classes) {
     const std::string f = sceneLightingFileName(all.shape, k.cls, glsl);
     shaders[f] = sceneShader(all, f);
+  }
+  if (!dump.empty()) {
+    fs::create_directories(dump);
+    for (const BuiltScene* s : {&simple, &all})
+      for (const auto& [name, text] : s->files)
+        if (name.find(".lighting_") != std::string::npos) std::ofstream(fs::path(dump) / name) << text;
   }
   const std::string classifyFile = tileClassificationFileName(all.shape, glsl);
   shaders[classifyFile] = sceneShader(all, classifyFile);
@@ -258,6 +270,27 @@ int main(int argc, char** argv) {
   }
   lighting(timed("`all_examples`: `lighting_special` on every tile (no classification)", shaders[specialFile]),
            shaders[specialFile], allG, everyTileAs(frame, LayoutClass::Special), LayoutClass::Special);
+
+  // --extra: each DIR/*.comp over the simple G-buffer, every tile under every class.
+  std::vector<Compiled> extras;
+  if (!extra.empty()) {
+    gpu::TileLists every = everyTileAs(frame, LayoutClass::Simple);
+    for (int c = 1; c < 4; ++c)
+      std::copy(every.raw.begin(), every.raw.begin() + frame.tiles(), every.raw.begin() + c * frame.tiles());
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(extra))
+      if (e.path().extension() == ".comp") files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    extras.reserve(files.size());
+    for (const fs::path& f : files) {
+      extras.push_back(compile(*ctx, f.filename().string(), readAll(f)));
+      Timed* t = timed("extra: " + f.filename().string() + ", on the simple scene's pixels", extras.back());
+      t->dispatches.push_back({extras.back().pipeline.get(), gpu::lightingResources(*extras.back().pipeline, frame,
+                                                                                    simpleG, every),
+                               frame.tiles(), 1});
+      t->pixels = 64.0 * frame.tiles();
+    }
+  }
 
   // The hand-written floor over as many invocations, with row12_simple's parameters.
   const std::string floorText = readAll(source + "/bench/shaders/minimal_ggx_lambert.comp");
