@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Scene lighting cost on lavapipe (issue 9; docs/performance.md, "Scene lighting").
+# Scene lighting cost on lavapipe (issue 9; docs/performance.md, "Scene lighting cost").
 # Works from any directory: builds the scene_lighting target (configuring the
 # build directory if needed), prints the machine, then runs build/bin/scene_lighting,
 # which prints one markdown table: the simple-only scene's lighting, the
