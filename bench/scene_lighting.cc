@@ -1,5 +1,5 @@
 // Scene lighting cost on lavapipe (issue 9, docs/performance.md "Scene
-// lighting"): what the deferred lighting `substratec scene` emits costs per
+// lighting cost"): what the deferred lighting `substratec scene` emits costs per
 // pixel for a scene of simple materials and for the scene of every example,
 // against the hand-written minimal GGX + Lambert kernel. Not a test;
 // bench/scene_lighting.sh builds and runs it.
