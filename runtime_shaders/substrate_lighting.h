@@ -42,6 +42,12 @@ mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
   return SUBSTRATE_MSPLAT3(1.0);
 }
 
+// Dynamic culling: false when the closure's weight is 0 (or not a number) at
+// this pixel, so the lighting skips it (its contribution would be 0).
+bool substrate_closure_visible(SubstrateClosure c) {
+  return c.weight > 0.0;
+}
+
 // Along the view: c.weight * substrate_closure_above_throughput(c, NoV) (the
 // weight clamped to half's range in half precision).
 mfloat3 substrate_closure_view_throughput(SubstrateClosure c, float NoV) {
@@ -57,8 +63,12 @@ mfloat3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
 // One closure lit by one light of radiance `radiance` (the light's radiance
 // times its solid angle / attenuation, i.e. what multiplies BSDF * NoL):
 // view throughput * light throughput * BSDF * NoL * radiance. Emissive is not
-// added here (the base pass adds it once).
+// added here (the base pass adds it once). A closure whose weight is 0 at this
+// pixel (a mix or a coverage that hides it) is skipped: nothing is evaluated.
 float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 radiance) {
+  if (!substrate_closure_visible(c)) {
+    return SUBSTRATE_SPLAT3(0.0);
+  }
   float3 N = substrate_closure_normal(c);
   float3 f = substrate_eval_closure(c, V, L);
   mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V)) * substrate_closure_light_throughput(c, dot(N, L));
@@ -67,7 +77,8 @@ float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 ra
 
 // The deferred light loop over the unpacked closures of a pixel. The optional
 // lobes branch on each closure's feature bits inside substrate_eval_closure,
-// so pixels without a feature never run its code.
+// so pixels without a feature never run its code; closures of weight 0 are
+// skipped (substrate_light_closure).
 float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES], uint count, float3 V, float3 L,
                                 float3 radiance) {
   float3 sum = SUBSTRATE_SPLAT3(0.0);

@@ -5,6 +5,106 @@
 #ifndef SUBSTRATE_UNPACK_H
 #define SUBSTRATE_UNPACK_H 1
 
+// The fields of one closure that follow its header bits, from stream bit
+// `pos` (advanced past them), into `c` (initialized by the caller): albedo,
+// F0, roughness, then weight, top transmittance, coverage above and the
+// feature data its bits announce (docs/storage.md, "Order of fields").
+// A feature compiled out (SUBSTRATE_USE_* 0: a lighting pass specialized to a
+// scene that never stores it) is skipped, not decoded, so the stream stays
+// aligned whatever it holds.
+void substrate_unpack_closure_fields(uint words[SUBSTRATE_MAX_WORDS], inout uint pos, uint feats, uint sss, bool isTop,
+                                     inout SubstrateClosure c) {
+  c.features = feats;
+  c.isTop = isTop;
+  c.sssType = sss;
+  c.coverageAbove = isTop ? 0.0 : 1.0;
+  c.diffuseAlbedo = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
+  pos += SUBSTRATE_BITS_COLOR;
+  c.f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
+  pos += SUBSTRATE_BITS_COLOR;
+  c.roughness = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ROUGHNESS), 8u);
+  pos += SUBSTRATE_BITS_ROUGHNESS;
+  if ((feats & SUBSTRATE_FEATURE_WEIGHT) != 0u) {
+    c.weight = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_WEIGHT), 8u);
+    pos += SUBSTRATE_BITS_WEIGHT;
+  }
+  if (!isTop) {
+    c.topTransmittance = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
+    pos += SUBSTRATE_BITS_COLOR;
+  }
+  if ((feats & SUBSTRATE_FEATURE_COVERAGE_ABOVE) != 0u) {
+    c.coverageAbove = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COVERAGE_ABOVE), 8u);
+    pos += SUBSTRATE_BITS_COVERAGE_ABOVE;
+  }
+  if ((feats & SUBSTRATE_FEATURE_F90) != 0u) {
+#if SUBSTRATE_USE_F90
+    c.f90 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
+#endif
+    pos += SUBSTRATE_BITS_COLOR;
+  }
+  if (sss != SUBSTRATE_SSS_NONE) {
+#if SUBSTRATE_USE_SSS
+    float3 mfp;
+    float phase;
+    substrate_dq_sss(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_SSS), mfp, phase);
+    c.sssMfp = mfp;
+    c.sssPhaseAnisotropy = phase;
+#else
+    c.sssType = SUBSTRATE_SSS_NONE;
+#endif
+    pos += SUBSTRATE_BITS_SSS;
+  }
+  if ((feats & SUBSTRATE_FEATURE_HAZE) != 0u) {
+#if SUBSTRATE_USE_HAZE
+    float r2;
+    float w2;
+    substrate_dq_haze(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_HAZE), r2, w2);
+    c.secondRoughness = r2;
+    c.secondRoughnessWeight = w2;
+#endif
+    pos += SUBSTRATE_BITS_HAZE;
+  }
+  if ((feats & SUBSTRATE_FEATURE_FUZZ) != 0u) {
+#if SUBSTRATE_USE_FUZZ
+    float fa;
+    float3 fc;
+    float fr;
+    substrate_dq_fuzz(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_FUZZ), fa, fc, fr);
+    c.fuzzAmount = fa;
+    c.fuzzColor = fc;
+    c.fuzzRoughness = fr;
+#endif
+    pos += SUBSTRATE_BITS_FUZZ;
+  }
+  if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
+#if SUBSTRATE_USE_ANISOTROPY
+    c.anisotropy = substrate_dq_anisotropy(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ANISOTROPY));
+#endif
+    pos += SUBSTRATE_BITS_ANISOTROPY;
+  }
+  if ((feats & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u) {
+#if SUBSTRATE_USE_SPECULAR_PROFILE
+    c.specularProfile = substrate_dq_specular_profile(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_SPECULAR_PROFILE));
+#endif
+    pos += SUBSTRATE_BITS_SPECULAR_PROFILE;
+  }
+  if ((feats & SUBSTRATE_FEATURE_GLINT) != 0u) {
+#if SUBSTRATE_USE_GLINT
+    uint density = SUBSTRATE_READ_BITS(words, pos, 8u);
+    uint4 rest = uint4(SUBSTRATE_READ_BITS(words, pos + 8u, 32u), SUBSTRATE_READ_BITS(words, pos + 40u, 32u),
+                       SUBSTRATE_READ_BITS(words, pos + 72u, 32u), SUBSTRATE_READ_BITS(words, pos + 104u, 32u));
+    float gv;
+    float2 guv;
+    float4 gd;
+    substrate_dq_glint(density, rest, gv, guv, gd);
+    c.glintValue = gv;
+    c.glintUv = guv;
+    c.glintUvDerivatives = gd;
+#endif
+    pos += SUBSTRATE_BITS_GLINT;
+  }
+}
+
 // Reads a pixel's closures from the stream alone (docs/storage.md, "Order of
 // fields"): the header gives the closure and basis counts (one closure and
 // one basis for a single-closure header), each closure header its basis, is-top,
@@ -57,82 +157,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
         basisAniso[basis] = true;
       }
-      closures[i].features = feats;
-      closures[i].isTop = isTop;
-      closures[i].sssType = sss;
-      closures[i].coverageAbove = isTop ? 0.0 : 1.0;
-
-      closures[i].diffuseAlbedo = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
-      pos += SUBSTRATE_BITS_COLOR;
-      closures[i].f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
-      pos += SUBSTRATE_BITS_COLOR;
-      closures[i].roughness = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ROUGHNESS), 8u);
-      pos += SUBSTRATE_BITS_ROUGHNESS;
-      if ((feats & SUBSTRATE_FEATURE_WEIGHT) != 0u) {
-        closures[i].weight = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_WEIGHT), 8u);
-        pos += SUBSTRATE_BITS_WEIGHT;
-      }
-      if (!isTop) {
-        closures[i].topTransmittance = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
-        pos += SUBSTRATE_BITS_COLOR;
-      }
-      if ((feats & SUBSTRATE_FEATURE_COVERAGE_ABOVE) != 0u) {
-        closures[i].coverageAbove =
-            substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COVERAGE_ABOVE), 8u);
-        pos += SUBSTRATE_BITS_COVERAGE_ABOVE;
-      }
-      if ((feats & SUBSTRATE_FEATURE_F90) != 0u) {
-        closures[i].f90 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
-        pos += SUBSTRATE_BITS_COLOR;
-      }
-      if (sss != SUBSTRATE_SSS_NONE) {
-        float3 mfp;
-        float phase;
-        substrate_dq_sss(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_SSS), mfp, phase);
-        closures[i].sssMfp = mfp;
-        closures[i].sssPhaseAnisotropy = phase;
-        pos += SUBSTRATE_BITS_SSS;
-      }
-      if ((feats & SUBSTRATE_FEATURE_HAZE) != 0u) {
-        float r2;
-        float w2;
-        substrate_dq_haze(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_HAZE), r2, w2);
-        closures[i].secondRoughness = r2;
-        closures[i].secondRoughnessWeight = w2;
-        pos += SUBSTRATE_BITS_HAZE;
-      }
-      if ((feats & SUBSTRATE_FEATURE_FUZZ) != 0u) {
-        float fa;
-        float3 fc;
-        float fr;
-        substrate_dq_fuzz(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_FUZZ), fa, fc, fr);
-        closures[i].fuzzAmount = fa;
-        closures[i].fuzzColor = fc;
-        closures[i].fuzzRoughness = fr;
-        pos += SUBSTRATE_BITS_FUZZ;
-      }
-      if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
-        closures[i].anisotropy = substrate_dq_anisotropy(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ANISOTROPY));
-        pos += SUBSTRATE_BITS_ANISOTROPY;
-      }
-      if ((feats & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u) {
-        closures[i].specularProfile =
-            substrate_dq_specular_profile(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_SPECULAR_PROFILE));
-        pos += SUBSTRATE_BITS_SPECULAR_PROFILE;
-      }
-      if ((feats & SUBSTRATE_FEATURE_GLINT) != 0u) {
-        uint density = SUBSTRATE_READ_BITS(words, pos, 8u);
-        uint4 rest = uint4(SUBSTRATE_READ_BITS(words, pos + 8u, 32u), SUBSTRATE_READ_BITS(words, pos + 40u, 32u),
-                           SUBSTRATE_READ_BITS(words, pos + 72u, 32u), SUBSTRATE_READ_BITS(words, pos + 104u, 32u));
-        float gv;
-        float2 guv;
-        float4 gd;
-        substrate_dq_glint(density, rest, gv, guv, gd);
-        closures[i].glintValue = gv;
-        closures[i].glintUv = guv;
-        closures[i].glintUvDerivatives = gd;
-        pos += SUBSTRATE_BITS_GLINT;
-      }
+      substrate_unpack_closure_fields(words, pos, feats, sss, isTop, closures[i]);
     }
   }
 
@@ -167,6 +192,39 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
     }
   }
   return count;
+}
+
+// A pixel whose material header is a single-closure one (bit 15 clear:
+// SIMPLE and SINGLE layouts, and COMPLEX or SPECIAL ones with one closure),
+// without the loops of substrate_unpack_material: its one closure, normal
+// from the top-layer word, tangent from the stored angle when anisotropic.
+void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLayer, out SubstrateClosure c) {
+  substrate_closure_init(c);
+  uint header = words[0] & 0xffffu;
+  uint feats = (header >> 2u) & 0x7fu;
+  uint pos = SUBSTRATE_BITS_HEADER;
+  substrate_unpack_closure_fields(words, pos, feats, (header >> 10u) & 3u, true, c);
+  float topRoughness;
+  substrate_dq_top_layer(topLayer, c.N, topRoughness);
+  float3 b0;
+  substrate_pack_frame(c.N, c.T, b0);
+#if SUBSTRATE_USE_ANISOTROPY
+  if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
+    c.T = substrate_tangent_angle_decode(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_TANGENT_ANGLE), c.N);
+  }
+#endif
+}
+
+// A pixel in the SIMPLE layout (class bits 0): the header is known, so the
+// three fields are read at their fixed offsets (16, 36, 56); the normal is the
+// top-layer word's. Only for pixels known to be SIMPLE (a SIMPLE tile).
+void substrate_unpack_simple(uint words[SUBSTRATE_MAX_WORDS], uint topLayer, out SubstrateClosure c) {
+  substrate_closure_init(c);
+  c.diffuseAlbedo = substrate_dq_color20(SUBSTRATE_READ_BITS(words, 16u, SUBSTRATE_BITS_COLOR));
+  c.f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, 36u, SUBSTRATE_BITS_COLOR));
+  c.roughness = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, 56u, SUBSTRATE_BITS_ROUGHNESS), 8u);
+  float topRoughness;
+  substrate_dq_top_layer(topLayer, c.N, topRoughness);
 }
 
 #endif

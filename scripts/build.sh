@@ -10,3 +10,6 @@ for f in examples/*.json; do
   build/bin/substratec report "$f"
   echo
 done
+# And one scene: its materials for its platform and the lighting they need (docs/scenes.md).
+build/bin/substratec scene examples/scenes/street.json -o build/scenes/street >/dev/null
+echo "scene street: build/scenes/street/scene.json"

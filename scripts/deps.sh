@@ -10,6 +10,7 @@ PACKAGES=(
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools libpng-dev
   clang-14 libclang-rt-14-dev llvm-14   # scripts/fuzz.sh: libFuzzer, ASan/UBSan runtimes, llvm-symbolizer
   libpugixml-dev
+  libxxhash-dev
 )
 
 missing=()

@@ -10,16 +10,20 @@
 #include "validate/toolchain.h"
 #include "emit/generate.h"
 #include "output/atomic_write.h"
+#include "output/depfile.h"
+#include "batch/batch.h"
 #include "gpu/harness.h"
 #include "gpu/sample_run.h"
 #include "preview/contact_sheet.h"
 #include "preview/environment.h"
 #include "preview/render.h"
+#include "scene/scene.h"
 #include "stability/stability.h"
 #include "sweep/sweep.h"
 #include "import/import.h"
 
 #include <filesystem>
+#include <map>
 
 namespace substratec {
 
@@ -43,17 +47,6 @@ int compileFailure(const import::MaterialSource& s, std::ostream& err) {
   err << "substratec: internal compiler error: the material imported from " << s.displayName
       << " does not compile\n";
   return kExitInternal;
-}
-
-/// Writes `files` into `dir` (all or none) and prints their paths.
-int writeOutputs(const std::string& dir, const std::vector<OutputFile>& files, std::ostream& out, std::ostream& err) {
-  std::string error = writeFilesAtomically(dir, files);
-  if (!error.empty()) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
-  }
-  for (const auto& f : files) out << (std::filesystem::path(dir) / f.name).string() << "\n";
-  return kExitOk;
 }
 
 struct ReportArgs {
@@ -157,7 +150,7 @@ void addPrecisionOption(CLI::App* command, std::string& precision) {
 Precision precisionOf(const std::string& name) { return name == "half" ? Precision::Half : Precision::Float; }
 
 struct CompileArgs {
-  std::string file;
+  std::vector<std::string> files;
   std::string material;
   std::string outDir;
   std::string target = "all";
@@ -168,35 +161,103 @@ struct CompileArgs {
   bool skipValidation = false;
   std::size_t maxInputSize = 16u << 20;
   std::string precision = "float";
+  int jobs = 0;
+  std::string platform;
+  std::string platforms;
+  std::string cache;
+  std::string depfile;
 };
 
-int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
-  CompileOptions o;
-  if (a.budget > 0) o.budgetOverride = a.budget;
-  if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
-  o.fullSimplification = a.fullSimplification;
-  o.read.maxInputBytes = a.maxInputSize;
-  auto source = loadMaterial(a.file, a.material, o.read, err);
-  if (!source) return kExitBadInput;
-  Diagnostics diags(source->displayName);
-  auto result = compileText(source->displayName, source->text, o, diags);
-  err << diags.formatAll();
-  if (!result) return compileFailure(*source, err);
-  GenerateOptions go;
-  go.glsl = a.target != "hlsl";
-  go.hlsl = a.target != "glsl";
-  go.emit.sourceName = std::filesystem::path(a.file).filename().string();
-  go.emit.diffuseModel = diffuseModelOf(a.diffuse);
-  go.emit.precision = precisionOf(a.precision);
-  Generated gen = generateFiles(*result, go);
-  // Validate in-process before anything is written: a shader that does not
-  // compile is the compiler's bug (exit 3), and the output folder stays as it was.
-  if (!a.skipValidation) validateGenerated(gen);
-  if (!gen.valid) {
-    err << "substratec: internal compiler error: generated code does not validate\n" << gen.failure << "\n";
-    return kExitInternal;
+/// Writes `files` atomically into `dir`, then the depfile when asked (its
+/// targets: every file written, or only `depTarget` when given, depending on
+/// `inputs`), and lists what was written on stdout.
+int writeOutputs(const std::string& dir, const std::vector<OutputFile>& files, const std::string& depfile,
+                 const std::vector<std::string>& inputs, std::ostream& out, std::ostream& err,
+                 const std::string& depTarget = "") {
+  std::string error = writeFilesAtomically(dir, files);
+  std::vector<std::string> written;
+  for (const auto& f : files) written.push_back((std::filesystem::path(dir) / f.name).string());
+  const std::vector<std::string> targets =
+      depTarget.empty() ? written : std::vector<std::string>{(std::filesystem::path(dir) / depTarget).string()};
+  if (error.empty() && !depfile.empty()) error = writeDepfile(depfile, targets, inputs);
+  if (!error.empty()) {
+    err << "substratec: error: " << error << "\n";
+    return kExitBadInput;
   }
-  return writeOutputs(a.outDir, gen.files, out, err);
+  for (const auto& w : written) out << w << "\n";
+  return kExitOk;
+}
+
+/// The options every material of a compile or a scene is built with.
+BatchOptions batchOptions(int budget, int maxClosures, std::size_t maxInputSize, const std::string& target,
+                          const std::string& diffuse, int jobs, const std::string& cache,
+                          const std::string& material = "") {
+  BatchOptions o;
+  if (budget > 0) o.compile.budgetOverride = budget;
+  if (maxClosures > 0) o.compile.maxClosuresOverride = maxClosures;
+  o.compile.read.maxInputBytes = maxInputSize;
+  o.generate.glsl = target != "hlsl";
+  o.generate.hlsl = target != "glsl";
+  o.generate.emit.diffuseModel = diffuseModelOf(diffuse);
+  o.jobs = jobs;
+  o.cacheDir = cache;
+  // glTF and MaterialX files are imported on the fly (the --material one, or
+  // the only one); substrate-material/1 files are read as they are.
+  o.load = [material](const std::string& path, const ReadLimits& read,
+                      Diagnostics& diags) -> std::optional<BatchSource> {
+    auto sources = import::loadMaterialSources(path, material, false, read, diags);
+    if (!sources) return std::nullopt;
+    import::MaterialSource& s = sources->front();
+    return BatchSource{std::move(s.displayName), std::move(s.text), s.imported};
+  };
+  return o;
+}
+
+/// Every file compiled (in parallel with -j, from --cache when unchanged) into
+/// one output directory; all of them are written, or none.
+int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
+  BatchOptions o =
+      batchOptions(a.budget, a.maxClosures, a.maxInputSize, a.target, a.diffuse, a.jobs, a.cache, a.material);
+  o.compile.fullSimplification = a.fullSimplification;
+  o.generate.emit.precision = precisionOf(a.precision);
+  o.validate = !a.skipValidation;
+  std::vector<std::string> inputs = a.files;
+  if (!a.platform.empty() || !a.platforms.empty()) {
+    std::string messages;
+    auto table = loadPlatformTable(a.platforms, o.compile.read, messages);
+    err << messages;
+    if (!table) return kExitBadInput;
+    if (!a.platforms.empty()) inputs.push_back(a.platforms);
+    if (!a.platform.empty()) {
+      const Platform* p = table->find(a.platform);
+      if (!p) {
+        err << fmt::format("substratec: error: unknown platform {} (known: {})\n", quoteForDiagnostic(a.platform),
+                           table->names());
+        return kExitUsage;
+      }
+      o.compile.platform = *p;
+    }
+  }
+  std::vector<MaterialBuild> built = buildMaterials(a.files, o);
+  int status = kExitOk;
+  std::map<std::string, std::string> names;  // material name -> file
+  std::vector<OutputFile> files;
+  for (MaterialBuild& b : built) {
+    err << b.messages;
+    if (b.internalError) status = kExitInternal;
+    if (!b.ok) {
+      if (status == kExitOk) status = kExitBadInput;
+      continue;
+    }
+    if (auto [at, fresh] = names.emplace(b.summary.name, b.path); !fresh) {
+      err << fmt::format("{}: /name: error: material {} has the name of {}: their outputs would overwrite each other\n",
+                         b.path, quoteForDiagnostic(b.summary.name), at->second);
+      if (status == kExitOk) status = kExitBadInput;
+    }
+    for (OutputFile& f : b.files) files.push_back(std::move(f));
+  }
+  if (status != kExitOk) return status;
+  return writeOutputs(a.outDir, files, a.depfile, inputs, out, err);
 }
 
 struct PreviewArgs {
@@ -463,7 +524,39 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     }
     files.push_back({m.name + ".json", m.text});
   }
-  return writeOutputs(a.outDir, files, out, err);
+  return writeOutputs(a.outDir, files, "", {}, out, err);
+}
+
+struct SceneArgs {
+  std::string manifest;
+  std::string outDir;
+  std::string platform;
+  std::string platforms;
+  std::string target = "all";
+  std::string diffuse = "chan2024";
+  int jobs = 0;
+  int budget = 0;
+  int maxClosures = 0;
+  std::size_t maxInputSize = 16u << 20;
+  std::string cache;
+  std::string depfile;
+};
+
+/// Every material of a scene for its platform, and the lighting the scene
+/// needs (scene/scene.h), written atomically into the output directory.
+int runScene(const SceneArgs& a, std::ostream& out, std::ostream& err) {
+  SceneOptions o;
+  o.manifest = a.manifest;
+  if (!a.platform.empty()) o.platform = a.platform;
+  o.platformsFile = a.platforms;
+  o.batch = batchOptions(a.budget, a.maxClosures, a.maxInputSize, a.target, a.diffuse, a.jobs, a.cache);
+  SceneBuild b = buildScene(o);
+  err << b.messages;
+  if (b.status != kExitOk) return b.status;
+  // The scene's depfile has one target, scene.json: which lighting files a
+  // scene has depends on its materials, so a build system cannot list them
+  // beforehand; it depends on scene.json (written with them, atomically).
+  return writeOutputs(a.outDir, b.files, a.depfile, b.inputs, out, err, "scene.json");
 }
 
 }  // namespace
@@ -495,7 +588,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
 
   CompileArgs compile;
   CLI::App* comp = app.add_subcommand("compile", "Generate flattened GLSL/HLSL, the packing layout and entry shaders");
-  comp->add_option("file", compile.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
+  comp->add_option("files", compile.files,
+                  "Material files (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
   comp->add_option("--material", compile.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   comp->add_option("-o,--output", compile.outDir, "Output directory")->required();
   comp->add_option("--target", compile.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}));
@@ -509,6 +603,13 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   comp->add_option("--max-input-size", compile.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
   addPrecisionOption(comp, compile.precision);
+  comp->add_option("-j,--jobs", compile.jobs, "Materials compiled at once (default: the machine's threads)")
+      ->check(CLI::Range(1, 256));
+  comp->add_option("--platform", compile.platform, "Simplify for this platform (docs/scenes.md)");
+  comp->add_option("--platforms", compile.platforms, "A substrate-platforms/1 file extending the built-in platforms");
+  comp->add_option("--cache", compile.cache,
+                   "Content-hash cache directory: an unchanged material (bytes, options, compiler) is not recompiled");
+  comp->add_option("--depfile", compile.depfile, "Write a Make-syntax dependency file (like glslc -MD -MF)");
 
   PreviewArgs prev;
   CLI::App* pre = app.add_subcommand("preview", "Render the material on a sphere (Vulkan, Mesa lavapipe) into a PNG");
@@ -580,6 +681,28 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   impc->add_option("--max-input-size", imp.maxInputSize, "Reject inputs larger than this many bytes")
       ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
 
+  SceneArgs scn;
+  CLI::App* sce = app.add_subcommand(
+      "scene", "Compile a scene's materials for its platform and the lighting it needs (docs/scenes.md)");
+  sce->add_option("manifest", scn.manifest, "Scene manifest (substrate-scene/1 JSON)")->required();
+  sce->add_option("-o,--output", scn.outDir, "Output directory")->required();
+  sce->add_option("--platform", scn.platform, "Platform to build for (overrides the manifest's)");
+  sce->add_option("--platforms", scn.platforms, "A substrate-platforms/1 file extending the built-in platforms");
+  sce->add_option("-j,--jobs", scn.jobs, "Materials compiled at once (default: the machine's threads)")
+      ->check(CLI::Range(1, 256));
+  sce->add_option("--target", scn.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}));
+  sce->add_option("--diffuse", scn.diffuse, "Diffuse model")
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
+  sce->add_option("--budget", scn.budget, "Bytes per pixel budget of every material (the platform still caps it)")
+      ->check(CLI::Range(8, 1024));
+  sce->add_option("--max-closures", scn.maxClosures, "Closure budget of every material")->check(CLI::Range(1, 8));
+  sce->add_option("--max-input-size", scn.maxInputSize, "Reject inputs larger than this many bytes")
+      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+  sce->add_option("--cache", scn.cache, "Content-hash cache directory for the materials");
+  sce->add_option("--depfile", scn.depfile,
+                  "Write a Make-syntax dependency file: the outputs depend on the manifest, the platforms file and "
+                  "every material");
+
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
   try {
@@ -605,6 +728,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
     if (swp->parsed()) return runSweep(sw, out, err);
     if (sta->parsed()) return runStability(stab, out, err);
     if (impc->parsed()) return runImport(imp, out, err);
+    if (sce->parsed()) return runScene(scn, out, err);
   } catch (const std::exception& e) {
     err << "substratec: internal compiler error: " << e.what() << "\n";
     return kExitInternal;

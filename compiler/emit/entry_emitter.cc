@@ -150,9 +150,17 @@ std::string emitForwardEntry(const Material& m, const StorageLayout& L, const Sy
   // lighting code exists once in the shader instead of once per closure.
   const bool loop = n > 1;
   const std::string cl = loop ? "closures[k]" : "closures[0]";
-  if (loop) s += fmt::format("  for (uint k = 0u; k < uint({}_CLOSURE_COUNT); ++k) {{\n", upper);
-  else s += fmt::format("  // closure 0 ('{}')\n", m.slabs[L.closures[0].slab].id);
-  const std::string in = loop ? "    " : "  ";
+  // A closure whose weight is 0 at this pixel is skipped (dynamic culling);
+  // a lone closure of static weight 1 needs no test.
+  const bool test = loop || L.closures[0].storesWeight;
+  if (loop) {
+    s += fmt::format("  for (uint k = 0u; k < uint({}_CLOSURE_COUNT); ++k) {{\n", upper);
+    s += "    if (!substrate_closure_visible(closures[k])) continue;  // weight 0 here: nothing to light\n";
+  } else {
+    s += fmt::format("  // closure 0 ('{}')\n", m.slabs[L.closures[0].slab].id);
+    if (test) s += "  if (substrate_closure_visible(closures[0])) {  // weight 0 here: nothing to light\n";
+  }
+  const std::string in = test ? "    " : "  ";
   s += fmt::format("{}color += substrate_light_closure({}, g.V, L, frame.lightRadiance.rgb);\n", in, cl);
   std::string pre = glsl ? fmt::format("textureLod(envPrefiltered, substrate_reflection_dir({0}, g.V), "
                                        "substrate_env_mip(substrate_env_roughness({0}), frame.envParams.x)).rgb", cl)
@@ -164,7 +172,7 @@ std::string emitForwardEntry(const Material& m, const StorageLayout& L, const Sy
                    "substrate_env_split_sum({1}, g.V, {2}, {3});\n", in, cl, pre, irr);
   if (usesEmissive(m, L))
     s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * {1}.emissive;\n", in, cl);
-  if (loop) s += "  }\n";
+  if (test) s += "  }\n";
   std::string color = "color", alpha = "coverage";
   if (m.settings.blendMode == BlendMode::AlphaHoldout) color = "SUBSTRATE_SPLAT3(0.0)";
   if (m.settings.blendMode == BlendMode::Masked)
@@ -244,60 +252,47 @@ std::string emitBasePassEntry(const Material& m, const StorageLayout& L, const S
 
 namespace substratec {
 
-std::string emitPackFunction(const Material& m, const StorageLayout& L, const Syntax& syn) {
-  const std::string upper = materialUpper(m);
-  const std::string v3 = syn.type(VType::Vec3);
+namespace {
+
+/// Header feature bits of a closure (SUBSTRATE_FEATURE_*, docs/storage.md).
+unsigned featureBits(const ClosureLayout& c) {
+  unsigned b = 0;
+  if (c.storedFeatures & kFeatF90) b |= 1;
+  if (c.storedFeatures & kFeatAnisotropy) b |= 2;
+  if (c.storedFeatures & kFeatHaze) b |= 4;
+  if (c.storedFeatures & kFeatFuzz) b |= 8;
+  if (c.storedFeatures & kFeatGlint) b |= 16;
+  if (c.storedFeatures & kFeatSpecularProfile) b |= 32;
+  if (c.storesWeight) b |= 64;
+  if (c.storesCoverageAbove) b |= 128;
+  return b;
+}
+
+/// The statements that pack every field of `L`, at static bit offsets, from
+/// `closures[closureIndex[i]]` for the layout's closure i. `topN` is the
+/// top-layer normal already computed (for a tangent angle in its frame).
+std::string packFields(const Material& m, const StorageLayout& L, const std::vector<int>& closureIndex,
+                       const std::string& indent) {
   const bool multi = L.closures.size() > 1;
   std::string s;
-  s += "// Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).\n";
-  s += "// Compiled when substrate_pack.h is included before this file (the base pass does).\n";
-  s += "#ifdef SUBSTRATE_PACK_H\n";
-  s += fmt::format("void {0}_pack(SubstrateClosure closures[{1}_CLOSURE_COUNT], float dither, out uint words[{1}_WORD_COUNT], "
-                   "out uint topLayer) {{\n",
-                   m.name, upper);
-  for (int w = 0; w < L.words(); ++w) s += fmt::format("  words[{}] = 0u;\n", w);
-  // Top-layer word: the top closures' normal and roughness, coverage-weighted.
-  std::string nsum, rsum, wsum;
-  for (std::size_t i = 0; i < L.closures.size(); ++i) {
-    if (!L.closures[i].isTop) continue;
-    const std::string c = fmt::format("closures[{}]", i);
-    nsum += (nsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.N", c);
-    rsum += (rsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.roughness", c);
-    wsum += (wsum.empty() ? "" : " + ") + fmt::format("{}.weight", c);
-  }
-  s += fmt::format("  {} topN = substrate_safe_normalize({}, closures[0].N);\n", v3, nsum);
-  s += fmt::format("  float topRoughness = saturate(({}) / max({}, 1e-6));\n", rsum, wsum);
-  s += "  topLayer = substrate_q_top_layer(topN, topRoughness, dither);\n";
-  // Each field: quantize, then or it in at its offset (straddling two words when it must).
   int offset = 0;
   auto put = [&](const std::string& code, int bits) {
     int w = offset / 32, sh = offset % 32;
-    s += fmt::format("  {{ uint q = {};\n    words[{}] |= q << {}u;", code, w, sh);
-    if (sh + bits > 32) s += fmt::format("\n    words[{}] |= q >> {}u;", w + 1, 32 - sh);
+    s += fmt::format("{}{{ uint q = {};\n{}  words[{}] |= q << {}u;", indent, code, indent, w, sh);
+    if (sh + bits > 32) s += fmt::format("\n{}  words[{}] |= q >> {}u;", indent, w + 1, 32 - sh);
     s += " }\n";
     offset += bits;
-  };
-  auto featureBits = [&](const ClosureLayout& c) {
-    unsigned b = 0;
-    if (c.storedFeatures & kFeatF90) b |= 1;
-    if (c.storedFeatures & kFeatAnisotropy) b |= 2;
-    if (c.storedFeatures & kFeatHaze) b |= 4;
-    if (c.storedFeatures & kFeatFuzz) b |= 8;
-    if (c.storedFeatures & kFeatGlint) b |= 16;
-    if (c.storedFeatures & kFeatSpecularProfile) b |= 32;
-    if (c.storesWeight) b |= 64;
-    if (c.storesCoverageAbove) b |= 128;
-    return b;
   };
   // The SSS type tells the unpacker an SSS field follows: non-zero only when one is stored.
   auto sssCode = [&](const ClosureLayout& c) {
     return (c.storedFeatures & kFeatSss) ? static_cast<unsigned>(m.slabs[c.slab].sssType) : 0u;
   };
+  auto closure = [&](int i) { return fmt::format("closures[{}]", closureIndex[i]); };
   const int cls = static_cast<int>(L.layoutClass);
   for (const LayoutField& f : L.fields) {
-    const std::string c = f.closure >= 0 ? fmt::format("closures[{}]", f.closure) : "";
+    const std::string c = f.closure >= 0 ? closure(f.closure) : "";
     const std::string field = f.name.substr(f.name.find('.') + 1);
-    s += fmt::format("  // {} ({} bits at {})\n", f.name, f.bits, offset);
+    s += fmt::format("{}// {} ({} bits at {})\n", indent, f.name, f.bits, offset);
     if (f.name == "header") {
       const ClosureLayout& c0 = L.closures[0];
       put(multi ? fmt::format("substrate_material_header_multi({}u, {}u, {}u)", cls, L.closures.size(), L.basisCount)
@@ -327,9 +322,10 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
     } else if (field == "specular_profile") {
       put(fmt::format("substrate_q_specular_profile({}.specularProfile)", c), f.bits);
     } else if (field == "glint") {
-      s += fmt::format("  uint4 glint{} = uint4(0u, 0u, 0u, 0u);\n", f.closure);
-      put(fmt::format("substrate_q_glint({0}.glintValue, {0}.glintUv, {0}.glintUvDerivatives, dither, glint{1})", c, f.closure), 8);
-      for (const char* part : {"x", "y", "z", "w"}) put(fmt::format("glint{}.{}", f.closure, part), 32);
+      const int k = closureIndex[f.closure];
+      s += fmt::format("{}uint4 glint{} = uint4(0u, 0u, 0u, 0u);\n", indent, k);
+      put(fmt::format("substrate_q_glint({0}.glintValue, {0}.glintUv, {0}.glintUvDerivatives, dither, glint{1})", c, k), 8);
+      for (const char* part : {"x", "y", "z", "w"}) put(fmt::format("glint{}.{}", k, part), 32);
     } else if (f.basis >= 0) {
       int first = 0;
       for (std::size_t i = 0; i < L.closures.size(); ++i)
@@ -337,7 +333,7 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
           first = static_cast<int>(i);
           break;
         }
-      const std::string n = fmt::format("closures[{}].N", first);
+      const std::string n = closure(first) + ".N";
       if (field == "normal") {
         put(fmt::format("substrate_q_normal({}, dither)", n), f.bits);
       } else {  // tangent_angle, in the frame of the normal as the unpacker decodes it
@@ -350,12 +346,75 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
             aniso = static_cast<int>(i);
             break;
           }
-        put(fmt::format("substrate_tangent_angle_encode(closures[{}].T, {}, dither)", aniso, stored), f.bits);
+        put(fmt::format("substrate_tangent_angle_encode({}.T, {}, dither)", closure(aniso), stored), f.bits);
       }
     }
   }
+  return s;
+}
+
+/// The run-time test that closure `k` is alone at this pixel with nothing it
+/// stores in use (storage/layout.h, runtimeSimpleClosures).
+std::string aloneAndPlain(const Material& m, const StorageLayout& L, int k) {
+  std::vector<std::string> terms;
+  const std::string c = fmt::format("closures[{}]", k);
+  for (int j = 0; j < static_cast<int>(L.closures.size()); ++j)
+    if (j != k) terms.push_back(fmt::format("!(closures[{}].weight > 0.0)", j));
+  const ClosureLayout& cl = L.closures[k];
+  if (cl.storesWeight) terms.push_back(c + ".weight >= 1.0");
+  if (cl.storesCoverageAbove) terms.push_back(fmt::format("!({}.coverageAbove > 0.0)", c));
+  const std::uint16_t f = cl.storedFeatures;
+  if (f & kFeatF90) terms.push_back(fmt::format("min(min({0}.f90.x, {0}.f90.y), {0}.f90.z) >= 1.0", c));
+  if (f & kFeatAnisotropy) terms.push_back(c + ".anisotropy == 0.0");
+  if (f & kFeatSss) terms.push_back(fmt::format("!(substrate_max3({}.sssMfp) > 0.0)", c));
+  if (f & kFeatHaze) terms.push_back(fmt::format("!({}.secondRoughnessWeight > 0.0)", c));
+  if (f & kFeatFuzz) terms.push_back(fmt::format("!({}.fuzzAmount > 0.0)", c));
+  if (f & kFeatGlint) terms.push_back(c + ".glintValue >= 1.0");
+  (void)m;
+  std::string s;
+  for (const std::string& t : terms) s += (s.empty() ? "" : " && ") + t;
+  return s.empty() ? "true" : s;
+}
+
+}  // namespace
+
+std::string emitPackFunction(const Material& m, const StorageLayout& L, const Syntax& syn, bool dynamicSimplification) {
+  const std::string upper = materialUpper(m);
+  const std::string v3 = syn.type(VType::Vec3);
+  std::string s;
+  s += "// Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).\n";
+  s += "// Compiled when substrate_pack.h is included before this file (the base pass does).\n";
+  s += "#ifdef SUBSTRATE_PACK_H\n";
+  s += fmt::format("void {0}_pack(SubstrateClosure closures[{1}_CLOSURE_COUNT], float dither, out uint words[{1}_WORD_COUNT], "
+                   "out uint topLayer) {{\n",
+                   m.name, upper);
+  for (int w = 0; w < L.words(); ++w) s += fmt::format("  words[{}] = 0u;\n", w);
+  // Dynamic simplification: a pixel where one closure is left, with nothing
+  // it stores in use, is stored in the SIMPLE layout (docs/scenes.md).
+  for (int k : dynamicSimplification ? runtimeSimpleClosures(m, L) : std::vector<int>{}) {
+    s += fmt::format("  // Dynamic simplification: closure {} ('{}') alone and plain at this pixel -> the SIMPLE layout.\n",
+                     k, m.slabs[L.closures[k].slab].id);
+    s += fmt::format("  if ({}) {{\n", aloneAndPlain(m, L, k));
+    s += fmt::format("    topLayer = substrate_q_top_layer(closures[{0}].N, saturate(closures[{0}].roughness), dither);\n", k);
+    s += packFields(m, simpleLayoutOf(L, k), {k}, "    ");
+    s += "    return;\n  }\n";
+  }
+  // Top-layer word: the top closures' normal and roughness, coverage-weighted.
+  std::string nsum, rsum, wsum;
+  for (std::size_t i = 0; i < L.closures.size(); ++i) {
+    if (!L.closures[i].isTop) continue;
+    const std::string c = fmt::format("closures[{}]", i);
+    nsum += (nsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.N", c);
+    rsum += (rsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.roughness", c);
+    wsum += (wsum.empty() ? "" : " + ") + fmt::format("{}.weight", c);
+  }
+  s += fmt::format("  {} topN = substrate_safe_normalize({}, closures[0].N);\n", v3, nsum);
+  s += fmt::format("  float topRoughness = saturate(({}) / max({}, 1e-6));\n", rsum, wsum);
+  s += "  topLayer = substrate_q_top_layer(topN, topRoughness, dither);\n";
+  std::vector<int> identity(L.closures.size());
+  for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<int>(i);
+  s += packFields(m, L, identity, "  ");
   s += "}\n#endif\n";
-  (void)syn;
   return s;
 }
 

@@ -17,8 +17,11 @@ std::string emitForwardEntry(const Material& m, const StorageLayout& layout, con
 std::string emitBasePassEntry(const Material& m, const StorageLayout& layout, const Syntax& syn);
 
 /// The packing function `<name>_pack(closures, dither, words, topLayer)`,
-/// static bit offsets following `layout` (appended to the material file).
-std::string emitPackFunction(const Material& m, const StorageLayout& layout, const Syntax& syn);
+/// static bit offsets following `layout` (appended to the material file);
+/// with `dynamicSimplification`, a pixel where one plain closure is left is
+/// packed in the SIMPLE layout instead (storage/layout.h, runtimeSimpleClosures).
+std::string emitPackFunction(const Material& m, const StorageLayout& layout, const Syntax& syn,
+                             bool dynamicSimplification = true);
 
 /// File names: `<name>.forward.frag` / `<name>.forward.ps.hlsl`, ...
 std::string forwardFileName(const Material& m, const Syntax& syn);

@@ -1,15 +1,14 @@
 #include "emit/generate.h"
 
 #include <algorithm>
-#include <atomic>
 #include <map>
 #include <string_view>
-#include <thread>
 
 #include <fmt/format.h>
 
 #include "emit/entry_emitter.h"
 #include "emit/layout_json.h"
+#include "util/parallel.h"
 #include "validate/runtime_files.h"
 #include "validate/shader_validate.h"
 
@@ -21,7 +20,7 @@ namespace {
 /// function (the base pass calls it) before the closing include guard.
 std::string materialFile(const CompileResult& r, const Syntax& syn, const EmitOptions& emit) {
   std::string material = emitMaterial(r.material, r.tree, r.after, syn, emit);
-  material.insert(material.rfind("#endif"), emitPackFunction(r.material, r.after, syn) + "\n");
+  material.insert(material.rfind("#endif"), emitPackFunction(r.material, r.after, syn, emit.dynamicSimplification) + "\n");
   return material;
 }
 
@@ -42,7 +41,7 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
   return g;
 }
 
-void validateGenerated(Generated& g, const ValidateOptions& options) {
+void validateGenerated(Generated& g, const ValidateOptions& options, std::size_t threads) {
   // The entries include the material files and the runtime by name: both are
   // served from memory, so nothing touches the disk.
   std::map<std::string, std::string_view> files;
@@ -51,32 +50,25 @@ void validateGenerated(Generated& g, const ValidateOptions& options) {
 
   std::vector<const OutputFile*> entries;
   for (const OutputFile& f : g.files)
-    if (f.name.ends_with(".frag") || f.name.ends_with(".ps.hlsl")) entries.push_back(&f);
+    if (f.name.ends_with(".frag") || f.name.ends_with(".ps.hlsl") || f.name.ends_with(".comp") ||
+        f.name.ends_with(".cs.hlsl"))
+      entries.push_back(&f);
 
-  // Entries are independent: compile them on up to hardware_concurrency
-  // threads (glslang and SPIRV-Tools are thread-safe per compilation). Results
-  // are kept by index, so the outcome does not depend on scheduling.
+  // Entries are independent (glslang and SPIRV-Tools are thread-safe per
+  // compilation); results are kept by index, so the outcome does not depend
+  // on scheduling.
   std::vector<ShaderValidation> results(entries.size());
-  std::atomic<std::size_t> next{0};
-  auto work = [&] {
-    for (std::size_t i; (i = next.fetch_add(1)) < entries.size();) {
-      const OutputFile& f = *entries[i];
-      ShaderSource src;
-      src.name = f.name;
-      src.text = f.contents;
-      src.language = f.name.ends_with(".frag") ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
-      src.stage = ShaderStage::Fragment;
-      src.memoryFiles = files;
-      src.hlsl16BitTypes = g.precision == Precision::Half;
-      results[i] = compileAndValidate(src, options);
-    }
-  };
-  const std::size_t threads =
-      std::min<std::size_t>(entries.size(), std::max(1u, std::thread::hardware_concurrency()));
-  std::vector<std::thread> pool;
-  for (std::size_t t = 1; t < threads; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  parallelFor(entries.size(), threads, [&](std::size_t i) {
+    const OutputFile& f = *entries[i];
+    ShaderSource src;
+    src.name = f.name;
+    src.text = f.contents;
+    src.language = f.name.ends_with(".frag") || f.name.ends_with(".comp") ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
+    src.stage = f.name.ends_with(".comp") || f.name.ends_with(".cs.hlsl") ? ShaderStage::Compute : ShaderStage::Fragment;
+    src.memoryFiles = files;
+    src.hlsl16BitTypes = g.precision == Precision::Half;
+    results[i] = compileAndValidate(src, options);
+  });
 
   for (std::size_t i = 0; i < entries.size(); ++i) {
     ShaderValidation& v = results[i];

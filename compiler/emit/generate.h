@@ -40,9 +40,9 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o);
 /// Compiles every entry shader in-process against the generated files and the
 /// embedded runtime (all in memory), runs spirv-val and counts instructions;
 /// with `options.optimize` also after SPIRV-Tools' performance passes.
-/// Entries compile in parallel. Fills `entries`, `valid`, `failure` (the first
-/// failing entry in file order).
-void validateGenerated(Generated& g, const ValidateOptions& options = {});
+/// Entries compile in parallel on up to `threads` threads (0: the machine's).
+/// Fills `entries`, `valid`, `failure` (the first failing entry in file order).
+void validateGenerated(Generated& g, const ValidateOptions& options = {}, std::size_t threads = 0);
 
 /// Compiles one compute kernel of the material (emit/kernel_emitter.h) for
 /// `target` to validated SPIR-V, against the material file generated with

@@ -160,6 +160,10 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   s += "  float3 direct = SUBSTRATE_SPLAT3(0.0);\n  float3 environment = SUBSTRATE_SPLAT3(0.0);\n";
   s += "  float3 emissive = SUBSTRATE_SPLAT3(0.0);\n";
   s += fmt::format("  for (int k = 0; k < {}_CLOSURE_COUNT; ++k) {{\n", upper);
+  // A pixel the base pass stored in a smaller layout (dynamic simplification)
+  // unpacks to fewer closures: the rest are not lit.
+  if (mode == KernelMode::Deferred) s += "    if (uint(k) >= count) continue;\n";
+  s += "    if (!substrate_closure_visible(closures[k])) continue;  // dynamic culling: weight 0\n";
   s += "    direct += substrate_light_closure(closures[k], g.V, L, radiance);\n";
   s += "    float3 viewT = substrate_closure_view_throughput(closures[k], dot(closures[k].N, g.V));\n";
   s += "    environment += viewT * substrate_env_split_sum(closures[k], g.V, prefiltered, irradiance);\n";
@@ -167,7 +171,8 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   s += "  }\n";
   s += fmt::format("  results[base + {}u] = float({});\n", kResultCount, count);
   s += fmt::format("  results[base + {}u] = coverage;\n", kResultCoverage);
-  s += fmt::format("  results[base + 2u] = 0.0;\n  results[base + 3u] = 0.0;\n");
+  s += fmt::format("  results[base + {}u] = {};\n  results[base + 3u] = 0.0;\n", kResultLayoutClass,
+                   mode == KernelMode::Deferred ? "float(substrate_layout_class(packed[0]))" : "0.0");
   for (auto [at, v] : {std::pair{kResultTransmittance, "transmittance"}, std::pair{kResultDirect, "direct"},
                        std::pair{kResultEnvironment, "environment"}, std::pair{kResultEmissive, "emissive"}})
     s += fmt::format("  results[base + {0}u] = {1}.x; results[base + {2}u] = {1}.y; results[base + {3}u] = {1}.z; "
@@ -293,6 +298,7 @@ float2 substrate_preview_uv(float3 n) {
   {1}_evaluate(g, closures, coverage, transmittance);
   float3 color = SUBSTRATE_SPLAT3(0.0);
   for (int k = 0; k < {0}_CLOSURE_COUNT; ++k) {{
+    if (!substrate_closure_visible(closures[k])) continue;  // dynamic culling: weight 0
     for (int l = 0; l < {2}; ++l) {{
       color += substrate_light_closure(closures[k], g.V, preview.lightDirection[l].xyz, preview.lightRadiance[l].rgb);
     }}
@@ -372,6 +378,7 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
   {1}_evaluate(g, closures, coverage, transmittance);
   float3 color = SUBSTRATE_SPLAT3(0.0);
   for (int c = 0; c < {0}_CLOSURE_COUNT; ++c) {{
+    if (!substrate_closure_visible(closures[c])) continue;  // dynamic culling: weight 0
     color += substrate_light_closure(closures[c], g.V, L, SUBSTRATE_SPLAT3(1.0));
     color += substrate_closure_view_throughput(closures[c], dot(closures[c].N, g.V)) *
              substrate_env_split_sum(closures[c], g.V, SUBSTRATE_SPLAT3(0.5), SUBSTRATE_SPLAT3(1.5));

@@ -53,6 +53,7 @@ inline constexpr int kSampleIrradiance = 10;   // rgb: environment irradiance fo
 inline constexpr int kResultHeaderFloats = 20;
 inline constexpr int kResultCount = 0;           // closure count (the unpacker's, in Deferred)
 inline constexpr int kResultCoverage = 1;
+inline constexpr int kResultLayoutClass = 2;     // Deferred: the class the base pass packed (word 0 bits 0-1); else 0
 inline constexpr int kResultTransmittance = 4;   // rgb
 inline constexpr int kResultDirect = 8;          // rgb: sum over closures of substrate_light_closure
 inline constexpr int kResultEnvironment = 12;    // rgb: sum of view throughput * substrate_env_split_sum

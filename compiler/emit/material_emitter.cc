@@ -23,6 +23,22 @@ std::string precisionDefine(Precision p) {
   return p == Precision::Half ? "#define SUBSTRATE_PRECISION_HALF 1  // colours, weights, throughputs in float16\n" : "";
 }
 
+std::string useDefines(std::uint16_t features) {
+  std::string s;
+  auto use = [&](const char* macro, std::uint16_t bit) {
+    s += fmt::format("#define {} {}\n", macro, (features & bit) ? 1 : 0);
+  };
+  use("SUBSTRATE_USE_F90", kFeatF90);
+  use("SUBSTRATE_USE_ANISOTROPY", kFeatAnisotropy);
+  use("SUBSTRATE_USE_HAZE", kFeatHaze);
+  use("SUBSTRATE_USE_FUZZ", kFeatFuzz);
+  use("SUBSTRATE_USE_SSS", kFeatSss);
+  use("SUBSTRATE_USE_GLINT", kFeatGlint);
+  use("SUBSTRATE_USE_SPECULAR_PROFILE", kFeatSpecularProfile);
+  use("SUBSTRATE_USE_EMISSIVE", kFeatEmissive);
+  return s;
+}
+
 namespace {
 
 // Closure feature bits (runtime_shaders/substrate_closure.h, docs/storage.md).
@@ -497,15 +513,7 @@ std::string Emitter::run() {
   out_ += fmt::format("// Features: {}.\n", all ? featureList(all) : "none");
   out_ += fmt::format("#ifndef SUBSTRATE_MATERIAL_{0}\n#define SUBSTRATE_MATERIAL_{0} 1\n\n", upper);
   line("// What this material uses: the runtime compiles nothing else.");
-  auto use = [&](const char* macro, bool on) { line(fmt::format("#define {} {}", macro, on ? 1 : 0)); };
-  use("SUBSTRATE_USE_F90", all & kFeatF90);
-  use("SUBSTRATE_USE_ANISOTROPY", all & kFeatAnisotropy);
-  use("SUBSTRATE_USE_HAZE", all & kFeatHaze);
-  use("SUBSTRATE_USE_FUZZ", all & kFeatFuzz);
-  use("SUBSTRATE_USE_SSS", all & kFeatSss);
-  use("SUBSTRATE_USE_GLINT", all & kFeatGlint);
-  use("SUBSTRATE_USE_SPECULAR_PROFILE", all & kFeatSpecularProfile);
-  use("SUBSTRATE_USE_EMISSIVE", all & kFeatEmissive);
+  out_ += useDefines(all);
   line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", opt_.diffuseModel));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));
   line(fmt::format("#define {}_WORD_COUNT {}", upper, L_.words()));

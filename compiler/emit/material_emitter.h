@@ -34,11 +34,19 @@ struct EmitOptions {
   /// per-sample inputs, `substratec stability`) assigns them before calling
   /// `<name>_evaluate`. Same names as the block, so the body is unchanged.
   bool inputsPerInvocation = false;
+  /// The pack function stores a pixel where one plain closure is left in the
+  /// SIMPLE layout (storage/layout.h, runtimeSimpleClosures). Off only to
+  /// compare with the static layout (tests).
+  bool dynamicSimplification = true;
 };
 
 /// `<name>.material.glsl` / `.hlsl`.
 std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayout& layout, const Syntax& syn,
                          const EmitOptions& options);
+
+/// `#define SUBSTRATE_USE_<FEATURE> 0|1` for each runtime switch
+/// (runtime_shaders/substrate_closure.h), 1 for the kFeat* bits of `features`.
+std::string useDefines(std::uint16_t features);
 
 /// Names used across emitted files.
 std::string materialUpper(const Material& m);  // NAME in macros

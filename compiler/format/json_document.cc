@@ -31,6 +31,20 @@ void lineColumnOf(const std::string& text, std::size_t offset, int& line, int& c
   }
 }
 
+std::string kindOfJson(const Json& j) {
+  switch (j.type()) {
+    case Json::value_t::null: return "null";
+    case Json::value_t::boolean: return j.get<bool>() ? "true" : "false";
+    case Json::value_t::string: return quoteForDiagnostic(j.get<std::string>());
+    case Json::value_t::array: return fmt::format("an array of {}", j.size());
+    case Json::value_t::object: return "an object";
+    case Json::value_t::number_integer:
+    case Json::value_t::number_unsigned:
+    case Json::value_t::number_float: return fmt::format("{:g}", j.get<double>());
+    default: return "a value";
+  }
+}
+
 namespace {
 
 std::string inputSizeError(std::size_t limit) {

@@ -36,6 +36,10 @@ std::optional<std::string> readSourceFile(const std::string& path, const ReadLim
 std::optional<Json> parseJsonDocument(const std::string& text, const ReadLimits& limits,
                                       Diagnostics& diags);
 
+/// A JSON value as diagnostics describe it: null, true, a quoted string (escaped),
+/// "an array of N", "an object", a number.
+std::string kindOfJson(const Json& j);
+
 /// 1-based line and column (in bytes) of a byte offset in text.
 void lineColumnOf(const std::string& text, std::size_t offset, int& line, int& column);
 

@@ -650,7 +650,10 @@ bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, ui
         const VkBufferUsageFlags usage = b.kind == DescriptorKind::UniformBuffer ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
                                                                                   : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
         if (!c.createBuffer(buf->data.size(), usage, objs, &buffer, &mapped, &why)) return fail(why);
-        if (buf->output) {
+        if (buf->output && buf->initialized) {
+          std::memcpy(mapped, buf->data.data(), buf->data.size());
+          readbacks.push_back({&buf->data, mapped, buf->data.size()});
+        } else if (buf->output) {
           auto* bytes = static_cast<unsigned char*>(mapped);
           for (size_t i = 0; i < buf->data.size(); ++i) bytes[i] = static_cast<unsigned char>(kQuietNan >> (8 * (i % 4)));
           readbacks.push_back({&buf->data, mapped, buf->data.size()});
@@ -727,6 +730,19 @@ bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, ui
                            b.arrayed ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D, objs, &up.image, &view, &why) ||
             !c.createBuffer(rb.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, objs, &rb.buffer, &mapped, &why))
           return fail(why);
+        if (si.upload) {  // the image's contents come from `data`, through a staging buffer
+          if (si.data.size() != rb.size)
+            return fail("StorageImageResource::data has " + std::to_string(si.data.size()) + " bytes, expected " +
+                        std::to_string(rb.size));
+          void* staged;
+          if (!c.createBuffer(rb.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, objs, &up.staging, &staged, &why))
+            return fail(why);
+          std::memcpy(staged, si.data.data(), rb.size);
+          VkBufferImageCopy region{};
+          region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, si.layers};
+          region.imageExtent = {si.width, si.height, 1};
+          up.regions.push_back(region);
+        }
         rb.mapped = mapped;
         rb.image = up.image;
         rb.region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, si.layers};

@@ -30,10 +30,12 @@ enum class StorageFormat { R32Uint, R32G32B32A32Sfloat };
 
 /// A uniform or storage buffer (the descriptor type comes from reflection). Not output: `data` is
 /// uploaded. Output: `data` only gives the size; before each dispatch the buffer is filled with
-/// quiet-NaN words (0x7fc00000), and afterwards it is read back into `data`.
+/// quiet-NaN words (0x7fc00000), and afterwards it is read back into `data`. Output with `initialized`:
+/// `data` is uploaded and read back (a buffer the shader updates, e.g. with atomics).
 struct BufferResource {
   std::vector<std::byte> data;
   bool output = false;
+  bool initialized = false;
 };
 
 /// An RGBA32F sampled texture, for CombinedImageSampler and SampledImage bindings. A Cube binding
@@ -52,12 +54,14 @@ struct SamplerResource {
   Address address = Address::Repeat;
 };
 
-/// An output storage image: cleared to NaN (float) or 0xFFFFFFFF (uint) before each dispatch, and
-/// read back into `data` afterwards (layer-major, row-major, 4 or 16 bytes a texel).
+/// A storage image: cleared to NaN (float) or 0xFFFFFFFF (uint) before each dispatch, or, with
+/// `upload`, filled from `data`; read back into `data` afterwards (layer-major, row-major, 4 or 16
+/// bytes a texel).
 struct StorageImageResource {
   uint32_t width = 0, height = 0, layers = 1;
   StorageFormat format = StorageFormat::R32G32B32A32Sfloat;
   std::vector<std::byte> data;
+  bool upload = false;
 };
 
 using Resource = std::variant<BufferResource, ImageResource, SamplerResource, StorageImageResource>;

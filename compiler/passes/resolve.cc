@@ -180,20 +180,6 @@ std::string kindOf(const Json& node) {
   return k != node.end() && k->is_string() ? k->get<std::string>() : "";
 }
 
-std::string kindOfJson(const Json& j) {
-  switch (j.type()) {
-    case Json::value_t::null: return "null";
-    case Json::value_t::boolean: return j.get<bool>() ? "true" : "false";
-    case Json::value_t::string: return quoteForDiagnostic(j.get<std::string>());
-    case Json::value_t::array: return fmt::format("an array of {}", j.size());
-    case Json::value_t::object: return "an object";
-    case Json::value_t::number_integer:
-    case Json::value_t::number_unsigned:
-    case Json::value_t::number_float: return fmt::format("{:g}", j.get<double>());
-    default: return "a value";
-  }
-}
-
 /// "a -> b -> c -> a", with long cycles shortened to their first and last
 /// nodes (a cycle through 20000 nodes must not make a megabyte-long line).
 std::string cycleChain(const std::vector<std::string>& names) {

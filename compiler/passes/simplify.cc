@@ -47,6 +47,7 @@ void disableFeature(Material& m, std::uint16_t feature) {
         break;
       case kFeatAnisotropy: s.pin(SlabPin::Anisotropy) = m.values.scalar(0); break;
       case kFeatSpecularProfile: s.specularProfileInput = -1; break;
+      case kFeatEmissive: s.pin(SlabPin::Emissive) = m.values.splat(VType::Vec3, 0); break;
       default: break;
     }
   }
@@ -101,6 +102,30 @@ void collapse(Material& m, int n, BlendRule rule) {
   m.slabs.push_back(std::move(merged));
 }
 
+bool present(const Material& m, std::uint16_t f) {
+  for (int s : analyzeTree(m).slabOrder)
+    if (m.slabs[s].features & f) return true;
+  return false;
+}
+
+/// Disables every feature of `mask` the material uses, in the documented
+/// order (emissive last), recording each as `action`.
+void disableAll(Material& m, std::uint16_t mask, const char* action, StorageLayout& layout,
+                std::vector<SimplifyStep>& steps) {
+  std::vector<std::uint16_t> order = featureDisableOrder();
+  order.push_back(kFeatEmissive);
+  for (std::uint16_t f : order) {
+    if (!(mask & f) || !present(m, f)) continue;
+    SimplifyStep step{action, featureList(f), "feature", 0, layout.bytes(), 0,
+                      static_cast<int>(layout.closures.size()), 0};
+    disableFeature(m, f);
+    layout = reprice(m);
+    step.bytesAfter = layout.bytes();
+    step.closuresAfter = static_cast<int>(layout.closures.size());
+    steps.push_back(step);
+  }
+}
+
 bool over(const StorageLayout& L, const SimplifyBudget& b) {
   if (b.full) return L.closures.size() > 1 || L.bytes() > kFullSimplificationBytes;
   return L.bytes() > b.bytesPerPixel || static_cast<int>(L.closures.size()) > b.maxClosures;
@@ -110,6 +135,8 @@ bool over(const StorageLayout& L, const SimplifyBudget& b) {
 
 bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& layout,
                       std::vector<SimplifyStep>& steps, Diagnostics& diags) {
+  // What the platform's lighting does not evaluate goes first.
+  disableAll(m, budget.disallowed, "disallow", layout, steps);
   while (over(layout, budget)) {
     TreeInfo t = analyzeTree(m);
     int n = pickOperator(m, t);
@@ -124,26 +151,22 @@ bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& 
   }
   for (std::uint16_t f : featureDisableOrder()) {
     if (!over(layout, budget)) break;
-    bool present = false;
-    for (int s : analyzeTree(m).slabOrder) present = present || (m.slabs[s].features & f);
-    if (!present) continue;
-    SimplifyStep step{"disable", featureList(f), "feature", 0, layout.bytes(), 0,
-                      static_cast<int>(layout.closures.size()), 0};
-    disableFeature(m, f);
-    layout = reprice(m);
-    step.bytesAfter = layout.bytes();
-    step.closuresAfter = static_cast<int>(layout.closures.size());
-    steps.push_back(step);
+    disableAll(m, f, "disable", layout, steps);
   }
+  // A collapse blends a disallowed feature's neutral value with another
+  // slab's: the blend may use it again.
+  disableAll(m, budget.disallowed, "disallow", layout, steps);
   if (over(layout, budget)) {
     if (budget.full)
       diags.error("", fmt::format("full simplification cannot fit a {}-byte payload: the smallest reachable size is {} "
                                   "bytes per pixel",
                                   kFullSimplificationBytes, layout.bytes()));
     else
-      diags.error("", fmt::format("material does not fit the budget of {} bytes per pixel and {} closures: the "
+      diags.error("", fmt::format("material does not fit the budget of {} bytes per pixel and {} closures{}: the "
                                   "smallest reachable size is {} bytes per pixel with {} closure(s)",
-                                  budget.bytesPerPixel, budget.maxClosures, layout.bytes(), layout.closures.size()));
+                                  budget.bytesPerPixel, budget.maxClosures,
+                                  budget.platform.empty() ? "" : " (platform " + quoteForDiagnostic(budget.platform) + ")",
+                                  layout.bytes(), layout.closures.size()));
     return false;
   }
   return true;

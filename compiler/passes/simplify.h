@@ -8,6 +8,9 @@
 // fails with an error naming the budget and the smallest size reachable.
 // Full simplification collapses everything into one slab and then disables
 // features until the packed size fits a 32-byte ray-tracing payload.
+// Features a platform does not allow (`disallowed`) are disabled first, in
+// the same order, and again after the collapses (a blend can bring one back);
+// those steps are recorded as "disallow".
 //
 // Rewrite: Material (priced)  ->  Material (fits), plus the list of steps.
 // Must run after shared-bases and pricing; it re-runs features, bases and
@@ -37,6 +40,8 @@ struct SimplifyBudget {
   int maxClosures = 8;
   bool full = false;
   BlendRule rule = BlendRule::ProjectRules;  // blending rules of the collapses
+  std::uint16_t disallowed = 0;              // kFeat* bits the platform does not allow (scene/platform.h)
+  std::string platform;                      // its name, for the diagnostic ("" without a platform)
 };
 
 /// The largest packed size of a fully simplified material (ray-tracing payload).
@@ -51,6 +56,8 @@ bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& 
                       std::vector<SimplifyStep>& steps, Diagnostics& diags);
 
 /// Disables one feature on every slab (used by simplification; exposed for tests).
+/// Emissive (not in featureDisableOrder: it costs no bytes) is disabled by a
+/// platform that does not allow it.
 void disableFeature(Material& m, std::uint16_t feature);
 
 }  // namespace substratec

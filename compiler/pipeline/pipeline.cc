@@ -1,5 +1,6 @@
 #include "pipeline/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
 
 #include <fmt/format.h>
@@ -68,13 +69,19 @@ std::optional<CompileResult> compileText(const std::string& displayName, const s
   // 8. layout and pricing.
   result.budgetBytes = options.budgetOverride.value_or(m.settings.bytesPerPixel);
   result.maxClosures = options.maxClosuresOverride.value_or(m.settings.maxClosures);
+  if (options.platform) {  // the platform caps what the material asks for
+    result.budgetBytes = std::min(result.budgetBytes, options.platform->bytesPerPixel);
+    result.maxClosures = std::min(result.maxClosures, options.platform->maxClosures);
+  }
   pass.run("price", [&] {
     result.before = computeLayout(m, analyzeTree(m));
     return true;
   });
   // 9. simplify to the budget (re-runs 6-8 after each step, so it comes last).
   result.after = result.before;
-  SimplifyBudget budget{result.budgetBytes, result.maxClosures, options.fullSimplification, options.blendRule};
+  SimplifyBudget budget{result.budgetBytes, result.maxClosures, options.fullSimplification, options.blendRule,
+                        options.platform ? options.platform->disallowedFeatures() : std::uint16_t{0},
+                        options.platform ? options.platform->name : std::string()};
   if (!pass.run("simplify", [&] { return simplifyToBudget(m, budget, result.after, result.steps, diags); }))
     return std::nullopt;
   result.tree = analyzeTree(m);

@@ -12,6 +12,7 @@
 #include "passes/build_tree.h"
 #include "passes/resolve.h"
 #include "passes/simplify.h"
+#include "scene/platform.h"
 #include "storage/layout.h"
 
 namespace substratec {
@@ -23,6 +24,7 @@ struct CompileOptions {
   std::optional<int> budgetOverride;       // --budget
   std::optional<int> maxClosuresOverride;  // --max-closures
   bool fullSimplification = false;         // --full-simplification
+  std::optional<Platform> platform;        // --platform: caps budget and closures, disallows features
   BlendRule blendRule = BlendRule::ProjectRules;  // collapse rules (PlainLerp: the accuracy baseline)
   bool printAfterAll = false;              // dump the IR after every pass into debugLog
   bool timePasses = false;                 // record per-pass wall time

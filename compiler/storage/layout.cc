@@ -14,27 +14,15 @@ std::string_view layoutClassName(LayoutClass c) {
   return "?";
 }
 
-StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
-  StorageLayout L;
+namespace {
+
+/// The class, basis-0 elision and field list of a layout whose closures and
+/// basis count are set (docs/storage.md, "Layout classes" and "Order of fields").
+void finishLayout(StorageLayout& L) {
   std::uint16_t all = 0;
-  for (int s : info.slabOrder) {
-    const Slab& slab = m.slabs[s];
-    ClosureLayout c;
-    c.slab = s;
-    c.basis = slab.basis;
-    c.isTop = info.isTop[info.slabNode[s]];
-    c.storedFeatures = slab.features & kStoredFeatureMask;
-    all |= c.storedFeatures;
-    L.closures.push_back(c);
-  }
+  for (const auto& c : L.closures) all |= c.storedFeatures;
   const int count = static_cast<int>(L.closures.size());
   const bool multi = count > 1;
-  for (auto& c : L.closures) {
-    const int node = info.slabNode[c.slab];
-    c.storesWeight = !info.unitWeight[node];
-    c.storesCoverageAbove = !c.isTop && !info.unitCoverageAbove[node];
-  }
-
   // Class.
   if (all & (kFeatGlint | kFeatSpecularProfile)) L.layoutClass = LayoutClass::Special;
   else if (multi || (all & kFeatAnisotropy)) L.layoutClass = LayoutClass::Complex;
@@ -43,7 +31,6 @@ StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
 
   // Bases: a lone closure's normal is the top-layer normal; with several,
   // basis 0's normal is elided when every top-layer closure uses basis 0.
-  L.basisCount = static_cast<int>(m.bases.size());
   bool topShare = true;
   for (const auto& c : L.closures)
     if (c.isTop && c.basis != 0) topShare = false;
@@ -87,7 +74,94 @@ StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
     if (!elided) add(p + "normal", bits::kNormal, "octahedral 2 x snorm16", -1, b);
     if (anisotropic) add(p + "tangent_angle", bits::kTangentAngle, "unorm14 of angle/2pi around the normal", -1, b);
   }
+}
+
+}  // namespace
+
+StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
+  StorageLayout L;
+  for (int s : info.slabOrder) {
+    const Slab& slab = m.slabs[s];
+    const int node = info.slabNode[s];
+    ClosureLayout c;
+    c.slab = s;
+    c.basis = slab.basis;
+    c.isTop = info.isTop[node];
+    c.storedFeatures = slab.features & kStoredFeatureMask;
+    c.storesWeight = !info.unitWeight[node];
+    c.storesCoverageAbove = !c.isTop && !info.unitCoverageAbove[node];
+    L.closures.push_back(c);
+  }
+  L.basisCount = static_cast<int>(m.bases.size());
+  finishLayout(L);
   return L;
+}
+
+StorageLayout simpleLayoutOf(const StorageLayout& L, int k) {
+  StorageLayout S;
+  ClosureLayout c = L.closures.at(k);
+  c.basis = 0;
+  c.isTop = true;
+  c.storesWeight = c.storesCoverageAbove = false;
+  c.storedFeatures = 0;
+  S.closures = {c};
+  S.basisCount = 1;
+  finishLayout(S);
+  return S;
+}
+
+namespace {
+
+/// The product of mix and coverage weights on the path of slab node `node`
+/// to the root is a constant (every factor is): it is never 0 or 1 at run
+/// time unless it is so statically.
+bool constantWeight(const Material& m, const TreeInfo& t, int node) {
+  const Slab& s = m.slabs[m.nodes[node].slab];
+  if (s.coverage != kNoValue && !m.values.isConst(s.coverage)) return false;
+  for (int p = t.parent[node]; p >= 0; p = t.parent[p]) {
+    const TreeNode& op = m.nodes[p];
+    switch (op.op) {
+      case TreeOp::Horizontal:
+      case TreeOp::CoverageWeight:
+        if (!m.values.isConst(op.a)) return false;
+        break;
+      case TreeOp::Select:
+        if (!m.values.isConst(op.a) || !m.values.isConst(op.b)) return false;
+        break;
+      default: break;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::vector<int> runtimeSimpleClosures(const Material& m, const StorageLayout& L) {
+  std::vector<int> out;
+  if (L.layoutClass == LayoutClass::Simple) return out;
+  const TreeInfo t = analyzeTree(m);
+  auto pinVaries = [&](const Slab& s, SlabPin p) { return !m.values.isConst(s.pin(p)); };
+  for (int k = 0; k < static_cast<int>(L.closures.size()); ++k) {
+    const ClosureLayout& c = L.closures[k];
+    const Slab& s = m.slabs[c.slab];
+    bool possible = !(c.storesWeight && constantWeight(m, t, t.slabNode[c.slab]));  // its weight can be 1
+    possible = possible && (c.isTop || c.storesCoverageAbove);                        // nothing above it can remain
+    for (int j = 0; j < static_cast<int>(L.closures.size()) && possible; ++j)
+      if (j != k)  // every other closure's weight can be 0
+        possible = L.closures[j].storesWeight && !constantWeight(m, t, t.slabNode[L.closures[j].slab]);
+    const std::uint16_t f = c.storedFeatures;
+    if (f & kFeatF90) possible = possible && pinVaries(s, SlabPin::F90);
+    if (f & kFeatAnisotropy) possible = possible && pinVaries(s, SlabPin::Anisotropy);
+    // Wrap lighting replaces the diffuse model even without a medium; the
+    // other SSS types light as the diffuse model does.
+    if (f & kFeatSss) possible = possible && s.sssType != SssType::Wrap && pinVaries(s, SlabPin::SssMfp);
+    if (f & kFeatHaze) possible = possible && pinVaries(s, SlabPin::SecondRoughnessWeight);
+    if (f & kFeatFuzz) possible = possible && pinVaries(s, SlabPin::FuzzAmount);
+    if (f & kFeatGlint) possible = possible && pinVaries(s, SlabPin::GlintValue);
+    if (f & kFeatSpecularProfile) possible = false;  // a static choice
+    if (possible) out.push_back(k);
+  }
+  return out;
 }
 
 }  // namespace substratec

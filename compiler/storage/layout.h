@@ -70,4 +70,22 @@ inline constexpr std::uint16_t kStoredFeatureMask =
 
 StorageLayout computeLayout(const Material& m, const TreeInfo& info);
 
+/// Dynamic simplification (docs/scenes.md): the closures of layout `L` that
+/// can be the only one left at a pixel, with nothing it stores in use — the
+/// base pass then packs the pixel in the SIMPLE layout. Closure k qualifies
+/// when every other closure stores a weight that is not a constant (it can be
+/// 0), its own weight can be 1, nothing covers it or its coverage above is
+/// stored (it can be 0), and each feature it stores has a pin that is not a
+/// constant and a neutral value the lighting treats as the feature off: F90
+/// 1, anisotropy 0, an MFP of 0 (not under wrap lighting, which replaces the
+/// diffuse model even without a medium), haze weight 0, fuzz amount 0, glint
+/// value 1. A specular profile is a static choice: never. Empty for a SIMPLE
+/// layout.
+std::vector<int> runtimeSimpleClosures(const Material& m, const StorageLayout& L);
+
+/// The SIMPLE layout of closure `k` of `L` alone (header, albedo, F0,
+/// roughness: 64 bits), which the base pass packs when runtimeSimpleClosures
+/// says it may.
+StorageLayout simpleLayoutOf(const StorageLayout& L, int k);
+
 }  // namespace substratec

@@ -414,6 +414,28 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
   return words;
 }
 
+std::optional<int> runtimeSimpleClosure(const Material& m, const StorageLayout& layout,
+                                        const std::vector<ClosureValues>& closures) {
+  for (int k : runtimeSimpleClosures(m, layout)) {
+    const ClosureLayout& c = layout.closures[k];
+    const ClosureValues& v = closures.at(k);
+    bool plain = true;
+    for (std::size_t j = 0; j < closures.size(); ++j)
+      if (static_cast<int>(j) != k && closures[j].weight > 0) plain = false;
+    if (c.storesWeight && !(v.weight >= 1)) plain = false;
+    if (c.storesCoverageAbove && v.coverageAbove > 0) plain = false;
+    const std::uint16_t f = c.storedFeatures;
+    if ((f & kFeatF90) && !(std::min({v.f90[0], v.f90[1], v.f90[2]}) >= 1)) plain = false;
+    if ((f & kFeatAnisotropy) && v.anisotropy != 0) plain = false;
+    if ((f & kFeatSss) && std::max({v.sssMfp[0], v.sssMfp[1], v.sssMfp[2]}) > 0) plain = false;
+    if ((f & kFeatHaze) && v.secondRoughnessWeight > 0) plain = false;
+    if ((f & kFeatFuzz) && v.fuzzAmount > 0) plain = false;
+    if ((f & kFeatGlint) && !(v.glintValue >= 1)) plain = false;
+    if (plain) return k;
+  }
+  return std::nullopt;
+}
+
 UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, std::uint32_t topLayer) {
   UnpackedMaterial out;
   StorageLayout& L = out.layout;

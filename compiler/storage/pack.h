@@ -25,6 +25,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "storage/layout.h"
@@ -179,6 +180,16 @@ std::uint32_t closureHeaderFeatures(const ClosureLayout& c);
 /// (more than 8 closures or bases, mismatched sizes, unknown fields).
 std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::vector<ClosureValues>& closures,
                                         const std::vector<BasisValues>& bases, double dither);
+
+/// Dynamic simplification as the generated pack function decides it
+/// (storage/layout.h, runtimeSimpleClosures): the closure of `layout` left
+/// alone at this pixel with nothing it stores in use (every other weight
+/// <= 0, its own weight >= 1 when stored, coverage above <= 0 when stored,
+/// F90 >= 1, anisotropy 0, MFP <= 0, haze weight and fuzz amount <= 0, glint
+/// value >= 1), whose SIMPLE layout (simpleLayoutOf) the base pass then
+/// packs; nullopt to pack `layout` itself.
+std::optional<int> runtimeSimpleClosure(const Material& m, const StorageLayout& layout,
+                                        const std::vector<ClosureValues>& closures);
 
 struct UnpackedMaterial {
   LayoutClass cls = LayoutClass::Simple;

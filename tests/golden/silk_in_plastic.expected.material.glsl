@@ -138,6 +138,24 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
   words[10] = 0u;
   words[11] = 0u;
   words[12] = 0u;
+  // Dynamic simplification: closure 0 ('root_top') alone and plain at this pixel -> the SIMPLE layout.
+  if (!(closures[1].weight > 0.0) && !(closures[2].weight > 0.0)) {
+    topLayer = substrate_q_top_layer(closures[0].N, saturate(closures[0].roughness), dither);
+    // header (16 bits at 0)
+    { uint q = substrate_material_header_single(0u, 0u, 0u);
+      words[0] |= q << 0u; }
+    // closure0.diffuse_albedo (20 bits at 16)
+    { uint q = substrate_q_color20(closures[0].diffuseAlbedo, dither);
+      words[0] |= q << 16u;
+      words[1] |= q >> 16u; }
+    // closure0.f0 (20 bits at 36)
+    { uint q = substrate_q_color20(closures[0].f0, dither);
+      words[1] |= q << 4u; }
+    // closure0.roughness (8 bits at 56)
+    { uint q = substrate_q_unorm(closures[0].roughness, 8u, dither);
+      words[1] |= q << 24u; }
+    return;
+  }
   vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);

@@ -1,0 +1,36 @@
+// The scene manifest, `substrate-scene/1` (schema/substrate-scene.schema.json,
+// docs/scenes.md): a name, the material files the scene uses, and optionally
+// the platform it is built for. Read with the materials' strict JSON reader;
+// every problem is located by JSON pointer (or line:col for syntax).
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "format/json_document.h"
+
+namespace substratec {
+
+/// Most materials one scene may list.
+inline constexpr std::size_t kMaxSceneMaterials = 4096;
+
+struct SceneMaterialRef {
+  std::string written;  // the path as the manifest writes it
+  std::string path;     // relative to the manifest's directory, lexically normalized (what is opened)
+  std::string pointer;  // "/materials/3"
+};
+
+struct SceneManifest {
+  std::string name;                    // a C identifier: names the scene's output files
+  std::vector<SceneMaterialRef> materials;
+  std::optional<std::string> platform;  // "platform", when given
+  std::string platformPointer;          // "/platform"
+};
+
+/// Parses the manifest text; `manifestPath` locates relative material paths.
+/// Duplicate material paths (after normalization) are errors.
+std::optional<SceneManifest> parseSceneManifest(const std::string& manifestPath, const std::string& text,
+                                                const ReadLimits& limits, Diagnostics& diags);
+
+}  // namespace substratec

@@ -1,0 +1,197 @@
+#include "scene/scene.h"
+
+#include <map>
+
+#include <fmt/format.h>
+
+#include "cli/cli.h"
+#include "scene/manifest.h"
+
+namespace substratec {
+
+namespace {
+
+using J = nlohmann::ordered_json;
+
+J featureArray(std::uint16_t mask) {
+  J a = J::array();
+  for (int b = 0; b < kFeatureCount; ++b)
+    if ((mask & kPlatformFeatures) & (1u << b)) a.push_back(std::string(featureName(b)));
+  return a;
+}
+
+/// The platform the scene is built for, or an error (status set) when the
+/// name is unknown: a --platform name is bad usage, a manifest's bad input
+/// located at its pointer.
+std::optional<Platform> choosePlatform(const SceneOptions& o, const SceneManifest& scene, const PlatformTable& table,
+                                       SceneBuild& b) {
+  const std::optional<std::string>& name = o.platform ? o.platform : scene.platform;
+  if (!name) return std::nullopt;
+  if (const Platform* p = table.find(*name)) return *p;
+  if (o.platform) {
+    b.status = kExitUsage;
+    b.messages += fmt::format("substratec: error: unknown platform {} (known: {})\n", quoteForDiagnostic(*name),
+                              table.names());
+  } else {
+    Diagnostics d(o.manifest);
+    d.error(scene.platformPointer,
+            fmt::format("unknown platform {} (known: {})", quoteForDiagnostic(*name), table.names()));
+    b.status = kExitBadInput;
+    b.messages += d.formatAll();
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+SceneBuild buildScene(const SceneOptions& o) {
+  SceneBuild b;
+  const ReadLimits& limits = o.batch.compile.read;
+  b.inputs.push_back(o.manifest);
+  std::optional<SceneManifest> scene;
+  {
+    Diagnostics d(o.manifest);
+    if (auto text = readSourceFile(o.manifest, limits, d)) scene = parseSceneManifest(o.manifest, *text, limits, d);
+    b.messages += d.formatAll();
+    if (!scene) return b.status = kExitBadInput, b;
+  }
+  if (!o.platformsFile.empty()) b.inputs.push_back(o.platformsFile);
+  std::optional<PlatformTable> table = loadPlatformTable(o.platformsFile, limits, b.messages);
+  if (!table) return b.status = kExitBadInput, b;
+  BatchOptions batch = o.batch;
+  batch.compile.platform = choosePlatform(o, *scene, *table, b);
+  if (b.status != 0) return b;
+
+  std::vector<std::string> paths;
+  for (const SceneMaterialRef& m : scene->materials) paths.push_back(m.path);
+  b.inputs.insert(b.inputs.end(), paths.begin(), paths.end());
+  std::vector<MaterialBuild> built = buildMaterials(paths, batch);
+  bool internal = false, bad = false;
+  for (const MaterialBuild& m : built) {
+    b.messages += m.messages;
+    internal = internal || m.internalError;
+    bad = bad || !m.ok;
+    b.cacheHits += m.fromCache;
+  }
+  if (internal) return b.status = kExitInternal, b;
+  if (bad) return b.status = kExitBadInput, b;
+  {  // Every material's files go into one directory: names must differ.
+    Diagnostics d(o.manifest);
+    std::map<std::string, std::size_t> seen;
+    for (std::size_t i = 0; i < built.size(); ++i)
+      if (auto [at, fresh] = seen.emplace(built[i].summary.name, i); !fresh)
+        d.error(scene->materials[i].pointer,
+                fmt::format("material {} ({}) has the name of {} ({}): their shaders would overwrite each other",
+                            quoteForDiagnostic(built[i].summary.name), scene->materials[i].path,
+                            scene->materials[at->second].pointer, scene->materials[at->second].path));
+    if (d.hasErrors()) {
+      b.messages += d.formatAll();
+      return b.status = kExitBadInput, b;
+    }
+  }
+
+  // The lighting: what the materials store after simplification, and no more.
+  std::vector<SceneMaterialShape> shapes;
+  for (const MaterialBuild& m : built) shapes.push_back(m.summary.shape());
+  const SceneShape shape = sceneShape(scene->name, shapes, o.batch.generate.emit.diffuseModel);
+  Generated lighting;
+  for (Target t : {Target::Glsl, Target::Hlsl}) {
+    if ((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl)) continue;
+    const Syntax& syn = syntaxFor(t);
+    lighting.files.push_back({tileClassificationFileName(shape, syn), emitTileClassification(shape, syn)});
+    for (const SceneLightingClass& k : shape.classes)
+      lighting.files.push_back({sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn)});
+  }
+  if (o.batch.validate) {
+    validateGenerated(lighting, {.optimize = true}, static_cast<std::size_t>(std::max(0, o.batch.jobs)));
+    if (!lighting.valid) {
+      b.messages += "substratec: internal compiler error: the scene's lighting does not validate\n" + lighting.failure + "\n";
+      return b.status = kExitInternal, b;
+    }
+  }
+  std::map<std::string, const EntryReport*> counts;
+  for (const EntryReport& e : lighting.entries) counts[e.file] = &e;
+
+  // scene.json
+  J report;
+  report["format"] = "substrate-scene-report/1";
+  report["scene"] = scene->name;
+  if (batch.compile.platform) {
+    const Platform& p = *batch.compile.platform;
+    report["platform"] = {{"name", p.name}, {"bytes_per_pixel", p.bytesPerPixel}, {"max_closures", p.maxClosures},
+                          {"features", featureArray(p.allowedFeatures)}};
+  } else {
+    report["platform"] = nullptr;
+  }
+  std::uint16_t features = 0;
+  int maxBytes = 0;
+  for (const MaterialBuild& m : built) {
+    features |= m.summary.features;
+    maxBytes = std::max(maxBytes, m.summary.bytes);
+  }
+  report["features"] = featureArray(features);
+  report["max_bytes_per_pixel"] = maxBytes;
+  report["max_closures"] = shape.maxClosures;
+  report["words"] = shape.maxWords;
+  report["material_buffer_slices"] = materialBufferSlices(shape);
+  J classes = J::array();
+  for (const SceneLightingClass& k : shape.classes) classes.push_back(tileClassName(k.cls));
+  report["tile_classes"] = classes;
+  const Syntax& first = syntaxFor(o.batch.generate.glsl ? Target::Glsl : Target::Hlsl);
+  std::size_t total = 0;
+  J entries = J::array();
+  auto instructions = [&](const std::string& file) {
+    J j = J::object();
+    if (auto it = counts.find(file); it != counts.end())
+      j = {{"instructions", it->second->instructions}, {"optimized_instructions", it->second->optimizedInstructions}};
+    return j;
+  };
+  for (const SceneLightingClass& k : shape.classes) {
+    J e = {{"class", tileClassName(k.cls)},
+           {"features", featureArray(k.features)},
+           {"max_closures", k.maxClosures},
+           {"words", k.maxWords},
+           {"materials", k.materials}};
+    J files = J::object();
+    for (Target t : {Target::Glsl, Target::Hlsl}) {
+      if ((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl)) continue;
+      const std::string file = sceneLightingFileName(shape, k.cls, syntaxFor(t));
+      files[std::string(syntaxFor(t).name)] = {{"file", file}, {"spirv", instructions(file)}};
+    }
+    e["shaders"] = files;
+    if (auto it = counts.find(sceneLightingFileName(shape, k.cls, first)); it != counts.end())
+      total += it->second->instructions;
+    entries.push_back(e);
+  }
+  report["lighting_spirv_instructions"] = total;
+  report["lighting"] = entries;
+  J classify = J::object();
+  for (Target t : {Target::Glsl, Target::Hlsl}) {
+    if ((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl)) continue;
+    const std::string file = tileClassificationFileName(shape, syntaxFor(t));
+    classify[std::string(syntaxFor(t).name)] = {{"file", file}, {"spirv", instructions(file)}};
+  }
+  report["tile_classification"] = classify;
+  J materials = J::array();
+  for (std::size_t i = 0; i < built.size(); ++i) {
+    const MaterialSummary& s = built[i].summary;
+    materials.push_back({{"name", s.name},
+                         {"file", scene->materials[i].written},
+                         {"bytes_per_pixel", s.bytes},
+                         {"closures", s.closures},
+                         {"layout", std::string(layoutClassName(s.layoutClass))},
+                         {"features", featureArray(s.features)},
+                         {"runtime_simple", s.runtimeSimple},
+                         {"budget", {{"bytes_per_pixel", s.budgetBytes}, {"max_closures", s.maxClosures}}},
+                         {"simplification_steps", s.simplificationSteps}});
+  }
+  report["materials"] = materials;
+
+  for (MaterialBuild& m : built)
+    for (OutputFile& f : m.files) b.files.push_back(std::move(f));
+  for (OutputFile& f : lighting.files) b.files.push_back(std::move(f));
+  b.files.push_back({"scene.json", report.dump(2) + "\n"});
+  return b;
+}
+
+}  // namespace substratec
