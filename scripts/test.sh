@@ -45,16 +45,11 @@ if [ "$SANITIZERS" != 0 ]; then
   # unloads Mesa's lavapipe and the validation layer (neither instrumented) at
   # vkDestroyInstance, and LeakSanitizer then reports what their globals held
   # as leaked, with stacks into unmapped code that no suppression can match.
-  gpu_suites="$(build-asan/bin/gpu_tests --gtest_list_tests | sed -n 's/^\([A-Za-z0-9_/]*\)\.$/\1/p' | paste -sd'|')"
-  gpu_regex="^(${gpu_suites})\\."
+  gpu_regex='^gpu_tests:'  # tests are "<binary>:<suite>" (tests/gtest_suites.cmake)
   exclude="${SUBSTRATEC_ASAN_EXCLUDE:-}"
   status=0
   ctest --preset asan -E "${gpu_regex}${exclude:+|$exclude}" || status=1
-  if [ -n "$exclude" ]; then
-    ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" ctest --preset asan -R "$gpu_regex" -E "$exclude" || status=1
-  else
-    ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" ctest --preset asan -R "$gpu_regex" || status=1
-  fi
+  ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" ctest --preset asan -R "$gpu_regex" ${exclude:+-E "$exclude"} || status=1
   [ "$status" -eq 0 ]
   stage_done "tests (asan)"
 fi
