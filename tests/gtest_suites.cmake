@@ -9,19 +9,36 @@
 # `ctest -R '^gpu_tests:'` selects a binary; a failure prints the suite's
 # whole GoogleTest output (outputOnFailure), which names the failing test.
 #
+# A suite named in SPLIT becomes two tests, "<binary>:<suite>:0" and ":1", each
+# one of GoogleTest's two shards of it (GTEST_TOTAL_SHARDS / GTEST_SHARD_INDEX):
+# the longest suites, so that `ctest -j 2` keeps both cores busy to the end.
+#
 # Called by tests/CMakeLists.txt (substratec_add_gtest_suites) with
 #   -DEXE=<binary> -DNAME=<binary name> -DOUT=<file to write> [-DENVIRONMENT=<k=v;...>]
+#   [-DSPLIT=<suite>,<suite>...]
+cmake_minimum_required(VERSION 3.25)  # script mode: IN_LIST and the other policies of the project
 execute_process(COMMAND "${EXE}" --gtest_list_tests OUTPUT_VARIABLE listing RESULT_VARIABLE status
                 TIMEOUT 60)
 if(NOT status EQUAL 0)
   message(FATAL_ERROR "${EXE} --gtest_list_tests failed (${status})")
 endif()
 string(REPLACE "\n" ";" lines "${listing}")
+string(REPLACE "," ";" split "${SPLIT}")
 set(script "")
 foreach(line IN LISTS lines)
   # A suite line has no leading space and ends in '.' (a "# TypeParam" comment may follow).
   if(line MATCHES "^([A-Za-z0-9_/]+)\\.( .*)?$")
     set(suite "${CMAKE_MATCH_1}")
+    if(suite IN_LIST split)
+      foreach(shard 0 1)
+        set(test "${NAME}:${suite}:${shard}")
+        set(env ${ENVIRONMENT})
+        list(APPEND env GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=${shard})
+        string(APPEND script "add_test([=[${test}]=] [=[${EXE}]=] [=[--gtest_filter=${suite}.*]=])\n")
+        string(APPEND script "set_tests_properties([=[${test}]=] PROPERTIES ENVIRONMENT [=[${env}]=])\n")
+      endforeach()
+      continue()
+    endif()
     string(APPEND script "add_test([=[${NAME}:${suite}]=] [=[${EXE}]=] [=[--gtest_filter=${suite}.*]=])\n")
     if(ENVIRONMENT)
       string(APPEND script "set_tests_properties([=[${NAME}:${suite}]=] PROPERTIES ENVIRONMENT [=[${ENVIRONMENT}]=])\n")
