@@ -123,8 +123,9 @@ MaterialBuild buildOne(const std::string& path, const BatchOptions& o, std::size
   b.ok = true;
   b.files = std::move(gen.files);
   b.summary = summarize(*r);
-  if (cache) {  // a cache that cannot be written costs the next build time, not this one's result
-    std::string error = cache->store(keyText, {b.files, b.summary, b.messages});
+  if (cache) {  // written by the command with its outputs (all or none)
+    std::string error;
+    b.cacheEntry = cache->entryFile(keyText, {b.files, b.summary, b.messages}, &error);
     if (!error.empty()) b.messages += "substratec: warning: --cache: " + error + "\n";
   }
   return b;

@@ -69,6 +69,9 @@ struct MaterialBuild {
   bool internalError = false;    // the generated code did not validate (a compiler bug: exit 3)
   std::string messages;          // diagnostics (and the failure dump), as printed
   std::vector<OutputFile> files; // what `compile` writes for it
+  /// Its --cache entry, written with the command's outputs (all or none), not
+  /// by the build; unset for a cache hit, a failure or no --cache.
+  std::optional<OutputPath> cacheEntry;
   MaterialSummary summary;
   bool fromCache = false;
 };

@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 
+#include "output/file_identity.h"
 #include "validate/toolchain.h"
 
 namespace substratec {
@@ -105,7 +106,8 @@ std::string MaterialCache::entryPath(const std::string& keyText) const {
 }
 
 std::optional<CachedMaterial> MaterialCache::load(const std::string& keyText) const {
-  const std::string text = readAll(entryPath(keyText), kMaxEntryBytes);
+  const std::string path = entryPath(keyText);
+  const std::string text = readAll(path, kMaxEntryBytes);
   // "<magic> <checksum of the rest>\n<json>"
   const std::size_t eol = text.find('\n');
   if (eol == std::string::npos || text.compare(0, kMagic.size(), kMagic) != 0 || eol != kMagic.size() + 1 + 32 ||
@@ -129,13 +131,17 @@ std::optional<CachedMaterial> MaterialCache::load(const std::string& keyText) co
       m.files.push_back(std::move(out));
     }
     if (m.files.empty()) return std::nullopt;
+    // An entry used is an input of the command, like any file it reads
+    // (output/file_identity.h); one ignored is rewritten, as the cache's own.
+    if (auto id = fileIdOf(path)) noteFileRead(path, id->device, id->inode);
     return m;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;
   }
 }
 
-std::string MaterialCache::store(const std::string& keyText, const CachedMaterial& entry) const {
+std::optional<OutputPath> MaterialCache::entryFile(const std::string& keyText, const CachedMaterial& entry,
+                                                   std::string* error) const {
   nlohmann::ordered_json j;
   j["key"] = keyText;
   j["summary"] = summaryJson(entry.summary);
@@ -147,11 +153,17 @@ std::string MaterialCache::store(const std::string& keyText, const CachedMateria
   try {
     body = j.dump();
   } catch (const nlohmann::json::exception& e) {  // not UTF-8: kept out of the cache rather than altered
-    return std::string("cannot cache ") + entry.summary.name + ": " + e.what();
+    *error = std::string("cannot cache ") + entry.summary.name + ": " + e.what();
+    return std::nullopt;
   }
-  const std::filesystem::path path = entryPath(keyText);
-  return writeFilesAtomically(path.parent_path().string(),
-                              {{path.filename().string(), fmt::format("{} {}\n{}", kMagic, hash128(body), body)}});
+  return OutputPath{entryPath(keyText), fmt::format("{} {}\n{}", kMagic, hash128(body), body)};
+}
+
+std::string MaterialCache::store(const std::string& keyText, const CachedMaterial& entry) const {
+  std::string error;
+  auto file = entryFile(keyText, entry, &error);
+  if (!file) return error;
+  return writePathsAtomically({*file});
 }
 
 }  // namespace substratec

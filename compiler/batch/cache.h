@@ -43,6 +43,11 @@ class MaterialCache {
   std::optional<CachedMaterial> load(const std::string& keyText) const;
   /// Writes the entry of `keyText` atomically; "" or an error message.
   std::string store(const std::string& keyText, const CachedMaterial& entry) const;
+  /// The entry of `keyText` as a file to write with a command's outputs (so
+  /// that a command writes everything or nothing); nullopt and `error` when
+  /// it cannot be cached (not UTF-8).
+  std::optional<OutputPath> entryFile(const std::string& keyText, const CachedMaterial& entry,
+                                      std::string* error) const;
 
   /// Where the entry of `keyText` lives: DIR/<first two hex digits>/<key>.entry.
   std::string entryPath(const std::string& keyText) const;

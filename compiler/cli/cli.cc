@@ -11,6 +11,7 @@
 #include "emit/generate.h"
 #include "output/atomic_write.h"
 #include "output/depfile.h"
+#include "cli/command_outputs.h"
 #include "batch/batch.h"
 #include "gpu/harness.h"
 #include "gpu/sample_run.h"
@@ -78,6 +79,9 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
   nlohmann::ordered_json all = nlohmann::ordered_json::array();
   bool first = true;
   std::vector<import::MaterialSource> sources;
+  CommandOutputs outputs(out);  // writes only standard output
+  for (const auto& file : a.files) outputs.input(file);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   for (const auto& file : a.files) {
     Diagnostics diags(file);
     auto loaded = import::loadMaterialSources(file, a.material, true, optionsFrom(a).read, diags);
@@ -85,6 +89,7 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
     if (!loaded) status = kExitBadInput;
     else for (auto& s : *loaded) sources.push_back(std::move(s));
   }
+  if (int usage = outputs.check(err); usage != kExitOk) return usage;
   for (const auto& source : sources) {
     const std::string& file = source.displayName;
     Diagnostics diags(file);
@@ -168,22 +173,26 @@ struct CompileArgs {
   std::string depfile;
 };
 
-/// Writes `files` atomically into `dir`, then the depfile when asked (its
-/// targets: every file written, or only `depTarget` when given, depending on
-/// `inputs`), and lists what was written on stdout.
-int writeOutputs(const std::string& dir, const std::vector<OutputFile>& files, const std::string& depfile,
-                 const std::vector<std::string>& inputs, std::ostream& out, std::ostream& err,
+/// Commits `files` into `dir`, the depfile when asked (its targets: every
+/// file written, or only `depTarget` when given, depending on `inputs`) and
+/// the --cache entries, all or none (cli/command_outputs.h); then lists what
+/// was written on stdout.
+int writeOutputs(const CommandOutputs& outputs, const std::string& dir, const std::vector<OutputFile>& files,
+                 const std::string& depfile, const std::vector<std::string>& inputs,
+                 const std::vector<OutputPath>& cacheEntries, std::ostream& out, std::ostream& err,
                  const std::string& depTarget = "") {
-  std::string error = writeFilesAtomically(dir, files);
-  std::vector<std::string> written;
-  for (const auto& f : files) written.push_back((std::filesystem::path(dir) / f.name).string());
-  const std::vector<std::string> targets =
-      depTarget.empty() ? written : std::vector<std::string>{(std::filesystem::path(dir) / depTarget).string()};
-  if (error.empty() && !depfile.empty()) error = writeDepfile(depfile, targets, inputs);
-  if (!error.empty()) {
+  std::vector<OutputPath> paths;
+  if (std::string error = outputPathsIn(dir, files, &paths); !error.empty()) {
     err << "substratec: error: " << error << "\n";
     return kExitBadInput;
   }
+  std::vector<std::string> written;
+  for (const auto& p : paths) written.push_back(p.path);
+  const std::vector<std::string> targets =
+      depTarget.empty() ? written : std::vector<std::string>{(std::filesystem::path(dir) / depTarget).string()};
+  if (!depfile.empty()) paths.push_back({depfile, makeDepfile(targets, inputs)});
+  paths.insert(paths.end(), cacheEntries.begin(), cacheEntries.end());
+  if (int status = outputs.commit(paths, err); status != kExitOk) return status;
   for (const auto& w : written) out << w << "\n";
   return kExitOk;
 }
@@ -222,6 +231,13 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
   o.generate.emit.precision = precisionOf(a.precision);
   o.validate = !a.skipValidation;
   std::vector<std::string> inputs = a.files;
+  CommandOutputs outputs(out);
+  outputs.directory(a.outDir);
+  outputs.namedFile(a.depfile);
+  outputs.directory(a.cache);
+  for (const auto& f : a.files) outputs.input(f);
+  outputs.input(a.platforms);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   if (!a.platform.empty() || !a.platforms.empty()) {
     std::string messages;
     auto table = loadPlatformTable(a.platforms, o.compile.read, messages);
@@ -242,6 +258,7 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
   int status = kExitOk;
   std::map<std::string, std::string> names;  // material name -> file
   std::vector<OutputFile> files;
+  std::vector<OutputPath> cacheEntries;
   for (MaterialBuild& b : built) {
     err << b.messages;
     if (b.internalError) status = kExitInternal;
@@ -255,9 +272,10 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
       if (status == kExitOk) status = kExitBadInput;
     }
     for (OutputFile& f : b.files) files.push_back(std::move(f));
+    if (b.cacheEntry) cacheEntries.push_back(std::move(*b.cacheEntry));
   }
   if (status != kExitOk) return status;
-  return writeOutputs(a.outDir, files, a.depfile, inputs, out, err);
+  return writeOutputs(outputs, a.outDir, files, a.depfile, inputs, cacheEntries, out, err);
 }
 
 struct PreviewArgs {
@@ -285,8 +303,13 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   if (a.maxClosures > 0) o.maxClosuresOverride = a.maxClosures;
   o.fullSimplification = a.fullSimplification;
   o.read.maxInputBytes = a.maxInputSize;
+  CommandOutputs outputs(out);
+  outputs.namedFile(a.output);
+  outputs.input(a.file);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   auto source = loadMaterial(a.file, a.material, o.read, err);
   if (!source) return kExitBadInput;
+  if (int status = outputs.check(err); status != kExitOk) return status;  // its includes too, before rendering
   const std::string& text = source->text;
   std::vector<sweep::Step> entries;
   std::string error;
@@ -335,10 +358,13 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
     err << "substratec: internal compiler error: " << srgb.nanCount << " pixels of the preview are NaN\n";
     return kExitInternal;
   }
-  if (!preview::writePng(a.output, image.width, image.height, srgb.rgba, &error)) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
+  std::vector<uint8_t> png;
+  if (!preview::encodePng(image.width, image.height, srgb.rgba, png, &error)) {
+    err << "substratec: internal compiler error: cannot encode the PNG: " << error << "\n";
+    return kExitInternal;
   }
+  if (int status = outputs.commit({{a.output, std::string(png.begin(), png.end())}}, err); status != kExitOk)
+    return status;
   out << a.output << "\n";
   return kExitOk;
 }
@@ -365,8 +391,13 @@ struct SweepArgs {
 int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   CompileOptions o;
   o.read.maxInputBytes = a.maxInputSize;
+  CommandOutputs outputs(out);
+  outputs.namedFile(a.plot);
+  outputs.input(a.file);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   auto source = loadMaterial(a.file, a.material, o.read, err);
   if (!source) return kExitBadInput;
+  if (int status = outputs.check(err); status != kExitOk) return status;  // its includes too, before measuring
   std::vector<sweep::Step> steps;
   CompileResult full;
   std::string error;
@@ -392,15 +423,8 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
     return kExitInternal;
   }
   const std::string& name = full.material.name;
-  if (!a.plot.empty()) {
-    std::string failure = writeFilesAtomically(
-        std::filesystem::path(a.plot).parent_path().string().empty() ? "." : std::filesystem::path(a.plot).parent_path().string(),
-        {{std::filesystem::path(a.plot).filename().string(), sweep::plotSvg(name, rows)}});
-    if (!failure.empty()) {
-      err << "substratec: error: " << failure << "\n";
-      return kExitBadInput;
-    }
-  }
+  if (!a.plot.empty())
+    if (int status = outputs.commit({{a.plot, sweep::plotSvg(name, rows)}}, err); status != kExitOk) return status;
   if (a.json) out << sweep::formatJson(name, rows);
   else if (a.csv) out << sweep::formatCsv(rows);
   else out << sweep::formatTable(name, rows);
@@ -440,8 +464,12 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   o.budgetOverride = a.budget;
   o.maxClosuresOverride = a.maxClosures;
   o.fullSimplification = a.fullSimplification;
+  CommandOutputs outputs(out);  // writes only standard output
+  outputs.input(a.file);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   auto source = loadMaterial(a.file, a.material, o.read, err);
   if (!source) return kExitBadInput;
+  if (int status = outputs.check(err); status != kExitOk) return status;
   const std::string& text = source->text;
   {  // The material as written: its diagnostics name its own lines.
     Diagnostics diags(source->displayName);
@@ -505,6 +533,10 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
         << ": import reads .gltf, .glb, .materials.json and .mtlx files (this is a substrate-material/1 file)\n";
     return kExitBadInput;
   }
+  CommandOutputs outputs(out);
+  outputs.directory(a.outDir);
+  outputs.input(a.file);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   Diagnostics diags(a.file);
   auto materials = import::importFile(a.file, read, diags);
   if (materials && !a.material.empty()) {
@@ -524,7 +556,7 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     }
     files.push_back({m.name + ".json", m.text});
   }
-  return writeOutputs(a.outDir, files, "", {}, out, err);
+  return writeOutputs(outputs, a.outDir, files, "", {}, {}, out, err);
 }
 
 struct SceneArgs {
@@ -550,13 +582,20 @@ int runScene(const SceneArgs& a, std::ostream& out, std::ostream& err) {
   if (!a.platform.empty()) o.platform = a.platform;
   o.platformsFile = a.platforms;
   o.batch = batchOptions(a.budget, a.maxClosures, a.maxInputSize, a.target, a.diffuse, a.jobs, a.cache);
+  CommandOutputs outputs(out);
+  outputs.directory(a.outDir);
+  outputs.namedFile(a.depfile);
+  outputs.directory(a.cache);
+  outputs.input(a.manifest);
+  outputs.input(a.platforms);
+  if (int status = outputs.check(err); status != kExitOk) return status;
   SceneBuild b = buildScene(o);
   err << b.messages;
   if (b.status != kExitOk) return b.status;
   // The scene's depfile has one target, scene.json: which lighting files a
   // scene has depends on its materials, so a build system cannot list them
   // beforehand; it depends on scene.json (written with them, atomically).
-  return writeOutputs(a.outDir, b.files, a.depfile, b.inputs, out, err, "scene.json");
+  return writeOutputs(outputs, a.outDir, b.files, a.depfile, b.inputs, b.cacheEntries, out, err, "scene.json");
 }
 
 }  // namespace

@@ -15,6 +15,8 @@
 
 #include <fmt/format.h>
 
+#include "output/file_identity.h"
+
 namespace substratec {
 
 void lineColumnOf(const std::string& text, std::size_t offset, int& line, int& column) {
@@ -74,6 +76,7 @@ std::optional<std::string> readSourceFile(const std::string& path, const ReadLim
     diags.errorAt(0, 0, "cannot read file: it is a directory");
     return std::nullopt;
   }
+  noteFileRead(path, static_cast<std::uint64_t>(st.st_dev), static_cast<std::uint64_t>(st.st_ino));
   // A regular file is judged by its size before anything is read: an 80 MB
   // file costs one fstat, not 16 MiB of reading.
   if (S_ISREG(st.st_mode) && static_cast<std::uintmax_t>(st.st_size) > limits.maxInputBytes) {

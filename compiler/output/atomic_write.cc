@@ -27,56 +27,92 @@ bool isPlainFileName(const std::string& name) {
 /// Creates a new file `dir/.name.tmp<pid>.<n>` (mode 0666 & ~umask, like
 /// any output) and writes `contents` into it. Never follows or reuses an
 /// existing name (O_CREAT | O_EXCL). Returns "" and the path, or an error.
-std::string writeTemporary(const fs::path& dir, const OutputFile& f, fs::path* tempPath) {
+std::string writeTemporary(const fs::path& dest, const std::string& contents, fs::path* tempPath) {
+  const fs::path dir = dest.parent_path().empty() ? fs::path(".") : dest.parent_path();
+  const std::string name = dest.filename().string();
   int fd = -1;
   for (int attempt = 0; fd < 0; ++attempt) {
-    fs::path tmp = dir / fmt::format(".{}.tmp{}.{}", f.name, static_cast<long>(::getpid()), attempt);
+    fs::path tmp = dir / fmt::format(".{}.tmp{}.{}", name, static_cast<long>(::getpid()), attempt);
     fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
     if (fd >= 0) *tempPath = tmp;
     else if (errno != EEXIST || attempt >= 100)
-      return fmt::format("cannot write '{}': {}", (dir / f.name).string(), std::strerror(errno));
+      return fmt::format("cannot write '{}': {}", dest.string(), std::strerror(errno));
   }
   std::size_t done = 0;
-  while (done < f.contents.size()) {
-    ssize_t n = ::write(fd, f.contents.data() + done, f.contents.size() - done);
+  while (done < contents.size()) {
+    ssize_t n = ::write(fd, contents.data() + done, contents.size() - done);
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0) {
       std::string why = std::strerror(n < 0 ? errno : EIO);
       ::close(fd);
-      return fmt::format("cannot write '{}': {}", (dir / f.name).string(), why);
+      return fmt::format("cannot write '{}': {}", dest.string(), why);
     }
     done += static_cast<std::size_t>(n);
   }
-  if (::close(fd) != 0) return fmt::format("cannot write '{}': {}", (dir / f.name).string(), std::strerror(errno));
+  if (::close(fd) != 0) return fmt::format("cannot write '{}': {}", dest.string(), std::strerror(errno));
+  return "";
+}
+
+/// The directory a destination goes into ("." for a bare name).
+fs::path dirOf(const fs::path& dest) { return dest.parent_path().empty() ? fs::path(".") : dest.parent_path(); }
+
+/// Creates the directory `dest` goes into, and the directories above it that
+/// are missing, appending each one created to `created` (shallowest first).
+/// "" or an error naming `dest`.
+std::string makeDirectory(const fs::path& dest, std::vector<fs::path>& created) {
+  const fs::path dir = dirOf(dest);
+  std::error_code ec;
+  std::vector<fs::path> missing;
+  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {  // bounded by the path's depth
+    missing.insert(missing.begin(), p);
+    if (p == p.parent_path()) break;
+  }
+  for (const fs::path& p : missing) {
+    const bool made = fs::create_directory(p, ec);
+    if (ec) return fmt::format("cannot write '{}': cannot create the directory '{}': {}", dest.string(), p.string(), ec.message());
+    if (made) created.push_back(p);
+  }
+  if (!fs::is_directory(dir, ec))
+    return fmt::format("cannot write '{}': '{}' is not a directory", dest.string(), dir.string());
   return "";
 }
 
 }  // namespace
 
-std::string writeFilesAtomically(const std::string& dirName, const std::vector<OutputFile>& files) {
+std::string outputPathsIn(const std::string& dirName, const std::vector<OutputFile>& files,
+                          std::vector<OutputPath>* paths) {
   const fs::path dir = dirName.empty() ? fs::path(".") : fs::path(dirName);
   for (const auto& f : files)
     if (!isPlainFileName(f.name)) return fmt::format("refusing to write the output name '{}'", f.name);
+  for (const auto& f : files) paths->push_back({(dir / f.name).string(), f.contents});
+  return "";
+}
 
-  // The directories this run creates, deepest last, so a failure removes them again.
-  std::error_code ec;
-  std::vector<fs::path> created;
-  for (fs::path p = dir; !p.empty() && !fs::exists(p, ec); p = p.parent_path()) {
-    created.insert(created.begin(), p);
-    if (p == p.parent_path()) break;
+std::string writeFilesAtomically(const std::string& dirName, const std::vector<OutputFile>& files) {
+  std::vector<OutputPath> paths;
+  if (std::string error = outputPathsIn(dirName, files, &paths); !error.empty()) return error;
+  if (paths.empty()) {  // nothing to write: the directory alone
+    std::vector<fs::path> created;
+    return makeDirectory((dirName.empty() ? fs::path(".") : fs::path(dirName)) / "-", created);
   }
-  fs::create_directories(dir, ec);
-  if (ec) return fmt::format("cannot create output directory '{}': {}", dir.string(), ec.message());
+  return writePathsAtomically(paths);
+}
 
+std::string writePathsAtomically(const std::vector<OutputPath>& files) {
+  for (const auto& f : files)
+    if (!isPlainFileName(fs::path(f.path).filename().string()))
+      return fmt::format("refusing to write the output '{}'", f.path);
+
+  std::vector<fs::path> created;  // the directories this call creates, shallowest first
   std::vector<fs::path> temps(files.size()), backups(files.size());
   std::vector<bool> existed(files.size(), false);
   std::size_t renamed = 0;
   // On failure: put back what was replaced, remove what was added, remove the
-  // temporaries and the directories this run created. The folder is as it was.
+  // temporaries and the directories this call created. Everything is as it was.
   auto rollback = [&](std::string message) {
     std::error_code ignored;
     for (std::size_t i = renamed; i-- > 0;) {
-      const fs::path dest = dir / files[i].name;
+      const fs::path dest = files[i].path;
       if (!backups[i].empty()) fs::rename(backups[i], dest, ignored);
       else if (!existed[i]) fs::remove(dest, ignored);
     }
@@ -88,21 +124,26 @@ std::string writeFilesAtomically(const std::string& dirName, const std::vector<O
     return message;
   };
 
-  // Phase 1: every file to a new temporary beside its destination (same file system).
+  // Phase 1: every directory, then every file to a new temporary beside its
+  // destination (same file system). Any destination that cannot be written
+  // fails here, before anything is renamed.
+  for (const auto& f : files)
+    if (std::string error = makeDirectory(f.path, created); !error.empty()) return rollback(error);
   for (std::size_t i = 0; i < files.size(); ++i) {
-    std::string error = writeTemporary(dir, files[i], &temps[i]);
+    std::string error = writeTemporary(files[i].path, files[i].contents, &temps[i]);
     if (!error.empty()) return rollback(error);
   }
   // Phase 2: keep a hard link to every file about to be replaced (so a failure
   // half way can put it back), then rename each temporary into place (atomic
   // per file on POSIX).
   for (std::size_t i = 0; i < files.size(); ++i) {
-    const fs::path dest = dir / files[i].name;
+    const fs::path dest = files[i].path;
     struct stat st;
     if (::lstat(dest.c_str(), &st) != 0) continue;  // nothing to replace
     existed[i] = true;
+    const std::string name = dest.filename().string();
     for (int attempt = 0; attempt < 100; ++attempt) {
-      fs::path backup = dir / fmt::format(".{}.old{}.{}", files[i].name, static_cast<long>(::getpid()), attempt);
+      fs::path backup = dirOf(dest) / fmt::format(".{}.old{}.{}", name, static_cast<long>(::getpid()), attempt);
       if (::link(dest.c_str(), backup.c_str()) == 0) {
         backups[i] = backup;
         break;
@@ -110,8 +151,9 @@ std::string writeFilesAtomically(const std::string& dirName, const std::vector<O
       if (errno != EEXIST) break;  // no hard links here: the rename stays atomic, only the rollback is lost
     }
   }
+  std::error_code ec;
   for (std::size_t i = 0; i < files.size(); ++i) {
-    const fs::path dest = dir / files[i].name;
+    const fs::path dest = files[i].path;
     fs::rename(temps[i], dest, ec);
     if (ec) return rollback(fmt::format("cannot rename into '{}': {}", dest.string(), ec.message()));
     temps[i].clear();
@@ -120,6 +162,20 @@ std::string writeFilesAtomically(const std::string& dirName, const std::vector<O
   std::error_code ignored;
   for (const auto& b : backups)
     if (!b.empty()) fs::remove(b, ignored);
+  return "";
+}
+
+std::string checkWritable(const std::vector<std::string>& paths) {
+  for (const std::string& p : paths) {
+    std::vector<fs::path> created;
+    fs::path temp;
+    std::string error = makeDirectory(p, created);
+    if (error.empty()) error = writeTemporary(p, "", &temp);
+    std::error_code ignored;
+    if (!temp.empty()) fs::remove(temp, ignored);
+    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ignored);
+    if (!error.empty()) return error;
+  }
   return "";
 }
 

@@ -187,8 +187,10 @@ SceneBuild buildScene(const SceneOptions& o) {
   }
   report["materials"] = materials;
 
-  for (MaterialBuild& m : built)
+  for (MaterialBuild& m : built) {
     for (OutputFile& f : m.files) b.files.push_back(std::move(f));
+    if (m.cacheEntry) b.cacheEntries.push_back(std::move(*m.cacheEntry));
+  }
   for (OutputFile& f : lighting.files) b.files.push_back(std::move(f));
   b.files.push_back({"scene.json", report.dump(2) + "\n"});
   return b;

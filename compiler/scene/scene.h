@@ -28,6 +28,7 @@ struct SceneBuild {
   std::string messages;             // everything for stderr, in a fixed order
   std::vector<OutputFile> files;    // every output (materials, lighting, scene.json); empty unless status is 0
   std::vector<std::string> inputs;  // every file read (manifest, platforms file, materials): the depfile's
+  std::vector<OutputPath> cacheEntries;  // --cache entries to write with the outputs (all or none)
   int cacheHits = 0;                // materials taken from --cache
 };
 
