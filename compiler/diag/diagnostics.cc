@@ -20,6 +20,8 @@ std::string Diagnostic::format() const {
     return fmt::format("{}: {}: {}: {}", file, pointer.empty() ? "/" : pointer,
                        severityName(severity), message);
   }
+  // Not located in the text (the file cannot be opened or read): the path alone.
+  if (line <= 0) return fmt::format("{}: {}: {}", file, severityName(severity), message);
   return fmt::format("{}:{}:{}: {}: {}", file, line, column, severityName(severity), message);
 }
 
@@ -37,6 +39,15 @@ void Diagnostics::push(Diagnostic d) {
 void Diagnostics::errorAt(int line, int column, std::string message) {
   Diagnostic d;
   d.file = file_;
+  d.line = line;
+  d.column = column;
+  d.message = std::move(message);
+  push(std::move(d));
+}
+
+void Diagnostics::errorIn(std::string file, int line, int column, std::string message) {
+  Diagnostic d;
+  d.file = std::move(file);
   d.line = line;
   d.column = column;
   d.message = std::move(message);

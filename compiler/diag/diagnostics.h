@@ -18,7 +18,9 @@ struct Diagnostic {
   bool hasPointer = false;
   std::string message;
 
-  /// `file:LINE:COL: error: msg` or `file: /pointer: error: msg`.
+  /// `file:LINE:COL: error: msg` or `file: /pointer: error: msg`, or
+  /// `file: error: msg` when it is about the file as a whole (line 0: it
+  /// cannot be opened or read).
   std::string format() const;
 };
 
@@ -30,6 +32,8 @@ class Diagnostics {
       : file_(std::move(file)), limit_(errorLimit) {}
 
   void errorAt(int line, int column, std::string message);
+  /// An error located in another file than this one's (an included file).
+  void errorIn(std::string file, int line, int column, std::string message);
   void error(std::string pointer, std::string message);
   void warning(std::string pointer, std::string message);
   void warningAt(int line, int column, std::string message);

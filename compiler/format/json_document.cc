@@ -113,8 +113,31 @@ std::optional<std::string> readSourceFile(const std::string& path, const ReadLim
 
 namespace {
 
-/// Linear pre-scan: rejects byte-order marks and nesting deeper than the limit
-/// before the parser sees the text, so depth can never exhaust any stack.
+/// A byte JSON never has outside a string: a control byte other than the
+/// whitespace ones, DEL, or any byte of a multi-byte UTF-8 sequence.
+bool binaryByte(unsigned char c) { return c >= 0x7F || (c < 0x20 && c != '\t' && c != '\n' && c != '\r'); }
+
+/// What a file that is not JSON text seems to be, from its first bytes.
+std::string notJsonReason(const std::string& text, std::size_t offset) {
+  auto startsWith = [&](std::string_view magic) { return text.compare(0, magic.size(), magic) == 0; };
+  if (startsWith("\x89PNG")) return "not JSON (a PNG image)";
+  if (startsWith("glTF")) return "not JSON (a binary glTF container; give it the .glb extension)";
+  if (startsWith("\x1f\x8b")) return "not JSON (gzip-compressed data)";
+  if (startsWith("PK\x03\x04")) return "not JSON (a zip archive)";
+  if (startsWith("\x7f" "ELF")) return "not JSON (an executable)";
+  if (text.size() >= 2 && text[0] != 0 && text[1] == 0)
+    return "not JSON (UTF-16 without a byte-order mark?); material files must be UTF-8";
+  const auto c = static_cast<unsigned char>(text[offset]);
+  if (c == 0) return "not JSON (a NUL byte outside a string; is this a binary file?)";
+  if (c < 0x80) return fmt::format("not JSON (control byte 0x{:02X} outside a string; is this a binary file?)", c);
+  return fmt::format("not JSON (byte 0x{:02X} outside a string; only strings hold non-ASCII text)", c);
+}
+
+/// Linear pre-scan: rejects byte-order marks, bytes no JSON text has outside
+/// a string (binary files: "not JSON", at the first such byte, rather than
+/// whatever the parser or the nesting limit would make of them) and nesting
+/// deeper than the limit before the parser sees the text, so depth can never
+/// exhaust any stack.
 bool preScan(const std::string& text, const ReadLimits& limits, Diagnostics& diags) {
   if (text.size() >= 3 && static_cast<unsigned char>(text[0]) == 0xEF &&
       static_cast<unsigned char>(text[1]) == 0xBB && static_cast<unsigned char>(text[2]) == 0xBF) {
@@ -139,6 +162,11 @@ bool preScan(const std::string& text, const ReadLimits& limits, Diagnostics& dia
     }
     if (c == '"') {
       inString = true;
+    } else if (binaryByte(static_cast<unsigned char>(c))) {
+      int line, col;
+      lineColumnOf(text, i, line, col);
+      diags.errorAt(line, col, notJsonReason(text, i));
+      return false;
     } else if (c == '[' || c == '{') {
       if (++depth > limits.maxNesting) {
         int line, col;

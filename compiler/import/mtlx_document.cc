@@ -23,11 +23,13 @@ bool isInclude(pugi::xml_node n) {
 
 bool MtlxDocument::load(const std::string& text, const std::string& fileName, const std::string& baseDir,
                         const ReadLimits& limits, Diagnostics& diags) {
-  return loadOne(text, fileName, baseDir, 0, 0, 0, limits, diags);
+  const std::string path = (std::filesystem::path(baseDir) / fileName).string();
+  return loadOne(text, fileName, Reading{fileIdOf(path), path, diags.file()}, baseDir, 0, 0, 0, limits, diags);
 }
 
-bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName, const std::string& dir, int depth,
-                           int includeLine, int includeColumn, const ReadLimits& limits, Diagnostics& diags) {
+bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName, const Reading& reading,
+                           const std::string& dir, int depth, int includeLine, int includeColumn,
+                           const ReadLimits& limits, Diagnostics& diags) {
   auto loaded = std::make_unique<Loaded>();
   loaded->fileName = fileName;
   loaded->text = text;
@@ -50,7 +52,7 @@ bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName,
   }
   Loaded* self = loaded.get();
   docs_.push_back(std::move(loaded));
-  loading_.push_back(fileName);
+  loading_.push_back(reading);
   bool ok = true;
   for (pugi::xml_node n : root.children()) {
     if (n.type() != pugi::node_element) continue;
@@ -72,10 +74,22 @@ bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName,
         continue;
       }
       const std::filesystem::path path = std::filesystem::path(dir) / href;
-      const std::string name = std::filesystem::path(href).filename().string();
-      if (std::find(loading_.begin(), loading_.end(), path.lexically_normal().string()) != loading_.end() ||
-          name == fileName) {
-        fail(fmt::format("xi:include '{}': a file that is already being read (a cycle of includes)", href));
+      Reading next{fileIdOf(path.string()), path.string(),
+                   (std::filesystem::path(reading.display).parent_path() / href).string()};
+      // A cycle: the file is one of those being read (the same file, however
+      // its path is spelled; by path only where it has no identity).
+      auto same = [&](const Reading& r) {
+        return next.id && r.id ? *next.id == *r.id : path.lexically_normal() == std::filesystem::path(r.path).lexically_normal();
+      };
+      if (auto open = std::find_if(loading_.begin(), loading_.end(), same); open != loading_.end()) {
+        std::string chain;
+        for (auto it = open; it != loading_.end(); ++it) chain += it->display + " -> ";
+        int holderLine = 0, holderColumn = 0;  // in the file that holds this include
+        lineColumnOf(self->text, static_cast<std::size_t>(std::max<std::ptrdiff_t>(n.offset_debug(), 0)), holderLine,
+                     holderColumn);
+        diags.errorIn(reading.display, holderLine, holderColumn,
+                      fmt::format("xi:include '{}' closes a cycle of includes ({}{})", href, chain, open->display));
+        ok = false;
         continue;
       }
       Diagnostics readDiags(href);
@@ -85,9 +99,8 @@ bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName,
                          readDiags.all().empty() ? std::string("cannot read it") : readDiags.all().front().message));
         continue;
       }
-      loading_.push_back(path.lexically_normal().string());
-      if (!loadOne(*included, name, path.parent_path().string(), depth + 1, line, column, limits, diags)) ok = false;
-      loading_.pop_back();
+      const std::string name = std::filesystem::path(href).filename().string();
+      if (!loadOne(*included, name, next, path.parent_path().string(), depth + 1, line, column, limits, diags)) ok = false;
       continue;
     }
     const std::string name = n.attribute("name").as_string();

@@ -1,7 +1,8 @@
 // Reading a MaterialX document (https://materialx.org, version 1.38/1.39)
 // with pugixml: the XML parsed (syntax errors at file:line:col), XInclude
 // (`<xi:include href=...>`) resolved relative to the including file (depth
-// and count limited, cycles rejected), the top-level elements indexed by name,
+// and count limited; a cycle, found by file identity whatever the spelling,
+// is an error at the include that closes it, in the file that holds it), the top-level elements indexed by name,
 // and every element locatable as `line N` of its file plus its element path
 // (`nodegraph 'NG_brass1' / tiledimage 'image_color'`). Values are parsed from
 // MaterialX's comma-separated strings.
@@ -16,6 +17,7 @@
 
 #include "diag/diagnostics.h"
 #include "format/json_document.h"
+#include "output/file_identity.h"
 
 namespace substratec::import {
 
@@ -43,14 +45,21 @@ class MtlxDocument {
     pugi::xml_document doc;
     int includeLine = 0, includeColumn = 0;  // of the xi:include in the main file (0 for the main file)
   };
-  bool loadOne(const std::string& text, const std::string& fileName, const std::string& dir, int depth,
-               int includeLine, int includeColumn, const ReadLimits& limits, Diagnostics& diags);
+  /// A file being read: what it is (device and inode, when it is a file),
+  /// its path as read, and as diagnostics name it (relative to the main file
+  /// as the user gave it).
+  struct Reading {
+    std::optional<FileId> id;
+    std::string path, display;
+  };
+  bool loadOne(const std::string& text, const std::string& fileName, const Reading& reading, const std::string& dir,
+               int depth, int includeLine, int includeColumn, const ReadLimits& limits, Diagnostics& diags);
   const Loaded* owner(pugi::xml_node n) const;
 
   std::vector<std::unique_ptr<Loaded>> docs_;
   std::vector<pugi::xml_node> top_;
   std::map<std::string, pugi::xml_node> byName_;
-  std::vector<std::string> loading_;  // include stack, for cycles
+  std::vector<Reading> loading_;  // the include stack, for cycles
 };
 
 /// The numbers of a MaterialX value string ("0.8, 0.8, 0.8"; "1"; "true" is
