@@ -11,6 +11,7 @@
 #include "emit/generate.h"
 #include "output/atomic_write.h"
 #include "output/depfile.h"
+#include "cli/cli_options.h"
 #include "cli/command_outputs.h"
 #include "batch/batch.h"
 #include "gpu/harness.h"
@@ -150,7 +151,7 @@ void addPrecisionOption(CLI::App* command, std::string& precision) {
   command->add_option("--precision", precision,
                       "Lighting precision: float, or half (float16 colours, weights and throughputs; "
                       "docs/stability.md)")
-      ->check(CLI::IsMember({"float", "half"}));
+      ->check(CLI::IsMember({"float", "half"}))->capture_default_str();
 }
 Precision precisionOf(const std::string& name) { return name == "half" ? Precision::Half : Precision::Float; }
 
@@ -612,13 +613,13 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   rep->add_option("files", report.files, "Material files (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx: every material)")->required();
   rep->add_option("--material", report.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   rep->add_option("--budget", report.budget, "Bytes per pixel budget (overrides settings.bytes_per_pixel)")
-      ->check(CLI::Range(8, 1024));
+      ->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
   rep->add_option("--max-closures", report.maxClosures, "Closure budget (overrides settings.max_closures)")
-      ->check(CLI::Range(1, 8));
+      ->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");
   rep->add_flag("--full-simplification", report.fullSimplification, "Collapse everything into one closure");
   rep->add_flag("--json", report.json, "Print the report as JSON (docs/report.md)");
   rep->add_option("--max-input-size", report.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   rep->add_flag("--print-after-all", report.printAfterAll, "Dump the IR after every pass (stderr)");
   rep->add_flag("--time-passes", report.timePasses, "Print the time of every pass (stderr)");
   rep->add_flag("--spirv", report.spirv,
@@ -631,20 +632,22 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
                   "Material files (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
   comp->add_option("--material", compile.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   comp->add_option("-o,--output", compile.outDir, "Output directory")->required();
-  comp->add_option("--target", compile.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}));
+  comp->add_option("--target", compile.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}))->capture_default_str();
   comp->add_option("--diffuse", compile.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
-  comp->add_option("--budget", compile.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
-  comp->add_option("--max-closures", compile.maxClosures, "Closure budget")->check(CLI::Range(1, 8));
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
+  comp->add_option("--budget", compile.budget, "Bytes per pixel budget")->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
+  comp->add_option("--max-closures", compile.maxClosures, "Closure budget")->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");
   comp->add_flag("--full-simplification", compile.fullSimplification, "Collapse everything into one closure");
   comp->add_flag("--skip-validation", compile.skipValidation,
                  "Write the outputs without compiling them with glslang (debugging the generator)");
   comp->add_option("--max-input-size", compile.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   addPrecisionOption(comp, compile.precision);
   comp->add_option("-j,--jobs", compile.jobs, "Materials compiled at once (default: the machine's threads)")
-      ->check(CLI::Range(1, 256));
-  comp->add_option("--platform", compile.platform, "Simplify for this platform (docs/scenes.md)");
+      ->transform(cli::inRange(1, 256, "threads"))->default_str("the machine's threads");
+  comp->add_option("--platform", compile.platform,
+                   "Simplify for this platform (built in: " + PlatformTable::builtin().names() +
+                       "; more with --platforms; docs/scenes.md)");
   comp->add_option("--platforms", compile.platforms, "A substrate-platforms/1 file extending the built-in platforms");
   comp->add_option("--cache", compile.cache,
                    "Content-hash cache directory: an unchanged material (bytes, options, compiler) is not recompiled");
@@ -655,20 +658,20 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   pre->add_option("file", prev.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
   pre->add_option("--material", prev.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   pre->add_option("-o,--output", prev.output, "PNG file to write")->required();
-  pre->add_option("--budget", prev.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
-  pre->add_option("--max-closures", prev.maxClosures, "Closure budget")->check(CLI::Range(1, 8));
+  pre->add_option("--budget", prev.budget, "Bytes per pixel budget")->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
+  pre->add_option("--max-closures", prev.maxClosures, "Closure budget")->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");
   pre->add_flag("--full-simplification", prev.fullSimplification, "Collapse everything into one closure");
-  pre->add_option("--size", prev.size, "Image width and height in pixels")->check(CLI::Range(16, 2048));
-  pre->add_option("--env", prev.environment, "Procedural environment")->check(CLI::IsMember(preview::environmentNames()));
+  pre->add_option("--size", prev.size, "Image width and height in pixels")->transform(cli::inRange(16, 2048, "pixels"))->capture_default_str();
+  pre->add_option("--env", prev.environment, "Procedural environment")->check(CLI::IsMember(preview::environmentNames()))->capture_default_str();
   pre->add_flag("--sweep", prev.sweep,
                 "A contact sheet: the material at each simplification step, labelled with bytes and closures");
   pre->add_option("--target", prev.target, "Which generated language renders: glsl or hlsl")
-      ->check(CLI::IsMember({"glsl", "hlsl"}));
+      ->check(CLI::IsMember({"glsl", "hlsl"}))->capture_default_str();
   pre->add_option("--diffuse", prev.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
-  pre->add_option("--exposure", prev.exposure, "Exposure in stops before the tone curve")->check(CLI::Range(-16.0, 16.0));
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
+  pre->add_option("--exposure", prev.exposure, "Exposure in stops before the tone curve")->transform(cli::inRange(-16.0, 16.0, "stops"))->capture_default_str();
   pre->add_option("--max-input-size", prev.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   addPrecisionOption(pre, prev.precision);
 
   SweepArgs sw;
@@ -679,19 +682,19 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   swp->add_flag("--csv", sw.csv, "Print the rows as CSV");
   swp->add_option("--plot", sw.plot, "Also write an SVG plot of error against cost");
   swp->add_option("--max-error", sw.maxError, "Choose the cheapest row with rel_mse <= E and print its budget")
-      ->check(CLI::Range(0.0, 1e30));
-  swp->add_option("--pixels", sw.pixels, "Shading points per timed dispatch")->check(CLI::Range(64, 1 << 24));
+      ->transform(cli::inRange(0.0, 1e30, "(relative MSE)"));
+  swp->add_option("--pixels", sw.pixels, "Shading points per timed dispatch")->transform(cli::inRange(64, 1 << 24, "shading points"))->capture_default_str();
   swp->add_option("--runs", sw.runs, "Timed dispatches after the warm-up (the median is reported)")
-      ->check(CLI::Range(1, 100));
+      ->transform(cli::inRange(1, 100, "runs"))->capture_default_str();
   swp->add_option("--diffuse", sw.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
   swp->add_option("--max-input-size", sw.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   swp->add_option("--ground-truth-probes", sw.groundTruthProbes,
                   "Shading points walked for rel_mse_vs_ground_truth (0: skip the column)")
-      ->check(CLI::Range(0, 1024));
+      ->transform(cli::inRange(0, 1024, "shading points"))->capture_default_str();
   swp->add_option("--ground-truth-samples", sw.groundTruthSamples, "Random walks per shading point and channel group")
-      ->check(CLI::Range(1, 1 << 20));
+      ->transform(cli::inRange(1, 1 << 20, "walks"))->capture_default_str();
   addPrecisionOption(swp, sw.precision);
 
   StabilityArgs stab;
@@ -700,15 +703,15 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   sta->add_option("--material", stab.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
   sta->add_flag("--json", stab.json, "Print the counts and the worst cases as JSON");
   sta->add_option("--evaluations", stab.evaluations, "Shading points to evaluate at least (each path)")
-      ->check(CLI::Range(1L, 100000000L));
+      ->transform(cli::inRange(1L, 100000000L, "shading points"))->capture_default_str();
   sta->add_flag("--no-gpu", stab.noGpu, "CPU reference only");
   sta->add_flag("--gpu-only", stab.gpuOnly, "The generated shaders only (no CPU reference, no furnace)")
       ->excludes("--no-gpu");
-  sta->add_option("--budget", stab.budget, "Bytes per pixel budget")->check(CLI::Range(8, 1024));
-  sta->add_option("--max-closures", stab.maxClosures, "Closures per pixel")->check(CLI::Range(1, 8));
+  sta->add_option("--budget", stab.budget, "Bytes per pixel budget")->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
+  sta->add_option("--max-closures", stab.maxClosures, "Closures per pixel")->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");
   sta->add_flag("--full-simplification", stab.fullSimplification, "Collapse to one closure first");
   sta->add_option("--max-input-size", stab.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   addPrecisionOption(sta, stab.precision);
 
   ImportArgs imp;
@@ -718,30 +721,47 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   impc->add_option("-o,--output", imp.outDir, "Output directory (one <material>.json per material)")->required();
   impc->add_option("--material", imp.material, "Import only this material (by name)");
   impc->add_option("--max-input-size", imp.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
 
   SceneArgs scn;
   CLI::App* sce = app.add_subcommand(
       "scene", "Compile a scene's materials for its platform and the lighting it needs (docs/scenes.md)");
   sce->add_option("manifest", scn.manifest, "Scene manifest (substrate-scene/1 JSON)")->required();
   sce->add_option("-o,--output", scn.outDir, "Output directory")->required();
-  sce->add_option("--platform", scn.platform, "Platform to build for (overrides the manifest's)");
+  sce->add_option("--platform", scn.platform,
+                  "Platform to build for, overriding the manifest's (built in: " + PlatformTable::builtin().names() +
+                      "; more with --platforms)");
   sce->add_option("--platforms", scn.platforms, "A substrate-platforms/1 file extending the built-in platforms");
   sce->add_option("-j,--jobs", scn.jobs, "Materials compiled at once (default: the machine's threads)")
-      ->check(CLI::Range(1, 256));
-  sce->add_option("--target", scn.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}));
+      ->transform(cli::inRange(1, 256, "threads"))->default_str("the machine's threads");
+  sce->add_option("--target", scn.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}))->capture_default_str();
   sce->add_option("--diffuse", scn.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}));
+      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
   sce->add_option("--budget", scn.budget, "Bytes per pixel budget of every material (the platform still caps it)")
-      ->check(CLI::Range(8, 1024));
-  sce->add_option("--max-closures", scn.maxClosures, "Closure budget of every material")->check(CLI::Range(1, 8));
+      ->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
+  sce->add_option("--max-closures", scn.maxClosures, "Closure budget of every material")->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");
   sce->add_option("--max-input-size", scn.maxInputSize, "Reject inputs larger than this many bytes")
-      ->check(CLI::Range(std::size_t{1}, std::size_t{1} << 31));
+      ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   sce->add_option("--cache", scn.cache, "Content-hash cache directory for the materials");
   sce->add_option("--depfile", scn.depfile,
                   "Write a Make-syntax dependency file: the outputs depend on the manifest, the platforms file and "
                   "every material");
 
+  // No command, or a word that is none of them: say so and list them (CLI11
+  // alone says "A subcommand is required" or "arguments were not expected").
+  std::string commands;
+  bool known = false;
+  for (const CLI::App* c : app.get_subcommands({})) {
+    commands += (commands.empty() ? "" : ", ") + c->get_name();
+    known = known || (!args.empty() && c->check_name(args[0]));
+  }
+  if (args.empty() || (!known && !args[0].empty() && args[0][0] != '-')) {
+    err << "substratec: error: "
+        << (args.empty() ? std::string("a command is required") : "unknown command " + quoteForDiagnostic(args[0]))
+        << " (the commands: " << commands << ")\n";
+    err << "Run 'substratec --help' for usage.\n";
+    return kExitUsage;
+  }
   std::vector<std::string> argv = args;
   std::reverse(argv.begin(), argv.end());  // CLI11 parses a reversed vector
   try {
