@@ -56,13 +56,11 @@ int CommandOutputs::refuseInputs(const std::vector<std::string>& outputs, std::o
 
 int CommandOutputs::check(std::ostream& err) const {
   if (int status = refuseInputs(namedFiles_, err); status != kExitOk) return status;
-  std::vector<std::string> probes = namedFiles_;
-  for (const std::string& d : directories_) probes.push_back((std::filesystem::path(d) / "probe").string());
-  if (std::string error = checkWritable(probes); !error.empty()) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
-  }
-  return kExitOk;
+  std::string error = checkWritable(namedFiles_);
+  for (std::size_t i = 0; error.empty() && i < directories_.size(); ++i) error = checkWritableDirectory(directories_[i]);
+  if (error.empty()) return kExitOk;
+  err << "substratec: error: " << error << "\n";
+  return kExitBadInput;
 }
 
 int CommandOutputs::commit(const std::vector<OutputPath>& files, std::ostream& err) const {

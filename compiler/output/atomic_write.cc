@@ -165,18 +165,36 @@ std::string writePathsAtomically(const std::vector<OutputPath>& files) {
   return "";
 }
 
+namespace {
+
+/// Creates a temporary beside `p` (and the directories it needs), then
+/// removes them all; "" or the error.
+std::string probe(const fs::path& p) {
+  std::vector<fs::path> created;
+  fs::path temp;
+  std::string error = makeDirectory(p, created);
+  if (error.empty()) error = writeTemporary(p, "", &temp);
+  std::error_code ignored;
+  if (!temp.empty()) fs::remove(temp, ignored);
+  for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ignored);
+  return error;
+}
+
+}  // namespace
+
 std::string checkWritable(const std::vector<std::string>& paths) {
-  for (const std::string& p : paths) {
-    std::vector<fs::path> created;
-    fs::path temp;
-    std::string error = makeDirectory(p, created);
-    if (error.empty()) error = writeTemporary(p, "", &temp);
-    std::error_code ignored;
-    if (!temp.empty()) fs::remove(temp, ignored);
-    for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ignored);
-    if (!error.empty()) return error;
-  }
+  for (const std::string& p : paths)
+    if (std::string error = probe(p); !error.empty()) return error;
   return "";
+}
+
+std::string checkWritableDirectory(const std::string& dir) {
+  const fs::path file = fs::path(dir.empty() ? "." : dir) / "probe";
+  std::string error = probe(file);
+  // Named as the directory: "probe" is no file of the user's.
+  const std::string named = "'" + file.string() + "'";
+  if (auto at = error.find(named); at != std::string::npos) error.replace(at, named.size(), "into '" + dir + "'");
+  return error;
 }
 
 }  // namespace substratec

@@ -43,5 +43,8 @@ std::string writePathsAtomically(const std::vector<OutputPath>& files);
 /// removed again, so a command fails in a moment rather than after its work
 /// (writePathsAtomically still checks again). "" or the first failure.
 std::string checkWritable(const std::vector<std::string>& paths);
+/// The same for a directory a command writes into (created if missing):
+/// "cannot write into 'DIR': ...".
+std::string checkWritableDirectory(const std::string& dir);
 
 }  // namespace substratec

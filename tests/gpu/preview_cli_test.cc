@@ -154,6 +154,23 @@ TEST(Preview, ABrokenMaterialWritesNothing) {
   EXPECT_FALSE(fs::exists(png));
 }
 
+// The PNG is committed like every output (cli/command_outputs.h): an earlier
+// file replaced whole, no temporary left beside it.
+TEST(Preview, APreviewReplacesItsPngWholeAndLeavesNoTemporary) {
+  const fs::path dir = workDir() / "replace";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  std::ofstream(dir / "x.png") << "an earlier preview";
+  CliRun r = cli({"preview", example("row12_simple.json"), "-o", (dir / "x.png").string(), "--size", "16"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  Png png;
+  ASSERT_TRUE(readPng(dir / "x.png", &png));
+  EXPECT_EQ(png.width, 16);
+  std::size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(dir)) entries += !e.path().empty();
+  EXPECT_EQ(entries, 1u) << "a temporary was left behind";
+}
+
 TEST(Preview, AnUnknownEnvironmentIsAUsageError) {
   CliRun r = cli({"preview", example("row12_simple.json"), "-o", (workDir() / "x.png").string(), "--env", "moon"});
   EXPECT_EQ(r.status, 2);
