@@ -38,7 +38,8 @@ std::optional<SceneManifest> parseSceneManifest(const std::string& manifestPath,
   if (nameIt == doc->end()) {
     diags.error("", "missing required key \"name\"");
   } else if (!nameIt->is_string() || !isUsableIdentifier(nameIt->get<std::string>())) {
-    diags.error("/name", fmt::format("expected a C identifier of at most 128 bytes without \"__\" (it names the "
+    diags.error("/name", fmt::format("expected a C identifier of at most 128 bytes without \"__\", not beginning "
+                                     "with '_' or \"gl_\", not ending with '_', not a keyword (it names the "
                                      "scene's shaders), got {}",
                                      kindOfJson(*nameIt)));
   } else {

@@ -4,6 +4,9 @@
 // reference evaluates from the imported material at its inputs' defaults.
 #include <cmath>
 #include <cstring>
+#include <random>
+#include <set>
+#include <stdexcept>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -12,8 +15,10 @@
 
 #include <gtest/gtest.h>
 
+#include "emit/generate.h"
 #include "import/glb_container.h"
 #include "import/import.h"
+#include "passes/resolve.h"
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
 
@@ -150,11 +155,170 @@ TEST(GltfImport, NamesBecomeUniqueIdentifiers) {
   EXPECT_EQ((*r.materials)[2].name, "material_2");
   EXPECT_EQ((*r.materials)[3].name, "m_01_rust");
   Diagnostics d("t.gltf");
-  EXPECT_EQ(pickMaterial(*r.materials, "Car Paint", d), &(*r.materials)[0]);  // by its source name
-  EXPECT_EQ(pickMaterial(*r.materials, "m_01_rust", d), &(*r.materials)[3]);  // or its identifier
+  EXPECT_EQ(pickMaterial(*r.materials, "Car_Paint_2", d), &(*r.materials)[1]);  // by its identifier
+  EXPECT_EQ(pickMaterial(*r.materials, "01 rust", d), &(*r.materials)[3]);      // or its source name
   EXPECT_EQ(pickMaterial(*r.materials, "", d), nullptr);
   EXPECT_NE(d.formatAll().find("the file holds 4 materials; choose one with --material NAME:\n  Car_Paint (\"Car Paint\")"),
             std::string::npos) << d.formatAll();
+}
+
+// --- Names (issue 16): every name that reaches generated code --------------
+
+TEST(ImportNames, TheSanitizerMakesUsableIdentifiersDirectly) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"gl_Pos", "m_gl_Pos"},      {"GL_x", "m_GL_x"},    {"gL_Material", "m_gL_Material"},
+      {"gl_", "gl"},               {"__x", "x"},          {"a__b", "a_b"},
+      {"x_", "x"},                 {"_", ""},             {"float", "m_float"},
+      {"main", "m_main"},          {"sin", "m_sin"},      {"texture", "m_texture"},
+      {"cbuffer", "m_cbuffer"},    {"01 rust", "m_01_rust"}, {"Car Paint", "Car_Paint"},
+      {"M\xc3\xa9tal", "M_tal"},   {"\xe9\x87\x91", ""},  {"", ""}};
+  for (const auto& [in, want] : cases) {
+    EXPECT_EQ(sanitizeIdentifier(in), want) << in;
+    if (!want.empty()) EXPECT_TRUE(isUsableIdentifier(want)) << want;
+  }
+  const std::string longName(1000, 'a');
+  EXPECT_EQ(sanitizeIdentifier(longName), std::string(kMaxSanitizedIdentifier, 'a'));
+  EXPECT_EQ(sanitizeIdentifier(std::string(119, 'a') + "__b"), std::string(119, 'a'));  // cut, no trailing '_'
+}
+
+TEST(ImportNames, EveryStringSanitizesToAUsableIdentifierOrNothing) {
+  // Random names made of the pieces that break identifiers.
+  const std::vector<std::string> pieces = {"gl_", "GL_", "Gl", "_", "__", "float", "sin", "main", "9", "a", "Z",
+                                           "\xc3\xa9", " ", "-", "$", "texture", "lerp", "x"};
+  std::mt19937 rng(16);
+  int checked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::string s;
+    for (int n = static_cast<int>(rng() % 6); n >= 0; --n) s += pieces[rng() % pieces.size()];
+    const std::string id = sanitizeIdentifier(s);
+    if (id.empty()) continue;
+    ASSERT_TRUE(isUsableIdentifier(id)) << "\"" << s << "\" -> \"" << id << "\"";
+    ++checked;
+  }
+  EXPECT_GT(checked, 15000);  // most strings keep something
+}
+
+TEST(ImportNames, FreeNameSearchesAreLinearAndBounded) {
+  NameSet names;
+  std::set<std::string> seen;
+  for (int i = 0; i < 20000; ++i) {  // 20 000 collisions: O(n) in all, not O(n^2)
+    const std::string id = names.claim("a");
+    ASSERT_TRUE(isUsableIdentifier(id)) << id;
+    ASSERT_TRUE(seen.insert(id).second) << id;
+  }
+  EXPECT_EQ(names.size(), 20000u);
+  const std::string longBase(kMaxSanitizedIdentifier, 'b');
+  EXPECT_EQ(names.claim(longBase), longBase);
+  const std::string second = names.claim(longBase);
+  EXPECT_EQ(second, longBase + "_2");
+  EXPECT_LE(second.size(), 128u);
+  // Material names collide case-insensitively (file names, upper-case macros).
+  NameSet materials(/*caseInsensitive=*/true);
+  EXPECT_EQ(materials.claim("Gold"), "Gold");
+  EXPECT_EQ(materials.claim("gold"), "gold_2");
+  // The search gives up past its bound (unreachable with the default bound:
+  // at most size() + 1 tries are ever needed).
+  NameSet small(false, 3);
+  for (const char* n : {"c_2", "c_3", "c_4", "c_5"}) small.insert(n);
+  EXPECT_EQ(small.claim("c"), "c");
+  EXPECT_THROW(small.claim("c"), std::length_error);
+}
+
+/// Every file the material generates validates (glslang + spirv-val, GLSL and HLSL).
+void expectValidShaders(const ImportedMaterial& m) {
+  const CompileResult r = compiled(m);
+  Generated gen = generateFiles(r, GenerateOptions{});
+  validateGenerated(gen);
+  EXPECT_TRUE(gen.valid) << m.name << ": " << gen.failure;
+  EXPECT_FALSE(gen.files.empty());
+}
+
+TEST(ImportNames, ReservedGltfNamesImportInBoundedTimeAndValidate) {
+  // The material names that made the sanitizer loop forever (gl_), and every
+  // other kind of reserved name, each twice.
+  std::string list;
+  for (const char* n : {"gl_Pos", "gl_Pos", "Gl_Pos", "GL_POS", "float", "float", "sin", "__x", "_x_", "main",
+                        "cbuffer", "gl_", "\xe9\x87\x91\xe5\xb1\x9e"})
+    list += std::string(list.empty() ? "" : ", ") + R"({"name": ")" + n +
+            R"(", "pbrMetallicRoughness": {"roughnessFactor": 0.4, "baseColorTexture": {"index": 0}}})";
+  Imported r = gltf("[" + list + "]", R"(, "textures": [{"source": 0}], "images": [{"uri": "gl_Tex.png"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  std::vector<std::string> names;
+  for (const auto& m : *r.materials) names.push_back(m.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"m_gl_Pos", "m_gl_Pos_2", "m_Gl_Pos_3", "m_GL_POS_4", "m_float", "m_float_2",
+                                             "m_sin", "x", "x_2", "m_main", "m_cbuffer", "gl", "material_12"}));
+  for (const auto& m : *r.materials) {
+    ASSERT_TRUE(isUsableIdentifier(m.name)) << m.name;
+    compiled(m);
+  }
+  expectValidShaders((*r.materials)[2]);  // "Gl_Pos": its macros would begin with GL_
+}
+
+TEST(ImportNames, ReservedMaterialXNamesImportAndValidate) {
+  Imported r = mtlx(R"(  <nodegraph name="gl_NG">
+    <input name="gl_tint" type="color3" value="0.8, 0.5, 0.2" />
+    <input name="__gain" type="float" value="0.5" />
+    <tiledimage name="gl_img" type="color3">
+      <input name="file" type="filename" value="gl_color.png" />
+    </tiledimage>
+    <multiply name="float" type="color3">
+      <input name="in1" type="color3" interfacename="gl_tint" />
+      <input name="in2" type="color3" nodename="gl_img" />
+    </multiply>
+    <multiply name="sin" type="color3">
+      <input name="in1" type="color3" nodename="float" />
+      <input name="in2" type="float" interfacename="__gain" />
+    </multiply>
+    <output name="out" type="color3" nodename="sin" />
+  </nodegraph>
+  <standard_surface name="gl_SR" type="surfaceshader">
+    <input name="base_color" type="color3" nodegraph="gl_NG" output="out" />
+    <input name="specular_roughness" type="float" value="0.3" />
+  </standard_surface>
+  <surfacematerial name="gl_Material" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="gl_SR" />
+  </surfacematerial>
+  <surfacematerial name="GL_MATERIAL" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="gl_SR" />
+  </surfacematerial>
+)");
+  ASSERT_TRUE(r.materials) << r.diags;
+  ASSERT_EQ(r.materials->size(), 2u);
+  EXPECT_EQ((*r.materials)[0].name, "m_gl_Material");
+  EXPECT_EQ((*r.materials)[1].name, "m_GL_MATERIAL_2");  // names differ in more than letter case
+  const std::string& text = (*r.materials)[0].text;
+  for (const char* id : {"\"m_gl_tint\": {", "\"gain\": {", "\"m_gl_color\"", "\"m_float\": {", "\"m_sin\": {"})
+    EXPECT_NE(text.find(id), std::string::npos) << id << "\n" << text;
+  const auto doc = nlohmann::json::parse(text);
+  int ids = 0;
+  for (const char* section : {"inputs", "nodes"})
+    for (const auto& [id, body] : doc[section].items()) {
+      EXPECT_TRUE(isIdentifier(id) && !hasReservedPrefix(id)) << id;
+      ++ids;
+    }
+  EXPECT_GE(ids, 6);
+  expectValidShaders((*r.materials)[1]);
+}
+
+TEST(ImportNames, NonAsciiNamesStayUtf8InDescriptions) {
+  Imported r = gltf(R"([{"name": "金属 Métal"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  EXPECT_NE((*r.materials)[0].text.find(R"(materials[0] \"金属 Métal\" (glTF 2.0 PBR).)"), std::string::npos)
+      << (*r.materials)[0].text;
+  EXPECT_EQ((*r.materials)[0].text.find("\\\\x"), std::string::npos);
+  Imported x = mtlx(R"(  <standard_surface name="SR" type="surfaceshader" />
+  <surfacematerial name="Ébène_木" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR" />
+  </surfacematerial>
+)");
+  ASSERT_TRUE(x.materials) << x.diags;
+  EXPECT_NE((*x.materials)[0].text.find(R"(surfacematerial \"Ébène_木\" (MaterialX).)"), std::string::npos)
+      << (*x.materials)[0].text;
+  // Bytes that are not UTF-8 (an XML file need not be) are escaped, never written raw.
+  EXPECT_EQ(descriptionText("a\xff" "b\xc3"), "a\\xffb\\xc3");
+  EXPECT_EQ(descriptionText("\xed\xa0\x80"), "\\xed\\xa0\\x80");  // a UTF-8-encoded surrogate
+  EXPECT_EQ(descriptionText("tab\there"), "tab\\x09here");
+  EXPECT_EQ(descriptionText("金属金属", 7), "金属...");  // cut at a character boundary
 }
 
 // --- glTF mapping -----------------------------------------------------------
