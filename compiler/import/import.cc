@@ -11,6 +11,7 @@
 
 #include "import/glb_container.h"
 #include "import/gltf_import.h"
+#include "import/gltf_resources.h"
 #include "import/mtlx_import.h"
 
 namespace substratec::import {
@@ -46,14 +47,19 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
     ok = importMaterialXDocument(text, fileName, baseDir, limits, diags, &out);
   } else {
     std::string json = text;
+    std::optional<std::size_t> binBytes;
     if (kind == SourceKind::Glb || (kind == SourceKind::Gltf && looksLikeGlb(text))) {
       auto chunk = glbJsonChunk(text, diags);
       if (!chunk) return std::nullopt;
       json = std::move(*chunk);
+      binBytes = glbBinChunkSize(text);
     }
     auto doc = parseJsonDocument(json, limits, diags);
     if (!doc) return std::nullopt;
     ok = importGltfDocument(*doc, fileName, diags, &out);
+    // The buffers and images a .gltf or .glb refers to (gltf_resources.h);
+    // a .materials.json extract has none.
+    if (kind != SourceKind::GltfMaterials) ok = checkGltfResources(*doc, baseDir, binBytes, diags) && ok;
   }
   if (!ok || diags.hasErrors()) return std::nullopt;
   if (out.empty()) {

@@ -17,6 +17,7 @@
 
 #include "emit/generate.h"
 #include "import/glb_container.h"
+#include "import/gltf_resources.h"
 #include "import/import.h"
 #include "passes/resolve.h"
 #include "pipeline/pipeline.h"
@@ -40,8 +41,10 @@ Imported importAs(SourceKind kind, const std::string& text, const std::string& f
   return r;
 }
 
+/// The mapping alone: read as an extract (the resources a .gltf refers to are
+/// checked by the GltfResources tests).
 Imported gltf(const std::string& materialsJson, const std::string& rest = "") {
-  return importAs(SourceKind::Gltf, "{\"materials\": " + materialsJson + rest + "}", "t.gltf");
+  return importAs(SourceKind::GltfMaterials, "{\"materials\": " + materialsJson + rest + "}", "t.gltf");
 }
 
 Imported mtlx(const std::string& body) {
@@ -604,4 +607,98 @@ TEST(GltfImport, ATextureWithoutAnImageIsAnError) {
   EXPECT_FALSE(r.materials);
   EXPECT_NE(r.diags.find("t.gltf: /textures/0/source: error: expected the index of one of the document's 0 images"),
             std::string::npos) << r.diags;
+}
+
+// --- Buffers and images a .gltf or .glb refers to (issue 16) -----------------
+
+namespace {
+
+/// A .glb with a binary chunk of `bin` bytes (zeros) after the JSON.
+std::string glbWithBin(const std::string& json, std::uint32_t bin) {
+  std::string chunk = json;
+  while (chunk.size() % 4) chunk += ' ';
+  auto le = [](std::uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    return s;
+  };
+  std::string body = le(static_cast<std::uint32_t>(chunk.size())) + "JSON" + chunk + le(bin) + std::string("BIN\0", 4) +
+                     std::string(bin, '\0');
+  return "glTF" + le(2) + le(static_cast<std::uint32_t>(12 + body.size())) + body;
+}
+
+const char* kTwoImages = R"({"asset": {"version": "2.0"},
+  "materials": [{"name": "M", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+  "textures": [{"source": 0}, {"source": 1}],
+  "images": [{"uri": "used%20image.png"}, {"uri": "unused.png"}],
+  "buffers": [{"uri": "geometry.bin", "byteLength": 10}, {"uri": "data:application/octet-stream;base64,AAAA", "byteLength": 3},
+              {"uri": "data:application/octet-stream;base64,A$AA", "byteLength": 3}]})";
+
+}  // namespace
+
+TEST(GltfResources, AMissingFileIsAWarningAndAnErrorWhereAMaterialSamplesIt) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("substratec_res_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "m.gltf") << kTwoImages;
+  Diagnostics d("m.gltf");
+  EXPECT_FALSE(importFile((dir / "m.gltf").string(), ReadLimits{}, d));
+  const std::string all = d.formatAll();
+  const std::string at = (dir / "").string();
+  for (const std::string& want :
+       {"m.gltf: /images/0/uri: error: images[0] \"" + at + "used image.png\" cannot be read (No such file or directory): "
+        "material \"M\" samples it",
+        "m.gltf: /images/1/uri: warning: images[1] \"" + at + "unused.png\" cannot be read (No such file or directory); "
+        "no material samples it",
+        "m.gltf: /buffers/0/uri: warning: buffers[0] \"" + at + "geometry.bin\" cannot be read (No such file or "
+        "directory); materials do not need geometry",
+        std::string("m.gltf: /buffers/2/uri: warning: buffers[2] \"data:application/octet-stream;base64,A$AA\" cannot "
+                    "be read (a base64 data: URI with the character \"$\" at 1)")})
+    EXPECT_NE(all.find(want), std::string::npos) << want << "\n" << all;
+  EXPECT_EQ(all.find("buffers[1]"), std::string::npos) << all;  // a well-formed data: URI
+  // With the sampled image there, only the warnings are left.
+  std::ofstream(dir / "used image.png") << "png";
+  Diagnostics again("m.gltf");
+  auto ok = importFile((dir / "m.gltf").string(), ReadLimits{}, again);
+  EXPECT_TRUE(ok) << again.formatAll();
+  EXPECT_EQ(again.errorCount(), 0u);
+  // A buffer shorter than its byteLength is as good as missing.
+  std::ofstream(dir / "geometry.bin") << "short";
+  Diagnostics shortBuffer("m.gltf");
+  EXPECT_TRUE(importFile((dir / "m.gltf").string(), ReadLimits{}, shortBuffer));
+  EXPECT_NE(shortBuffer.formatAll().find("/buffers/0/byteLength: warning: buffers[0] holds 5 bytes, fewer than its "
+                                         "byteLength 10"), std::string::npos) << shortBuffer.formatAll();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GltfResources, AGlbImageInItsBinaryChunkIsReadableOnlyWhenTheChunkHoldsIt) {
+  const std::string json = R"({"asset": {"version": "2.0"},
+    "materials": [{"name": "M", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}], "images": [{"bufferView": 0, "mimeType": "image/png"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 4, "byteLength": 8}], "buffers": [{"byteLength": 12}]})";
+  Imported fits = importAs(SourceKind::Glb, glbWithBin(json, 12), "m.glb");
+  EXPECT_TRUE(fits.materials) << fits.diags;
+  EXPECT_EQ(fits.diags, "");
+  Imported cut = importAs(SourceKind::Glb, glbWithBin(json, 8), "m.glb");
+  EXPECT_FALSE(cut.materials);
+  EXPECT_NE(cut.diags.find("m.glb: /images/0/bufferView: error: images[0] in bufferViews[0] cannot be read (buffers[0] "
+                           "cannot be read): material \"M\" samples it"), std::string::npos) << cut.diags;
+  Imported none = importAs(SourceKind::Glb, glb(json), "m.glb");  // no binary chunk at all
+  EXPECT_FALSE(none.materials);
+  EXPECT_NE(none.diags.find("m.glb: /buffers/0: warning: buffers[0] has no uri and the document has no .glb binary chunk"),
+            std::string::npos) << none.diags;
+}
+
+TEST(GltfResources, MissingFilesAreReportedOncePerFileAndBounded) {
+  std::string buffers;
+  for (int i = 0; i < 100; ++i)
+    buffers += std::string(i ? ", " : "") + R"({"uri": "b)" + std::to_string(i % 50) + R"(.bin", "byteLength": 4})";
+  Imported r = importAs(SourceKind::Gltf, R"({"asset": {"version": "2.0"}, "materials": [{"name": "M"}], "buffers": [)" +
+                                              buffers + "]}", "m.gltf");
+  ASSERT_TRUE(r.materials) << r.diags;  // geometry is never needed
+  std::size_t lines = 0;
+  for (char c : r.diags) lines += c == '\n';
+  EXPECT_EQ(lines, static_cast<std::size_t>(kMaxResourceWarnings) + 1) << r.diags;  // 50 files: 32, then one line
+  EXPECT_NE(r.diags.find("m.gltf: /: warning: 18 more resources cannot be read (not listed)"), std::string::npos)
+      << r.diags;
 }
