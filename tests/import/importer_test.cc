@@ -4,6 +4,7 @@
 // reference evaluates from the imported material at its inputs' defaults.
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -701,4 +702,33 @@ TEST(GltfResources, MissingFilesAreReportedOncePerFileAndBounded) {
   EXPECT_EQ(lines, static_cast<std::size_t>(kMaxResourceWarnings) + 1) << r.diags;  // 50 files: 32, then one line
   EXPECT_NE(r.diags.find("m.gltf: /: warning: 18 more resources cannot be read (not listed)"), std::string::npos)
       << r.diags;
+}
+
+// --- Fuzzing regressions (issue 16) -------------------------------------------
+
+TEST(ImportFuzzRegressions, EveryInputThatOnceCrashedIsImportedOrRejected) {
+  // tests/import/fuzz_regressions: inputs mtlx_fuzzer and gltf_fuzzer found
+  // (fuzz/, scripts/fuzz.sh), checked as the fuzzers check them: imported, with
+  // usable names and materials that compile, or rejected with an error.
+  const std::filesystem::path dir = std::filesystem::path(SUBSTRATEC_SOURCE_DIR) / "tests/import/fuzz_regressions";
+  int checked = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    const SourceKind kind = sourceKindOf(name);
+    if (kind == SourceKind::Substrate) continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Diagnostics d(name);
+    auto materials = importText(kind, name, text, "/nonexistent-substratec-fuzz/dir", ReadLimits{}, d);
+    if (!materials) {
+      EXPECT_TRUE(d.hasErrors()) << name;
+    } else {
+      for (const auto& m : *materials) {
+        EXPECT_TRUE(isUsableIdentifier(m.name)) << name << ": " << m.name;
+        compiled(m);
+      }
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 1);
 }
