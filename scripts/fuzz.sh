@@ -1,20 +1,29 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (fuzz/, in the "asan" preset's build-asan/:
-# clang 14, ASan + UBSan) and runs each for SECONDS (default 60) from a seed corpus made of
-# examples/*.json and tests/bad/*.json, with the format's dictionary.
+# clang 14, ASan + UBSan) and runs each from its seed corpus with its
+# dictionary: parser_fuzzer and pipeline_fuzzer (the material format; seeds
+# examples/*.json and tests/bad/*.json; fuzz/substrate.dict) for SECONDS each
+# (default 60); mtlx_fuzzer, gltf_fuzzer and manifest_fuzzer (the MaterialX
+# and glTF importers and the scene manifest; seeds tests/import/corpus — the
+# same files as ../shared/corpus — with .glb containers made from a few of its
+# glTF extracts, examples/scenes and tests/import/fuzz_regressions;
+# fuzz/mtlx.dict, gltf.dict, scene.dict) for IMPORT_SECONDS each (default 30:
+# CI's budget, 3 x 30 s on top of 2 x 60 s).
 # Fails if any target finds a crash, a leak, a timeout (> 10 s per input) or
 # an out-of-memory (> 2 GiB); the input is kept in build-asan/fuzz/artifacts/.
 # Prints the executions each target ran. docs/robustness.md describes it.
 #
-#   scripts/fuzz.sh [SECONDS]          # both targets
+#   scripts/fuzz.sh [SECONDS]          # every target
 #   FUZZ_TARGETS=parser_fuzzer scripts/fuzz.sh 30
+#   IMPORT_SECONDS=60 FUZZ_TARGETS="mtlx_fuzzer gltf_fuzzer" scripts/fuzz.sh
 #
 # New inputs that reach new coverage accumulate in build-asan/fuzz/corpus/<target>/
 # between runs (a clean clone starts from the seeds alone).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"
-TARGETS="${FUZZ_TARGETS:-parser_fuzzer pipeline_fuzzer}"
+IMPORT_SECONDS="${IMPORT_SECONDS:-30}"
+TARGETS="${FUZZ_TARGETS:-parser_fuzzer pipeline_fuzzer mtlx_fuzzer gltf_fuzzer manifest_fuzzer}"
 BUILD=build-asan/fuzz
 
 cmake --preset asan >/dev/null
@@ -42,14 +51,48 @@ for f in examples/*.json tests/bad/*.json; do
   esac
 done
 
+# The importers' and the manifest's seeds.
+mkdir -p "$SEEDS/mtlx_fuzzer" "$SEEDS/gltf_fuzzer" "$SEEDS/manifest_fuzzer"
+find tests/import/corpus/materialx tests/import/fuzz_regressions -name '*.mtlx' | sort | while read -r f; do
+  cp "$f" "$SEEDS/mtlx_fuzzer/$(echo "$f" | tr / _)"
+done
+for f in tests/import/corpus/gltf/*.json tests/import/fuzz_regressions/*.gltf tests/import/fuzz_regressions/*.glb; do
+  if [ -f "$f" ]; then cp "$f" "$SEEDS/gltf_fuzzer/$(basename "$f")"; fi
+done
+# .glb containers of three extracts, with a binary chunk a buffer and an image view point into.
+python3 - "$SEEDS/gltf_fuzzer" tests/import/corpus/gltf/CompareVolume.materials.json \
+  tests/import/corpus/gltf/ClearCoatTest.materials.json tests/import/corpus/gltf/CompareSheen.materials.json <<'PY'
+import json, struct, sys, os
+out = sys.argv[1]
+for path in sys.argv[2:]:
+    doc = json.load(open(path, encoding="utf-8"))
+    doc["buffers"] = [{"byteLength": 16}]
+    doc["bufferViews"] = [{"buffer": 0, "byteOffset": 4, "byteLength": 8}]
+    doc.setdefault("images", []).append({"bufferView": 0, "mimeType": "image/png"})
+    text = json.dumps(doc).encode("utf-8")
+    text += b" " * (-len(text) % 4)
+    body = struct.pack("<I", len(text)) + b"JSON" + text + struct.pack("<I", 16) + b"BIN\0" + bytes(16)
+    name = os.path.basename(path).replace(".materials.json", ".glb")
+    open(os.path.join(out, name), "wb").write(b"glTF" + struct.pack("<II", 2, 12 + len(body)) + body)
+PY
+for f in examples/scenes/*.json tests/import/fuzz_regressions/*.scene.json; do
+  if [ -f "$f" ]; then cp "$f" "$SEEDS/manifest_fuzzer/$(basename "$f")"; fi
+done
+
 status=0
 for t in $TARGETS; do
+  case "$t" in
+    mtlx_fuzzer) dict=fuzz/mtlx.dict; secs="$IMPORT_SECONDS" ;;
+    gltf_fuzzer) dict=fuzz/gltf.dict; secs="$IMPORT_SECONDS" ;;
+    manifest_fuzzer) dict=fuzz/scene.dict; secs="$IMPORT_SECONDS" ;;
+    *) dict=fuzz/substrate.dict; secs="$SECONDS_EACH" ;;
+  esac
   corpus="$BUILD/corpus/$t"
   mkdir -p "$corpus"
   log="$BUILD/$t.log"
-  echo "fuzz: $t for ${SECONDS_EACH}s (log: $log)"
+  echo "fuzz: $t for ${secs}s (log: $log)"
   set +e
-  build-asan/bin/$t -max_total_time="$SECONDS_EACH" -dict=fuzz/substrate.dict -timeout=10 -rss_limit_mb=2048 \
+  build-asan/bin/$t -max_total_time="$secs" -dict="$dict" -timeout=10 -rss_limit_mb=2048 \
     -max_len=16384 -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/$t-" \
     "$corpus" "$SEEDS/$t" >"$log" 2>&1
   rc=$?
@@ -62,7 +105,7 @@ for t in $TARGETS; do
     tail -40 "$log" >&2
     status=1
   else
-    echo "fuzz: $t ran ${execs:-?} executions in ${SECONDS_EACH}s, no crash (corpus: $units inputs)"
+    echo "fuzz: $t ran ${execs:-?} executions in ${secs}s, no crash (corpus: $units inputs)"
   fi
 done
 exit $status

@@ -7,7 +7,8 @@
 #   3. the libFuzzer targets, each for a bounded time (scripts/fuzz.sh).
 # Knobs (environment):
 #   SUBSTRATEC_SANITIZERS=0        skip stage 2
-#   SUBSTRATEC_FUZZ_SECONDS=N      seconds per fuzz target (default 60; 0 skips stage 3)
+#   SUBSTRATEC_FUZZ_SECONDS=N      seconds per format fuzz target (default 60; 0 skips stage 3)
+#   SUBSTRATEC_IMPORT_FUZZ_SECONDS=N  seconds per importer/manifest fuzz target (default 30)
 #   SUBSTRATEC_ASAN_EXCLUDE=REGEX  tests stage 2 leaves out (default: none)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -55,6 +56,6 @@ if [ "$SANITIZERS" != 0 ]; then
 fi
 
 if [ "$FUZZ_SECONDS" != 0 ]; then
-  scripts/fuzz.sh "$FUZZ_SECONDS"
-  stage_done "fuzz (build + ${FUZZ_SECONDS} s per target)"
+  IMPORT_SECONDS="${SUBSTRATEC_IMPORT_FUZZ_SECONDS:-30}" scripts/fuzz.sh "$FUZZ_SECONDS"
+  stage_done "fuzz (build + 2 x ${FUZZ_SECONDS} s + 3 x ${SUBSTRATEC_IMPORT_FUZZ_SECONDS:-30} s)"
 fi

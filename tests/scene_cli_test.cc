@@ -223,4 +223,36 @@ TEST(Scene, EveryMistakeIsLocatedAndNothingIsWritten) {
   }
 }
 
+TEST(Scene, EveryErrorOfOneRunIsReported) {
+  // A duplicate listing, a missing material, a material with an error, an
+  // unknown platform, and two materials whose names differ only in letter
+  // case: one run reports all five (the manifest's errors used to stop it).
+  const fs::path work = freshDir("all_errors");
+  fs::create_directories(work);
+  const std::string plaster = slurp(kSource / "examples" / "scenes" / "materials" / "plaster.json");
+  std::ofstream(work / "a.json") << plaster;
+  std::string upper = plaster;
+  upper.replace(upper.find("\"name\": \"plaster\""), 17, "\"name\": \"PLASTER\"");
+  std::ofstream(work / "b.json") << upper;
+  std::ofstream(work / "bad.json") << slurp(kSource / "tests" / "bad" / "103_roughness_above_one.json");
+  const fs::path manifest = work / "s.json";
+  std::ofstream(manifest) << R"({"format": "substrate-scene/1", "name": "s", "platform": "ps2",
+    "materials": ["a.json", "./a.json", "missing.json", "bad.json", "b.json"]})";
+  const fs::path out = work / "out";
+  CliResult r = cli({"scene", manifest.string(), "-o", out.string()});
+  EXPECT_EQ(r.status, 1) << r.err;
+  int found = 0;
+  for (const std::string& want :
+       {manifest.string() + ": /materials/1: error: \"./a.json\" is already listed at /materials/0",
+        manifest.string() + ": /platform: error: unknown platform \"ps2\"", std::string("missing.json"),
+        (work / "bad.json").string() + ": /nodes/base/roughness: error: expected a float in [0,1], got 2",
+        manifest.string() + ": /materials/4: error: material \"PLASTER\" (" + (work / "b.json").string() +
+            ") has the name of /materials/0 (" + (work / "a.json").string() + ") but for letter case"}) {
+    EXPECT_NE(r.err.find(want), std::string::npos) << want << "\n" << r.err;
+    found += r.err.find(want) != std::string::npos;
+  }
+  EXPECT_EQ(found, 5);
+  EXPECT_FALSE(fs::exists(out)) << "nothing written";
+}
+
 }  // namespace

@@ -517,45 +517,98 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
 }
 
 struct ImportArgs {
-  std::string file;
+  std::vector<std::string> files;
   std::string outDir;
   std::string material;
+  bool force = false;
   std::size_t maxInputSize = 16u << 20;
 };
 
-/// `import`: every material of a glTF / MaterialX file (or the --material one)
-/// as substrate-material/1 files in the output directory, all or none; each is
-/// compiled first, so what is written is known to compile.
+/// `import`: every material of glTF / MaterialX files and of the importable
+/// files under directories (or the --material one) as substrate-material/1
+/// files in the output directory, all or none; each is compiled first, so what
+/// is written is known to compile. A file in the way is replaced only when an
+/// import of the same source wrote it (import::replaceCheck), or with --force.
 int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
   ReadLimits read;
   read.maxInputBytes = a.maxInputSize;
-  if (import::sourceKindOf(a.file) == import::SourceKind::Substrate) {
-    err << "substratec: error: " << a.file
-        << ": import reads .gltf, .glb, .materials.json and .mtlx files (this is a substrate-material/1 file)\n";
-    return kExitBadInput;
-  }
+  std::string messages;
+  auto inputs = import::collectImportInputs(a.files, messages);
+  err << messages;
+  if (!inputs) return kExitBadInput;
   CommandOutputs outputs(out);
   outputs.directory(a.outDir);
-  outputs.input(a.file);
+  for (const import::ImportInput& in : *inputs) outputs.input(in.path);
   if (int status = outputs.check(err); status != kExitOk) return status;
-  Diagnostics diags(a.file);
-  auto materials = import::importFile(a.file, read, diags);
-  if (materials && !a.material.empty()) {
-    const import::ImportedMaterial* m = import::pickMaterial(*materials, a.material, diags);
-    if (m) materials = std::vector<import::ImportedMaterial>{*m};
-    else materials.reset();
+  // Every file's materials, named uniquely across the files (case-insensitively:
+  // they become file names), located by file.
+  std::vector<import::ImportedMaterial> materials;
+  std::vector<std::string> sourceOf;  // the input each material comes from
+  import::NameSet names(/*caseInsensitive=*/true);
+  bool failed = false;
+  for (const import::ImportInput& in : *inputs) {
+    Diagnostics diags(in.path);
+    auto imported = import::importFile(in.path, read, diags);
+    if (!imported && in.fromDirectory && diags.errorCount() == 1 &&
+        diags.all().back().message == "the file holds no material") {
+      err << in.path << ": warning: the file holds no material; skipped\n";  // e.g. a MaterialX library
+      continue;
+    }
+    err << diags.formatAll();
+    if (!imported) {
+      failed = true;
+      continue;
+    }
+    for (auto& m : *imported) {
+      const std::string wanted = m.name;
+      const std::string name = names.claim(wanted);
+      if (name != wanted) {
+        err << fmt::format("{}: warning: material {} is written as {}.json: an earlier file has a material named {}\n",
+                           in.path, quoteForDiagnostic(m.sourceName.empty() ? wanted : m.sourceName), name, wanted);
+        import::renameMaterial(m, name);
+      }
+      if (inputs->size() > 1) m.location = in.path + " " + m.location;
+      materials.push_back(std::move(m));
+      sourceOf.push_back(in.path);
+    }
   }
-  err << diags.formatAll();
-  if (!materials) return kExitBadInput;
+  if (failed) return kExitBadInput;
+  if (!a.material.empty()) {
+    Diagnostics diags(inputs->size() == 1 ? inputs->front().path : "");
+    const import::ImportedMaterial* m = import::pickMaterial(materials, a.material, diags);
+    if (inputs->size() == 1) err << diags.formatAll();
+    else for (const Diagnostic& d : diags.all()) err << "substratec: error: " << d.message << "\n";  // several files
+    if (!m) return kExitBadInput;
+    const std::size_t i = static_cast<std::size_t>(m - materials.data());
+    materials = {materials[i]};
+    sourceOf = {sourceOf[i]};
+  }
+  }
   std::vector<OutputFile> files;
-  for (const auto& m : *materials) {
-    const import::MaterialSource source{a.file + "[" + m.name + "]", m.text, true};
+  for (std::size_t i = 0; i < materials.size(); ++i) {
+    const import::ImportedMaterial& m = materials[i];
+    const import::MaterialSource source{sourceOf[i] + "[" + m.name + "]", m.text, true};
     Diagnostics compileDiags(source.displayName);
     if (!compileText(source.displayName, m.text, CompileOptions{}, compileDiags)) {
       err << compileDiags.formatAll();
       return compileFailure(source, err);
     }
     files.push_back({m.name + ".json", m.text});
+  }
+  // Nothing is replaced that an import of the same source did not write.
+  std::vector<std::string> foreign;
+  for (std::size_t i = 0; i < files.size() && !a.force; ++i) {
+    const std::string path = (std::filesystem::path(a.outDir) / files[i].name).string();
+    const std::string source = std::filesystem::path(sourceOf[i]).filename().string();
+    if (import::replaceCheck(path, files[i].contents, source) == import::Replace::Foreign)
+      foreign.push_back(fmt::format("substratec: error: {} exists and was not written by importing {} (it is not the "
+                                    "same text, nor a material whose description begins \"Imported from {} \"): not "
+                                    "replaced; --force replaces it\n",
+                                    path, source, source));
+  }
+  if (!foreign.empty()) {
+    for (const auto& f : foreign) err << f;
+    return kExitUsage;
   }
   return writeOutputs(outputs, a.outDir, files, "", {}, {}, out, err);
 }
@@ -717,9 +770,13 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   ImportArgs imp;
   CLI::App* impc = app.add_subcommand("import", "Import glTF 2.0 (.gltf, .glb, .materials.json) or MaterialX (.mtlx) "
                                                  "materials as substrate-material/1 files (docs/import.md)");
-  impc->add_option("file", imp.file, "A .gltf, .glb, .materials.json or .mtlx file")->required();
+  impc->add_option("files", imp.files,
+                   "The .gltf, .glb, .materials.json or .mtlx files, and directories to search for them")
+      ->required();
   impc->add_option("-o,--output", imp.outDir, "Output directory (one <material>.json per material)")->required();
-  impc->add_option("--material", imp.material, "Import only this material (by name)");
+  impc->add_option("--material", imp.material, "Import only this material (by name or identifier)");
+  impc->add_flag("--force", imp.force,
+                 "Replace files in the output directory that an import of the same source did not write");
   impc->add_option("--max-input-size", imp.maxInputSize, "Reject inputs larger than this many bytes")
       ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
 

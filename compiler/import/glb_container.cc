@@ -21,6 +21,17 @@ std::uint32_t le32(const std::string& b, std::size_t at) {
 
 }  // namespace
 
+std::optional<std::size_t> glbBinChunkSize(const std::string& b) {
+  std::size_t at = 12;
+  for (int chunk = 0; at + 8 <= b.size() && chunk < 2; ++chunk) {
+    const std::uint32_t length = le32(b, at), type = le32(b, at + 4);
+    if (length > b.size() - at - 8) return std::nullopt;
+    if (chunk == 1 && type == kChunkBin) return length;
+    at += 8 + std::size_t{length};
+  }
+  return std::nullopt;
+}
+
 bool looksLikeGlb(const std::string& bytes) { return bytes.size() >= 4 && le32(bytes, 0) == kMagic; }
 
 std::optional<std::string> glbJsonChunk(const std::string& b, Diagnostics& diags) {

@@ -16,6 +16,10 @@ namespace substratec::import {
 /// diagnostic "byte N: ..." when the container is malformed.
 std::optional<std::string> glbJsonChunk(const std::string& bytes, Diagnostics& diags);
 
+/// The size of the binary chunk ("BIN\0", the second chunk) of a container
+/// glbJsonChunk accepted, or nullopt when it has none.
+std::optional<std::size_t> glbBinChunkSize(const std::string& bytes);
+
 /// True when `bytes` starts with the .glb magic.
 bool looksLikeGlb(const std::string& bytes);
 

@@ -175,7 +175,7 @@ std::string MaterialReader::imageDescription(int texture, const std::string& ptr
       if (uri.rfind("data:", 0) == 0 || uri == "<embedded>") label = "embedded";
       else label = uri.substr(uri.find_last_of('/') == std::string::npos ? 0 : uri.find_last_of('/') + 1);
     } else if (img.contains("name") && img["name"].is_string()) {
-      label = img["name"].get<std::string>();
+      label = descriptionText(img["name"].get<std::string>());
     } else {
       label = "bufferView";
     }
@@ -454,7 +454,7 @@ bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostic
       return false;
     }
   bool ok = true;
-  std::set<std::string> used;
+  NameSet used(/*caseInsensitive=*/true);
   for (std::size_t i = 0; i < mats->size(); ++i) {
     const std::string ptr = "/materials/" + std::to_string(i);
     const Json& m = (*mats)[i];
@@ -468,7 +468,7 @@ bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostic
     const std::string label = sourceName.empty() ? fmt::format("materials[{}]", i) : quoteForDiagnostic(sourceName);
     MaterialWriter w(name);
     w.setDescription(fmt::format("Imported from {} materials[{}]{} (glTF 2.0 PBR).", fileName, i,
-                                 sourceName.empty() ? "" : " " + quoteForDiagnostic(sourceName)));
+                                 sourceName.empty() ? "" : " " + quoteForDescription(sourceName)));
     GltfPbr g;
     MaterialReader reader(doc, m, ptr, label, diags, w);
     if (!reader.read(g)) {

@@ -33,9 +33,43 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
                                                         const ReadLimits& limits, Diagnostics& diags);
 
 /// The material called `wanted` (its source name or its identifier), or the
-/// only one when `wanted` is empty; otherwise an error listing the materials.
+/// only one when `wanted` is empty; otherwise an error listing the materials
+/// (or, when several answer to `wanted`, those, with their locations).
 const ImportedMaterial* pickMaterial(const std::vector<ImportedMaterial>& all, const std::string& wanted,
                                      Diagnostics& diags);
+
+// ---------------------------------------------------------------------------
+// `substratec import FILE|DIR... -o DIR` (docs/import.md).
+
+/// How deep `import` searches a directory, and how many files it imports at most.
+inline constexpr int kMaxImportDepth = 16;
+inline constexpr std::size_t kMaxImportFiles = 1024;
+
+struct ImportInput {
+  std::string path;            // as given, or found under a directory given
+  bool fromDirectory = false;  // found by searching a directory
+};
+
+/// The files `import` reads for its arguments: a file as given; a directory
+/// searched (at most kMaxImportDepth levels; symbolic links to directories
+/// not followed) for .gltf, .glb, .materials.json and .mtlx files, in path
+/// order; every file once (the same file named twice is read once). nullopt
+/// with the errors in `messages` when an argument is a substrate-material/1
+/// file, a directory holds nothing importable, or there are more than
+/// kMaxImportFiles files; warnings (directories not searched) go there too.
+std::optional<std::vector<ImportInput>> collectImportInputs(const std::vector<std::string>& args,
+                                                            std::string& messages);
+
+/// Whether `import` may write `text` to `path`, which exists or not: it
+/// replaces only what an import of the same source wrote — a file holding
+/// exactly `text`, or a substrate-material/1 document whose description
+/// begins "Imported from <sourceFileName> " (the importer's marker) —
+/// unless forced.
+enum class Replace { Absent, Identical, Imported, Foreign };
+Replace replaceCheck(const std::string& path, const std::string& text, const std::string& sourceFileName);
+
+/// Gives `m` the identifier `name`, in the text too (the document's "name").
+void renameMaterial(ImportedMaterial& m, const std::string& name);
 
 /// One material to compile: the text and how diagnostics call it.
 struct MaterialSource {

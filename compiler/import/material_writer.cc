@@ -2,33 +2,107 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
 
 #include "passes/resolve.h"
 
 namespace substratec::import {
+
+namespace {
+/// The longest description written (the format's string limit is 64 KiB).
+constexpr std::size_t kMaxDescription = 4096;
+}  // namespace
 
 std::string sanitizeIdentifier(std::string_view s, std::string_view prefix) {
   std::string out;
   for (char c : s) {
     const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9');
     if (ok) out += c;
-    else if (out.empty() || out.back() != '_') out += '_';
+    else if (!out.empty() && out.back() != '_') out += '_';  // no leading '_', no "__"
+    if (out.size() > 2 * kMaxSanitizedIdentifier) break;      // the rest would be cut anyway
   }
   while (!out.empty() && out.back() == '_') out.pop_back();
-  while (out.size() > 1 && out[0] == '_' && out[1] == '_') out.erase(0, 1);
-  if (!out.empty() && out[0] >= '0' && out[0] <= '9') out = std::string(prefix) + (out[0] == '_' ? "" : "_") + out;
-  if (out.size() > 120) out.resize(120);
+  if (out.empty()) return out;
+  if ((out[0] >= '0' && out[0] <= '9') || hasReservedPrefix(out) || isReservedWord(out))
+    out = std::string(prefix) + "_" + out;
+  if (out.size() > kMaxSanitizedIdentifier) out.resize(kMaxSanitizedIdentifier);
   while (!out.empty() && out.back() == '_') out.pop_back();
+  // By construction usable; a prefix that is not would be the caller's bug.
+  return isUsableIdentifier(out) ? out : std::string();
+}
+
+std::string NameSet::key(const std::string& s) const {
+  if (!caseInsensitive_) return s;
+  std::string k = s;
+  for (char& c : k)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return k;
+}
+
+std::string NameSet::claim(const std::string& base) {
+  if (!contains(base)) {
+    insert(base);
+    return base;
+  }
+  std::size_t& k = next_[key(base)];
+  if (k < 2) k = 2;
+  for (std::size_t tries = 0; tries < maxTries_; ++tries, ++k) {
+    const std::string suffix = "_" + std::to_string(k);
+    std::string stem = base.substr(0, std::min(base.size(), 128 - suffix.size()));
+    while (!stem.empty() && stem.back() == '_') stem.pop_back();
+    const std::string id = stem + suffix;
+    if (!contains(id)) {
+      insert(id);
+      ++k;
+      return id;
+    }
+  }
+  throw std::length_error(fmt::format("no free name like \"{}\" after {} tries", base, maxTries_));
+}
+
+std::string uniqueMaterialName(NameSet& used, std::string_view wanted, const std::string& fallback) {
+  std::string base = sanitizeIdentifier(wanted);
+  if (base.empty()) base = fallback;
+  return used.claim(base);
+}
+
+std::string descriptionText(std::string_view s, std::size_t maxBytes) {
+  std::string out;
+  std::size_t i = 0;
+  while (i < s.size()) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    // The length of the UTF-8 sequence at i (RFC 3629: no overlong forms, no
+    // surrogates, at most U+10FFFF), 0 when the bytes are not one.
+    std::size_t n = 0;
+    if (c >= 0x20 && c < 0x7f) n = 1;
+    else if (c >= 0xc2 && c <= 0xdf) n = 2;
+    else if (c >= 0xe0 && c <= 0xef) n = 3;
+    else if (c >= 0xf0 && c <= 0xf4) n = 4;
+    if (n > 1) {
+      if (i + n > s.size()) n = 0;
+      for (std::size_t j = 1; n && j < n; ++j)
+        if ((static_cast<unsigned char>(s[i + j]) & 0xc0) != 0x80) n = 0;
+      if (n) {
+        const auto c1 = static_cast<unsigned char>(s[i + 1]);
+        if ((c == 0xe0 && c1 < 0xa0) || (c == 0xed && c1 >= 0xa0) || (c == 0xf0 && c1 < 0x90) || (c == 0xf4 && c1 >= 0x90))
+          n = 0;
+      }
+    }
+    const std::string piece = n ? std::string(s.substr(i, n)) : fmt::format("\\x{:02x}", c);
+    if (out.size() + piece.size() > maxBytes) {
+      out += "...";
+      break;
+    }
+    out += piece;
+    i += n ? n : 1;
+  }
   return out;
 }
 
-std::string uniqueMaterialName(std::set<std::string>& used, std::string_view wanted, const std::string& fallback) {
-  std::string base = sanitizeIdentifier(wanted);
-  if (base.empty()) base = fallback;
-  std::string id = base;
-  for (int k = 2; used.count(id) || !isUsableIdentifier(id); ++k) id = base + "_" + std::to_string(k);
-  used.insert(id);
-  return id;
+std::string quoteForDescription(std::string_view s, std::size_t maxBytes) {
+  return "\"" + descriptionText(s, maxBytes) + "\"";
 }
 
 MaterialWriter::MaterialWriter(const std::string& name) : name_(name) { used_.insert(name_); }
@@ -36,14 +110,12 @@ MaterialWriter::MaterialWriter(const std::string& name) : name_(name) { used_.in
 std::string MaterialWriter::uniqueId(std::string_view wanted) {
   std::string base = sanitizeIdentifier(wanted);
   if (base.empty()) base = "value";
-  std::string id = base;
-  for (int k = 2; used_.count(id) || !isUsableIdentifier(id); ++k) id = base + "_" + std::to_string(k);
-  used_.insert(id);
-  return id;
+  return used_.claim(base);
 }
 
 Value MaterialWriter::addInput(std::string_view name, Json body) {
   std::string id = uniqueId(name);
+  if (auto d = body.find("description"); d != body.end()) *d = descriptionText(d->get<std::string>(), kMaxDescription);
   inputs_[id] = std::move(body);
   return "$" + id;
 }
@@ -91,7 +163,7 @@ std::string MaterialWriter::text() const {
   Json doc = Json::object();
   doc["format"] = "substrate-material/1";
   doc["name"] = name_;
-  if (!description_.empty()) doc["description"] = description_;
+  if (!description_.empty()) doc["description"] = descriptionText(description_, kMaxDescription);
   if (!settings_.empty()) doc["settings"] = settings_;
   // Inputs no node reads are left out (a parameter the mapping did not need
   // would still cost a uniform).
@@ -110,7 +182,9 @@ std::string MaterialWriter::text() const {
   if (!inputs.empty()) doc["inputs"] = inputs;
   doc["nodes"] = nodes_;
   doc["output"] = output_;
-  return doc.dump(2) + "\n";
+  // Every string is valid UTF-8 by now (names are ASCII, descriptions went
+  // through descriptionText); replacing what is not is only a safety net.
+  return doc.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 // ---------------------------------------------------------------------------

@@ -11,6 +11,8 @@
 #include <set>
 #include <string>
 #include <string_view>
+#include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -24,10 +26,47 @@ using Json = nlohmann::ordered_json;
 /// A null Json means "not given" wherever a Value is optional.
 using Value = Json;
 
-/// `s` made a usable identifier of at most 120 bytes: characters other than
-/// [A-Za-z0-9_] become '_', runs of '_' collapse, a leading digit gets
-/// `prefix` in front; empty stays empty.
+/// The longest identifier the sanitizer makes: the format allows 128 bytes,
+/// which leaves room for a "_<k>" suffix of up to 7 digits.
+inline constexpr std::size_t kMaxSanitizedIdentifier = 120;
+
+/// `s` made an identifier usable for every name that reaches generated code
+/// (a material, an input, a node; isUsableIdentifier in passes/resolve.h), in
+/// one pass: characters other than [A-Za-z0-9_] become '_', runs of '_'
+/// collapse, leading and trailing '_' go (generated code adds prefixes and
+/// suffixes, so they would make a reserved "__"); a name that would then begin
+/// with a digit or with "gl_" in any case, or be a C/GLSL/HLSL keyword or
+/// built-in function, gets `prefix` and '_' in front (`gl_Pos` -> `m_gl_Pos`,
+/// `float` -> `m_float`); at most kMaxSanitizedIdentifier bytes. Empty when
+/// nothing usable is left (the caller's fallback then names it). `prefix`
+/// must itself be usable.
 std::string sanitizeIdentifier(std::string_view s, std::string_view prefix = "m");
+
+/// Names taken in one namespace, and the search for a free one. Every name it
+/// gives out is `base` or `base_<k>`: `claim` tries k = 2, 3, ... from where
+/// the last search for the same base stopped (so n equal names cost O(n), not
+/// O(n^2)), and gives up with an exception after `maxTries` tries (at most
+/// size() + 1 tries can be needed, since every try is a distinct name). With
+/// `caseInsensitive`, names that differ only in letter case collide (material
+/// names: they become file names and upper-case macros).
+class NameSet {
+ public:
+  explicit NameSet(bool caseInsensitive = false, std::size_t maxTries = std::size_t{1} << 24)
+      : caseInsensitive_(caseInsensitive), maxTries_(maxTries) {}
+  bool contains(const std::string& name) const { return used_.count(key(name)) != 0; }
+  void insert(const std::string& name) { used_.insert(key(name)); }
+  std::size_t size() const { return used_.size(); }
+  /// A free name like `base` (a usable identifier of at most
+  /// kMaxSanitizedIdentifier bytes), now taken.
+  std::string claim(const std::string& base);
+
+ private:
+  std::string key(const std::string& s) const;
+  bool caseInsensitive_;
+  std::size_t maxTries_;
+  std::unordered_set<std::string> used_;
+  std::unordered_map<std::string, std::size_t> next_;  // key(base) -> the next suffix to try
+};
 
 /// One imported material: what its source calls it, its identifier (the
 /// material's `name`, unique within its source) and its text.
@@ -39,16 +78,24 @@ struct ImportedMaterial {
 };
 
 /// A material identifier for `wanted` (sanitized; `fallback` when that is
-/// empty) not yet in `used`, which it joins.
-std::string uniqueMaterialName(std::set<std::string>& used, std::string_view wanted, const std::string& fallback);
+/// empty) not yet in `used` (case-insensitively), which it joins.
+std::string uniqueMaterialName(NameSet& used, std::string_view wanted, const std::string& fallback);
+
+/// Text from a source (a name, a file name) made fit for a description: valid
+/// UTF-8 kept as it is (non-ASCII names stay readable), control characters and
+/// bytes that are not UTF-8 written as \xNN, at most `maxBytes` bytes (cut at
+/// a character boundary, "..." appended).
+std::string descriptionText(std::string_view s, std::size_t maxBytes = 256);
+/// `"` + descriptionText(s) + `"`.
+std::string quoteForDescription(std::string_view s, std::size_t maxBytes = 256);
 
 class MaterialWriter {
  public:
   /// `name` is the material's name (sanitized; made unique by the caller).
   explicit MaterialWriter(const std::string& name);
 
-  /// A fresh identifier like `wanted` (sanitized), not yet used by an input or
-  /// a node, and usable as a material name too (no keyword, no "gl_").
+  /// A fresh identifier like `wanted` (sanitized; "value" when nothing is
+  /// left), not yet used by an input, a node or the material's name.
   std::string uniqueId(std::string_view wanted);
 
   /// Inputs; each returns the reference "$name" (the name made unique).
@@ -74,7 +121,7 @@ class MaterialWriter {
   Value addInput(std::string_view name, Json body);
   std::string name_, description_, output_;
   Json settings_ = Json::object(), inputs_ = Json::object(), nodes_ = Json::object();
-  std::set<std::string> used_;
+  NameSet used_;
 };
 
 // ---------------------------------------------------------------------------

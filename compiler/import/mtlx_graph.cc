@@ -261,6 +261,14 @@ Value convertValue(const Value& v, const std::string& from, const std::string& t
   return combine({swizzle(v, "x"), swizzle(v, "y"), swizzle(v, "z"), 1.0});  // 3 -> 4
 }
 
+/// A connected value `t` can become `to`: both are value types (float,
+/// colour, vector...) or the same type; a value whose type is not one (an
+/// unknown type such as "color6") would reach a pin with the wrong size.
+bool convertible(const Value& v, const std::string& from, const std::string& to) {
+  if (v.is_null() || from == to) return true;
+  return mtlxComponents(from) > 0 && mtlxComponents(to) > 0;
+}
+
 }  // namespace
 
 MtlxValues::Typed MtlxValues::inputOf(pugi::xml_node node, const std::string& name, const std::string& type,
@@ -270,6 +278,11 @@ MtlxValues::Typed MtlxValues::inputOf(pugi::xml_node node, const std::string& na
   if (!in) return {def.empty() ? Value() : mtlxLiteral(def, itype, ""), itype};
   bool connected = false;
   Typed t = connection(in, itype, frozen, depth, &connected);
+  if (connected && !convertible(t.v, t.type, itype)) {
+    error(in, fmt::format("input '{}' of type '{}' is connected to a value of type '{}' (not a value type it converts "
+                          "to)", name, itype, t.type));
+    return {Value(), itype};
+  }
   if (connected) return {convertValue(t.v, t.type, itype), itype};
   if (in.attribute("value")) {
     const auto v = parseMtlxNumbers(str(in, "value"));
@@ -288,6 +301,11 @@ Value MtlxValues::param(pugi::xml_node shader, const std::string& name, const st
   if (!in) return mtlxLiteral(def, type, "");
   bool connected = false;
   Typed t = connection(in, type, false, 0, &connected);
+  if (connected && !convertible(t.v, t.type, type)) {
+    error(in, fmt::format("input '{}' of type '{}' is connected to a value of type '{}' (not a value type it converts "
+                          "to)", name, type, t.type));
+    return mtlxLiteral(def, type, "");
+  }
   if (connected) return convertValue(t.v, t.type, type);
   const auto v = parseMtlxNumbers(str(in, "value"));
   if (!v) {
@@ -302,7 +320,14 @@ Value MtlxValues::param(pugi::xml_node shader, const std::string& name, const st
 std::optional<std::vector<double>> MtlxValues::constant(pugi::xml_node shader, const std::string& name,
                                                         const std::string& type, const std::vector<double>& def) {
   Typed t = inputOf(shader, name, type, def, true, 0);
-  return literalOf(t.v);
+  // Exactly the type's components (callers index them): a single number
+  // broadcasts; any other count (an input declared with another type) is
+  // not this constant.
+  auto lit = literalOf(t.v);
+  const std::size_t n = static_cast<std::size_t>(std::max(0, mtlxComponents(type)));
+  if (!lit || n == 0 || lit->size() == n) return lit;
+  if (lit->size() == 1) return std::vector<double>(n, (*lit)[0]);
+  return std::nullopt;
 }
 
 MtlxValues::Typed MtlxValues::nodeValue(pugi::xml_node node, const std::string& output, bool frozen, int depth) {

@@ -56,7 +56,7 @@ bool importMaterialXDocument(const std::string& text, const std::string& fileNam
   MtlxDocument doc;
   if (!doc.load(text, fileName, baseDir, limits, diags)) return false;
   bool ok = true;
-  std::set<std::string> used;
+  NameSet used(/*caseInsensitive=*/true);
   for (pugi::xml_node material : doc.topLevel()) {
     if (std::string(material.name()) != "surfacematerial") continue;
     const std::string sourceName = material.attribute("name").as_string();
@@ -64,7 +64,7 @@ bool importMaterialXDocument(const std::string& text, const std::string& fileNam
     int line = 0, column = 0;
     doc.lineColumn(material, line, column);
     MaterialWriter w(name);
-    w.setDescription(fmt::format("Imported from {} surfacematerial {} (MaterialX).", fileName, quoteForDiagnostic(sourceName)));
+    w.setDescription(fmt::format("Imported from {} surfacematerial {} (MaterialX).", fileName, quoteForDescription(sourceName)));
     MtlxValues values(doc, w, diags, quoteForDiagnostic(sourceName));
     for (const char* other : {"displacementshader", "volumeshader"})
       if (material.find_child_by_attribute("input", "name", other))

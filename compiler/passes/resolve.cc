@@ -149,25 +149,64 @@ const char* const kReserved[] = {
     "groupshared", "nointerpolation", "linear", "centroid", "row_major", "column_major", "snorm",
     "unorm", "technique", "pass", "string", "matrix", "vector", "register", "packoffset",
     "globallycoherent", "export", "typename", "lerp", "saturate", "mix", "clamp", "dot", "pow",
-    "sqrt", "abs", "min", "max", "length", "normalize"};
+    "sqrt", "abs", "min", "max", "length", "normalize",
+    // More GLSL and HLSL types and keywords
+    "mat2x2", "mat2x3", "mat2x4", "mat3x2", "mat3x3", "mat3x4", "mat4x2", "mat4x3", "mat4x4", "dmat2", "dmat3",
+    "dmat4", "sampler", "sampler1D", "sampler3D", "samplerCube", "sampler2DShadow", "sampler2DArray", "texture2D",
+    "image", "atomic_uint", "struct", "subroutine", "sampler_state", "SamplerComparisonState", "Texture1D",
+    "Texture3D", "TextureCube", "Texture2DArray", "RWTexture2D", "Buffer", "RWBuffer", "ByteAddressBuffer",
+    "StructuredBuffer", "RWStructuredBuffer", "ConstantBuffer", "float1", "float2x2", "float2x3", "float3x2",
+    "float3x4", "float4x3", "half1", "double1", "double2", "double3", "double4", "int1", "uint1", "bool1", "bool2",
+    "bool3", "bool4", "dword", "min16float", "min10float", "min16int", "min12int", "min16uint", "uniform",
+    "static", "const", "inline", "discard", "nointerpolation", "sample", "triangle", "line", "point", "lineadj",
+    "triangleadj", "vertices", "indices", "primitives", "payload", "in", "out", "inout", "NULL", "compile",
+    "compile_fragment", "pixelfragment", "vertexfragment", "stateblock", "stateblock_state", "shared", "interface",
+    "pixelshader", "vertexshader", "sizeof", "typedef", "Texture", "TEXTURE", "SAMPLER", "Sampler",
+    // GLSL and HLSL built-in functions
+    "radians", "degrees", "sin", "cos", "tan", "asin", "acos", "atan", "atan2", "sinh", "cosh", "tanh", "asinh",
+    "acosh", "atanh", "exp", "log", "exp2", "log2", "log10", "inversesqrt", "rsqrt", "rcp", "sign", "floor",
+    "ceil", "trunc", "round", "roundEven", "fract", "frac", "mod", "fmod", "modf", "step", "smoothstep", "isnan",
+    "isinf", "isfinite", "fma", "mad", "frexp", "ldexp", "distance", "cross", "faceforward", "reflect", "refract",
+    "matrixCompMult", "outerProduct", "transpose", "determinant", "inverse", "mul", "lessThan", "lessThanEqual",
+    "greaterThan", "greaterThanEqual", "equal", "notEqual", "any", "all", "not", "textureSize", "textureLod",
+    "textureGrad", "textureOffset", "texelFetch", "textureGather", "imageLoad", "imageStore", "imageSize",
+    "dFdx", "dFdy", "fwidth", "ddx", "ddy", "ddx_coarse", "ddy_coarse", "ddx_fine", "ddy_fine", "clip", "lit",
+    "noise", "sincos", "dst", "tex2D", "tex2Dlod", "tex2Dgrad", "tex2Dbias", "tex2Dproj", "texCUBE", "barrier",
+    "memoryBarrier", "groupMemoryBarrier", "GroupMemoryBarrierWithGroupSync", "AllMemoryBarrier",
+    "DeviceMemoryBarrier", "floatBitsToInt", "floatBitsToUint", "intBitsToFloat", "uintBitsToFloat", "asfloat",
+    "asint", "asuint", "asdouble", "packUnorm2x16", "packSnorm2x16", "packUnorm4x8", "packSnorm4x8",
+    "unpackUnorm2x16", "unpackSnorm2x16", "unpackUnorm4x8", "unpackSnorm4x8", "packHalf2x16", "unpackHalf2x16",
+    "f16tof32", "f32tof16", "bitfieldExtract", "bitfieldInsert", "bitfieldReverse", "bitCount", "findLSB",
+    "findMSB", "countbits", "firstbithigh", "firstbitlow", "reversebits", "uaddCarry", "usubBorrow", "umulExtended",
+    "imulExtended", "atomicAdd", "atomicMin", "atomicMax", "atomicAnd", "atomicOr", "atomicXor", "atomicExchange",
+    "atomicCompSwap", "InterlockedAdd", "EmitVertex", "EndPrimitive", "interpolateAtCentroid",
+    "interpolateAtSample", "interpolateAtOffset", "subpassLoad", "errorf", "printf", "abort", "source_mark"};
 
 }  // namespace
 
 bool isIdentifier(const std::string& s, std::size_t maxBytes) {
   if (s.empty() || s.size() > maxBytes) return false;
   auto alpha = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
-  if (!alpha(s[0])) return false;
+  if (!alpha(s[0]) || s[0] == '_') return false;  // generated code prefixes it: "i_" + "_x" would hold "__"
   for (char c : s)
     if (!alpha(c) && !(c >= '0' && c <= '9')) return false;
   return s.find("__") == std::string::npos;  // reserved in GLSL and C++
 }
 
+bool hasReservedPrefix(const std::string& s) {
+  // "gl_" in any letter case: the material's macros are its name in upper case (GL_..., reserved in GLSL).
+  return s.size() >= 3 && (s[0] == 'g' || s[0] == 'G') && (s[1] == 'l' || s[1] == 'L') && s[2] == '_';
+}
+
+bool isReservedWord(const std::string& s) {
+  static const std::unordered_set<std::string> words(std::begin(kReserved), std::end(kReserved));
+  return words.count(s) != 0;
+}
+
 bool isUsableIdentifier(const std::string& s, std::size_t maxBytes) {
   if (!isIdentifier(s, maxBytes)) return false;
-  if (s.rfind("gl_", 0) == 0) return false;
-  for (const char* r : kReserved)
-    if (s == r) return false;
-  return true;
+  if (s.back() == '_') return false;  // generated code suffixes it: "x_" + "_evaluate" would hold "__"
+  return !hasReservedPrefix(s) && !isReservedWord(s);
 }
 
 namespace {
@@ -266,8 +305,8 @@ class Resolver {
     if (name.size() > limits_.maxIdentifierBytes && isIdentifier(name, name.size()))
       return fmt::format("{} {} of {} bytes is longer than the limit of {} bytes (the identifier-length limit)", what,
                          quoteForDiagnostic(name), name.size(), limits_.maxIdentifierBytes);
-    return fmt::format("{} {} is not a C identifier of at most {} bytes (letters, digits, '_'; no leading digit, "
-                       "no \"__\")",
+    return fmt::format("{} {} is not a C identifier of at most {} bytes (letters, digits, '_'; no leading digit or "
+                       "'_', no \"__\")",
                        what, quoteForDiagnostic(name), limits_.maxIdentifierBytes);
   }
 
@@ -339,7 +378,8 @@ void Resolver::readTop() {
     d_.error("/name", identifierError("name", name));
   } else if (!isUsableIdentifier(nameIt->get<std::string>(), limits_.maxIdentifierBytes)) {
     d_.error("/name", fmt::format("{} is not usable as a name: it must be a C identifier of at most {} "
-                                  "bytes, without \"__\", and not a C/GLSL/HLSL keyword",
+                                  "bytes, without \"__\", not beginning with '_' or \"gl_\" (in any case), not "
+                                  "ending with '_', and not a C/GLSL/HLSL keyword or built-in function",
                                   quoteForDiagnostic(nameIt->get<std::string>()), limits_.maxIdentifierBytes));
   } else {
     out_.name = nameIt->get<std::string>();

@@ -70,11 +70,20 @@ struct ResolvedDoc {
 std::optional<ResolvedDoc> resolveDocument(const Json& doc, Diagnostics& diags,
                                            const ResolveLimits& limits = {});
 
-/// True for C identifiers (letters, digits, '_', no leading digit, no "__").
-/// Node ids and input names must be identifiers; generated code prefixes them.
+/// True for C identifiers (letters, digits, '_', no leading digit or '_', no
+/// "__"). Node ids and input names must be identifiers; generated code
+/// prefixes them ("i_", "t_", "C_"...), so a leading '_' would make a "__",
+/// reserved in GLSL and C++.
 bool isIdentifier(const std::string& s, std::size_t maxBytes = 128);
-/// Identifiers that are also not reserved in C, GLSL or HLSL (the material
-/// name, which names generated symbols).
+/// Identifiers that are also usable as the material's (or a scene's) name,
+/// which generated code suffixes ("_evaluate", "_Inputs") and upper-cases
+/// (macros): no trailing '_', no "gl_" prefix in any letter case (GLSL
+/// reserves "gl_" names and "GL_" macros), not a C, GLSL or HLSL keyword or
+/// built-in function name.
 bool isUsableIdentifier(const std::string& s, std::size_t maxBytes = 128);
+/// "gl_" in any letter case starts `s` (reserved in GLSL as a name or a macro).
+bool hasReservedPrefix(const std::string& s);
+/// `s` is a C, GLSL or HLSL keyword, type or built-in function name.
+bool isReservedWord(const std::string& s);
 
 }  // namespace substratec

@@ -11,6 +11,14 @@ namespace substratec {
 
 std::optional<SceneManifest> parseSceneManifest(const std::string& manifestPath, const std::string& text,
                                                 const ReadLimits& limits, Diagnostics& diags) {
+  const std::size_t errorsBefore = diags.errorCount();
+  auto scene = readSceneManifest(manifestPath, text, limits, diags);
+  if (!scene || diags.errorCount() > errorsBefore) return std::nullopt;
+  return scene;
+}
+
+std::optional<SceneManifest> readSceneManifest(const std::string& manifestPath, const std::string& text,
+                                               const ReadLimits& limits, Diagnostics& diags) {
   auto doc = parseJsonDocument(text, limits, diags);
   if (!doc) return std::nullopt;
   if (!doc->is_object()) {
@@ -38,7 +46,8 @@ std::optional<SceneManifest> parseSceneManifest(const std::string& manifestPath,
   if (nameIt == doc->end()) {
     diags.error("", "missing required key \"name\"");
   } else if (!nameIt->is_string() || !isUsableIdentifier(nameIt->get<std::string>())) {
-    diags.error("/name", fmt::format("expected a C identifier of at most 128 bytes without \"__\" (it names the "
+    diags.error("/name", fmt::format("expected a C identifier of at most 128 bytes without \"__\", not beginning "
+                                     "with '_' or \"gl_\", not ending with '_', not a keyword (it names the "
                                      "scene's shaders), got {}",
                                      kindOfJson(*nameIt)));
   } else {
@@ -79,7 +88,6 @@ std::optional<SceneManifest> parseSceneManifest(const std::string& manifestPath,
       scene.materials.push_back({written, path, ptr});
     }
   }
-  if (diags.hasErrors()) return std::nullopt;
   return scene;
 }
 

@@ -29,8 +29,16 @@ struct SceneManifest {
 };
 
 /// Parses the manifest text; `manifestPath` locates relative material paths.
-/// Duplicate material paths (after normalization) are errors.
+/// Duplicate material paths (after normalization) are errors. Every error is
+/// reported (one does not hide the others); nullopt when there is any.
 std::optional<SceneManifest> parseSceneManifest(const std::string& manifestPath, const std::string& text,
                                                 const ReadLimits& limits, Diagnostics& diags);
+
+/// The same, but what could be read even when there are errors (nullopt only
+/// when the text is not a JSON object): the materials listed correctly, each
+/// once, and the name and platform when they are usable. A scene build uses it
+/// to go on to its materials' errors after the manifest's.
+std::optional<SceneManifest> readSceneManifest(const std::string& manifestPath, const std::string& text,
+                                               const ReadLimits& limits, Diagnostics& diags);
 
 }  // namespace substratec

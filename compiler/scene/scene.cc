@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 
+#include <cctype>
 #include <map>
 
 #include <fmt/format.h>
@@ -48,47 +49,64 @@ SceneBuild buildScene(const SceneOptions& o) {
   SceneBuild b;
   const ReadLimits& limits = o.batch.compile.read;
   b.inputs.push_back(o.manifest);
+  // Every error of one run is reported: the manifest's, the platform's, every
+  // material's and the name clashes among those that compile. Only a manifest
+  // that cannot be read at all (not JSON, not an object) stops here.
+  bool bad = false;
   std::optional<SceneManifest> scene;
   {
     Diagnostics d(o.manifest);
-    if (auto text = readSourceFile(o.manifest, limits, d)) scene = parseSceneManifest(o.manifest, *text, limits, d);
+    if (auto text = readSourceFile(o.manifest, limits, d)) scene = readSceneManifest(o.manifest, *text, limits, d);
     b.messages += d.formatAll();
     if (!scene) return b.status = kExitBadInput, b;
+    bad = d.hasErrors();
   }
   if (!o.platformsFile.empty()) b.inputs.push_back(o.platformsFile);
   std::optional<PlatformTable> table = loadPlatformTable(o.platformsFile, limits, b.messages);
-  if (!table) return b.status = kExitBadInput, b;
   BatchOptions batch = o.batch;
-  batch.compile.platform = choosePlatform(o, *scene, *table, b);
-  if (b.status != 0) return b;
+  if (!table) {
+    bad = true;
+  } else {
+    batch.compile.platform = choosePlatform(o, *scene, *table, b);
+    if (b.status == kExitUsage) return b;  // an unknown --platform: bad usage, before anything is built
+    if (b.status != 0) bad = true;
+    b.status = 0;
+  }
 
   std::vector<std::string> paths;
   for (const SceneMaterialRef& m : scene->materials) paths.push_back(m.path);
   b.inputs.insert(b.inputs.end(), paths.begin(), paths.end());
   std::vector<MaterialBuild> built = buildMaterials(paths, batch);
-  bool internal = false, bad = false;
+  bool internal = false;
   for (const MaterialBuild& m : built) {
     b.messages += m.messages;
     internal = internal || m.internalError;
     bad = bad || !m.ok;
     b.cacheHits += m.fromCache;
   }
-  if (internal) return b.status = kExitInternal, b;
-  if (bad) return b.status = kExitBadInput, b;
-  {  // Every material's files go into one directory: names must differ.
+  {  // Every material's files go into one directory: names must differ (also in letter
+     // case: file systems that ignore it, and the upper-case macros of one kernel).
     Diagnostics d(o.manifest);
     std::map<std::string, std::size_t> seen;
-    for (std::size_t i = 0; i < built.size(); ++i)
-      if (auto [at, fresh] = seen.emplace(built[i].summary.name, i); !fresh)
+    for (std::size_t i = 0; i < built.size(); ++i) {
+      if (!built[i].ok) continue;
+      std::string key = built[i].summary.name;
+      for (char& c : key) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (auto [at, fresh] = seen.emplace(key, i); !fresh)
         d.error(scene->materials[i].pointer,
-                fmt::format("material {} ({}) has the name of {} ({}): their shaders would overwrite each other",
+                fmt::format("material {} ({}) has the name of {} ({}){}: their shaders would overwrite each other",
                             quoteForDiagnostic(built[i].summary.name), scene->materials[i].path,
-                            scene->materials[at->second].pointer, scene->materials[at->second].path));
-    if (d.hasErrors()) {
-      b.messages += d.formatAll();
-      return b.status = kExitBadInput, b;
+                            scene->materials[at->second].pointer, scene->materials[at->second].path,
+                            built[at->second].summary.name == built[i].summary.name
+                                ? ""
+                                : fmt::format(" but for letter case ({})",
+                                              quoteForDiagnostic(built[at->second].summary.name))));
     }
+    b.messages += d.formatAll();
+    bad = bad || d.hasErrors();
   }
+  if (internal) return b.status = kExitInternal, b;
+  if (bad) return b.status = kExitBadInput, b;
 
   // The lighting: what the materials store after simplification, and no more.
   std::vector<SceneMaterialShape> shapes;

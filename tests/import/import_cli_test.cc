@@ -3,6 +3,7 @@
 // --material choice among a file's materials.
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -101,4 +102,151 @@ TEST(ImportCli, BadImportsExitOne) {
   CliRun materialOnJson = cli({"report", "--material", "x", (fs::path(SUBSTRATEC_SOURCE_DIR) / "examples/car_paint.json").string()});
   EXPECT_EQ(materialOnJson.status, 1);
   EXPECT_NE(materialOnJson.err.find("--material chooses among the materials of"), std::string::npos);
+}
+
+// --- issue 16 ----------------------------------------------------------------
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void spit(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << text;
+}
+
+std::vector<std::string> listing(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace
+
+TEST(ImportCli, ReplacesOnlyWhatAnImportOfTheSameSourceWrote) {
+  const fs::path out = scratch("replace");
+  const std::string file = (kCorpus / "gltf/CompareVolume.materials.json").string();
+  ASSERT_EQ(cli({"import", file, "-o", out.string()}).status, 0);
+  const std::string gold = slurp(out / "gold.json");
+  EXPECT_EQ(cli({"import", file, "-o", out.string()}).status, 0);  // the same text again
+  // A stale import of the same source (its marker) is replaced.
+  spit(out / "gold.json", "{\n  \"format\": \"substrate-material/1\",\n  \"name\": \"gold\",\n  \"description\": "
+                          "\"Imported from CompareVolume.materials.json materials[2] (an older import).\",\n  \"nodes\": {}\n}\n");
+  EXPECT_EQ(cli({"import", file, "-o", out.string()}).status, 0);
+  EXPECT_EQ(slurp(out / "gold.json"), gold);
+  // A file the user wrote, an import of another source, a non-JSON file, a
+  // directory: refused, exit 2, nothing written (checker.json stays deleted).
+  const std::vector<std::string> foreign = {
+      "{\"format\": \"substrate-material/1\", \"name\": \"gold\", \"description\": \"my own gold\", \"nodes\": {}}\n",
+      "{\"format\": \"substrate-material/1\", \"name\": \"gold\", \"description\": \"Imported from Other.gltf "
+      "materials[0].\", \"nodes\": {}}\n",
+      "{\"format\": \"substrate-material/1\", \"name\": \"gold\", \"description\": \"Imported from "
+      "CompareVolume.materials.jsonx materials[0].\", \"nodes\": {}}\n",
+      "not json at all", ""};
+  int refused = 0;
+  for (const std::string& text : foreign) {
+    spit(out / "gold.json", text);
+    fs::remove(out / "checker.json");
+    CliRun r = cli({"import", file, "-o", out.string()});
+    EXPECT_EQ(r.status, 2) << text;
+    EXPECT_NE(r.err.find((out / "gold.json").string() + " exists and was not written by importing "
+                         "CompareVolume.materials.json"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("--force replaces it"), std::string::npos);
+    EXPECT_EQ(slurp(out / "gold.json"), text);
+    EXPECT_FALSE(fs::exists(out / "checker.json"));  // nothing written
+    refused += r.status == 2;
+  }
+  EXPECT_EQ(refused, 5);
+  fs::remove(out / "gold.json");
+  fs::create_directory(out / "gold.json");
+  EXPECT_EQ(cli({"import", file, "-o", out.string()}).status, 2);
+  fs::remove(out / "gold.json");
+  spit(out / "gold.json", foreign[0]);
+  CliRun forced = cli({"import", file, "-o", out.string(), "--force"});
+  EXPECT_EQ(forced.status, 0) << forced.err;
+  EXPECT_EQ(slurp(out / "gold.json"), gold);
+  EXPECT_TRUE(fs::exists(out / "checker.json"));
+}
+
+TEST(ImportCli, ReadsSeveralFilesAndDirectoriesInPathOrder) {
+  const fs::path tree = scratch("tree");
+  const fs::path volume = kCorpus / "gltf/CompareVolume.materials.json";
+  spit(tree / "b/volume.materials.json", slurp(volume));
+  spit(tree / "a/deeper/brass.mtlx", slurp(kCorpus / "materialx/StandardSurface/standard_surface_brass_tiled.mtlx"));
+  spit(tree / "a/notes.txt", "not a material");
+  spit(tree / "a/plain.json", slurp(fs::path(SUBSTRATEC_SOURCE_DIR) / "examples/car_paint.json"));  // not importable
+  fs::path deep = tree / "c";
+  for (int i = 0; i < 20; ++i) deep /= "d";  // past the depth bound (16 levels)
+  spit(deep / "deep.materials.json", slurp(volume));
+  const fs::path out = scratch("tree_out");
+  CliRun r = cli({"import", tree.string(), volume.string(), "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("deeper than 16 levels below"), std::string::npos) << r.err;
+  // a/deeper/brass.mtlx, then b/volume.materials.json, then the file given:
+  // its four materials again, renamed.
+  EXPECT_EQ(listing(out), (std::vector<std::string>{"Tiled_Brass.json", "checker.json", "checker_2.json",
+                                                    "glTF_Transmission.json", "glTF_Transmission_2.json",
+                                                    "glTF_Volume.json", "glTF_Volume_2.json", "gold.json",
+                                                    "gold_2.json"}))
+      << r.out << r.err;
+  EXPECT_NE(r.err.find("warning: material \"gold\" is written as gold_2.json: an earlier file has a material named gold"),
+            std::string::npos) << r.err;
+  EXPECT_NE(slurp(out / "gold_2.json").find("\"name\": \"gold_2\""), std::string::npos);
+  // The same file twice is read once.
+  const fs::path once = scratch("once");
+  EXPECT_EQ(cli({"import", volume.string(), volume.string(), "-o", once.string()}).status, 0);
+  EXPECT_EQ(listing(once).size(), 4u);
+  // A directory with nothing importable is an error, and nothing is written.
+  const fs::path empty = scratch("empty_dir");
+  spit(empty / "x.txt", "");
+  CliRun none = cli({"import", empty.string(), volume.string(), "-o", scratch("none_out").string()});
+  EXPECT_EQ(none.status, 1);
+  EXPECT_NE(none.err.find(empty.string() + ": is a directory holding no .gltf, .glb, .materials.json or .mtlx file"),
+            std::string::npos) << none.err;
+  EXPECT_FALSE(fs::exists(scratch("none_out")));
+}
+
+TEST(ImportCli, ADirectoryWhereAFileIsExpectedSaysSo) {
+  const fs::path dir = scratch("a_directory");
+  fs::create_directories(dir);
+  const std::vector<std::vector<std::string>> commands = {
+      {"report", dir.string()},
+      {"compile", dir.string(), "-o", scratch("d1").string()},
+      {"preview", dir.string(), "-o", scratch("d2.png").string()},
+      {"sweep", dir.string()},
+      {"stability", dir.string(), "--no-gpu"},
+      {"scene", dir.string(), "-o", scratch("d3").string()},
+      {"compile", (fs::path(SUBSTRATEC_SOURCE_DIR) / "examples/car_paint.json").string(), "--platforms", dir.string(),
+       "-o", scratch("d4").string()}};
+  int checked = 0;
+  for (const auto& args : commands) {
+    CliRun r = cli(args);
+    EXPECT_EQ(r.status, 1) << args[0] << "\n" << r.err;
+    EXPECT_NE(r.err.find("is a directory"), std::string::npos) << args[0] << "\n" << r.err;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 7);
+}
+
+TEST(ImportCli, AMaterialNameTwoMaterialsAnswerToIsAnErrorListingBoth) {
+  const fs::path file = scratch("twice") / "twice.gltf";
+  spit(file, R"({"asset": {"version": "2.0"}, "materials": [{"name": "Gold"}, {"name": "Silver"}, {"name": "Gold"}]})");
+  for (const char* command : {"import", "compile"}) {
+    CliRun r = cli({command, file.string(), "--material", "Gold", "-o", scratch("twice_out").string()});
+    EXPECT_EQ(r.status, 1) << command;
+    EXPECT_NE(r.err.find("2 materials are called \"Gold\"; choose one by its identifier:\n  Gold at /materials/0\n"
+                         "  Gold_2 (\"Gold\") at /materials/2"),
+              std::string::npos) << command << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(scratch("twice_out")));
+  }
+  const fs::path out = scratch("twice_out");
+  CliRun ok = cli({"import", file.string(), "--material", "Gold_2", "-o", out.string()});
+  EXPECT_EQ(ok.status, 0) << ok.err;
+  EXPECT_EQ(listing(out), std::vector<std::string>{"Gold_2.json"});
 }

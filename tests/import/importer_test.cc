@@ -4,6 +4,10 @@
 // reference evaluates from the imported material at its inputs' defaults.
 #include <cmath>
 #include <cstring>
+#include <iterator>
+#include <random>
+#include <set>
+#include <stdexcept>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -12,8 +16,11 @@
 
 #include <gtest/gtest.h>
 
+#include "emit/generate.h"
 #include "import/glb_container.h"
+#include "import/gltf_resources.h"
 #include "import/import.h"
+#include "passes/resolve.h"
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
 
@@ -35,8 +42,10 @@ Imported importAs(SourceKind kind, const std::string& text, const std::string& f
   return r;
 }
 
+/// The mapping alone: read as an extract (the resources a .gltf refers to are
+/// checked by the GltfResources tests).
 Imported gltf(const std::string& materialsJson, const std::string& rest = "") {
-  return importAs(SourceKind::Gltf, "{\"materials\": " + materialsJson + rest + "}", "t.gltf");
+  return importAs(SourceKind::GltfMaterials, "{\"materials\": " + materialsJson + rest + "}", "t.gltf");
 }
 
 Imported mtlx(const std::string& body) {
@@ -150,11 +159,170 @@ TEST(GltfImport, NamesBecomeUniqueIdentifiers) {
   EXPECT_EQ((*r.materials)[2].name, "material_2");
   EXPECT_EQ((*r.materials)[3].name, "m_01_rust");
   Diagnostics d("t.gltf");
-  EXPECT_EQ(pickMaterial(*r.materials, "Car Paint", d), &(*r.materials)[0]);  // by its source name
-  EXPECT_EQ(pickMaterial(*r.materials, "m_01_rust", d), &(*r.materials)[3]);  // or its identifier
+  EXPECT_EQ(pickMaterial(*r.materials, "Car_Paint_2", d), &(*r.materials)[1]);  // by its identifier
+  EXPECT_EQ(pickMaterial(*r.materials, "01 rust", d), &(*r.materials)[3]);      // or its source name
   EXPECT_EQ(pickMaterial(*r.materials, "", d), nullptr);
   EXPECT_NE(d.formatAll().find("the file holds 4 materials; choose one with --material NAME:\n  Car_Paint (\"Car Paint\")"),
             std::string::npos) << d.formatAll();
+}
+
+// --- Names (issue 16): every name that reaches generated code --------------
+
+TEST(ImportNames, TheSanitizerMakesUsableIdentifiersDirectly) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"gl_Pos", "m_gl_Pos"},      {"GL_x", "m_GL_x"},    {"gL_Material", "m_gL_Material"},
+      {"gl_", "gl"},               {"__x", "x"},          {"a__b", "a_b"},
+      {"x_", "x"},                 {"_", ""},             {"float", "m_float"},
+      {"main", "m_main"},          {"sin", "m_sin"},      {"texture", "m_texture"},
+      {"cbuffer", "m_cbuffer"},    {"01 rust", "m_01_rust"}, {"Car Paint", "Car_Paint"},
+      {"M\xc3\xa9tal", "M_tal"},   {"\xe9\x87\x91", ""},  {"", ""}};
+  for (const auto& [in, want] : cases) {
+    EXPECT_EQ(sanitizeIdentifier(in), want) << in;
+    if (!want.empty()) EXPECT_TRUE(isUsableIdentifier(want)) << want;
+  }
+  const std::string longName(1000, 'a');
+  EXPECT_EQ(sanitizeIdentifier(longName), std::string(kMaxSanitizedIdentifier, 'a'));
+  EXPECT_EQ(sanitizeIdentifier(std::string(119, 'a') + "__b"), std::string(119, 'a'));  // cut, no trailing '_'
+}
+
+TEST(ImportNames, EveryStringSanitizesToAUsableIdentifierOrNothing) {
+  // Random names made of the pieces that break identifiers.
+  const std::vector<std::string> pieces = {"gl_", "GL_", "Gl", "_", "__", "float", "sin", "main", "9", "a", "Z",
+                                           "\xc3\xa9", " ", "-", "$", "texture", "lerp", "x"};
+  std::mt19937 rng(16);
+  int checked = 0;
+  for (int i = 0; i < 20000; ++i) {
+    std::string s;
+    for (int n = static_cast<int>(rng() % 6); n >= 0; --n) s += pieces[rng() % pieces.size()];
+    const std::string id = sanitizeIdentifier(s);
+    if (id.empty()) continue;
+    ASSERT_TRUE(isUsableIdentifier(id)) << "\"" << s << "\" -> \"" << id << "\"";
+    ++checked;
+  }
+  EXPECT_GT(checked, 15000);  // most strings keep something
+}
+
+TEST(ImportNames, FreeNameSearchesAreLinearAndBounded) {
+  NameSet names;
+  std::set<std::string> seen;
+  for (int i = 0; i < 20000; ++i) {  // 20 000 collisions: O(n) in all, not O(n^2)
+    const std::string id = names.claim("a");
+    ASSERT_TRUE(isUsableIdentifier(id)) << id;
+    ASSERT_TRUE(seen.insert(id).second) << id;
+  }
+  EXPECT_EQ(names.size(), 20000u);
+  const std::string longBase(kMaxSanitizedIdentifier, 'b');
+  EXPECT_EQ(names.claim(longBase), longBase);
+  const std::string second = names.claim(longBase);
+  EXPECT_EQ(second, longBase + "_2");
+  EXPECT_LE(second.size(), 128u);
+  // Material names collide case-insensitively (file names, upper-case macros).
+  NameSet materials(/*caseInsensitive=*/true);
+  EXPECT_EQ(materials.claim("Gold"), "Gold");
+  EXPECT_EQ(materials.claim("gold"), "gold_2");
+  // The search gives up past its bound (unreachable with the default bound:
+  // at most size() + 1 tries are ever needed).
+  NameSet small(false, 3);
+  for (const char* n : {"c_2", "c_3", "c_4", "c_5"}) small.insert(n);
+  EXPECT_EQ(small.claim("c"), "c");
+  EXPECT_THROW(small.claim("c"), std::length_error);
+}
+
+/// Every file the material generates validates (glslang + spirv-val, GLSL and HLSL).
+void expectValidShaders(const ImportedMaterial& m) {
+  const CompileResult r = compiled(m);
+  Generated gen = generateFiles(r, GenerateOptions{});
+  validateGenerated(gen);
+  EXPECT_TRUE(gen.valid) << m.name << ": " << gen.failure;
+  EXPECT_FALSE(gen.files.empty());
+}
+
+TEST(ImportNames, ReservedGltfNamesImportInBoundedTimeAndValidate) {
+  // The material names that made the sanitizer loop forever (gl_), and every
+  // other kind of reserved name, each twice.
+  std::string list;
+  for (const char* n : {"gl_Pos", "gl_Pos", "Gl_Pos", "GL_POS", "float", "float", "sin", "__x", "_x_", "main",
+                        "cbuffer", "gl_", "\xe9\x87\x91\xe5\xb1\x9e"})
+    list += std::string(list.empty() ? "" : ", ") + R"({"name": ")" + n +
+            R"(", "pbrMetallicRoughness": {"roughnessFactor": 0.4, "baseColorTexture": {"index": 0}}})";
+  Imported r = gltf("[" + list + "]", R"(, "textures": [{"source": 0}], "images": [{"uri": "gl_Tex.png"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  std::vector<std::string> names;
+  for (const auto& m : *r.materials) names.push_back(m.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"m_gl_Pos", "m_gl_Pos_2", "m_Gl_Pos_3", "m_GL_POS_4", "m_float", "m_float_2",
+                                             "m_sin", "x", "x_2", "m_main", "m_cbuffer", "gl", "material_12"}));
+  for (const auto& m : *r.materials) {
+    ASSERT_TRUE(isUsableIdentifier(m.name)) << m.name;
+    compiled(m);
+  }
+  expectValidShaders((*r.materials)[2]);  // "Gl_Pos": its macros would begin with GL_
+}
+
+TEST(ImportNames, ReservedMaterialXNamesImportAndValidate) {
+  Imported r = mtlx(R"(  <nodegraph name="gl_NG">
+    <input name="gl_tint" type="color3" value="0.8, 0.5, 0.2" />
+    <input name="__gain" type="float" value="0.5" />
+    <tiledimage name="gl_img" type="color3">
+      <input name="file" type="filename" value="gl_color.png" />
+    </tiledimage>
+    <multiply name="float" type="color3">
+      <input name="in1" type="color3" interfacename="gl_tint" />
+      <input name="in2" type="color3" nodename="gl_img" />
+    </multiply>
+    <multiply name="sin" type="color3">
+      <input name="in1" type="color3" nodename="float" />
+      <input name="in2" type="float" interfacename="__gain" />
+    </multiply>
+    <output name="out" type="color3" nodename="sin" />
+  </nodegraph>
+  <standard_surface name="gl_SR" type="surfaceshader">
+    <input name="base_color" type="color3" nodegraph="gl_NG" output="out" />
+    <input name="specular_roughness" type="float" value="0.3" />
+  </standard_surface>
+  <surfacematerial name="gl_Material" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="gl_SR" />
+  </surfacematerial>
+  <surfacematerial name="GL_MATERIAL" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="gl_SR" />
+  </surfacematerial>
+)");
+  ASSERT_TRUE(r.materials) << r.diags;
+  ASSERT_EQ(r.materials->size(), 2u);
+  EXPECT_EQ((*r.materials)[0].name, "m_gl_Material");
+  EXPECT_EQ((*r.materials)[1].name, "m_GL_MATERIAL_2");  // names differ in more than letter case
+  const std::string& text = (*r.materials)[0].text;
+  for (const char* id : {"\"m_gl_tint\": {", "\"gain\": {", "\"m_gl_color\"", "\"m_float\": {", "\"m_sin\": {"})
+    EXPECT_NE(text.find(id), std::string::npos) << id << "\n" << text;
+  const auto doc = nlohmann::json::parse(text);
+  int ids = 0;
+  for (const char* section : {"inputs", "nodes"})
+    for (const auto& [id, body] : doc[section].items()) {
+      EXPECT_TRUE(isIdentifier(id) && !hasReservedPrefix(id)) << id;
+      ++ids;
+    }
+  EXPECT_GE(ids, 6);
+  expectValidShaders((*r.materials)[1]);
+}
+
+TEST(ImportNames, NonAsciiNamesStayUtf8InDescriptions) {
+  Imported r = gltf(R"([{"name": "金属 Métal"}])");
+  ASSERT_TRUE(r.materials) << r.diags;
+  EXPECT_NE((*r.materials)[0].text.find(R"(materials[0] \"金属 Métal\" (glTF 2.0 PBR).)"), std::string::npos)
+      << (*r.materials)[0].text;
+  EXPECT_EQ((*r.materials)[0].text.find("\\\\x"), std::string::npos);
+  Imported x = mtlx(R"(  <standard_surface name="SR" type="surfaceshader" />
+  <surfacematerial name="Ébène_木" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="SR" />
+  </surfacematerial>
+)");
+  ASSERT_TRUE(x.materials) << x.diags;
+  EXPECT_NE((*x.materials)[0].text.find(R"(surfacematerial \"Ébène_木\" (MaterialX).)"), std::string::npos)
+      << (*x.materials)[0].text;
+  // Bytes that are not UTF-8 (an XML file need not be) are escaped, never written raw.
+  EXPECT_EQ(descriptionText("a\xff" "b\xc3"), "a\\xffb\\xc3");
+  EXPECT_EQ(descriptionText("\xed\xa0\x80"), "\\xed\\xa0\\x80");  // a UTF-8-encoded surrogate
+  EXPECT_EQ(descriptionText("tab\there"), "tab\\x09here");
+  EXPECT_EQ(descriptionText("金属金属", 7), "金属...");  // cut at a character boundary
 }
 
 // --- glTF mapping -----------------------------------------------------------
@@ -441,4 +609,127 @@ TEST(GltfImport, ATextureWithoutAnImageIsAnError) {
   EXPECT_FALSE(r.materials);
   EXPECT_NE(r.diags.find("t.gltf: /textures/0/source: error: expected the index of one of the document's 0 images"),
             std::string::npos) << r.diags;
+}
+
+// --- Buffers and images a .gltf or .glb refers to (issue 16) -----------------
+
+namespace {
+
+/// A .glb with a binary chunk of `bin` bytes (zeros) after the JSON.
+std::string glbWithBin(const std::string& json, std::uint32_t bin) {
+  std::string chunk = json;
+  while (chunk.size() % 4) chunk += ' ';
+  auto le = [](std::uint32_t v) {
+    std::string s(4, '\0');
+    for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((v >> (8 * i)) & 0xff);
+    return s;
+  };
+  std::string body = le(static_cast<std::uint32_t>(chunk.size())) + "JSON" + chunk + le(bin) + std::string("BIN\0", 4) +
+                     std::string(bin, '\0');
+  return "glTF" + le(2) + le(static_cast<std::uint32_t>(12 + body.size())) + body;
+}
+
+const char* kTwoImages = R"({"asset": {"version": "2.0"},
+  "materials": [{"name": "M", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+  "textures": [{"source": 0}, {"source": 1}],
+  "images": [{"uri": "used%20image.png"}, {"uri": "unused.png"}],
+  "buffers": [{"uri": "geometry.bin", "byteLength": 10}, {"uri": "data:application/octet-stream;base64,AAAA", "byteLength": 3},
+              {"uri": "data:application/octet-stream;base64,A$AA", "byteLength": 3}]})";
+
+}  // namespace
+
+TEST(GltfResources, AMissingFileIsAWarningAndAnErrorWhereAMaterialSamplesIt) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("substratec_res_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "m.gltf") << kTwoImages;
+  Diagnostics d("m.gltf");
+  EXPECT_FALSE(importFile((dir / "m.gltf").string(), ReadLimits{}, d));
+  const std::string all = d.formatAll();
+  const std::string at = (dir / "").string();
+  for (const std::string& want :
+       {"m.gltf: /images/0/uri: error: images[0] \"" + at + "used image.png\" cannot be read (No such file or directory): "
+        "material \"M\" samples it",
+        "m.gltf: /images/1/uri: warning: images[1] \"" + at + "unused.png\" cannot be read (No such file or directory); "
+        "no material samples it",
+        "m.gltf: /buffers/0/uri: warning: buffers[0] \"" + at + "geometry.bin\" cannot be read (No such file or "
+        "directory); materials do not need geometry",
+        std::string("m.gltf: /buffers/2/uri: warning: buffers[2] \"data:application/octet-stream;base64,A$AA\" cannot "
+                    "be read (a base64 data: URI with the character \"$\" at 1)")})
+    EXPECT_NE(all.find(want), std::string::npos) << want << "\n" << all;
+  EXPECT_EQ(all.find("buffers[1]"), std::string::npos) << all;  // a well-formed data: URI
+  // With the sampled image there, only the warnings are left.
+  std::ofstream(dir / "used image.png") << "png";
+  Diagnostics again("m.gltf");
+  auto ok = importFile((dir / "m.gltf").string(), ReadLimits{}, again);
+  EXPECT_TRUE(ok) << again.formatAll();
+  EXPECT_EQ(again.errorCount(), 0u);
+  // A buffer shorter than its byteLength is as good as missing.
+  std::ofstream(dir / "geometry.bin") << "short";
+  Diagnostics shortBuffer("m.gltf");
+  EXPECT_TRUE(importFile((dir / "m.gltf").string(), ReadLimits{}, shortBuffer));
+  EXPECT_NE(shortBuffer.formatAll().find("/buffers/0/byteLength: warning: buffers[0] holds 5 bytes, fewer than its "
+                                         "byteLength 10"), std::string::npos) << shortBuffer.formatAll();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(GltfResources, AGlbImageInItsBinaryChunkIsReadableOnlyWhenTheChunkHoldsIt) {
+  const std::string json = R"({"asset": {"version": "2.0"},
+    "materials": [{"name": "M", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+    "textures": [{"source": 0}], "images": [{"bufferView": 0, "mimeType": "image/png"}],
+    "bufferViews": [{"buffer": 0, "byteOffset": 4, "byteLength": 8}], "buffers": [{"byteLength": 12}]})";
+  Imported fits = importAs(SourceKind::Glb, glbWithBin(json, 12), "m.glb");
+  EXPECT_TRUE(fits.materials) << fits.diags;
+  EXPECT_EQ(fits.diags, "");
+  Imported cut = importAs(SourceKind::Glb, glbWithBin(json, 8), "m.glb");
+  EXPECT_FALSE(cut.materials);
+  EXPECT_NE(cut.diags.find("m.glb: /images/0/bufferView: error: images[0] in bufferViews[0] cannot be read (buffers[0] "
+                           "cannot be read): material \"M\" samples it"), std::string::npos) << cut.diags;
+  Imported none = importAs(SourceKind::Glb, glb(json), "m.glb");  // no binary chunk at all
+  EXPECT_FALSE(none.materials);
+  EXPECT_NE(none.diags.find("m.glb: /buffers/0: warning: buffers[0] has no uri and the document has no .glb binary chunk"),
+            std::string::npos) << none.diags;
+}
+
+TEST(GltfResources, MissingFilesAreReportedOncePerFileAndBounded) {
+  std::string buffers;
+  for (int i = 0; i < 100; ++i)
+    buffers += std::string(i ? ", " : "") + R"({"uri": "b)" + std::to_string(i % 50) + R"(.bin", "byteLength": 4})";
+  Imported r = importAs(SourceKind::Gltf, R"({"asset": {"version": "2.0"}, "materials": [{"name": "M"}], "buffers": [)" +
+                                              buffers + "]}", "m.gltf");
+  ASSERT_TRUE(r.materials) << r.diags;  // geometry is never needed
+  std::size_t lines = 0;
+  for (char c : r.diags) lines += c == '\n';
+  EXPECT_EQ(lines, static_cast<std::size_t>(kMaxResourceWarnings) + 1) << r.diags;  // 50 files: 32, then one line
+  EXPECT_NE(r.diags.find("m.gltf: /: warning: 18 more resources cannot be read (not listed)"), std::string::npos)
+      << r.diags;
+}
+
+// --- Fuzzing regressions (issue 16) -------------------------------------------
+
+TEST(ImportFuzzRegressions, EveryInputThatOnceCrashedIsImportedOrRejected) {
+  // tests/import/fuzz_regressions: inputs mtlx_fuzzer and gltf_fuzzer found
+  // (fuzz/, scripts/fuzz.sh), checked as the fuzzers check them: imported, with
+  // usable names and materials that compile, or rejected with an error.
+  const std::filesystem::path dir = std::filesystem::path(SUBSTRATEC_SOURCE_DIR) / "tests/import/fuzz_regressions";
+  int checked = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    const SourceKind kind = sourceKindOf(name);
+    if (kind == SourceKind::Substrate) continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    Diagnostics d(name);
+    auto materials = importText(kind, name, text, "/nonexistent-substratec-fuzz/dir", ReadLimits{}, d);
+    if (!materials) {
+      EXPECT_TRUE(d.hasErrors()) << name;
+    } else {
+      for (const auto& m : *materials) {
+        EXPECT_TRUE(isUsableIdentifier(m.name)) << name << ": " << m.name;
+        compiled(m);
+      }
+    }
+    ++checked;
+  }
+  EXPECT_GE(checked, 1);
 }

@@ -133,6 +133,16 @@ TEST(SceneManifest, EveryMistakeIsLocated) {
         "dir/s.json: /materials/2: error: \"./a.json\" is already listed at /materials/0",
         "dir/s.json: /materials/3: error: expected a material file path (relative to the manifest), got 7"})
     EXPECT_NE(all.find(want), std::string::npos) << want << "\n" << all;
+  // What could be read is kept for the scene build, which goes on to the
+  // materials' errors: a.json once, the name and platform dropped.
+  Diagnostics again("dir/s.json");
+  auto partial = readSceneManifest("dir/s.json", R"({"format": "substrate-scene/1", "name": "s",
+    "materials": ["a.json", "./a.json", 7, "b.json"]})", ReadLimits{}, again);
+  ASSERT_TRUE(partial.has_value());
+  EXPECT_EQ(again.errorCount(), 2u) << again.formatAll();
+  ASSERT_EQ(partial->materials.size(), 2u);
+  EXPECT_EQ(partial->materials[0].pointer, "/materials/0");
+  EXPECT_EQ(partial->materials[1].pointer, "/materials/3");
   Diagnostics empty("s.json");
   EXPECT_FALSE(parseSceneManifest("s.json", R"({"format": "substrate-scene/1", "name": "x", "materials": []})",
                                   ReadLimits{}, empty));

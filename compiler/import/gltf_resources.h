@@ -1,0 +1,33 @@
+// The files a .gltf or .glb refers to — `buffers` (geometry) and `images`
+// (textures) — checked when a document is imported: a resource that cannot
+// be read is a warning per file, or an error for an image a material samples.
+//
+// What "needs" means here: importing a material reads no texel and no vertex
+// (an imported material's textures are texture2d inputs the renderer binds by
+// name). Geometry is therefore never needed: a missing or short buffer is a
+// warning. An image that a texture of one of the document's materials samples
+// is needed by that material — without it the renderer has nothing to bind —
+// so an image that cannot be read (a missing or unreadable file, a malformed
+// data: URI, a bufferView into a buffer that cannot be read or is too short)
+// is an error at /images/N; an image no material samples is a warning. The
+// corpus' .materials.json extracts carry no resources and are not checked.
+#pragma once
+#include <optional>
+#include <string>
+
+#include "diag/diagnostics.h"
+#include "import/material_writer.h"
+
+namespace substratec::import {
+
+/// Most missing-resource warnings reported one by one (then one line for the rest).
+inline constexpr int kMaxResourceWarnings = 32;
+
+/// Checks `doc`'s buffers and images: file URIs relative to `baseDir`
+/// (percent-decoded), data: URIs decoded, a .glb's buffer 0 without a URI
+/// against `glbBinBytes` (the size of its binary chunk; nullopt for a .gltf or
+/// a .glb without one). Diagnostics located by JSON pointer. False on errors.
+bool checkGltfResources(const Json& doc, const std::string& baseDir, std::optional<std::size_t> glbBinBytes,
+                        Diagnostics& diags);
+
+}  // namespace substratec::import
