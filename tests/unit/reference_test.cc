@@ -370,7 +370,9 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
   layerAbove(cover, through, 0.7, {t1[0] * 0.96, t1[1] * 0.96, t1[2] * 0.96});  // the root's top first
   const double coverMid = cover;
   const D3 throughMid = through;
-  layerAbove(cover, through, 1.0, {t2[0] * 0.96, t2[1] * 0.94, t2[2] * 0.92});
+  // The second interface on the way down: its layer times SUBSTRATE_EXTRA_INTERFACE
+  // (substrate_extra_interfaces), the lighting applies the angular part of one.
+  layerAbove(cover, through, 1.0, {t2[0] * 0.96 * 0.91, t2[1] * 0.94 * 0.91, t2[2] * 0.92 * 0.91});
   MaterialResult<double> m = evaluateMaterial<double>(r, tiltedGeometry(), {}, {});
   const Closure<double>& base = m.closures[closureOf(r, "base")];
   EXPECT_NEAR(base.coverageAbove, cover, 1e-12);
