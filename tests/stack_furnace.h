@@ -165,6 +165,20 @@ inline Case randomCase(int depth, Shape shape, Rng& rng) {
   return c;
 }
 
+/// The issue's own stack: white slabs (albedo 1, F0 0, roughness 1e-4),
+/// fully present, every one but the bottom transparent (sss_mfp 1e6 and a
+/// thickness of 0), the bottom opaque (sss_mfp 0 at the surface thickness).
+inline Case whiteStack(int depth, Shape shape) {
+  Case c;
+  c.text = "white stack";
+  for (int k = 0; k < depth; ++k) {
+    for (double v : {1.0, 0.0, 1e-4, k == depth - 1 ? 0.0 : 1e6}) c.inputs.values.push_back({v, v, v, v});
+    if (covered(shape)) c.inputs.values.push_back({1, 1, 1, 1});
+  }
+  for (int j = 1; j < depth; ++j) c.inputs.values.push_back({0, 0, 0, 0});
+  return c;
+}
+
 /// The view at cosine mu in the XZ plane (normal +Z, tangent +X).
 inline reference::V3<double> viewAt(double mu) { return {std::sqrt(std::max(0.0, 1 - mu * mu)), 0, mu}; }
 

@@ -323,10 +323,7 @@ TEST(Furnace, StacksOfWhiteTransparentSlabsAtEveryDepth) {
     Diagnostics d("stack.json");
     auto r = compileText("stack.json", stackMaterial(depth, Shape::NestedBases), o, d);
     ASSERT_TRUE(r.has_value()) << d.formatAll();
-    reference::InputValues in;
-    for (int k = 0; k < depth; ++k)
-      for (double v : {1.0, 0.0, 1e-4, k == depth - 1 ? 0.0 : 1e6}) in.values.push_back({v, v, v, v});
-    for (int j = 1; j < depth; ++j) in.values.push_back({0, 0, 0, 0});
+    const reference::InputValues in = whiteStack(depth, Shape::NestedBases).inputs;
     std::string line;
     for (double mu : kNoV) {
       reference::Geometry g;
