@@ -176,6 +176,54 @@ TEST(Cli, JsonReportHasTheDocumentedKeys) {
   EXPECT_EQ(j["budget"]["bytes_per_pixel"], 80);
 }
 
+TEST(Cli, AClearCoatWithoutAMediumHidesItsBaseWhichIsCulled) {
+  // Issue 16: the clear-coat example with its coat's sss_mfp left out (and the
+  // default thickness): the coat is opaque, so the glinting paint can never
+  // show. The report charges only the coat, lists the paint as culled, and
+  // the warning points at the coat.
+  const std::string opaque = (kSource / "tests/warnings/001_opaque_clear_coat.json").string();
+  CliRun r = cli({"report", "--json", opaque});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find(opaque + ": /nodes/coat: warning: 'coat' hides the base 'paint' of vertical 'root'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("sss_mfp"), std::string::npos);
+  EXPECT_NE(r.err.find("transmittance_to_mfp"), std::string::npos);
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["before"]["closures"], 1);
+  EXPECT_EQ(j["before"]["bytes"], 12);
+  std::vector<std::string> culled;
+  for (const auto& c : j["culled"]) culled.push_back(c["node"].get<std::string>());
+  EXPECT_EQ(culled, (std::vector<std::string>{"paint", "root"}));
+  // The text report says it too.
+  CliRun t = cli({"report", opaque});
+  ASSERT_EQ(t.status, 0) << t.err;
+  EXPECT_NE(t.out.find("paint: base of vertical 'root': hidden by its opaque top 'coat'"), std::string::npos)
+      << t.out;
+
+  // The example itself (sss_mfp 1e6): both closures, nothing culled, no warning.
+  CliRun c = cli({"report", "--json", example("clear_coat_over_glints.json")});
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_EQ(c.err, "");
+  auto k = nlohmann::json::parse(c.out);
+  EXPECT_EQ(k["before"]["closures"], 2);
+  EXPECT_EQ(k["before"]["bytes"], 44);
+  EXPECT_TRUE(k["culled"].empty());
+}
+
+TEST(Cli, OpaqueTopsOverOpaqueTopsCollapseToTheVisibleClosure) {
+  // Thirteen slabs, each the opaque top of the next: 13 closures -> 1.
+  CliRun r = cli({"report", "--json", (kSource / "tests/warnings/003_opaque_tops_over_opaque_tops.json").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["before"]["closures"], 1);
+  EXPECT_EQ(j["culled"].size(), 24u);  // twelve bases, twelve verticals
+  int warnings = 0;
+  for (std::size_t at = r.err.find(": warning: "); at != std::string::npos; at = r.err.find(": warning: ", at + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 12) << r.err;
+}
+
 TEST(Cli, BudgetFlagsOverrideSettings) {
   CliRun r = cli({"report", "--json", "--budget", "48", "--max-closures", "2", example("row12_simple.json")});
   ASSERT_EQ(r.status, 0) << r.err;

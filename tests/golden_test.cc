@@ -3,6 +3,7 @@
 // Run with --update-golden to regenerate them (then review the diff).
 // Output is normalized (no absolute paths; '\n' line endings).
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <set>
 #include <filesystem>
@@ -125,6 +126,21 @@ TEST(Golden, EveryBadMaterialXInputDiagnostic) {
     EXPECT_NE(diags.formatAll().find(": error: "), std::string::npos);
     checkGolden(kSource / "tests/bad" / (b.stem().string() + ".expected.txt"), diags.formatAll());
   }
+}
+
+TEST(Golden, EveryWarningDiagnostic) {
+  // tests/warnings: valid materials that compile with located warnings.
+  auto files = filesIn(kSource / "tests/warnings", ".json");
+  ASSERT_GE(files.size(), 3u);
+  for (const auto& f : files) {
+    SCOPED_TRACE(f.filename().string());
+    auto [r, diags] = compileAs(f, f.filename().string());
+    EXPECT_TRUE(r.has_value()) << diags;
+    EXPECT_NE(diags.find(": warning: "), std::string::npos);
+    EXPECT_EQ(diags.find(": error: "), std::string::npos);
+    checkGolden(kSource / "tests/warnings" / (f.stem().string() + ".expected.txt"), diags);
+  }
+  std::printf("[ golden   ] %zu materials with warnings\n", files.size());
 }
 
 // Every example at the budgets of issue 3: it fits (bytes, closures, class,

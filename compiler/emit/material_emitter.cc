@@ -403,7 +403,7 @@ void Emitter::emitClosures() {
                      s.collapsedFrom.empty() ? "" : fmt::format(" (a blended {})", s.collapsedFrom)));
     // The walk up to the root: mix/coverage weights, and the layers above.
     std::string weight = s.coverage == kNoValue ? "" : fmt::format("C_{}", id);
-    std::vector<std::string> layerLines;
+    std::vector<std::pair<int, int>> layers;  // (vertical, its top) for each vertical above, bottom-up
     for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
       const TreeNode& op = m_.nodes[p];
       std::string f;
@@ -415,19 +415,7 @@ void Emitter::emitClosures() {
                             : fmt::format("step({}, {})", expr(op.a), expr(op.b));
           break;
         case TreeOp::Vertical:
-          if (op.right == x) {
-            const TreeNode& top = m_.nodes[op.left];
-            // The top's interfaces transmit 1 - F0 at normal incidence: a slab's
-            // inline, an operator's (a partial coat, a mix of coats) through TI.
-            std::string tTop = fmt::format("TI_{}", top.id);
-            if (top.op == TreeOp::Slab)
-              tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
-            layerLines.push_back(fmt::format("substrate_layer_above(ca_{0}, ta_{0}, C_{1}, {2});  // under '{1}' (vertical '{3}')",
-                                             id, top.id, tTop, op.id));
-            if (top.op == TreeOp::Slab)
-              layerLines.push_back(fmt::format("va_{0} += C_{1} * substrate_roughness_to_variance({2});", id, top.id,
-                                               expr(m_.slabs[top.slab].pin(SlabPin::Roughness))));
-          }
+          if (op.right == x) layers.emplace_back(p, op.left);
           break;
         default: break;
       }
@@ -435,7 +423,25 @@ void Emitter::emitClosures() {
     }
     if (!cl.isTop) {
       line(fmt::format("float ca_{0} = 0.0; {1} ta_{0} = {2}; float va_{0} = 0.0;", id, v3, vec3(1, 1, 1)));
-      for (auto it = layerLines.rbegin(); it != layerLines.rend(); ++it) line(*it);  // from the root down
+      // From the root down. The top's interfaces transmit 1 - F0 at normal
+      // incidence: a slab's inline, an operator's (a partial coat, a mix of
+      // coats) through TI. The lighting applies the angular part of one
+      // interface; every further interface on the way down (the root's top's
+      // second and later, every interface of the layers below it) is folded in
+      // here as substrate_extra_interfaces (substrate_tree.h).
+      for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
+        const TreeNode& top = m_.nodes[it->second];
+        std::string tTop = fmt::format("TI_{}", top.id);
+        if (top.op == TreeOp::Slab)
+          tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
+        const int extra = t_.interfaces[it->second] - (it == layers.rbegin() ? 1 : 0);
+        if (extra > 0) tTop = fmt::format("{} * substrate_extra_interfaces({})", tTop, Syntax::literal(extra));
+        if (top.op == TreeOp::Slab)
+          line(fmt::format("va_{0} += C_{1} * substrate_roughness_to_variance({2});", id, top.id,
+                           expr(m_.slabs[top.slab].pin(SlabPin::Roughness))));
+        line(fmt::format("substrate_layer_above(ca_{0}, ta_{0}, C_{1}, {2});  // under '{1}' (vertical '{3}')", id,
+                         top.id, tTop, m_.nodes[it->first].id));
+      }
     }
     line(fmt::format("substrate_closure_init({});", c));
     const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);

@@ -17,6 +17,7 @@ TreeInfo analyzeTree(const Material& m) {
   t.unitWeight.assign(n, false);
   t.unitCoverageAbove.assign(n, false);
   t.unitCoverage.assign(n, false);
+  t.interfaces.assign(n, 0);
   t.bsdfId.assign(m.slabs.size(), -1);
   t.slabNode.assign(m.slabs.size(), -1);
   t.layerVertical.assign(n, -1);
@@ -62,6 +63,10 @@ TreeInfo analyzeTree(const Material& m) {
         case TreeOp::Vertical: one = c(node.left) || c(node.right); break; // sat(a+1), Ct + 1*(1-Ct)
       }
       t.unitCoverage[*it] = one;
+      auto k = [&](int j) { return j >= 0 ? t.interfaces[j] : 0; };
+      t.interfaces[*it] = node.op == TreeOp::Slab       ? 1
+                          : node.op == TreeOp::Vertical ? k(node.left) + k(node.right)
+                                                        : std::max(k(node.left), k(node.right));
     }
   }
   std::vector<Item> stack{{m.root, -1, 0, 0, false, true, true, -1}};

@@ -21,6 +21,8 @@ struct TreeInfo {
                                  // root are statically 1 (transmittance not included)
   std::vector<bool> unitCoverageAbove;  // slabs: every layer above has coverage statically 1
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
+  std::vector<int> interfaces;   // any node: the most interfaces a path down through the subtree
+                                 // crosses (slab 1, vertical top + base, other operators the larger side)
   std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order)
   std::vector<int> bsdfId;       // slab index -> position in slabOrder
   std::vector<int> slabNode;     // slab index -> its tree node (-1 if not in the tree)

@@ -2,16 +2,21 @@
 
 #include <fmt/format.h>
 
+#include <set>
+#include <string>
+
 namespace substratec {
 
 namespace {
 
 class Culler {
  public:
-  explicit Culler(Material& m) : m_(m) {}
+  Culler(Material& m, Diagnostics& diags) : m_(m), diags_(diags) {}
 
   /// Returns the node that replaces `i`, or -1 if the subtree is empty.
-  int visit(int i) {
+  /// `layer`: the thickness of the layer that holds `i` (TreeInfo::layerVertical:
+  /// the nearest vertical whose top layer holds it; kNoValue: the surface thickness).
+  int visit(int i, ValueId layer) {
     TreeNode n = m_.nodes[i];  // copy: m_.nodes may grow
     ValueDag& dag = m_.values;
     auto drop = [&](int child, const std::string& why) {
@@ -23,12 +28,12 @@ class Culler {
         if (dag.isConstEqual(n.a, 0)) {
           drop(n.right, fmt::format("foreground of horizontal '{}': mix is constant 0", n.id));
           note(n.id, "horizontal with constant mix 0 replaced by its background");
-          return visit(n.left);
+          return visit(n.left, layer);
         }
         if (dag.isConstEqual(n.a, 1)) {
           drop(n.left, fmt::format("background of horizontal '{}': mix is constant 1", n.id));
           note(n.id, "horizontal with constant mix 1 replaced by its foreground");
-          return visit(n.right);
+          return visit(n.right, layer);
         }
         break;
       case TreeOp::CoverageWeight:
@@ -39,7 +44,7 @@ class Culler {
         }
         if (dag.isConstEqual(n.a, 1)) {
           note(n.id, "coverage_weight with constant weight 1 removed (no effect)");
-          return visit(n.left);
+          return visit(n.left, layer);
         }
         break;
       case TreeOp::Select:
@@ -49,13 +54,26 @@ class Culler {
                fmt::format("side {} of select '{}': the constant value always picks {}", pickA ? "b" : "a", n.id,
                            pickA ? "a" : "b"));
           note(n.id, fmt::format("select with a constant value replaced by side {}", pickA ? "a" : "b"));
-          return visit(pickA ? n.left : n.right);
+          return visit(pickA ? n.left : n.right, layer);
         }
         break;
       default: break;
     }
-    int l = n.left >= 0 ? visit(n.left) : -1;
-    int r = n.right >= 0 ? visit(n.right) : -1;
+    // A vertical's top is a layer of the vertical's thickness; its base stays in `layer`.
+    int l = n.left >= 0 ? visit(n.left, n.op == TreeOp::Vertical ? n.a : layer) : -1;
+    int r = n.right >= 0 ? visit(n.right, layer) : -1;
+    if (n.op == TreeOp::Vertical && l >= 0 && r >= 0) {
+      const bool hidden = opaque(l, n.a, false);
+      if (hidden || opaque(l, n.a, true)) warnHidden(n, l, hidden);
+      // Replaced by its top only where the top stays opaque in the layer that
+      // then holds it (its slabs take that layer's thickness): otherwise the
+      // rewrite would change what the top lets through.
+      if (hidden && opaque(l, layer, false)) {
+        drop(n.right, fmt::format("base of vertical '{}': hidden by its opaque top '{}'", n.id, m_.nodes[l].id));
+        note(n.id, fmt::format("vertical '{}' replaced by its top: the top is opaque", n.id));
+        return l;
+      }
+    }
     if (n.op == TreeOp::CoverageWeight) {
       if (l < 0) {
         note(n.id, fmt::format("coverage_weight '{}' removed: its subtree is empty", n.id));
@@ -106,14 +124,72 @@ class Culler {
     return i;
   }
   void note(const std::string& what, std::string why) { m_.culled.push_back({what, std::move(why)}); }
+
+  /// A statically positive thickness: `layer`'s constant, or the surface
+  /// thickness; with `anyThickness`, every thickness that is not the constant 0.
+  bool thick(ValueId layer, bool anyThickness) const {
+    if (layer == kNoValue) return m_.settings.surfaceThickness > 0;
+    if (anyThickness) return !m_.values.isConstEqual(layer, 0);
+    return m_.values.isConst(layer) && m_.values.node(layer).c[0] > 0;
+  }
+  /// The subtree at `i`, in a layer of thickness `layer`, has coverage 1 and
+  /// transmittance 0 whatever the inputs: its light never reaches below it.
+  /// A slab: coverage constant 1 (or none), sss_mfp the constant 0 (no
+  /// medium: T = exp(-d / 0) = 0 for d > 0) and a positive constant thickness;
+  /// horizontal, select, add: both sides opaque (C = 1, T = 0 whatever the
+  /// mix); coverage_weight: weight constant 1 over an opaque subtree;
+  /// vertical: its top (in the vertical's thickness) or its base opaque
+  /// (substrate_op_vertical: C = 1, T = 0). With `anyThickness`: the same for
+  /// every run-time thickness > 0 (for the warning only).
+  bool opaque(int i, ValueId layer, bool anyThickness) const {
+    const TreeNode& n = m_.nodes[i];
+    switch (n.op) {
+      case TreeOp::Slab: {
+        const Slab& s = m_.slabs[n.slab];
+        return (s.coverage == kNoValue || m_.values.isConstEqual(s.coverage, 1)) &&
+               m_.values.isConstEqual(s.pin(SlabPin::SssMfp), 0) && thick(layer, anyThickness);
+      }
+      case TreeOp::Horizontal:
+      case TreeOp::Select:
+      case TreeOp::Add: return opaque(n.left, layer, anyThickness) && opaque(n.right, layer, anyThickness);
+      case TreeOp::CoverageWeight: return m_.values.isConstEqual(n.a, 1) && opaque(n.left, layer, anyThickness);
+      case TreeOp::Vertical: return opaque(n.left, n.a, anyThickness) || opaque(n.right, layer, anyThickness);
+    }
+    return false;
+  }
+
+  /// The warning on the top `l` of vertical `v` that hides its base (always,
+  /// or for every thickness > 0); once per vertical over the pass's rounds.
+  void warnHidden(const TreeNode& v, int l, bool always) {
+    if (!warned_.insert(v.id).second) return;
+    const TreeNode& top = m_.nodes[l];
+    diags_.warning(top.pointer,
+                   fmt::format("'{}' hides the base '{}' of vertical '{}'{}: it has no medium (sss_mfp is 0 or absent), "
+                               "so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. 1e6 for "
+                               "a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper",
+                               top.id, m_.nodes[v.right].id, v.id, always ? "" : " whenever its thickness is > 0"));
+  }
+
   Material& m_;
+  Diagnostics& diags_;
+  std::set<std::string> warned_;  // verticals already warned about
 };
 
 }  // namespace
 
 bool cullStaticMatter(Material& m, Diagnostics& diags) {
   if (m.root < 0) return false;
-  int root = Culler(m).visit(m.root);
+  // Rounds until nothing more is removed: replacing a vertical by its opaque
+  // top moves that top's slabs into the enclosing layer, which can make a top
+  // nested in it provably opaque in turn. Each round that changes the tree
+  // removes a node, so there are at most as many rounds as nodes.
+  Culler culler(m, diags);
+  int root = m.root;
+  for (std::size_t round = 0; round <= m.nodes.size(); ++round) {
+    const std::size_t before = m.culled.size();
+    root = culler.visit(root, kNoValue);
+    if (root < 0 || m.culled.size() == before) break;
+  }
   if (root < 0) {
     diags.error("/output", "no matter is left after static culling (every slab is under a constant zero weight)");
     return false;

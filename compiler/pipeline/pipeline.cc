@@ -60,7 +60,8 @@ std::optional<CompileResult> compileText(const std::string& displayName, const s
   // 4. Substrate tree: instance the Substrate graph from the output.
   if (!pass.run("build-tree", [&] { return buildSubstrateTree(*resolved, table, m, diags, options.tree); }))
     return std::nullopt;
-  // 5. static culling: before any analysis, so culled matter costs nothing.
+  // 5. static culling (constant weights, bases under opaque tops): before any
+  //    analysis, so culled matter costs nothing.
   if (!pass.run("cull", [&] { return cullStaticMatter(m, diags); })) return std::nullopt;
   // 6. features per slab (needs the culled tree: top/bottom positions).
   pass.run("features", [&] { analyzeFeatures(m); return true; });

@@ -60,6 +60,13 @@ void layerAbove(T& c, V3<T>& t, T cLayer, const V3<T>& tLayer) {
   c = cNew;
 }
 
+// substrate_extra_interfaces: SUBSTRATE_EXTRA_INTERFACE^n, the angular part of
+// n more interfaces above folded into a transmittance along the normal.
+template <class T>
+T extraInterfaces(int n) {
+  return std::pow(T(0.91), T(n));
+}
+
 // --- substrate_values.h, tree-walk helpers
 
 // substrate_value_pow: y == 0 -> 1; max(x, 0) == 0 -> 0; else min(pow, FLT_MAX).
@@ -282,7 +289,9 @@ class Walk {
     // The layers above, from the root down (substrate_layer_above); a slab on
     // top of a vertical transmits T (1 - F0) and widens the roughness below by
     // C * variance(its roughness). An operator on top: its TI (its slabs'
-    // T (1 - F0) through the operators), no widening.
+    // T (1 - F0) through the operators), no widening. Every interface after
+    // the first (TreeInfo::interfaces of the tops, less one for the root's)
+    // times extraInterfaces.
     T ca = T(0), va = T(0);
     V3<T> ta = splat3(T(1));
     if (!cl.isTop) {
@@ -295,6 +304,8 @@ class Walk {
           va = va + C_[it->top] * roughnessToVariance(scalar(ts.pin(SlabPin::Roughness)));
           tTop = tTop * (splat3(T(1)) - vec3(ts.pin(SlabPin::F0)));
         }
+        const int extra = t_.interfaces[it->top] - (it == layers.rbegin() ? 1 : 0);
+        if (extra > 0) tTop = tTop * extraInterfaces<T>(extra);
         layerAbove(ca, ta, C_[it->top], tTop);
       }
     }

@@ -17,6 +17,7 @@
 #include "cli/cli.h"
 #include "emit/generate.h"
 #include "gpu/sample_run.h"
+#include "../stack_furnace.h"
 #include "material_fixture.h"
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
@@ -380,6 +381,75 @@ TEST(LayeringEnergy, APartialCoatsInterfaceKeepsWhatItReflects) {
                                                 f0));
     for (double mu : {1.0, 0.5, 0.1}) EXPECT_LE(materialAlbedo(r, mu), 1.001) << mu;
   }
+}
+
+TEST(LayeringEnergy, RandomStacksNeverGainEnergyInTheGeneratedShaders) {
+  // Issue 16, the lavapipe twin of Furnace.RandomStacksOfTwoToEightSlabsNeverGainEnergy
+  // (unit_tests): the closures the forward kernel writes for random stacks
+  // (tests/stack_furnace.h), integrated under a white furnace on the CPU. One
+  // kernel per stack shape, every case an input set of one dispatch (CI time:
+  // three pipelines).
+  using namespace stackfurnace;
+  std::string error;
+  gpu::Context* ctx = gputest::sharedContext(&error);
+  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+  constexpr int kCasesPerStack = 12;
+  const std::pair<int, Shape> stacks[] = {{3, Shape::NestedBases}, {5, Shape::CoveredNestedBases}, {8, Shape::NestedTops}};
+  // The views, padded to one work group with head-on views.
+  std::vector<gpu::Sample> samples(kernel::kLocalSize);
+  for (std::size_t i = 0; i < samples.size(); ++i)
+    samples[i].geometry.V = viewAt(i < std::size(kNoV) ? kNoV[i] : 1.0);
+  const auto sampleBytes = gpu::sampleBuffer(samples);
+  long cases = 0, views = 0, closures = 0;
+  double worst = 0, largestGap = 0;
+  std::string where;
+  for (const auto& [depth, shape] : stacks) {
+    CompileOptions o;
+    o.budgetOverride = 4096;
+    o.maxClosuresOverride = 8;
+    const CompileResult r = compile(stackMaterial(depth, shape), o);
+    ASSERT_EQ(r.after.closures.size(), static_cast<std::size_t>(depth));
+    const ShaderValidation shader = compileKernel(r, Target::Glsl, KernelMode::Forward);
+    ASSERT_TRUE(shader.ok) << shader.log;
+    auto pipeline = ctx->createPipeline(shader.spirv, &error);
+    ASSERT_NE(pipeline, nullptr) << error;
+    const int stride = gpu::resultStride(r);
+    Rng rng{0x6e0000u + static_cast<std::uint64_t>(depth)};
+    for (int k = 0; k < kCasesPerStack; ++k) {
+      // The issue's white stack first, then random ones.
+      const Case c = k == 0 ? whiteStack(depth, shape) : randomCase(depth, shape, rng);
+      ++cases;
+      gpu::Resources res = gputest::kernelResources(r.material, pipeline->reflection(), shader.spirv, c.inputs,
+                                                    sampleBytes, static_cast<std::size_t>(stride) * samples.size());
+      ASSERT_TRUE(ctx->dispatch(*pipeline, res, static_cast<uint32_t>(samples.size()) / kernel::kLocalSize, 1, 1,
+                                &error))
+          << error;
+      const std::vector<float> out = gpu::floatsOf(res, 0, 7);
+      for (std::size_t i = 0; i < std::size(kNoV); ++i) {
+        std::vector<reference::Closure<double>> gpuClosures;
+        for (int q = 0; q < depth; ++q)
+          gpuClosures.push_back(gputest::closureFromResults(out, stride, static_cast<int>(i), q));
+        closures += depth;
+        const auto seed = static_cast<std::uint32_t>(101 + views++);
+        const double a = furnace(gpuClosures, samples[i].geometry.V, seed);
+        const double cpu =
+            furnace(reference::evaluateMaterial<double>(r, samples[i].geometry, c.inputs, {}).closures,
+                    samples[i].geometry.V, seed);
+        const std::string what =
+            fmt::format("depth {} ({}), NoV {}: {}", depth, shapeName(shape), kNoV[i], c.text);
+        EXPECT_TRUE(std::isfinite(a)) << what;
+        EXPECT_LE(a, kTolerance) << what;
+        EXPECT_NEAR(a, cpu, 2e-3) << "the shader's layering and the CPU reference's differ: " << what;
+        largestGap = std::max(largestGap, std::abs(a - cpu));
+        if (a > worst) worst = a, where = what;
+      }
+    }
+  }
+  std::printf("[ layering ] random stacks on lavapipe: %ld cases, %ld views, %ld closures; largest %.5f at %s; "
+              "largest |gpu - cpu| %.2e\n",
+              cases, views, closures, worst, where.c_str(), largestGap);
+  ASSERT_GT(cases, 0);
+  ASSERT_GT(closures, cases);
 }
 
 }  // namespace

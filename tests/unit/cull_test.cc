@@ -4,6 +4,7 @@
 // the pass must leave alone (anything whose weight is not a constant 0 or 1).
 #include "passes/cull.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "test_util.h"
@@ -526,6 +527,225 @@ TEST_F(CullTest, CoverageWeightWithAnEmptiedSubtreeIsRecorded) {
   std::vector<std::string> what;
   for (const CullNote& n : m.culled) what.push_back(n.what);
   EXPECT_EQ(what, (std::vector<std::string>{"b", "outer_a", "outer", "root"}));
+}
+
+// ---------------------------------------------------------------------------
+// a vertical whose top is opaque (issue 16, "A clear coat that is not clear")
+
+TEST_F(CullTest, AnOpaqueTopHidesTheBase) {
+  // No sss_mfp: no medium, so a layer of thickness 1e-4 transmits exp(-d/0) = 0.
+  auto after = cull(R"(
+    "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": "coat", "base": "paint"})",
+                    R"(VERTICAL root thickness=0.0001
+  SLAB coat
+      diffuse_albedo = 0
+  SLAB paint
+      roughness = 0.6
+)");
+  EXPECT_EQ(after, R"(SLAB coat
+    diffuse_albedo = 0
+culled paint: base of vertical 'root': hidden by its opaque top 'coat'
+culled root: vertical 'root' replaced by its top: the top is opaque
+)");
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(diags,
+            "test.json: /nodes/coat: warning: 'coat' hides the base 'paint' of vertical 'root': it has no medium "
+            "(sss_mfp is 0 or absent), so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. "
+            "1e6 for a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper\n");
+}
+
+TEST_F(CullTest, AnOpaqueMixOfCoatsHidesTheBase) {
+  // Both sides opaque: C = 1, T = 0 whatever the mix.
+  auto after = cull(R"(
+    "a": {"kind": "slab", "roughness": 0.2, "sss_mfp": 0},
+    "b": {"kind": "slab", "roughness": 0.8},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": {"kind": "horizontal", "background": "a", "foreground": "b", "mix": "$m"},
+             "base": "paint", "thickness": 0.001})",
+                    R"(VERTICAL root thickness=0.001
+  HORIZONTAL root_top mix=$m
+    SLAB a
+        roughness = 0.2
+    SLAB b
+        roughness = 0.8
+  SLAB paint
+      roughness = 0.6
+)");
+  EXPECT_EQ(after, R"(HORIZONTAL root_top mix=$m
+  SLAB a
+      roughness = 0.2
+  SLAB b
+      roughness = 0.8
+culled paint: base of vertical 'root': hidden by its opaque top 'root_top'
+culled root: vertical 'root' replaced by its top: the top is opaque
+)");
+  EXPECT_NE(diags.find("test.json: /nodes/root/top: warning: 'root_top' hides the base 'paint'"), std::string::npos)
+      << diags;
+}
+
+TEST_F(CullTest, OpaqueTopsOverOpaqueTopsCollapseToTheVisibleOne) {
+  // Thirteen slabs, each the opaque top of the next: only the first can show.
+  std::string nodes;
+  for (int k = 0; k < 13; ++k) nodes += fmt::format(R"("s{}": {{"kind": "slab", "roughness": 0.{}}}, )", k, k % 10);
+  for (int k = 0; k < 12; ++k)
+    nodes += fmt::format(R"("{}": {{"kind": "vertical", "top": "s{}", "base": "{}"}}{})", k == 0 ? "root" : fmt::format("v{}", k),
+                         k, k == 11 ? "s12" : fmt::format("v{}", k + 1), k == 11 ? "" : ", ");
+  m = buildMaterial(material(nodes, kInputs), Stage::Tree);
+  Diagnostics d("test.json");
+  ASSERT_TRUE(cullStaticMatter(m, d));
+  EXPECT_EQ(dumpMaterial(m).substr(0, dumpMaterial(m).find("culled")), "SLAB s0\n    roughness = 0\n");
+  // Every vertical replaced by its top, every hidden base recorded.
+  int bases = 0, verticals = 0;
+  for (const CullNote& n : m.culled) {
+    bases += n.why.starts_with("base of vertical") ? 1 : 0;
+    verticals += n.why.find("replaced by its top: the top is opaque") != std::string::npos ? 1 : 0;
+  }
+  EXPECT_EQ(bases, 12);
+  EXPECT_EQ(verticals, 12);
+  EXPECT_FALSE(d.hasErrors()) << d.formatAll();
+}
+
+TEST_F(CullTest, NoModify_ATopWithAMedium) {
+  expectUnchanged(R"(
+    "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "sss_mfp": 1000000},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": "coat", "base": "paint"})",
+                  R"(VERTICAL root thickness=0.0001
+  SLAB coat
+      diffuse_albedo = 0
+      sss_mfp = 1e+06
+  SLAB paint
+      roughness = 0.6
+)");
+}
+
+TEST_F(CullTest, NoModify_AnOpaqueTopOfNoThickness) {
+  // Thickness 0: the layer has no extent and lets everything through (T = 1).
+  expectUnchanged(R"(
+    "coat": {"kind": "slab", "f0": 0.04},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": "coat", "base": "paint", "thickness": 0})",
+                  R"(VERTICAL root thickness=0
+  SLAB coat
+  SLAB paint
+      roughness = 0.6
+)");
+}
+
+TEST_F(CullTest, NoModify_AnOpaqueTopOfRunTimeCoverage) {
+  // Where the coat is absent the base shows.
+  expectUnchanged(R"(
+    "coat": {"kind": "slab"},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": {"kind": "coverage_weight", "a": "coat", "weight": "$w"}, "base": "paint"})",
+                  R"(VERTICAL root thickness=0.0001
+  WEIGHT root_top weight=$w
+    SLAB coat
+  SLAB paint
+      roughness = 0.6
+)");
+}
+
+TEST_F(CullTest, NoModify_AnOpaqueTopMixedWithATransparentOne) {
+  expectUnchanged(R"(
+    "a": {"kind": "slab", "roughness": 0.2},
+    "b": {"kind": "slab", "roughness": 0.8, "sss_mfp": 10},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": {"kind": "horizontal", "background": "a", "foreground": "b", "mix": "$m"},
+             "base": "paint"})",
+                  R"(VERTICAL root thickness=0.0001
+  HORIZONTAL root_top mix=$m
+    SLAB a
+        roughness = 0.2
+    SLAB b
+        roughness = 0.8
+        sss_mfp = 10
+  SLAB paint
+      roughness = 0.6
+)");
+}
+
+TEST_F(CullTest, AnOpaqueTopOfRunTimeThicknessWarnsButStays) {
+  // Hidden for every thickness > 0, shown at exactly 0: kept, with the warning.
+  const std::string dump = R"(VERTICAL root thickness=$v
+  SLAB coat
+  SLAB paint
+      roughness = 0.6
+)";
+  EXPECT_EQ(cull(R"(
+    "coat": {"kind": "slab", "f0": 0.04},
+    "paint": {"kind": "slab", "roughness": 0.6},
+    "root": {"kind": "vertical", "top": "coat", "base": "paint", "thickness": "$v"})",
+                 dump),
+            dump);
+  EXPECT_TRUE(m.culled.empty());
+  EXPECT_NE(diags.find("test.json: /nodes/coat: warning: 'coat' hides the base 'paint' of vertical 'root' whenever "
+                       "its thickness is > 0"),
+            std::string::npos)
+      << diags;
+}
+
+TEST_F(CullTest, NoModify_AnOpaqueTopThatWouldTurnTransparentOutsideItsVertical) {
+  // `inner`'s top is opaque at inner's thickness, but replacing `inner` by it
+  // would put `coat` in the layer of `root` (thickness 0: transparent), and
+  // `hidden` would show: kept, with the warning. (`root`'s top mixes in a
+  // transparent slab, so `under` shows too.)
+  const std::string dump = R"(VERTICAL root thickness=0
+  HORIZONTAL root_top mix=$m
+    VERTICAL inner thickness=0.001
+      SLAB coat
+      SLAB hidden
+          roughness = 0.6
+    SLAB clear
+        sss_mfp = 10
+  SLAB under
+      roughness = 0.3
+)";
+  EXPECT_EQ(cull(R"(
+    "coat": {"kind": "slab", "f0": 0.04},
+    "hidden": {"kind": "slab", "roughness": 0.6},
+    "clear": {"kind": "slab", "sss_mfp": 10},
+    "under": {"kind": "slab", "roughness": 0.3},
+    "inner": {"kind": "vertical", "top": "coat", "base": "hidden", "thickness": 0.001},
+    "root": {"kind": "vertical", "top": {"kind": "horizontal", "background": "inner", "foreground": "clear", "mix": "$m"},
+              "base": "under", "thickness": 0})",
+                 dump),
+            dump);
+  EXPECT_TRUE(m.culled.empty());
+  EXPECT_EQ(diags,
+            "test.json: /nodes/coat: warning: 'coat' hides the base 'hidden' of vertical 'inner': it has no medium "
+            "(sss_mfp is 0 or absent), so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. "
+            "1e6 for a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper\n");
+}
+
+TEST_F(CullTest, AnOpaqueTopInsideAnOpaqueTopIsCulledInTheNextRound) {
+  // Round 1: `root`'s top `inner` is opaque (its top `coat` is), so `under`
+  // goes and `root` becomes `inner`; `coat` could not hide `hidden` yet (it
+  // sat in outer's layer of thickness 0). Round 2: `inner` is at the surface
+  // (thickness 1e-4): `coat` stays opaque there, `hidden` goes.
+  auto after = cull(R"(
+    "coat": {"kind": "slab", "f0": 0.04},
+    "hidden": {"kind": "slab", "roughness": 0.6},
+    "under": {"kind": "slab", "roughness": 0.3},
+    "inner": {"kind": "vertical", "top": "coat", "base": "hidden", "thickness": 0.001},
+    "root": {"kind": "vertical", "top": "inner", "base": "under", "thickness": 0})",
+                    R"(VERTICAL root thickness=0
+  VERTICAL inner thickness=0.001
+    SLAB coat
+    SLAB hidden
+        roughness = 0.6
+  SLAB under
+      roughness = 0.3
+)");
+  EXPECT_EQ(after, R"(SLAB coat
+culled under: base of vertical 'root': hidden by its opaque top 'inner'
+culled root: vertical 'root' replaced by its top: the top is opaque
+culled hidden: base of vertical 'inner': hidden by its opaque top 'coat'
+culled inner: vertical 'inner' replaced by its top: the top is opaque
+)");
+  EXPECT_TRUE(ok);
 }
 
 // ---------------------------------------------------------------------------

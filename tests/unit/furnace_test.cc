@@ -28,6 +28,8 @@
 
 #include <fmt/format.h>
 
+#include "../stack_furnace.h"
+#include "pipeline/pipeline.h"
 #include "reference/energy_lut.h"
 #include "reference/reference.h"
 
@@ -255,6 +257,85 @@ TEST(Furnace, NoClosureReturnsMoreEnergyThanItReceives) {
   for (std::size_t i = 1; i < 5 && i < grid.size(); ++i)
     std::printf("[ furnace  ]        %.5f  %s\n", grid[i].albedo, describe(grid[i].config).c_str());
   EXPECT_EQ(over, 0);
+}
+
+TEST(Furnace, RandomStacksOfTwoToEightSlabsNeverGainEnergy) {
+  // Issue 16: every interface of a stack reflects its share; what it passes on
+  // must shrink with it at every depth (substrate_extra_interfaces). Before the
+  // fix, three white transparent slabs returned 1.08 at NoV 0.1, six 1.38.
+  // Random stacks (tests/stack_furnace.h) of every depth the test reaches, both
+  // shapes, each compiled twice: with every closure kept (the layering model
+  // itself) and with the default budget (what simplification ships).
+  using namespace stackfurnace;
+  const auto t0 = std::chrono::steady_clock::now();
+  constexpr int kCasesPerMaterial = 5;
+  long cases = 0, views = 0, closures = 0;
+  double worst = 0;
+  std::string where;
+  for (int depth = 2; depth <= 8; ++depth)
+    for (Shape shape : kShapes)
+      for (bool everyClosure : {true, false}) {
+        CompileOptions o;
+        if (everyClosure) {
+          o.budgetOverride = 4096;
+          o.maxClosuresOverride = 8;
+        }
+        Diagnostics d("stack.json");
+        auto r = compileText("stack.json", stackMaterial(depth, shape), o, d);
+        ASSERT_TRUE(r.has_value()) << d.formatAll();
+        if (everyClosure) ASSERT_EQ(r->after.closures.size(), static_cast<std::size_t>(depth)) << shapeName(shape);
+        Rng rng{0x5eed0000u + static_cast<std::uint64_t>(depth) * 8 + static_cast<std::uint64_t>(shape) * 2 +
+                (everyClosure ? 1 : 0)};
+        for (int k = 0; k < kCasesPerMaterial; ++k) {
+          const Case c = randomCase(depth, shape, rng);
+          ++cases;
+          for (double mu : kNoV) {
+            reference::Geometry g;
+            g.V = stackfurnace::viewAt(mu);
+            const auto m = reference::evaluateMaterial<double>(*r, g, c.inputs, {});
+            closures += static_cast<long>(m.closures.size());
+            const double a = furnace(m.closures, g.V, 7 + static_cast<std::uint32_t>(views++));
+            const std::string what = fmt::format("depth {} ({}, {}), NoV {}: {}", depth, shapeName(shape),
+                                                 everyClosure ? "every closure" : "default budget", mu, c.text);
+            EXPECT_TRUE(std::isfinite(a)) << what;
+            EXPECT_LE(a, kTolerance) << what;
+            if (a > worst) worst = a, where = what;
+          }
+        }
+      }
+  std::printf("[ furnace  ] random stacks: %ld cases (depth 2..8, 3 shapes, 2 budgets), %ld views, %ld closures; "
+              "largest %.5f at %s (%.1f s)\n",
+              cases, views, closures, worst, where.c_str(), elapsedSeconds(t0));
+  ASSERT_GT(cases, 0);
+  ASSERT_GT(closures, cases);
+}
+
+TEST(Furnace, StacksOfWhiteTransparentSlabsAtEveryDepth) {
+  // The issue's own case: white slabs (albedo 1, F0 0, roughness ~0), every
+  // one but the bottom transparent (sss_mfp 1e6, thickness 0), every closure
+  // kept. Prints the furnace per depth (docs/stability.md records them).
+  using namespace stackfurnace;
+  int measured = 0;
+  for (int depth = 2; depth <= 8; ++depth) {
+    CompileOptions o;
+    o.budgetOverride = 4096;
+    o.maxClosuresOverride = 8;
+    Diagnostics d("stack.json");
+    auto r = compileText("stack.json", stackMaterial(depth, Shape::NestedBases), o, d);
+    ASSERT_TRUE(r.has_value()) << d.formatAll();
+    const reference::InputValues in = whiteStack(depth, Shape::NestedBases).inputs;
+    std::string line;
+    for (double mu : kNoV) {
+      reference::Geometry g;
+      g.V = stackfurnace::viewAt(mu);
+      const double a = furnace(reference::evaluateMaterial<double>(*r, g, in, {}).closures, g.V, 11);
+      ++measured;
+      EXPECT_LE(a, kTolerance) << "depth " << depth << ", NoV " << mu;
+      line += fmt::format("  NoV {}: {:.4f}", mu, a);
+    }
+    std::printf("[ furnace  ] %d white slabs:%s\n", depth, line.c_str());
+  }
+  ASSERT_EQ(measured, 7 * 4);
 }
 
 TEST(Furnace, AWhiteRoughConductorReturnsNearlyAllOfIt) {

@@ -172,7 +172,7 @@ TEST(Layout, EmissiveCostsNoBytes) {
 
 TEST(Layout, VerticalBaseStoresTopTransmittance) {
   Priced p = price(material(R"(
-    "coat": {"kind": "slab", "roughness": 0.1},
+    "coat": {"kind": "slab", "roughness": 0.1, "sss_mfp": 10},
     "base": {"kind": "slab", "roughness": 0.6},
     "root": {"kind": "vertical", "top": "coat", "base": "base"})",
                             kInputs));
@@ -234,7 +234,7 @@ TEST(Layout, CoverageAboveIsStoredUnderAHorizontalWithAPartlyCoveringSide) {
 TEST(Layout, CoverageAboveIsStoredUnderEveryLayerBelowAPartlyCoveringOne) {
   Priced p = price(material(R"(
     "coat": {"kind": "slab", "roughness": 0.1},
-    "mid": {"kind": "slab", "roughness": 0.3},
+    "mid": {"kind": "slab", "roughness": 0.3, "sss_mfp": 10},
     "base": {"kind": "slab", "roughness": 0.6},
     "root": {"kind": "vertical", "top": {"kind": "coverage_weight", "a": "coat", "weight": "$w"},
              "base": {"kind": "vertical", "top": "mid", "base": "base"}})",
@@ -255,8 +255,8 @@ TEST(Layout, NoModify_NoCoverageAboveUnderFullyCoveringLayers) {
            R"("a")",
        }) {
     Priced p = price(material(std::string(R"(
-      "a": {"kind": "slab", "roughness": 0.1},
-      "b": {"kind": "slab", "roughness": 0.2},
+      "a": {"kind": "slab", "roughness": 0.1, "sss_mfp": 10},
+      "b": {"kind": "slab", "roughness": 0.2, "sss_mfp": 10},
       "base": {"kind": "slab", "roughness": 0.6},
       "root": {"kind": "vertical", "base": "base", "top": )") + top + "}",
                               kInputs));
@@ -273,8 +273,8 @@ TEST(Layout, NoModify_NoCoverageAboveUnderFullyCoveringLayers) {
 
 TEST(Layout, Basis0NormalIsElidedWhenEveryTopClosureUsesBasis0) {
   Priced p = price(material(R"(
-    "a": {"kind": "slab", "normal": "$nA", "roughness": 0.1},
-    "b": {"kind": "slab", "normal": "$nA", "roughness": 0.2},
+    "a": {"kind": "slab", "normal": "$nA", "roughness": 0.1, "sss_mfp": 10},
+    "b": {"kind": "slab", "normal": "$nA", "roughness": 0.2, "sss_mfp": 10},
     "base": {"kind": "slab", "normal": "$nB", "roughness": 0.6},
     "root": {"kind": "vertical", "base": "base",
              "top": {"kind": "horizontal", "background": "a", "foreground": "b", "mix": "$m"}})",

@@ -3,6 +3,8 @@
 // expected values are computed here, by hand, from the formulas in the runtime
 // headers (substrate_tree.h, substrate_values.h, substrate_common.h) and the
 // documented model (docs/codegen.md), never taken from the code under test.
+#include <fstream>
+#include <sstream>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -370,7 +372,9 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
   layerAbove(cover, through, 0.7, {t1[0] * 0.96, t1[1] * 0.96, t1[2] * 0.96});  // the root's top first
   const double coverMid = cover;
   const D3 throughMid = through;
-  layerAbove(cover, through, 1.0, {t2[0] * 0.96, t2[1] * 0.94, t2[2] * 0.92});
+  // The second interface on the way down: its layer times SUBSTRATE_EXTRA_INTERFACE
+  // (substrate_extra_interfaces), the lighting applies the angular part of one.
+  layerAbove(cover, through, 1.0, {t2[0] * 0.96 * 0.91, t2[1] * 0.94 * 0.91, t2[2] * 0.92 * 0.91});
   MaterialResult<double> m = evaluateMaterial<double>(r, tiltedGeometry(), {}, {});
   const Closure<double>& base = m.closures[closureOf(r, "base")];
   EXPECT_NEAR(base.coverageAbove, cover, 1e-12);
@@ -941,4 +945,31 @@ TEST(ReferenceExamples, EveryExampleEvaluatesToFiniteClosures) {
 }
 
 }  // namespace
+TEST(ReferenceOperators, TheClearCoatExampleLetsThePaintShow) {
+  // Issue 16: examples/clear_coat_over_glints.json renders as a clear coat:
+  // the paint under it receives all but the coat's interface (1 - F0 = 0.96
+  // head-on), and its glints keep their weight. Without sss_mfp (the
+  // tests/warnings twin) the coat is opaque and the paint is culled.
+  auto read = [](const char* rel) {
+    std::ifstream in(std::string(SUBSTRATEC_SOURCE_DIR) + "/" + rel, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  };
+  const CompileResult r = compile(read("examples/clear_coat_over_glints.json"));
+  ASSERT_EQ(r.after.closures.size(), 2u);
+  Geometry g;  // head-on
+  const MaterialResult<double> m = evaluateMaterial<double>(r, g, {}, {});
+  const Closure<double>& paint = m.closures[closureOf(r, "paint")];
+  EXPECT_FALSE(paint.isTop);
+  EXPECT_NEAR(paint.coverageAbove, 1.0, 1e-12);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(paint.topTransmittance[c], 0.96, 1e-6);
+  const D3 view = viewThroughput<double>(paint, 1.0);
+  for (int c = 0; c < 3; ++c) EXPECT_GT(view[c], 0.95);
+  EXPECT_NE(paint.features & kFeatureGlint, 0u);
+  const CompileResult opaque = compile(read("tests/warnings/001_opaque_clear_coat.json"));
+  ASSERT_EQ(opaque.after.closures.size(), 1u);
+  EXPECT_EQ(opaque.material.slabs[opaque.after.closures[0].slab].id, "coat");
+}
+
 }  // namespace substratec

@@ -65,18 +65,20 @@ basis 0: normal = $nA
   EXPECT_EQ(m.bases[0].tangent, kNoValue);
 }
 
+// The verticals below have a thickness of 0: their tops have no medium
+// (sss_mfp), so with a thickness they would hide their bases (cull.h).
 TEST_F(SharedBasesTest, DefaultNormalsShareABasis) {
   auto after = run(R"(
     "a": {"kind": "slab", "roughness": 0.2},
     "b": {"kind": "slab", "roughness": 0.8},
-    "root": {"kind": "vertical", "top": "a", "base": "b"})",
-                   R"(VERTICAL root thickness=0.0001
+    "root": {"kind": "vertical", "top": "a", "base": "b", "thickness": 0})",
+                   R"(VERTICAL root thickness=0
   SLAB a
       roughness = 0.2
   SLAB b
       roughness = 0.8
 )");
-  EXPECT_EQ(after, R"(VERTICAL root thickness=0.0001
+  EXPECT_EQ(after, R"(VERTICAL root thickness=0
   SLAB a
       roughness = 0.2
       basis = 0
@@ -267,8 +269,8 @@ TEST_F(SharedBasesTest, IsotropicSlabJoinsAnAnisotropicBasisWithTheSameNormal) {
   auto after = run(R"(
     "coat": {"kind": "slab", "roughness": 0.1, "tangent": "$tB"},
     "base": {"kind": "slab", "anisotropy": 0.7, "tangent": "$tA"},
-    "root": {"kind": "vertical", "top": "coat", "base": "base"})",
-                   R"(VERTICAL root thickness=0.0001
+    "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0})",
+                   R"(VERTICAL root thickness=0
   SLAB coat
       roughness = 0.1
       tangent = $tB
@@ -277,7 +279,7 @@ TEST_F(SharedBasesTest, IsotropicSlabJoinsAnAnisotropicBasisWithTheSameNormal) {
       tangent = $tA
       features = anisotropy
 )");
-  EXPECT_EQ(after, R"(VERTICAL root thickness=0.0001
+  EXPECT_EQ(after, R"(VERTICAL root thickness=0
   SLAB coat
       roughness = 0.1
       tangent = $tB
@@ -362,14 +364,14 @@ TEST_F(SharedBasesTest, BasesAreNumberedInClosureOrder) {
   auto after = run(R"(
     "a": {"kind": "slab", "normal": "$nA"},
     "b": {"kind": "slab", "normal": "$nB"},
-    "root": {"kind": "vertical", "top": "b", "base": "a"})",
-                   R"(VERTICAL root thickness=0.0001
+    "root": {"kind": "vertical", "top": "b", "base": "a", "thickness": 0})",
+                   R"(VERTICAL root thickness=0
   SLAB b
       normal = $nB
   SLAB a
       normal = $nA
 )");
-  EXPECT_EQ(after, R"(VERTICAL root thickness=0.0001
+  EXPECT_EQ(after, R"(VERTICAL root thickness=0
   SLAB b
       normal = $nB
       basis = 0
@@ -388,8 +390,8 @@ TEST_F(SharedBasesTest, NumberingFollowsClosureOrderNotCreationOrder) {
     "x": {"kind": "slab", "normal": "$nA"},
     "y": {"kind": "slab", "normal": "$nB", "anisotropy": 0.3},
     "z": {"kind": "slab", "normal": "$nA", "anisotropy": 0.3, "tangent": "$tA"},
-    "root": {"kind": "vertical", "top": "x", "base": {"kind": "add", "a": "y", "b": "z"}})",
-                   R"(VERTICAL root thickness=0.0001
+    "root": {"kind": "vertical", "top": "x", "base": {"kind": "add", "a": "y", "b": "z"}, "thickness": 0})",
+                   R"(VERTICAL root thickness=0
   SLAB x
       normal = $nA
   ADD root_base
@@ -403,7 +405,7 @@ TEST_F(SharedBasesTest, NumberingFollowsClosureOrderNotCreationOrder) {
         tangent = $tA
         features = anisotropy
 )");
-  EXPECT_EQ(after, R"(VERTICAL root thickness=0.0001
+  EXPECT_EQ(after, R"(VERTICAL root thickness=0
   SLAB x
       normal = $nA
       basis = 0
