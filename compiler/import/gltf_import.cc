@@ -18,8 +18,20 @@ std::string wrapName(int mode) {
     case 10497: return "REPEAT";
     case 33071: return "CLAMP_TO_EDGE";
     case 33648: return "MIRRORED_REPEAT";
+    case -1: return "(not a wrap mode)";
   }
   return std::to_string(mode);
+}
+
+/// An index or enum `j[key]`: a non-negative integer of at most 2^31 - 1, else
+/// -1 (a float, a string, a huge number: never converted out of range).
+int smallIndex(const Json& j, const char* key, int absent = -1) {
+  auto it = j.find(key);
+  if (it == j.end()) return absent;
+  if (!it->is_number_integer()) return -1;
+  if (it->is_number_unsigned()) return it->get<std::uint64_t>() <= 0x7fffffffu ? static_cast<int>(it->get<std::uint64_t>()) : -1;
+  const long long v = it->get<long long>();
+  return v >= 0 && v <= 0x7fffffff ? static_cast<int>(v) : -1;
 }
 
 /// How a factor becomes a value: always an input when given (Plain), or a
@@ -154,11 +166,11 @@ std::string MaterialReader::imageDescription(int texture, const std::string& ptr
   const Json& t = doc_["textures"][texture];
   std::string out = fmt::format("textures[{}]", texture);
   int source = -1;
-  if (auto s = t.find("source"); s != t.end() && s->is_number_integer()) source = s->get<int>();
+  if (t.contains("source")) source = smallIndex(t, "source");
   if (auto e = t.find("extensions"); e != t.end() && e->is_object())
     for (const auto& [name, ext] : e->items())
       if (ext.is_object() && ext.contains("source") && ext["source"].is_number_integer()) {
-        source = ext["source"].get<int>();
+        source = smallIndex(ext, "source");
         out += " (" + name + ")";
       }
   const Json images = doc_.value("images", Json::array());
@@ -183,9 +195,9 @@ std::string MaterialReader::imageDescription(int texture, const std::string& ptr
   }
   if (auto s = t.find("sampler"); s != t.end() && s->is_number_integer()) {
     const Json samplers = doc_.value("samplers", Json::array());
-    const int si = s->get<int>();
+    const int si = smallIndex(t, "sampler");
     if (samplers.is_array() && si >= 0 && si < static_cast<int>(samplers.size()) && samplers[si].is_object()) {
-      const int ws = samplers[si].value("wrapS", kRepeat), wt = samplers[si].value("wrapT", kRepeat);
+      const int ws = smallIndex(samplers[si], "wrapS", kRepeat), wt = smallIndex(samplers[si], "wrapT", kRepeat);
       if (ws != kRepeat || wt != kRepeat) {
         warn(ptr, fmt::format("textures[{}] samples with wrap {}/{}: a material does not choose its sampler "
                               "(the renderer binds one); recorded in the input's description",

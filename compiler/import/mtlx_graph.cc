@@ -273,6 +273,23 @@ bool convertible(const Value& v, const std::string& from, const std::string& to)
 
 MtlxValues::Typed MtlxValues::inputOf(pugi::xml_node node, const std::string& name, const std::string& type,
                                       const std::vector<double>& def, bool frozen, int depth) {
+  Typed t = declaredInput(node, name, type, def, frozen, depth);
+  // An input declared with another size than its node takes (a vector4
+  // `pivot` of place2d) is converted to what the node takes, so that the
+  // value nodes built from it combine; a float broadcasts as it is.
+  const int have = mtlxComponents(t.type), want = mtlxComponents(type);
+  if (t.v.is_null() || have == want || have == 1 || want == 0) return t;
+  pugi::xml_node in = node.find_child_by_attribute("input", "name", name.c_str());
+  if (have == 0) {
+    error(in, fmt::format("input '{}' is a '{}', where its node takes a {}", name, t.type, type));
+    return {Value(), type};
+  }
+  warn(in, fmt::format("input '{}' is declared {}, its node takes a {}: converted", name, t.type, type));
+  return {convertValue(t.v, t.type, type), type};
+}
+
+MtlxValues::Typed MtlxValues::declaredInput(pugi::xml_node node, const std::string& name, const std::string& type,
+                                            const std::vector<double>& def, bool frozen, int depth) {
   pugi::xml_node in = node.find_child_by_attribute("input", "name", name.c_str());
   const std::string itype = in && in.attribute("type") ? str(in, "type") : type;
   if (!in) return {def.empty() ? Value() : mtlxLiteral(def, itype, ""), itype};

@@ -75,6 +75,9 @@ class MtlxValues {
   };
   Typed inputOf(pugi::xml_node node, const std::string& name, const std::string& type, const std::vector<double>& def,
                 bool frozen, int depth);
+  /// The input as declared (its own type), before inputOf fits it to `type`.
+  Typed declaredInput(pugi::xml_node node, const std::string& name, const std::string& type,
+                      const std::vector<double>& def, bool frozen, int depth);
   Typed connection(pugi::xml_node input, const std::string& type, bool frozen, int depth, bool* connected);
   Typed nodeValue(pugi::xml_node node, const std::string& output, bool frozen, int depth);
   Typed compute(pugi::xml_node node, const std::string& kind, const std::string& type, const std::string& output,
