@@ -583,7 +583,6 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     materials = {materials[i]};
     sourceOf = {sourceOf[i]};
   }
-  }
   std::vector<OutputFile> files;
   for (std::size_t i = 0; i < materials.size(); ++i) {
     const import::ImportedMaterial& m = materials[i];
