@@ -156,6 +156,23 @@ TEST(OutputsAreNotInputs, AnIncludedFileIsAnInput) {
   ASSERT_EQ(cli({"compile", gold.string(), "-o", (dir / "out").string()}).status, 0);  // and without the clash, it compiles
 }
 
+// ... and so a prerequisite in the depfile: a build system rebuilds when an
+// include changes. A cache entry used is not one.
+TEST(OutputsAreNotInputs, AnIncludedFileIsADepfilePrerequisite) {
+  const fs::path dir = freshDir("include_depfile");
+  const fs::path gold = mtlxWithInclude(dir);
+  for (int run = 0; run < 2; ++run) {  // the second from the cache
+    CliResult r = cli({"compile", gold.string(), "-o", (dir / "out").string(), "--depfile", (dir / "out.d").string(),
+                       "--cache", (dir / "cache").string()});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::string depfile = slurp(dir / "out.d");
+    EXPECT_NE(depfile.find(" \\\n  " + gold.string() + " \\\n  " + (dir / "shader.mtlx").string() + "\n"),
+              std::string::npos)
+        << depfile;
+    EXPECT_EQ(depfile.find(".entry"), std::string::npos) << depfile;
+  }
+}
+
 // A cache entry the command used is an input too (one it ignored, being
 // corrupt, it rewrites as the cache's own).
 TEST(OutputsAreNotInputs, ACacheEntryUsedIsAnInput) {

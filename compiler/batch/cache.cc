@@ -133,7 +133,7 @@ std::optional<CachedMaterial> MaterialCache::load(const std::string& keyText) co
     if (m.files.empty()) return std::nullopt;
     // An entry used is an input of the command, like any file it reads
     // (output/file_identity.h); one ignored is rewritten, as the cache's own.
-    if (auto id = fileIdOf(path)) noteFileRead(path, id->device, id->inode);
+    if (auto id = fileIdOf(path)) noteFileRead(path, id->device, id->inode, /*cacheEntry=*/true);
     return m;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;

@@ -175,7 +175,8 @@ struct CompileArgs {
 };
 
 /// Commits `files` into `dir`, the depfile when asked (its targets: every
-/// file written, or only `depTarget` when given, depending on `inputs`) and
+/// file written, or only `depTarget` when given, depending on `inputs` and
+/// every other file read, the MaterialX includes) and
 /// the --cache entries, all or none (cli/command_outputs.h); then lists what
 /// was written on stdout.
 int writeOutputs(const CommandOutputs& outputs, const std::string& dir, const std::vector<OutputFile>& files,
@@ -191,7 +192,7 @@ int writeOutputs(const CommandOutputs& outputs, const std::string& dir, const st
   for (const auto& p : paths) written.push_back(p.path);
   const std::vector<std::string> targets =
       depTarget.empty() ? written : std::vector<std::string>{(std::filesystem::path(dir) / depTarget).string()};
-  if (!depfile.empty()) paths.push_back({depfile, makeDepfile(targets, inputs)});
+  if (!depfile.empty()) paths.push_back({depfile, makeDepfile(targets, outputs.prerequisites(inputs))});
   paths.insert(paths.end(), cacheEntries.begin(), cacheEntries.end());
   if (int status = outputs.commit(paths, err); status != kExitOk) return status;
   for (const auto& w : written) out << w << "\n";

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 
@@ -52,6 +53,18 @@ int CommandOutputs::refuseInputs(const std::vector<std::string>& outputs, std::o
             "; refusing to write to it";
   err << "substratec: error: " << error << "\n";
   return kExitUsage;
+}
+
+std::vector<std::string> CommandOutputs::prerequisites(const std::vector<std::string>& named) const {
+  std::vector<std::string> more;
+  for (const InputFile& f : reads_.files())
+    if (!f.cacheEntry && std::find(named.begin(), named.end(), f.path) == named.end() &&
+        std::find(more.begin(), more.end(), f.path) == more.end())
+      more.push_back(f.path);
+  std::sort(more.begin(), more.end());
+  std::vector<std::string> all = named;
+  all.insert(all.end(), more.begin(), more.end());
+  return all;
 }
 
 int CommandOutputs::check(std::ostream& err) const {

@@ -44,6 +44,10 @@ class CommandOutputs {
 
   /// Every file the command has read so far.
   std::vector<InputFile> inputs() const { return reads_.files(); }
+  /// A depfile's prerequisites: `named` (the inputs as given, in order), then
+  /// every other file read but a cache entry (MaterialX includes), sorted so
+  /// that -j does not change the bytes.
+  std::vector<std::string> prerequisites(const std::vector<std::string>& named) const;
 
  private:
   /// kExitUsage (with the message) when a named file is a directory, or one

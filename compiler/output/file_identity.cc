@@ -73,19 +73,19 @@ std::vector<InputFile> ReadLog::files() const {
 void ReadLog::add(const std::string& path) {
   if (auto id = fileIdOf(path)) {
     std::lock_guard<std::mutex> lock(gLogMutex);
-    record(path, *id);
+    record(path, *id, false);
   }
 }
 
-void ReadLog::record(const std::string& path, FileId id) {  // gLogMutex held
+void ReadLog::record(const std::string& path, FileId id, bool cacheEntry) {  // gLogMutex held
   for (const InputFile& f : files_)
     if (f.id == id) return;
-  files_.push_back({path, id});
+  files_.push_back({path, id, cacheEntry});
 }
 
-void noteFileRead(const std::string& path, std::uint64_t device, std::uint64_t inode) {
+void noteFileRead(const std::string& path, std::uint64_t device, std::uint64_t inode, bool cacheEntry) {
   std::lock_guard<std::mutex> lock(gLogMutex);
-  if (gActive) gActive->record(path, FileId{device, inode});
+  if (gActive) gActive->record(path, FileId{device, inode}, cacheEntry);
 }
 
 std::string sameFileAsInput(const std::vector<std::string>& outputs, const std::vector<InputFile>& inputs) {

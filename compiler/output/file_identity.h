@@ -34,6 +34,7 @@ std::optional<FileId> fileIdOf(const std::string& path);
 struct InputFile {
   std::string path;
   FileId id;
+  bool cacheEntry = false;  // a --cache entry used (an input, but no depfile prerequisite)
 };
 
 /// Records every file read (readSourceFile, the --cache reader) while it is
@@ -53,15 +54,15 @@ class ReadLog {
   void add(const std::string& path);
 
  private:
-  friend void noteFileRead(const std::string& path, std::uint64_t device, std::uint64_t inode);
-  void record(const std::string& path, FileId id);
+  friend void noteFileRead(const std::string& path, std::uint64_t device, std::uint64_t inode, bool cacheEntry);
+  void record(const std::string& path, FileId id, bool cacheEntry);
   ReadLog* previous_ = nullptr;
   std::vector<InputFile> files_;
 };
 
 /// Called by the readers with the fstat of the file they opened: recorded in
 /// the active ReadLog, if any.
-void noteFileRead(const std::string& path, std::uint64_t device, std::uint64_t inode);
+void noteFileRead(const std::string& path, std::uint64_t device, std::uint64_t inode, bool cacheEntry = false);
 
 /// What a command is about to write: each path (existing or not; a file that
 /// does not exist yet is compared through its nearest existing directory and
