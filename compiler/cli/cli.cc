@@ -595,10 +595,14 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     }
     files.push_back({m.name + ".json", m.text});
   }
-  // Nothing is replaced that an import of the same source did not write.
+  // Nothing is replaced that an import of the same source did not write. An
+  // output that is one of the files read is refused first (writeOutputs):
+  // that it is an input is the truer message.
   std::vector<std::string> foreign;
+  const std::vector<InputFile> inputsRead = outputs.inputs();
   for (std::size_t i = 0; i < files.size() && !a.force; ++i) {
     const std::string path = (std::filesystem::path(a.outDir) / files[i].name).string();
+    if (!sameFileAsInput({path}, inputsRead).empty()) continue;
     const std::string source = std::filesystem::path(sourceOf[i]).filename().string();
     if (import::replaceCheck(path, files[i].contents, source) == import::Replace::Foreign)
       foreign.push_back(fmt::format("substratec: error: {} exists and was not written by importing {} (it is not the "
