@@ -519,8 +519,12 @@ MtlxValues::Typed MtlxValues::bake(pugi::xml_node node, const std::string& kind,
 MtlxValues::Typed MtlxValues::bakeOrFold(pugi::xml_node node, const std::string& kind, const std::string& type,
                                          bool frozen, int depth) {
   // Every input at its constant value (interface inputs at their defaults).
+  // A single number broadcasts to the type's components (the folds below index them).
   auto c = [&](const char* name, const std::string& t, std::vector<double> def) {
-    return literalOf(inputOf(node, name, t, def, true, depth + 1).v);
+    auto lit = literalOf(inputOf(node, name, t, def, true, depth + 1).v);
+    const std::size_t want = static_cast<std::size_t>(std::max(1, mtlxComponents(t)));
+    if (lit && lit->size() == 1 && want > 1) lit = std::vector<double>(want, (*lit)[0]);
+    return lit;
   };
   const int readsBefore = frozenReads_;
   const int n = std::max(1, mtlxComponents(type));
@@ -544,7 +548,7 @@ MtlxValues::Typed MtlxValues::bakeOrFold(pugi::xml_node node, const std::string&
   else if (kind == "ln") unary("in", [](double x) { return x > 0 ? std::log(x) : 0.0; });
   else if (kind == "sign") unary("in", [](double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; });
   else if (kind == "rgbtohsv" || kind == "hsvtorgb") {
-    if (auto x = c("in", type, {0, 0, 0})) {
+    if (auto x = c("in", type, {0, 0, 0}); x && x->size() >= 3) {  // a colour (a float node type has no hue)
       const auto h = kind == "rgbtohsv" ? rgbToHsv((*x)[0], (*x)[1], (*x)[2]) : hsvToRgb((*x)[0], (*x)[1], (*x)[2]);
       r = std::vector<double>(h.begin(), h.end());
       if (n == 4) r->push_back(x->size() > 3 ? (*x)[3] : 1);
