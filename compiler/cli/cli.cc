@@ -522,7 +522,7 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
     }
     const std::string forcingName = source.displayName + " (with forcing inputs)";
     Diagnostics diags(forcingName);
-    auto r = compileText(forcingName, forceable, o, diags);
+    auto r = compileText(forcingName, forceable, stability::forcingOptions(o, kinds), diags);
     if (!r) {
       err << "substratec: internal compiler error: the material with forcing inputs does not compile\n"
           << diags.formatAll();

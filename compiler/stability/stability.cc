@@ -58,6 +58,7 @@ struct Rewriter {
     else if (!fallback.is_null()) own = fallback;
     else return;
     node[pin] = forcedPin(own, kind(kindName));
+    ++kind(kindName).pins;
     used.insert(kindName);
   }
   void visit(json& node) {
@@ -426,6 +427,16 @@ void furnace(const CompileResult& r, const Grid& grid, int samples, const refere
 }
 
 }  // namespace
+
+CompileOptions forcingOptions(const CompileOptions& base, const std::vector<ForcedKind>& kinds) {
+  CompileOptions o = base;
+  constexpr std::size_t kNodesPerPin = 4;  // forcedPin: add, two multiplies, one_minus
+  for (const ForcedKind& k : kinds) {
+    o.resolve.maxInputs += 2;
+    o.resolve.maxNodes += kNodesPerPin * static_cast<std::size_t>(k.pins);
+  }
+  return o;
+}
 
 bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
                    std::string* error) {

@@ -72,6 +72,7 @@ struct ForcedKind {
   std::string name;            // "roughness", "anisotropy", ...
   std::vector<double> values;  // forced values (the grid adds "own")
   std::string flagInput, valueInput;  // the inputs forceableText added
+  long pins = 0;                      // pins it forced (each became four value nodes)
 };
 
 /// The material rewritten so that its slab parameters can be forced (see
@@ -79,6 +80,13 @@ struct ForcedKind {
 /// JSON object (the caller compiled it first: its diagnostics come from there).
 bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
                    std::string* error);
+
+/// The options forceableText's output compiles with: `base`, with the input-
+/// and node-count limits raised by exactly what the rewrite added (two inputs
+/// per kind, four value nodes per forced pin), so that a material within the
+/// limits stays within them once rewritten (1023 inputs + 16 used to fail with
+/// "more than 1024 inputs"): the harness's own inputs are not the user's.
+CompileOptions forcingOptions(const CompileOptions& base, const std::vector<ForcedKind>& kinds);
 
 struct Options {
   long evaluations = 100000;  // at least this many (CPU; the GPU runs the same points in each path)
