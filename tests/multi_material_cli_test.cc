@@ -4,6 +4,7 @@
 // format, and `stability` on normal-mapped materials (docs/stability.md,
 // "Textures"): the furnace reports how many evaluations were lit and fails
 // when none was.
+#include <array>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -12,6 +13,8 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
+#include "gpu/sample_run.h"
+#include "pipeline/pipeline.h"
 
 // A named namespace: cli_tests is a unity build, and its files' anonymous
 // namespaces share one translation unit.
@@ -85,6 +88,40 @@ TEST(StabilityTextures, AFurnaceThatNeverSawLightFailsWithExitFour) {
   EXPECT_GT(j["furnace_evaluations"].get<long>(), 0);
   EXPECT_FALSE(j["furnace_exercised"].get<bool>());
   EXPECT_NE(r.err.find("the furnace was never exercised"), std::string::npos) << r.err;
+}
+
+/// What each texture feeds decides its neutral texel: a normal map (through
+/// the decode 2·rgb − 1 and a normalize), a direction map (a tangent), a colour.
+TEST(StabilityTextures, RolesComeFromWhatEachTextureFeeds) {
+  const std::string text = R"({
+    "format": "substrate-material/1", "name": "roles",
+    "inputs": {"albedo_map": {"type": "texture2d"}, "normal_map": {"type": "texture2d"},
+               "direction_map": {"type": "texture2d"}, "unused_map": {"type": "texture2d"}},
+    "nodes": {
+      "n": {"kind": "normalize", "x": {"kind": "subtract", "a": {"kind": "multiply",
+            "a": {"kind": "texture", "texture": "$normal_map"}, "b": 2}, "b": 1}},
+      "t": {"kind": "normalize", "x": {"kind": "texture", "texture": "$direction_map"}},
+      "root": {"kind": "slab", "diffuse_albedo": {"kind": "texture", "texture": "$albedo_map"},
+               "normal": "n", "tangent": "t", "anisotropy": 0.5}
+    },
+    "output": "root"})";
+  Diagnostics diags("roles.json");
+  const auto r = compileText("roles.json", text, CompileOptions{}, diags);
+  ASSERT_TRUE(r.has_value()) << diags.formatAll();
+  const auto roles = gpu::textureRoles(r->material);
+  auto roleOf = [&](const char* name) { return roles.at(static_cast<std::size_t>(r->material.inputIndex(name))); };
+  EXPECT_EQ(roleOf("normal_map"), gpu::TextureRole::Normal);
+  EXPECT_EQ(roleOf("direction_map"), gpu::TextureRole::Tangent);
+  EXPECT_EQ(roleOf("albedo_map"), gpu::TextureRole::Colour);
+  // The flat texel decodes to the geometric normal, the direction texel to the tangent.
+  const auto flat = gpu::neutralTexel(gpu::TextureRole::Normal), along = gpu::neutralTexel(gpu::TextureRole::Tangent);
+  EXPECT_EQ((std::array<double, 3>{2 * flat[0] - 1, 2 * flat[1] - 1, 2 * flat[2] - 1}), (std::array<double, 3>{0, 0, 1}));
+  EXPECT_EQ((std::array<double, 3>{2 * along[0] - 1, 2 * along[1] - 1, 2 * along[2] - 1}),
+            (std::array<double, 3>{1, 0, 0}));
+  // The CPU side of the neutral set: every lookup of the normal map is the flat texel.
+  const auto lookup = gpu::textureFunction(r->material, gpu::TextureSet::Neutral);
+  EXPECT_EQ(lookup(r->material.inputIndex("normal_map"), 0.13, 0.77), flat);
+  EXPECT_EQ(lookup(r->material.inputIndex("albedo_map"), 0.5, 0.5), (std::array<double, 4>{0.5, 0.5, 0.5, 1}));
 }
 
 /// A material without textures is the same under both sets.
