@@ -26,6 +26,7 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 
 namespace substratec {
 
@@ -224,8 +225,44 @@ BatchOptions batchOptions(int budget, int maxClosures, std::size_t maxInputSize,
   return o;
 }
 
+/// Without --material, what `compile` builds of `files`: a glTF or MaterialX
+/// file holding several materials gives every one of them (like `report`),
+/// each its own input "FILE[NAME]" named by its material; the others are
+/// themselves. The files are imported here once, and `o.load` hands out what
+/// was imported. Import errors are printed and make `*status` bad input.
+std::vector<std::string> everyMaterialOf(const std::vector<std::string>& files, BatchOptions& o, std::ostream& err,
+                                         int* status) {
+  auto imported = std::make_shared<std::map<std::string, BatchSource>>();
+  std::vector<std::string> units;
+  for (const std::string& file : files) {
+    if (import::sourceKindOf(file) == import::SourceKind::Substrate || imported->count(file)) {
+      units.push_back(file);
+      continue;
+    }
+    Diagnostics diags(file);
+    auto sources = import::loadMaterialSources(file, "", true, o.compile.read, diags);
+    err << diags.formatAll();
+    if (!sources) {
+      *status = kExitBadInput;
+      continue;
+    }
+    for (import::MaterialSource& s : *sources) {
+      const std::string unit = sources->size() == 1 ? file : s.displayName;
+      (*imported)[unit] = BatchSource{s.displayName, std::move(s.text), s.imported};
+      units.push_back(unit);
+    }
+  }
+  o.load = [imported, load = o.load](const std::string& path, const ReadLimits& read,
+                                     Diagnostics& diags) -> std::optional<BatchSource> {
+    if (auto it = imported->find(path); it != imported->end()) return it->second;
+    return load(path, read, diags);
+  };
+  return units;
+}
+
 /// Every file compiled (in parallel with -j, from --cache when unchanged) into
-/// one output directory; all of them are written, or none.
+/// one output directory; all of them are written, or none. Every material of
+/// a file that holds several, without --material (everyMaterialOf).
 int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
   BatchOptions o =
       batchOptions(a.budget, a.maxClosures, a.maxInputSize, a.target, a.diffuse, a.jobs, a.cache, a.material);
@@ -256,8 +293,9 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
       o.compile.platform = *p;
     }
   }
-  std::vector<MaterialBuild> built = buildMaterials(a.files, o);
   int status = kExitOk;
+  const std::vector<std::string> units = a.material.empty() ? everyMaterialOf(a.files, o, err, &status) : a.files;
+  std::vector<MaterialBuild> built = buildMaterials(units, o);
   std::map<std::string, std::string> names;  // material name -> file
   std::vector<OutputFile> files;
   std::vector<OutputPath> cacheEntries;
@@ -455,6 +493,7 @@ struct StabilityArgs {
   bool fullSimplification = false;
   std::size_t maxInputSize = 16u << 20;
   std::string precision = "float";
+  bool stressTextures = false;
 };
 
 /// The material on the hard-case grid (compiler/stability/stability.h): counts
@@ -469,29 +508,13 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   CommandOutputs outputs(out);  // writes only standard output
   outputs.input(a.file);
   if (int status = outputs.check(err); status != kExitOk) return status;
-  auto source = loadMaterial(a.file, a.material, o.read, err);
-  if (!source) return kExitBadInput;
-  if (int status = outputs.check(err); status != kExitOk) return status;
-  const std::string& text = source->text;
-  {  // The material as written: its diagnostics name its own lines.
-    Diagnostics diags(source->displayName);
-    if (!compileText(source->displayName, text, o, diags)) {
-      err << diags.formatAll();
-      return compileFailure(*source, err);
-    }
-  }
-  std::string forceable, error;
-  std::vector<stability::ForcedKind> kinds;
-  if (!stability::forceableText(text, &forceable, &kinds, &error)) {
-    err << "substratec: error: " << a.file << ": " << error << "\n";
-    return kExitBadInput;
-  }
-  Diagnostics diags(a.file + " (with forcing inputs)");
-  auto r = compileText(a.file + " (with forcing inputs)", forceable, o, diags);
-  if (!r) {
-    err << "substratec: internal compiler error: the material with forcing inputs does not compile\n" << diags.formatAll();
-    return kExitInternal;
-  }
+  // Every material of a glTF or MaterialX file without --material (like `report`).
+  Diagnostics loadDiags(a.file);
+  auto sources = import::loadMaterialSources(a.file, a.material, true, o.read, loadDiags);
+  err << loadDiags.formatAll();
+  if (!sources) return kExitBadInput;
+  if (int status = outputs.check(err); status != kExitOk) return status;  // the includes read, too
+  std::string error;
   std::unique_ptr<gpu::Context> ctx;
   if (!a.noGpu) {
     ctx = gpu::Context::create(gpu::Context::Options{}, &error);
@@ -506,15 +529,59 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   so.gpu = !a.noGpu;
   so.cpu = !a.gpuOnly;
   so.precision = precisionOf(a.precision);
-  stability::Report report;
-  if (!stability::run(*r, kinds, so, ctx.get(), &report, &error)) {
-    err << "substratec: internal compiler error: " << error << "\n";
-    return kExitInternal;
+  so.textures = a.stressTextures ? gpu::TextureSet::Checker : gpu::TextureSet::Neutral;
+  int status = kExitOk;
+  nlohmann::ordered_json all = nlohmann::ordered_json::array();
+  bool first = true;
+  for (const import::MaterialSource& source : *sources) {
+    const std::string& text = source.text;
+    {  // The material as written: its diagnostics name its own lines.
+      Diagnostics diags(source.displayName);
+      if (!compileText(source.displayName, text, o, diags)) {
+        err << diags.formatAll();
+        status = std::max(status, compileFailure(source, err));
+        continue;
+      }
+    }
+    std::string forceable;
+    std::vector<stability::ForcedKind> kinds;
+    if (!stability::forceableText(text, &forceable, &kinds, &error)) {
+      err << "substratec: error: " << source.displayName << ": " << error << "\n";
+      status = std::max(status, static_cast<int>(kExitBadInput));
+      continue;
+    }
+    const std::string forcingName = source.displayName + " (with forcing inputs)";
+    Diagnostics diags(forcingName);
+    auto r = compileText(forcingName, forceable, stability::forcingOptions(o, kinds), diags);
+    if (!r) {
+      err << "substratec: internal compiler error: the material with forcing inputs does not compile\n"
+          << diags.formatAll();
+      return kExitInternal;
+    }
+    stability::Report report;
+    if (!stability::run(*r, kinds, so, ctx.get(), &report, &error)) {
+      err << "substratec: internal compiler error: " << error << "\n";
+      return kExitInternal;
+    }
+    if (a.json) {
+      all.push_back(stability::toJson(report));
+    } else {
+      if (!first) out << "\n";
+      out << stability::formatText(report);
+    }
+    first = false;
+    if (!stability::furnaceExercised(report))
+      err << fmt::format("substratec: error: {}: the furnace was never exercised: none of its {} evaluations returned "
+                         "any light{}\n",
+                         source.displayName, report.furnaceEvaluations,
+                         a.stressTextures ? " (--stress-textures binds a checker that, read as a normal map, points "
+                                            "below the surface)"
+                                          : "");
+    if (!stability::passed(report)) status = std::max(status, static_cast<int>(kExitUnstable));
   }
-  out << (a.json ? stability::formatJson(report) : stability::formatText(report));
-  if (report.nonfinite || report.gpuNonfinite || (report.furnaceJudged && report.furnaceMax > 1.001))
-    return kExitUnstable;
-  return kExitOk;
+  // One material: its object (as before); several: an array, in file order.
+  if (a.json && !all.empty()) out << (sources->size() == 1 ? all[0] : all).dump(2) << "\n";
+  return status;
 }
 
 struct ImportArgs {
@@ -735,8 +802,8 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   CLI::App* swp = app.add_subcommand("sweep", "Cost against error at the full budget and at each simplification step");
   swp->add_option("file", sw.file, "Material file (substrate-material/1 JSON, or .gltf/.glb/.materials.json/.mtlx)")->required();
   swp->add_option("--material", sw.material, "Choose one material of a .gltf, .glb, .materials.json or .mtlx file (by name)");
-  swp->add_flag("--json", sw.json, "Print {\"material\": ..., \"rows\": [...]}");
-  swp->add_flag("--csv", sw.csv, "Print the rows as CSV");
+  CLI::Option* swJson = swp->add_flag("--json", sw.json, "Print {\"material\": ..., \"rows\": [...]}");
+  swp->add_flag("--csv", sw.csv, "Print the rows as CSV (not with --json: one format on stdout)")->excludes(swJson);
   swp->add_option("--plot", sw.plot, "Also write an SVG plot of error against cost");
   swp->add_option("--max-error", sw.maxError, "Choose the cheapest row with rel_mse <= E and print its budget")
       ->transform(cli::inRange(0.0, 1e30, "(relative MSE)"));
@@ -770,6 +837,9 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   sta->add_option("--max-input-size", stab.maxInputSize, "Reject inputs larger than this many bytes")
       ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   addPrecisionOption(sta, stab.precision);
+  sta->add_flag("--stress-textures", stab.stressTextures,
+                "Bind every texture to the GPU tests' checker (normal maps tilt, half below the surface) instead of "
+                "its neutral value (flat normal, mid-grey)");
 
   ImportArgs imp;
   CLI::App* impc = app.add_subcommand("import", "Import glTF 2.0 (.gltf, .glb, .materials.json) or MaterialX (.mtlx) "

@@ -1,6 +1,7 @@
 #include "emit/material_emitter.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <map>
 #include <set>
@@ -59,6 +60,7 @@ class Emitter {
   std::string opExpr(const ValueNode& n);
   void need(ValueId v);                        // marks v and its arguments as used
   void emitValues();
+  bool nonZero(ValueId v) const;  // a constant without a 0, or max(c, x) with a positive constant c
   std::string vec3(double x, double y, double z) const {
     return syn_.construct(VType::Vec3, fmt::format("{}, {}, {}", Syntax::literal(x), Syntax::literal(y), Syntax::literal(z)));
   }
@@ -136,6 +138,24 @@ std::string Emitter::expr(ValueId v) {
   }
 }
 
+bool Emitter::nonZero(ValueId v) const {
+  const ValueNode& n = m_.values.node(v);
+  auto positiveConst = [&](ValueId c) {
+    const ValueNode& k = m_.values.node(c);
+    if (k.op != Op::Const) return false;
+    for (int i = 0; i < std::max(1, componentCount(k.type)); ++i)
+      if (!(k.c[i] > 0)) return false;
+    return true;
+  };
+  if (n.op == Op::Const) {
+    for (int i = 0; i < std::max(1, componentCount(n.type)); ++i)
+      if (n.c[i] == 0 || !std::isfinite(n.c[i])) return false;
+    return true;
+  }
+  // max(c, x) with c > 0 in every component is at least c (a NaN x gives c or NaN, never 0).
+  return n.op == Op::Max && n.argCount == 2 && (positiveConst(n.args[0]) || positiveConst(n.args[1]));
+}
+
 std::string Emitter::opExpr(const ValueNode& n) {
   auto a = [&](int i) { return expr(n.args[i]); };
   auto call = [&](const char* f) {
@@ -147,7 +167,14 @@ std::string Emitter::opExpr(const ValueNode& n) {
     case Op::Add: return fmt::format("({} + {})", a(0), a(1));
     case Op::Subtract: return fmt::format("({} - {})", a(0), a(1));
     case Op::Multiply: return fmt::format("({} * {})", a(0), a(1));
-    case Op::Divide: return call("substrate_safe_div");
+    case Op::Divide:
+      // A divisor that cannot be 0 needs no guard, only the overflow clamp:
+      // inline (two instructions), not a call. A shader inlines every call,
+      // and SPIRV-Tools' inliner is quadratic in the calls of one function:
+      // the blending of a wide tree divides by max(1e-6, w) thousands of times.
+      if (nonZero(n.args[1]))
+        return fmt::format("clamp({} / {}, -SUBSTRATE_VALUES_FLT_MAX, SUBSTRATE_VALUES_FLT_MAX)", a(0), a(1));
+      return call("substrate_safe_div");
     case Op::Min: return call("min");
     case Op::Max: return call("max");
     case Op::Lerp: return syn_.lerp(a(0), a(1), a(2));

@@ -167,9 +167,66 @@ std::array<double, 4> sampleTexture(int input, double u, double v) {
   return {p[0], p[1], p[2], p[3]};
 }
 
+std::string_view textureSetName(TextureSet set) { return set == TextureSet::Neutral ? "neutral" : "checker"; }
+
+std::vector<TextureRole> textureRoles(const Material& m) {
+  // Marks on the DAG (bit 0: reaches a normal, bit 1: reaches a tangent),
+  // pushed from the uses to the arguments: ids are topologically sorted
+  // (arguments have smaller ids), so one sweep from the top is enough.
+  constexpr std::uint8_t kNormal = 1, kTangent = 2;
+  const ValueDag& dag = m.values;
+  std::vector<std::uint8_t> mark(dag.size(), 0);
+  auto seed = [&](ValueId v, std::uint8_t bit) {
+    if (v != kNoValue && v < mark.size()) mark[v] |= bit;
+  };
+  for (const Slab& slab : m.slabs) {
+    seed(slab.pin(SlabPin::Normal), kNormal);
+    seed(slab.pin(SlabPin::Tangent), kTangent);
+  }
+  for (ValueId id = 0; id < dag.size(); ++id) {  // the helpers' own normals
+    const ValueNode& n = dag.node(id);
+    if (n.op == Op::ThinFilm) seed(n.args[0], kNormal);
+    if (n.op == Op::RotationToTangent || n.op == Op::ViewDependentCoverage) seed(n.args[1], kNormal);
+  }
+  std::vector<TextureRole> roles(m.inputs.size(), TextureRole::Colour);
+  std::vector<std::uint8_t> inputMark(m.inputs.size(), 0);
+  for (ValueId id = static_cast<ValueId>(dag.size()); id-- > 0;) {
+    if (!mark[id]) continue;
+    const ValueNode& n = dag.node(id);
+    if (n.op == Op::Sample && n.attr < inputMark.size()) inputMark[n.attr] |= mark[id];
+    for (int a = 0; a < n.argCount; ++a) seed(n.args[a], mark[id]);
+  }
+  for (std::size_t i = 0; i < roles.size(); ++i)
+    if (m.inputs[i].type == VType::Texture)
+      roles[i] = (inputMark[i] & kNormal) ? TextureRole::Normal
+                 : (inputMark[i] & kTangent) ? TextureRole::Tangent
+                                             : TextureRole::Colour;
+  return roles;
+}
+
+std::array<double, 4> neutralTexel(TextureRole role) {
+  switch (role) {
+    case TextureRole::Normal: return {0.5, 0.5, 1, 1};
+    case TextureRole::Tangent: return {1, 0.5, 0.5, 1};
+    case TextureRole::Colour: break;
+  }
+  return {0.5, 0.5, 0.5, 1};
+}
+
+reference::TextureFn textureFunction(const Material& m, TextureSet set) {
+  if (set == TextureSet::Checker) return sampleTexture;
+  std::vector<std::array<double, 4>> texels;
+  for (TextureRole role : textureRoles(m)) texels.push_back(neutralTexel(role));
+  return [texels](int input, double, double) {
+    return input >= 0 && static_cast<std::size_t>(input) < texels.size() ? texels[input] : neutralTexel(TextureRole::Colour);
+  };
+}
+
 Resources kernelResources(const Material& m, const ShaderReflection& reflection,
                                const std::vector<uint32_t>& spirv, const std::vector<std::array<double, 4>>& inputValues,
-                               const std::vector<std::byte>& samples, std::size_t resultFloats) {
+                               const std::vector<std::byte>& samples, std::size_t resultFloats, TextureSet textures) {
+  const std::vector<TextureRole> roles =
+      textures == TextureSet::Neutral ? textureRoles(m) : std::vector<TextureRole>{};
   Resources res;
   for (const DescriptorBinding& b : reflection.bindings) {
     const auto key = std::make_pair(b.set, b.binding);
@@ -193,7 +250,16 @@ Resources kernelResources(const Material& m, const ShaderReflection& reflection,
       const int index = inputOfResource(m, b.name);
       ImageResource img;
       img.width = img.height = kTextureSize;
-      img.mips = {textureTexels(index)};
+      if (textures == TextureSet::Neutral) {
+        const auto texel = neutralTexel(index >= 0 && static_cast<std::size_t>(index) < roles.size()
+                                            ? roles[index]
+                                            : TextureRole::Colour);
+        std::vector<float> flat(kTextureSize * kTextureSize * 4);
+        for (std::size_t i = 0; i < flat.size(); ++i) flat[i] = static_cast<float>(texel[i % 4]);
+        img.mips = {flat};
+      } else {
+        img.mips = {textureTexels(index)};
+      }
       res[key] = img;
     } else if (b.set == 1 && b.kind == DescriptorKind::Sampler) {
       res[key] = SamplerResource{};

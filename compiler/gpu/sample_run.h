@@ -8,6 +8,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "emit/kernel_emitter.h"
@@ -39,16 +40,46 @@ std::vector<std::byte> sampleBuffer(const std::vector<Sample>& samples);
 
 /// The procedural kTextureSize² RGBA texture bound to texture input `input`
 /// (smooth gradients and a checker, values in [0, 1]), and its nearest/repeat lookup.
+/// The stress set: decoded as a tangent-space normal map (2·rgb − 1) half of
+/// its texels point below the surface (b = 0.2 gives z = −0.6).
 std::vector<float> textureTexels(int input);
 std::array<double, 4> sampleTexture(int input, double u, double v);
 
+/// Which texels the harness binds to a material's texture inputs.
+enum class TextureSet : std::uint8_t {
+  Checker,  // textureTexels: gradients and a checker (the GPU tests, `stability --stress-textures`)
+  Neutral,  // each texture at rest, by its role (neutralTexel): what `stability` runs by default
+};
+std::string_view textureSetName(TextureSet set);  // "checker", "neutral"
+
+/// What a texture input feeds, found on the value DAG: a texture that reaches
+/// a slab's `normal` pin (or the normal of a helper: thin_film,
+/// rotation_to_tangent, view_dependent_coverage) is a normal map; one that
+/// reaches only `tangent` pins is a direction map; anything else is a colour
+/// (colours, scalars packed in channels, masks, specular profiles).
+enum class TextureRole : std::uint8_t { Colour, Normal, Tangent };
+/// One role per Material::inputs entry (Colour for inputs that are not textures).
+std::vector<TextureRole> textureRoles(const Material& m);
+
+/// A texture at rest: a normal map's flat texel (0.5, 0.5, 1, 1), which
+/// decodes to the geometric normal; a direction map's (1, 0.5, 0.5, 1), which
+/// decodes to the geometric tangent (read as glTF's anisotropy texture: the
+/// tangent direction at half strength); a colour's mid-grey (0.5, 0.5, 0.5)
+/// with alpha 1 (fully present).
+std::array<double, 4> neutralTexel(TextureRole role);
+
+/// The CPU reference's texture lookup of `set` for material `m` (sampleTexture
+/// for Checker; each input's neutralTexel for Neutral).
+reference::TextureFn textureFunction(const Material& m, TextureSet set);
+
 /// The resources of one sample-kernel dispatch: the inputs block filled from
 /// the module's own member offsets (GLSL std140 and HLSL cbuffer packing
-/// differ) with `inputValues` (empty: defaults), the textures and samplers by
-/// name, the energy tables, the samples, and an output buffer of `resultFloats` floats.
+/// differ) with `inputValues` (empty: defaults), the textures (of `textures`)
+/// and samplers by name, the energy tables, the samples, and an output buffer
+/// of `resultFloats` floats.
 Resources kernelResources(const Material& m, const ShaderReflection& reflection, const std::vector<uint32_t>& spirv,
                           const std::vector<std::array<double, 4>>& inputValues, const std::vector<std::byte>& samples,
-                          std::size_t resultFloats);
+                          std::size_t resultFloats, TextureSet textures = TextureSet::Checker);
 
 /// Floats per sample in a sample kernel's results.
 int resultStride(const CompileResult& r);

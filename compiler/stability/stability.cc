@@ -58,6 +58,7 @@ struct Rewriter {
     else if (!fallback.is_null()) own = fallback;
     else return;
     node[pin] = forcedPin(own, kind(kindName));
+    ++kind(kindName).pins;
     used.insert(kindName);
   }
   void visit(json& node) {
@@ -255,8 +256,9 @@ std::array<T, 3> toT(const V3& v) {
 
 /// One CPU evaluation in T: "" if everything is finite, else what is not (and its value).
 template <class T>
-std::string evaluate(const CompileResult& r, const Point& p, const reference::InputValues& in, double* value) {
-  const auto m = reference::evaluateMaterial<T>(r, p.g, in, gpu::sampleTexture);
+std::string evaluate(const CompileResult& r, const Point& p, const reference::InputValues& in,
+                     const reference::TextureFn& textures, double* value) {
+  const auto m = reference::evaluateMaterial<T>(r, p.g, in, textures);
   if (!std::isfinite(m.coverage)) return *value = m.coverage, "coverage";
   if (!finite3(m.transmittance)) return *value = m.transmittance[0], "transmittance";
   const auto V = toT<T>(p.g.V), L = toT<T>(p.light), one = toT<T>({1, 1, 1}), pi = toT<T>({kPi, kPi, kPi});
@@ -295,7 +297,8 @@ std::string resultName(int at) {
 }
 
 bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& points,
-            const std::vector<std::pair<long, int>>& work, gpu::Context& ctx, Report* report, std::string* error) {
+            const std::vector<std::pair<long, int>>& work, gpu::TextureSet textures, gpu::Context& ctx, Report* report,
+            std::string* error) {
   EmitOptions emit;
   emit.inputsPerInvocation = true;
   emit.precision = report->precision;
@@ -336,7 +339,7 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
         }
       }
       gpu::Resources res = gpu::kernelResources(r.material, pipeline->reflection(), v.spirv, {},
-                                                gpu::sampleBuffer(samples), padded * stride);
+                                                gpu::sampleBuffer(samples), padded * stride, textures);
       if (inputCount > 0) {
         gpu::BufferResource buf;
         buf.data.resize(inputs.size() * sizeof(float));
@@ -367,7 +370,10 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
 /// The furnace: directional albedo (sum over closures of the view throughput
 /// times the importance-sampled integral under a white environment) of
 /// configurations with white inputs and albedo forced to 1, at NoV 1, 0.5, 0.1.
-void furnace(const CompileResult& r, const Grid& grid, int samples, Report* report) {
+/// Counts the evaluations and those that returned any light (the lit ones: a
+/// normal turned away from the view returns none, and tests nothing).
+void furnace(const CompileResult& r, const Grid& grid, int samples, const reference::TextureFn& textures,
+             Report* report) {
   // The configurations with albedo 1 (when the material has the kind), at most kFurnaceConfigurations spread over the grid.
   std::vector<long> chosen;
   int albedo = -1;
@@ -395,7 +401,7 @@ void furnace(const CompileResult& r, const Grid& grid, int samples, Report* repo
     for (double mu : {1.0, 0.5, 0.1}) {
       reference::Geometry g;
       g.V = {std::sqrt(1 - mu * mu), 0, mu};
-      const auto m = reference::evaluateMaterial<double>(r, g, in, gpu::sampleTexture);
+      const auto m = reference::evaluateMaterial<double>(r, g, in, textures);
       double albedoSum[3] = {0, 0, 0};
       for (auto cl : m.closures) {
         // Glints conserve energy over a pixel's footprint, not at a point: a
@@ -409,6 +415,8 @@ void furnace(const CompileResult& r, const Grid& grid, int samples, Report* repo
         for (int k = 0; k < 3; ++k) albedoSum[k] += t[k] * e[k];
       }
       const double a = std::max({albedoSum[0], albedoSum[1], albedoSum[2]});
+      ++report->furnaceEvaluations;
+      if (a > 0) ++report->furnaceLit;
       if (a > report->furnaceMax || report->furnaceWorst.where.empty()) {
         report->furnaceMax = std::max(report->furnaceMax, a);
         report->furnaceWorst = {"furnace", "directional albedo (largest channel)", grid.describe(cfg),
@@ -419,6 +427,16 @@ void furnace(const CompileResult& r, const Grid& grid, int samples, Report* repo
 }
 
 }  // namespace
+
+CompileOptions forcingOptions(const CompileOptions& base, const std::vector<ForcedKind>& kinds) {
+  CompileOptions o = base;
+  constexpr std::size_t kNodesPerPin = 4;  // forcedPin: add, two multiplies, one_minus
+  for (const ForcedKind& k : kinds) {
+    o.resolve.maxInputs += 2;
+    o.resolve.maxNodes += kNodesPerPin * static_cast<std::size_t>(k.pins);
+  }
+  return o;
+}
 
 bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
                    std::string* error) {
@@ -461,6 +479,8 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
   const std::vector<Point> points = shadingPoints();
   report->material = r.material.name;
   report->precision = o.precision;
+  report->textures = o.textures;
+  const reference::TextureFn textures = gpu::textureFunction(r.material, o.textures);
   for (const ForcedKind& k : kinds) report->forced.push_back(k.name);
   report->configurations = grid.count;
   report->shadingPoints = static_cast<long>(points.size());
@@ -480,10 +500,10 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
       const reference::InputValues in = inputsOf(r.material, grid, cfg);
       ++report->evaluations;
       double value = 0;
-      std::string bad = evaluate<double>(r, points[point], in, &value);
+      std::string bad = evaluate<double>(r, points[point], in, textures, &value);
       const char* where = "cpu double";
       if (bad.empty()) {
-        bad = evaluate<float>(r, points[point], in, &value);
+        bad = evaluate<float>(r, points[point], in, textures, &value);
         where = "cpu float";
       }
       if (bad.empty()) continue;
@@ -492,8 +512,8 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
         report->worst.push_back({where, bad, grid.describe(cfg), points[point].label, value});
     }
   }
-  if (o.gpu && !runGpu(r, grid, points, work, *gpu, report, error)) return false;
-  if (o.cpu) furnace(r, grid, o.furnaceSamples, report);
+  if (o.gpu && !runGpu(r, grid, points, work, o.textures, *gpu, report, error)) return false;
+  if (o.cpu) furnace(r, grid, o.furnaceSamples, textures, report);
   report->furnaceJudged = o.cpu;
   // `add` sums two pieces of matter: more light than arrives, by construction.
   for (const TreeNode& n : r.material.nodes)
@@ -501,10 +521,22 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
   return true;
 }
 
+bool furnaceExercised(const Report& r) { return !r.cpu || r.furnaceLit > 0; }
+
+bool passed(const Report& r) {
+  return r.nonfinite == 0 && r.gpuNonfinite == 0 && !(r.furnaceJudged && r.furnaceMax > kFurnaceLimit) &&
+         furnaceExercised(r);
+}
+
 std::string formatText(const Report& r) {
   std::string s = fmt::format("----- STABILITY - {} -----\n", r.material);
   s += fmt::format("forced parameters: {}\n", r.forced.empty() ? std::string("none") : fmt::format("{}", fmt::join(r.forced, ", ")));
   s += fmt::format("configurations:    {} x {} shading points\n", r.configurations, r.shadingPoints);
+  s += fmt::format("textures:          {}\n", r.textures == gpu::TextureSet::Neutral
+                                                  ? "neutral (flat normal maps, mid-grey colours; --stress-textures: "
+                                                    "the checker)"
+                                                  : "checker (--stress-textures: normal maps tilt, half of them "
+                                                    "below the surface)");
   if (r.cpu)
     s += fmt::format("cpu evaluations:   {} (double and float), non-finite: {}\n", r.evaluations, r.nonfinite);
   else
@@ -516,12 +548,15 @@ std::string formatText(const Report& r) {
                      r.furnaceWorst.geometry, r.furnaceJudged ? "" : "  [not judged: `add` sums matter]");
   else
     s += "furnace max:       not run (--gpu-only)\n";
+  if (r.cpu)
+    s += fmt::format("furnace lit:       {} of {} evaluations{}\n", r.furnaceLit, r.furnaceEvaluations,
+                     r.furnaceLit == 0 ? "  [never exercised: no evaluation returned any light]" : "");
   for (const Case& c : r.worst)
     s += fmt::format("non-finite: {} {} = {} at {}; {}\n", c.where, c.quantity, c.value, c.configuration, c.geometry);
   return s;
 }
 
-std::string formatJson(const Report& r) {
+json toJson(const Report& r) {
   auto caseJson = [](const Case& c) {
     json j;
     j["where"] = c.where;
@@ -542,12 +577,18 @@ std::string formatJson(const Report& r) {
   j["gpu_evaluations"] = r.gpuEvaluations;
   j["gpu_nonfinite"] = r.gpuNonfinite;
   j["gpu_precision"] = precisionName(r.precision);
+  j["textures"] = gpu::textureSetName(r.textures);
+  j["furnace_evaluations"] = r.furnaceEvaluations;
+  j["furnace_lit"] = r.furnaceLit;
+  j["furnace_exercised"] = furnaceExercised(r);
   j["furnace_max"] = r.furnaceMax;
   j["furnace_judged"] = r.furnaceJudged;
   j["furnace_worst"] = caseJson(r.furnaceWorst);
   j["worst"] = json::array();
   for (const Case& c : r.worst) j["worst"].push_back(caseJson(c));
-  return j.dump(2) + "\n";
+  return j;
 }
+
+std::string formatJson(const Report& r) { return toJson(r).dump(2) + "\n"; }
 
 }  // namespace substratec::stability

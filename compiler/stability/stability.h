@@ -43,14 +43,26 @@
 //   the view throughput times reference::envIntegrated under a white
 //   environment (4,096 points: noise well under 1e-3), glints off (they
 //   conserve energy over a footprint, not at a point). Judged (<= 1.001) unless
-//   the tree has an `add`, which sums matter.
+//   the tree has an `add`, which sums matter. Its denominator is the number of
+//   evaluations that returned any light (`furnace lit`): none is a failure (a
+//   furnace that saw only black tested nothing).
+//
+// TEXTURES
+//   By default every texture input is bound at rest (gpu::TextureSet::Neutral):
+//   normal maps flat, direction maps along the tangent, colours mid-grey, so
+//   the shading normals face the viewer wherever the geometric one does. With
+//   Options::textures Checker (`--stress-textures`) the GPU tests' checker,
+//   whose texels decoded as a normal map tilt and point below the surface.
 #pragma once
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "emit/material_emitter.h"
 #include "gpu/harness.h"
+#include "gpu/sample_run.h"
 #include "pipeline/pipeline.h"
 
 namespace substratec::stability {
@@ -60,6 +72,7 @@ struct ForcedKind {
   std::string name;            // "roughness", "anisotropy", ...
   std::vector<double> values;  // forced values (the grid adds "own")
   std::string flagInput, valueInput;  // the inputs forceableText added
+  long pins = 0;                      // pins it forced (each became four value nodes)
 };
 
 /// The material rewritten so that its slab parameters can be forced (see
@@ -68,13 +81,23 @@ struct ForcedKind {
 bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
                    std::string* error);
 
+/// The options forceableText's output compiles with: `base`, with the input-
+/// and node-count limits raised by exactly what the rewrite added (two inputs
+/// per kind, four value nodes per forced pin), so that a material within the
+/// limits stays within them once rewritten (1023 inputs + 16 used to fail with
+/// "more than 1024 inputs"): the harness's own inputs are not the user's.
+CompileOptions forcingOptions(const CompileOptions& base, const std::vector<ForcedKind>& kinds);
+
 struct Options {
   long evaluations = 100000;  // at least this many (CPU; the GPU runs the same points in each path)
   bool gpu = true;
   bool cpu = true;  // the CPU reference's grid and the furnace (neither depends on `precision`)
   int furnaceSamples = 4096;  // importance samples per furnace integral (noise well under 1e-3)
   Precision precision = Precision::Float;  // of the GPU kernels' lighting
+  gpu::TextureSet textures = gpu::TextureSet::Neutral;  // Checker: --stress-textures
 };
+
+inline constexpr double kFurnaceLimit = 1.001;  // the largest directional albedo a judged furnace allows
 
 /// One non-finite (or, for the furnace, the largest) case: where it was found.
 struct Case {
@@ -88,11 +111,13 @@ struct Case {
 struct Report {
   std::string material;
   Precision precision = Precision::Float;  // of the GPU kernels
+  gpu::TextureSet textures = gpu::TextureSet::Neutral;
   std::vector<std::string> forced;  // the kinds
   long configurations = 0, shadingPoints = 0;
   long evaluations = 0, nonfinite = 0;        // CPU: points evaluated (each in double and in float), bad ones
   long gpuEvaluations = 0, gpuNonfinite = 0;  // GPU: points evaluated over both paths, bad ones
   double furnaceMax = 0;                      // largest directional albedo, white inputs, white furnace (glints off)
+  long furnaceEvaluations = 0, furnaceLit = 0;  // furnace evaluations, and those that returned any light
   bool cpu = true;                            // Options::cpu: the CPU grid and the furnace ran
   bool furnaceJudged = true;                  // false when the tree has an `add` (it sums matter: > 1 by design)
                                               // or without the CPU part
@@ -106,7 +131,14 @@ struct Report {
 bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Options& options, gpu::Context* gpu,
          Report* report, std::string* error);
 
+/// False when the CPU part ran and no furnace evaluation returned any light.
+bool furnaceExercised(const Report& report);
+/// Every check met: nothing non-finite, the furnace exercised and (when
+/// judged) at most kFurnaceLimit. `stability` exits 4 otherwise.
+bool passed(const Report& report);
+
 std::string formatText(const Report& report);
-std::string formatJson(const Report& report);
+nlohmann::ordered_json toJson(const Report& report);
+std::string formatJson(const Report& report);  // toJson, indented
 
 }  // namespace substratec::stability

@@ -399,14 +399,67 @@ std::string formatCsv(const std::vector<Row>& rows) {
   return s;
 }
 
+namespace {
+
+/// Code points of UTF-8 text (continuation bytes are not counted).
+std::size_t codePoints(std::string_view text) {
+  std::size_t n = 0;
+  for (unsigned char c : text) n += (c & 0xC0) != 0x80;
+  return n;
+}
+
+/// `text` with XML's five special characters escaped.
+std::string xmlEscaped(std::string_view text) {
+  std::string out;
+  for (char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+/// At most `maxPoints` code points of `text`, the last one an ellipsis when cut.
+std::string truncatedTo(std::string_view text, std::size_t maxPoints) {
+  if (codePoints(text) <= maxPoints) return std::string(text);
+  std::string out;
+  std::size_t points = 0;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const unsigned char c = static_cast<unsigned char>(text[i]);
+    if ((c & 0xC0) != 0x80 && ++points == maxPoints) break;
+    out += text[i];
+  }
+  return out + "\u2026";
+}
+
+}  // namespace
+
+double plotTextWidth(std::string_view text, double fontSize) {
+  return kPlotGlyphWidth * fontSize * static_cast<double>(codePoints(text));
+}
+
 std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
-  // Error (log10 rel_mse, floored at 1e-8: the full budget may be exact) against cost (ns per pixel).
-  constexpr double W = 640, H = 400, L = 70, R = 20, T = 40, B = 50;
-  double xMin = 1e300, xMax = 0, yMin = 1e300, yMax = -1e300;
-  auto ly = [](double e) { return std::log10(std::max(e, 1e-8)); };
+  // Error (log10 rel_mse, floored at 1e-8: the full budget may be exact)
+  // against cost (ns per pixel). Every text is placed from its estimated
+  // extent (plotTextWidth; a glyph rises a font size above its baseline and
+  // descends a quarter of one below it) so that it
+  // stays inside the canvas: labels of points near the right edge end left of
+  // their point, and a title longer than the canvas is cut with an ellipsis.
+  constexpr double W = kPlotWidth, H = kPlotHeight, L = 70, R = 20, T = 40, B = 50;
+  constexpr double kFont = 11, kTitleFont = 14, kPad = 2;
+  double xMin = 1e300, xMax = -1e300, yMin = 1e300, yMax = -1e300;
+  // Non-finite or huge values are pinned to the axes' ends rather than
+  // stretching them (or making every coordinate NaN).
+  auto ly = [](double e) { return std::isnan(e) ? 8.0 : std::clamp(std::log10(std::max(e, 1e-8)), -8.0, 8.0); };
+  auto lx = [](double ns) { return std::isfinite(ns) ? std::clamp(ns, 0.0, 1e12) : 1e12; };
   for (const Row& r : rows) {
-    xMin = std::min(xMin, r.gpuNsPerPixel);
-    xMax = std::max(xMax, r.gpuNsPerPixel);
+    xMin = std::min(xMin, lx(r.gpuNsPerPixel));
+    xMax = std::max(xMax, lx(r.gpuNsPerPixel));
     yMin = std::min(yMin, ly(r.relMse));
     yMax = std::max(yMax, ly(r.relMse));
   }
@@ -414,31 +467,51 @@ std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
   if (xMax - xMin < 1e-9) xMax = xMin + 1;
   yMin = std::floor(yMin);
   yMax = std::max(std::ceil(yMax), yMin + 1);
-  auto px = [&](double x) { return L + (x - xMin) / (xMax - xMin) * (W - L - R); };
+  auto px = [&](double x) { return L + (lx(x) - xMin) / (xMax - xMin) * (W - L - R); };
   auto py = [&](double y) { return T + (yMax - y) / (yMax - yMin) * (H - T - B); };
+  // A text at (x, y) with `anchor`, moved inside the canvas from its extent.
+  auto text = [&](double x, double y, const std::string& content, double font, const char* anchor,
+                  const std::string& extra = "") {
+    const double w = plotTextWidth(content, font);
+    const double shift = std::string_view(anchor) == "middle" ? w / 2 : std::string_view(anchor) == "end" ? w : 0;
+    x = std::clamp(x - shift, kPad, std::max(kPad, W - kPad - w)) + shift;
+    y = std::clamp(y, font + kPad, H - kPad - 0.25 * font);  // ascent above the baseline, descent below
+    const std::string anchorAttr =
+        std::string_view(anchor) == "start" ? "" : fmt::format(" text-anchor=\"{}\"", anchor);
+    const std::string fontAttr = font == kFont ? "" : fmt::format(" font-size=\"{}\"", font);
+    return fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\"{}{}{}>{}</text>\n", x, y, fontAttr, anchorAttr, extra,
+                       xmlEscaped(content));
+  };
   std::string s = fmt::format(
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" font-family=\"sans-serif\" "
-      "font-size=\"11\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
-      W, H);
-  s += fmt::format("<text x=\"{}\" y=\"20\" font-size=\"14\">{}: error against cost</text>\n", L, material);
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" "
+      "font-family=\"sans-serif\" font-size=\"{2}\">\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
+      W, H, kFont);
+  const std::string suffix = ": error against cost";
+  const auto titlePoints = static_cast<std::size_t>((W - 2 * kPad) / (kPlotGlyphWidth * kTitleFont));
+  const std::size_t suffixPoints = codePoints(suffix);
+  s += text(L, 20, truncatedTo(material, titlePoints > suffixPoints + 1 ? titlePoints - suffixPoints : 1) + suffix,
+            kTitleFont, "start");
   s += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"black\"/>\n", L, H - B, W - R);
   s += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"black\"/>\n", L, T, H - B);
-  s += fmt::format("<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">lavapipe ns per shading point</text>\n",
-                   (L + W - R) / 2, H - 12);
-  s += fmt::format("<text x=\"16\" y=\"{}\" transform=\"rotate(-90 16 {})\" text-anchor=\"middle\">rel_mse vs the "
+  s += text((L + W - R) / 2, H - 12, "lavapipe ns per shading point", kFont, "middle");
+  // Rotated by -90 degrees about its anchor: its extent runs up and down from
+  // (16, middle), its glyphs' height to the left of x = 16.
+  s += fmt::format("<text x=\"16\" y=\"{0}\" transform=\"rotate(-90 16 {0})\" text-anchor=\"middle\">rel_mse vs the "
                    "full tree (log10)</text>\n",
-                   (T + H - B) / 2, (T + H - B) / 2);
+                   (T + H - B) / 2);
   for (int e = static_cast<int>(yMin); e <= static_cast<int>(yMax); ++e)
-    s += fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"end\">1e{}</text>\n", L - 6, py(e) + 4, e);
+    s += text(L - 6, py(e) + 4, fmt::format("1e{}", e), kFont, "end");
   for (int k = 0; k <= 4; ++k) {
     const double x = xMin + (xMax - xMin) * k / 4;
-    s += fmt::format("<text x=\"{:.1f}\" y=\"{}\" text-anchor=\"middle\">{:.0f}</text>\n", px(x), H - B + 16, x);
+    s += text(L + (W - L - R) * k / 4, H - B + 16, fmt::format("{:.0f}", x), kFont, "middle");
   }
   for (const Row& r : rows) {
     const double x = px(r.gpuNsPerPixel), y = py(ly(r.relMse));
     s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"#c0392b\"/>\n", x, y);
-    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{} ({} B, {} cl)</text>\n", x + 6, y - 6, r.label, r.bytes,
-                     r.closures);
+    const std::string label = fmt::format("{} ({} B, {} cl)", r.label, r.bytes, r.closures);
+    // Right of the point when it fits, else left of it.
+    const bool fitsRight = x + 6 + plotTextWidth(label, kFont) <= W - kPad;
+    s += fitsRight ? text(x + 6, y - 6, label, kFont, "start") : text(x - 6, y - 6, label, kFont, "end");
   }
   s += "</svg>\n";
   return s;

@@ -9,6 +9,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "emit/material_emitter.h"
@@ -86,6 +87,14 @@ std::string formatTable(const std::string& material, const std::vector<Row>& row
 std::string formatJson(const std::string& material, const std::vector<Row>& rows);
 std::string formatCsv(const std::vector<Row>& rows);
 std::string plotSvg(const std::string& material, const std::vector<Row>& rows);
+
+/// The plot's canvas (its viewBox is 0 0 kPlotWidth kPlotHeight) and the
+/// estimate of a text's extent every label is placed from: kPlotGlyphWidth
+/// font sizes per code point (wider than sans-serif's average glyph), a font
+/// size above the baseline and a quarter of one below. Every text of plotSvg
+/// lies inside the canvas by this estimate.
+inline constexpr double kPlotWidth = 640, kPlotHeight = 400, kPlotGlyphWidth = 0.62;
+double plotTextWidth(std::string_view text, double fontSize);
 
 /// mean((x − y)² / (y² + 0.01)): the sweep's rel_mse of x against the reference y.
 double relMse(const std::vector<double>& x, const std::vector<double>& y);

@@ -74,6 +74,17 @@ void expectFinite(const std::string& file) {
   EXPECT_EQ(j["gpu_nonfinite"], 0) << j["worst"].dump(1);
   EXPECT_TRUE(j.contains("furnace_max"));
   EXPECT_FALSE(j["forced"].empty());
+  // The furnace's denominator: evaluations that returned light (textures at rest).
+  EXPECT_EQ(j["textures"], "neutral");
+  EXPECT_GT(j["furnace_lit"].get<long>(), 0) << "a furnace that saw only black tests nothing";
+  EXPECT_TRUE(j["furnace_exercised"].get<bool>());
+  // The checker stays a stress case for finiteness (--stress-textures; CPU
+  // reference only: the GPU paths read the same texels).
+  CliRun stress = cli({"stability", file, "--stress-textures", "--no-gpu", "--evaluations", "20000", "--json"});
+  ASSERT_TRUE(stress.status == 0 || stress.status == 4) << stress.err;
+  const auto s = nlohmann::json::parse(stress.out);
+  EXPECT_EQ(s["textures"], "checker");
+  EXPECT_EQ(s["nonfinite"], 0) << s["worst"].dump(1);
 }
 
 /// The same grid with the shaders lighting in half precision (`--precision
