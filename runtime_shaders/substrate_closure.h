@@ -58,6 +58,7 @@ struct SubstrateClosure {
   float weight;               // mix and coverage weights on the path to the root
   float3 topTransmittance;    // transmittance of the layers above along the normal (1 on top)
   float coverageAbove;        // coverage of the layers above (0 on top)
+  uint extraInterfaces;       // interfaces above beyond the first, 0..3 (closure header bits 14-15)
   uint features;              // SUBSTRATE_FEATURE_* bits
   bool isTop;                 // nothing layered above
 };
@@ -103,6 +104,11 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_EMISSIVE
 #define SUBSTRATE_USE_EMISSIVE 1
 #endif
+// 1: some closure lies under more than one interface (a stack of layers), so
+// the lighting raises the interface term to the power 1 + extraInterfaces.
+#ifndef SUBSTRATE_USE_EXTRA_INTERFACES
+#define SUBSTRATE_USE_EXTRA_INTERFACES 1
+#endif
 // 1: every closure the shader lights has a unit N (the generated material
 // function guarantees it for a unit g.N: its normals go through
 // substrate_tangent_to_world, which normalizes, or are g.N itself), so
@@ -142,6 +148,7 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.weight = 1.0;
   c.topTransmittance = SUBSTRATE_SPLAT3(1.0);
   c.coverageAbove = 0.0;
+  c.extraInterfaces = 0u;
   c.features = 0u;
   c.isTop = true;
 }

@@ -27,16 +27,41 @@ float substrate_interface_transmission(float mu) {
   return 1.0 - x2 * x2 * x;
 }
 
-// lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5), coverageAbove): the
-// transmittance of the layers above along a direction at cosine mu (their
-// media and their interfaces), blended by their coverage. No transcendental
-// when nothing covers the closure (top layers). The remap (exp, log) and the
-// interface term (1 - (1 - mu)^5 cancels at grazing) are float; the
-// throughput, in [0, 1], is mfloat.
+// The angular part of the 1 + `extra` interfaces above a closure (extra =
+// SubstrateClosure.extraInterfaces, 0..3): (1 - (1 - mu)^5)^(1 + extra), by
+// multiplies. A stack of clear coats lets through no more than each of its
+// interfaces in turn: with one term for the whole stack every further
+// interface reflected its F(mu) and still passed everything on (issue 16:
+// six white transparent slabs returned 1.38 of the light at NoV 0.1).
+// Interfaces beyond 1 + 3 are folded into topTransmittance by the material
+// (substrate_extra_interfaces, substrate_tree.h). Compiled only when some
+// closure of the material (or scene) has extra interfaces.
+float substrate_interfaces_transmission(float mu, uint extra) {
+  float g = substrate_interface_transmission(mu);
+#if SUBSTRATE_USE_EXTRA_INTERFACES
+  float g2 = g * g;
+  if (extra == 1u) {
+    g = g2;
+  } else if (extra == 2u) {
+    g = g2 * g;
+  } else if (extra >= 3u) {
+    g = g2 * g2;
+  }
+#endif
+  return g;
+}
+
+// lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5)^(1 + extraInterfaces),
+// coverageAbove): the transmittance of the layers above along a direction at
+// cosine mu (their media and their interfaces), blended by their coverage. No
+// transcendental when nothing covers the closure (top layers). The remap
+// (exp, log) and the interface term (1 - (1 - mu)^5 cancels at grazing) are
+// float; the throughput, in [0, 1], is mfloat.
 mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
-    float3 through = substrate_transmittance_at_cosine(c.topTransmittance, mu) * substrate_interface_transmission(mu);
+    float3 through = substrate_transmittance_at_cosine(c.topTransmittance, mu) *
+                     substrate_interfaces_transmission(mu, c.extraInterfaces);
     return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
   }
   return SUBSTRATE_MSPLAT3(1.0);

@@ -343,9 +343,11 @@ uint substrate_material_header_multi(uint layoutClass, uint closureCount, uint b
   return (layoutClass & 3u) | (((closureCount - 1u) & 7u) << 2u) | ((basisCount & 15u) << 5u) | SUBSTRATE_HEADER_MULTI;
 }
 
-// Closure header: basis id (0-2), is top (3), SUBSTRATE_FEATURE_* (4-11), SSS type (12-13).
-uint substrate_closure_header(uint basis, bool isTop, uint features, uint sssType) {
-  return (basis & 7u) | (isTop ? 8u : 0u) | ((features & 0xffu) << 4u) | ((sssType & 3u) << 12u);
+// Closure header: basis id (0-2), is top (3), SUBSTRATE_FEATURE_* (4-11), SSS type (12-13),
+// extra interfaces above (14-15, SubstrateClosure.extraInterfaces).
+uint substrate_closure_header(uint basis, bool isTop, uint features, uint sssType, uint extraInterfaces) {
+  return (basis & 7u) | (isTop ? 8u : 0u) | ((features & 0xffu) << 4u) | ((sssType & 3u) << 12u) |
+         ((extraInterfaces & 3u) << 14u);
 }
 
 // The layout class of a pixel (SUBSTRATE_LAYOUT_*), from word 0.

@@ -41,15 +41,16 @@ void substrate_layer_above(inout float c, inout float3 t, float cLayer, float3 t
 
 // What one more interface above lets through, folded into a transmittance
 // along the normal. The lighting (substrate_closure_above_throughput) applies
-// the angular part of ONE interface, 1 - (1 - mu)^5, to the layers above as a
-// whole; a closure under n interfaces must receive no more than that to the
-// power n, or every interface of a stack of clear coats reflects its share
-// and still passes everything on (three white transparent slabs returned 1.08
-// of the light at NoV 0.1, six 1.38). Q is the largest q with
-// q^(1/mu) <= 1 - (1 - mu)^5 for every mu in (0, 1] (0.9139, at mu ~ 0.1),
-// rounded down: the emitter multiplies each further interface's layer by Q,
-// so T^(1/mu) carries (Q^(n-1))^(1/mu) <= (1 - (1 - mu)^5)^(n-1) at every
-// cosine.
+// the angular part of 1 + k interfaces, (1 - (1 - mu)^5)^(1 + k), with k the
+// closure's extraInterfaces = min(n - 1, 3) for a closure under n interfaces;
+// it must receive no more than the n-th power, or every interface of a stack
+// of clear coats reflects its share and still passes everything on (three
+// white transparent slabs returned 1.08 of the light at NoV 0.1, six 1.38).
+// The interfaces beyond the fourth are folded in here: Q is the largest q
+// with q^(1/mu) <= 1 - (1 - mu)^5 for every mu in (0, 1] (0.9139, at
+// mu ~ 0.1), rounded down; the emitter multiplies the layer of each interface
+// past the first 1 + k on the way down by Q, so T^(1/mu) carries
+// (Q^(n-1-k))^(1/mu) <= (1 - (1 - mu)^5)^(n-1-k) at every cosine.
 // With coverage the bound holds too: the pair (C, T) of substrate_layer_above
 // never lets through more than the product of the layers (Jensen: x^(1/mu) is
 // convex), and each covered path crosses at most the interfaces counted.

@@ -149,6 +149,9 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
         isTop = ((h >> 3u) & 1u) != 0u;
         feats = (h >> 4u) & 0xffu;
         sss = (h >> 12u) & 3u;
+#if SUBSTRATE_USE_EXTRA_INTERFACES
+        closures[i].extraInterfaces = (h >> 14u) & 3u;
+#endif
       }
       closureBasis[i] = basis;
       if (isTop && basis != 0u) {

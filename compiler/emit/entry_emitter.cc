@@ -300,8 +300,8 @@ std::string packFields(const Material& m, const StorageLayout& L, const std::vec
           f.bits);
     } else if (field == "header") {
       const ClosureLayout& cl = L.closures[f.closure];
-      put(fmt::format("substrate_closure_header({}u, {}, {}u, {}u)", cl.basis, cl.isTop ? "true" : "false",
-                      featureBits(cl), sssCode(cl)),
+      put(fmt::format("substrate_closure_header({}u, {}, {}u, {}u, {}u)", cl.basis, cl.isTop ? "true" : "false",
+                      featureBits(cl), sssCode(cl), cl.extraInterfaces),
           f.bits);
     } else if (field == "diffuse_albedo" || field == "f0" || field == "f90" || field == "top_transmittance") {
       const char* member = field == "diffuse_albedo" ? "diffuseAlbedo" : field == "f0" ? "f0"

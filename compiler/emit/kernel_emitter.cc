@@ -78,7 +78,8 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   put(kClosureCoverageAbove, c + ".coverageAbove");
   put(kClosureFeatures, "float(" + c + ".features)");
   put(kClosureIsTop, c + ".isTop ? 1.0 : 0.0");
-  for (int at = kClosureIsTop + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
+  put(kClosureExtraInterfaces, "float(" + c + ".extraInterfaces)");
+  for (int at = kClosureExtraInterfaces + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
   return s;
 }
 

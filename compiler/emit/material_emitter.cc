@@ -40,6 +40,12 @@ std::string useDefines(std::uint16_t features) {
   return s;
 }
 
+std::string extraInterfacesDefine(const StorageLayout& layout) {
+  bool any = false;
+  for (const ClosureLayout& c : layout.closures) any = any || c.extraInterfaces > 0;
+  return fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", any ? 1 : 0);
+}
+
 namespace {
 
 // Closure feature bits (runtime_shaders/substrate_closure.h, docs/storage.md).
@@ -452,16 +458,17 @@ void Emitter::emitClosures() {
       line(fmt::format("float ca_{0} = 0.0; {1} ta_{0} = {2}; float va_{0} = 0.0;", id, v3, vec3(1, 1, 1)));
       // From the root down. The top's interfaces transmit 1 - F0 at normal
       // incidence: a slab's inline, an operator's (a partial coat, a mix of
-      // coats) through TI. The lighting applies the angular part of one
-      // interface; every further interface on the way down (the root's top's
-      // second and later, every interface of the layers below it) is folded in
-      // here as substrate_extra_interfaces (substrate_tree.h).
+      // coats) through TI. The lighting applies the angular part of the first
+      // 1 + extraInterfaces interfaces on the way down (at most 4); every
+      // further one is folded in here as substrate_extra_interfaces
+      // (substrate_tree.h).
+      int lit = 1 + cl.extraInterfaces;
       for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
         const TreeNode& top = m_.nodes[it->second];
         std::string tTop = fmt::format("TI_{}", top.id);
         if (top.op == TreeOp::Slab)
           tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
-        const int extra = t_.interfaces[it->second] - (it == layers.rbegin() ? 1 : 0);
+        const int extra = foldedInterfaces(t_.interfaces[it->second], lit);
         if (extra > 0) tTop = fmt::format("{} * substrate_extra_interfaces({})", tTop, Syntax::literal(extra));
         if (top.op == TreeOp::Slab)
           line(fmt::format("va_{0} += C_{1} * substrate_roughness_to_variance({2});", id, top.id,
@@ -529,6 +536,8 @@ void Emitter::emitClosures() {
     if (!cl.isTop) {
       line(fmt::format("{}.topTransmittance = ta_{};", c, id));
       line(fmt::format("{}.coverageAbove = ca_{};", c, id));
+      if (cl.extraInterfaces > 0)  // the lighting's interface term to the power 1 + this
+        line(fmt::format("{}.extraInterfaces = {}u;", c, cl.extraInterfaces));
       line(fmt::format("{}.isTop = false;", c));
     }
     line(fmt::format("{}.features = {}u;", c, bits));
@@ -547,6 +556,7 @@ std::string Emitter::run() {
   out_ += fmt::format("#ifndef SUBSTRATE_MATERIAL_{0}\n#define SUBSTRATE_MATERIAL_{0} 1\n\n", upper);
   line("// What this material uses: the runtime compiles nothing else.");
   out_ += useDefines(all);
+  out_ += extraInterfacesDefine(L_);
   line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", opt_.diffuseModel));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));
   line(fmt::format("#define {}_WORD_COUNT {}", upper, L_.words()));

@@ -47,6 +47,10 @@ std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayo
 /// `#define SUBSTRATE_USE_<FEATURE> 0|1` for each runtime switch
 /// (runtime_shaders/substrate_closure.h), 1 for the kFeat* bits of `features`.
 std::string useDefines(std::uint16_t features);
+/// `#define SUBSTRATE_USE_EXTRA_INTERFACES 0|1`: 1 when a closure of `layout`
+/// lies under more than one interface (ClosureLayout::extraInterfaces > 0),
+/// so the lighting compiles the interface term's power only for stacks.
+std::string extraInterfacesDefine(const StorageLayout& layout);
 
 /// Names used across emitted files.
 std::string materialUpper(const Material& m);  // NAME in macros

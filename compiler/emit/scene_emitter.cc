@@ -195,6 +195,8 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
       scene.name, layoutClassName(k.cls), layoutClassName(k.cls), materialList(k.materials), featureNames(k.features),
       k.maxClosures, k.maxWords);
   s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
+  // Extra interfaces are in closure headers only: a lone closure is on top.
+  s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
   s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", scene.diffuseModel);
   s += fmt::format("#define SUBSTRATE_MAX_CLOSURES {}\n", k.maxClosures);
   s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", k.maxWords);

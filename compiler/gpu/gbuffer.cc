@@ -36,6 +36,7 @@ ClosureValues closureValues(const reference::Closure<double>& c) {
   v.weight = c.weight;
   v.topTransmittance = c.topTransmittance;
   v.coverageAbove = c.coverageAbove;
+  v.extraInterfaces = c.extraInterfaces;
   return v;
 }
 
@@ -65,6 +66,7 @@ reference::Closure<double> closureOf(const ClosureValues& v, const BasisValues& 
   c.weight = v.weight;
   c.topTransmittance = v.topTransmittance;
   c.coverageAbove = v.coverageAbove;
+  c.extraInterfaces = v.extraInterfaces;
   c.features = v.features;
   c.isTop = v.isTop;
   return c;

@@ -18,6 +18,7 @@ TreeInfo analyzeTree(const Material& m) {
   t.unitCoverageAbove.assign(n, false);
   t.unitCoverage.assign(n, false);
   t.interfaces.assign(n, 0);
+  t.interfacesAbove.assign(n, 0);
   t.bsdfId.assign(m.slabs.size(), -1);
   t.slabNode.assign(m.slabs.size(), -1);
   t.layerVertical.assign(n, -1);
@@ -33,6 +34,7 @@ TreeInfo analyzeTree(const Material& m) {
     bool unit;        // every weight on the path so far is exactly 1
     bool coverAbove;  // every layer above has coverage exactly 1
     int layer;        // the nearest vertical whose top layer holds this subtree (-1: none)
+    int above;        // interfaces of the tops above (TreeInfo::interfacesAbove)
   };
   // Static coverage first (children before parents): the coverage of a subtree
   // is 1 for a slab and stays 1 through operators whose rule keeps it there.
@@ -69,7 +71,7 @@ TreeInfo analyzeTree(const Material& m) {
                                                         : std::max(k(node.left), k(node.right));
     }
   }
-  std::vector<Item> stack{{m.root, -1, 0, 0, false, true, true, -1}};
+  std::vector<Item> stack{{m.root, -1, 0, 0, false, true, true, -1, 0}};
   while (!stack.empty()) {
     Item it = stack.back();
     stack.pop_back();
@@ -85,19 +87,21 @@ TreeInfo analyzeTree(const Material& m) {
       t.isBottom[it.node] = !it.onTopSide;
       t.unitWeight[it.node] = it.unit && t.unitCoverage[it.node];  // a blended slab may carry a coverage
       t.unitCoverageAbove[it.node] = it.coverAbove;
+      t.interfacesAbove[it.node] = it.above;
       t.bsdfId[node.slab] = static_cast<int>(t.slabOrder.size());
       t.slabNode[node.slab] = it.node;
       t.slabOrder.push_back(node.slab);
       continue;
     }
-    Item l{node.left, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove, it.layer};
-    Item r{node.right, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove, it.layer};
+    Item l{node.left, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove, it.layer, it.above};
+    Item r{node.right, it.node, it.depth + 1, it.layerDepth, it.onTopSide, it.unit, it.coverAbove, it.layer, it.above};
     switch (node.op) {
       case TreeOp::Vertical:
         l.onTopSide = true;           // the top has a layer below it
         l.layer = it.node;            // the top is this vertical's layer (the base stays in the enclosing one)
         r.layerDepth += 1;            // the base is under one more layer
         r.coverAbove = it.coverAbove && t.unitCoverage[node.left];
+        r.above += node.left >= 0 ? t.interfaces[node.left] : 0;
         break;
       case TreeOp::Horizontal:
       case TreeOp::CoverageWeight:

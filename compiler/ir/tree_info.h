@@ -23,6 +23,8 @@ struct TreeInfo {
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
   std::vector<int> interfaces;   // any node: the most interfaces a path down through the subtree
                                  // crosses (slab 1, vertical top + base, other operators the larger side)
+  std::vector<int> interfacesAbove;  // slabs: the interfaces of the tops of the verticals whose base
+                                     // holds the slab, summed (0 on top): what the light crosses to it
   std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order)
   std::vector<int> bsdfId;       // slab index -> position in slabOrder
   std::vector<int> slabNode;     // slab index -> its tree node (-1 if not in the tree)
@@ -36,5 +38,28 @@ struct TreeInfo {
 };
 
 TreeInfo analyzeTree(const Material& m);
+
+/// The most interfaces beyond the first one above a closure that its stored
+/// extra-interface count holds (2 bits: docs/storage.md); the lighting applies
+/// the angular part of 1 + that many interfaces, the emitter folds the rest
+/// into the layers' transmittance (substrate_extra_interfaces).
+inline constexpr int kMaxStoredExtraInterfaces = 3;
+
+/// The extra-interface count a closure under `interfacesAbove` interfaces
+/// stores: min(n - 1, 3), 0 on top.
+inline int storedExtraInterfaces(int interfacesAbove) {
+  return interfacesAbove <= 1 ? 0 : (interfacesAbove - 1 < kMaxStoredExtraInterfaces ? interfacesAbove - 1
+                                                                                     : kMaxStoredExtraInterfaces);
+}
+
+/// Walking the tops above a closure from the root down, with `budget` the
+/// interfaces the lighting still applies (1 + storedExtraInterfaces at the
+/// root): how many of the next top's `interfaces` are folded into its
+/// transmittance (budget updated). Its first ones are the lighting's.
+inline int foldedInterfaces(int interfaces, int& budget) {
+  const int lit = interfaces < budget ? interfaces : budget;
+  budget -= lit;
+  return interfaces - lit;
+}
 
 }  // namespace substratec

@@ -27,14 +27,27 @@ T interfaceTransmission(T mu) {
   return T(1) - x2 * x2 * x;
 }
 
-// substrate_closure_above_throughput: lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5),
-// sat(coverageAbove)), and exactly 1 (no transcendental) when nothing covers the closure.
+// substrate_interfaces_transmission: (1 - (1 - sat(mu))^5)^(1 + extra) by
+// multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
+template <class T>
+T interfacesTransmission(T mu, std::uint32_t extra) {
+  T g = interfaceTransmission(mu);
+  const T g2 = g * g;
+  if (extra == 1u) g = g2;
+  else if (extra == 2u) g = g2 * g;
+  else if (extra >= 3u) g = g2 * g2;
+  return g;
+}
+
+// substrate_closure_above_throughput: lerp(1, T_N^(1/max(mu, 1e-4)) *
+// (1 - (1 - mu)^5)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
+// transcendental) when nothing covers the closure.
 template <class T>
 V3<T> aboveThroughput(const Closure<T>& c, T mu) {
   T cover = saturate(c.coverageAbove);
   if (cover > T(0)) {
     const V3<T> t = transmittanceAtCosine(c.topTransmittance, mu);
-    const T i = interfaceTransmission(mu);
+    const T i = interfacesTransmission(mu, c.extraInterfaces);
     return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
   }
   return splat3(T(1));

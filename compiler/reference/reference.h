@@ -68,6 +68,7 @@ struct Closure {
   T weight = T(1);
   V3<T> topTransmittance{T(1), T(1), T(1)};
   T coverageAbove = T(0);
+  std::uint32_t extraInterfaces = 0;  // interfaces above beyond the first, 0..3
   std::uint32_t features = 0;
   bool isTop = true;
 };

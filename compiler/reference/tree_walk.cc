@@ -289,12 +289,14 @@ class Walk {
     // The layers above, from the root down (substrate_layer_above); a slab on
     // top of a vertical transmits T (1 - F0) and widens the roughness below by
     // C * variance(its roughness). An operator on top: its TI (its slabs'
-    // T (1 - F0) through the operators), no widening. Every interface after
-    // the first (TreeInfo::interfaces of the tops, less one for the root's)
-    // times extraInterfaces.
+    // T (1 - F0) through the operators), no widening. The lighting applies
+    // 1 + cl.extraInterfaces interfaces (the first ones from the root down);
+    // every further one (TreeInfo::interfaces of the tops) times
+    // extraInterfaces.
     T ca = T(0), va = T(0);
     V3<T> ta = splat3(T(1));
     if (!cl.isTop) {
+      int lit = 1 + cl.extraInterfaces;
       for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
         const TreeNode& top = m_.nodes[it->top];
         V3<T> tTop = TI_[it->top];
@@ -304,7 +306,7 @@ class Walk {
           va = va + C_[it->top] * roughnessToVariance(scalar(ts.pin(SlabPin::Roughness)));
           tTop = tTop * (splat3(T(1)) - vec3(ts.pin(SlabPin::F0)));
         }
-        const int extra = t_.interfaces[it->top] - (it == layers.rbegin() ? 1 : 0);
+        const int extra = foldedInterfaces(t_.interfaces[it->top], lit);
         if (extra > 0) tTop = tTop * extraInterfaces<T>(extra);
         layerAbove(ca, ta, C_[it->top], tTop);
       }
@@ -367,6 +369,7 @@ class Walk {
     if (!cl.isTop) {
       c.topTransmittance = ta;
       c.coverageAbove = ca;
+      c.extraInterfaces = static_cast<std::uint32_t>(cl.extraInterfaces);
       c.isTop = false;
     }
     c.features = bits;

@@ -48,7 +48,7 @@ void finishLayout(StorageLayout& L) {
     const std::string p = fmt::format("closure{}.", i);
     if (multi)
       add(p + "header", bits::kClosureHeader,
-          "basis id 3 | is top 1 | feature bits 8 | sss type 2 | reserved 2", i);
+          "basis id 3 | is top 1 | feature bits 8 | sss type 2 | extra interfaces 2", i);
     add(p + "diffuse_albedo", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
     add(p + "f0", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
     add(p + "roughness", bits::kRoughness, "unorm8", i);
@@ -90,6 +90,7 @@ StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
     c.storedFeatures = slab.features & kStoredFeatureMask;
     c.storesWeight = !info.unitWeight[node];
     c.storesCoverageAbove = !c.isTop && !info.unitCoverageAbove[node];
+    c.extraInterfaces = storedExtraInterfaces(info.interfacesAbove[node]);
     L.closures.push_back(c);
   }
   L.basisCount = static_cast<int>(m.bases.size());
@@ -104,6 +105,7 @@ StorageLayout simpleLayoutOf(const StorageLayout& L, int k) {
   c.isTop = true;
   c.storesWeight = c.storesCoverageAbove = false;
   c.storedFeatures = 0;
+  c.extraInterfaces = 0;
   S.closures = {c};
   S.basisCount = 1;
   finishLayout(S);

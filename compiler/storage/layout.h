@@ -48,6 +48,7 @@ struct ClosureLayout {
   bool isTop = true;
   bool storesWeight = false;         // grey mix/coverage weight (not statically 1)
   bool storesCoverageAbove = false;  // below a layer whose coverage is not statically 1
+  int extraInterfaces = 0;  // interfaces above beyond the first, up to 3 (storedExtraInterfaces; closure header)
   std::uint16_t storedFeatures = 0;
 };
 

@@ -309,6 +309,8 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
     throw std::invalid_argument(fmt::format("packMaterial: {} bases (the format holds 1 to 8)", layout.basisCount));
   if (!multi && (layout.basisCount != 1 || layout.closures[0].basis != 0))
     throw std::invalid_argument("packMaterial: a single closure must use basis 0, the only basis");
+  if (!multi && layout.closures[0].extraInterfaces != 0)
+    throw std::invalid_argument("packMaterial: a single closure is on top (its header holds no extra interfaces)");
   if (static_cast<int>(bases.size()) < layout.basisCount)
     throw std::invalid_argument("packMaterial: fewer BasisValues than layout bases");
   for (const auto& c : layout.closures)
@@ -349,9 +351,13 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
       const ClosureValues& v = closures[f.closure];
       if (what == "header") {
         expectBits(f, bits::kClosureHeader);
+        if (c.extraInterfaces < 0 || c.extraInterfaces > kMaxStoredExtraInterfaces)
+          throw std::invalid_argument(fmt::format("packMaterial: closure {} has {} extra interfaces (0 to 3)",
+                                                  f.closure, c.extraInterfaces));
         std::uint32_t h = static_cast<std::uint32_t>(c.basis) | (c.isTop ? 8u : 0u);
         h |= closureHeaderFeatures(c) << 4;
         h |= headerSssType(c, v) << 12;
+        h |= static_cast<std::uint32_t>(c.extraInterfaces) << 14;
         put(16, h);
       } else if (what == "diffuse_albedo") {
         expectBits(f, bits::kColor);
@@ -480,6 +486,7 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
       c.isTop = (h >> 3) & 1u;
       feats = (h >> 4) & 0xffu;
       sss = (h >> 12) & 3u;
+      c.extraInterfaces = static_cast<int>((h >> 14) & 3u);
       if (c.basis >= basisCount)
         throw std::runtime_error(fmt::format("unpackMaterial: closure {} uses basis {} of {}", i, c.basis, basisCount));
     } else {
@@ -495,6 +502,7 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
     v.isTop = c.isTop;
     v.basis = c.basis;
     v.sssType = sss;
+    v.extraInterfaces = static_cast<std::uint32_t>(c.extraInterfaces);
     if (!c.isTop) v.coverageAbove = 1;  // below layers of static coverage 1 unless stored
 
     v.diffuseAlbedo = dequantizeColor(field(p + "diffuse_albedo", bits::kColor, i));

@@ -87,6 +87,7 @@ struct ClosureValues {
   Vec3d topTransmittance{1, 1, 1};
   double coverageAbove = 0;  // 0 on top; 1 when below layers of static coverage 1
   std::uint32_t features = 0;  // kClosure* bits (set by the unpacker; ignored by the packer)
+  std::uint32_t extraInterfaces = 0;  // closure header bits 14-15 (set by the unpacker; the packer reads the layout)
   bool isTop = true;           // set by the unpacker; the packer reads the layout
   int basis = 0;               // set by the unpacker; the packer reads the layout
 };

@@ -13,6 +13,7 @@
 #define SUBSTRATE_USE_GLINT 0
 #define SUBSTRATE_USE_SPECULAR_PROFILE 0
 #define SUBSTRATE_USE_EMISSIVE 0
+#define SUBSTRATE_USE_EXTRA_INTERFACES 0
 #define SUBSTRATE_DIFFUSE_MODEL 2
 #define COATED_CARBON_FIBER_CLOSURE_COUNT 3
 #define COATED_CARBON_FIBER_WORD_COUNT 10
@@ -165,7 +166,7 @@ void coated_carbon_fiber_pack(SubstrateClosure closures[COATED_CARBON_FIBER_CLOS
   { uint q = substrate_material_header_multi(2u, 3u, 2u);
     words[0] |= q << 0u; }
   // closure0.header (16 bits at 16)
-  { uint q = substrate_closure_header(0u, true, 0u, 0u);
+  { uint q = substrate_closure_header(0u, true, 0u, 0u, 0u);
     words[0] |= q << 16u; }
   // closure0.diffuse_albedo (20 bits at 32)
   { uint q = substrate_q_color20(closures[0].diffuseAlbedo, dither);
@@ -178,7 +179,7 @@ void coated_carbon_fiber_pack(SubstrateClosure closures[COATED_CARBON_FIBER_CLOS
   { uint q = substrate_q_unorm(closures[0].roughness, 8u, dither);
     words[2] |= q << 8u; }
   // closure1.header (16 bits at 80)
-  { uint q = substrate_closure_header(1u, false, 66u, 0u);
+  { uint q = substrate_closure_header(1u, false, 66u, 0u, 0u);
     words[2] |= q << 16u; }
   // closure1.diffuse_albedo (20 bits at 96)
   { uint q = substrate_q_color20(closures[1].diffuseAlbedo, dither);
@@ -201,7 +202,7 @@ void coated_carbon_fiber_pack(SubstrateClosure closures[COATED_CARBON_FIBER_CLOS
   { uint q = substrate_q_anisotropy(closures[1].anisotropy, dither);
     words[5] |= q << 12u; }
   // closure2.header (16 bits at 180)
-  { uint q = substrate_closure_header(0u, false, 64u, 0u);
+  { uint q = substrate_closure_header(0u, false, 64u, 0u, 0u);
     words[5] |= q << 20u;
     words[6] |= q >> 12u; }
   // closure2.diffuse_albedo (20 bits at 196)

@@ -13,6 +13,7 @@
 #define SUBSTRATE_USE_GLINT 0
 #define SUBSTRATE_USE_SPECULAR_PROFILE 0
 #define SUBSTRATE_USE_EMISSIVE 0
+#define SUBSTRATE_USE_EXTRA_INTERFACES 0
 #define SUBSTRATE_DIFFUSE_MODEL 2
 #define DIELECTRIC_OVER_ANISO_FIBER_CLOSURE_COUNT 2
 #define DIELECTRIC_OVER_ANISO_FIBER_WORD_COUNT 6
@@ -93,7 +94,7 @@ void dielectric_over_aniso_fiber_pack(SubstrateClosure closures[DIELECTRIC_OVER_
   { uint q = substrate_material_header_multi(2u, 2u, 1u);
     words[0] |= q << 0u; }
   // closure0.header (16 bits at 16)
-  { uint q = substrate_closure_header(0u, true, 0u, 0u);
+  { uint q = substrate_closure_header(0u, true, 0u, 0u, 0u);
     words[0] |= q << 16u; }
   // closure0.diffuse_albedo (20 bits at 32)
   { uint q = substrate_q_color20(closures[0].diffuseAlbedo, dither);
@@ -106,7 +107,7 @@ void dielectric_over_aniso_fiber_pack(SubstrateClosure closures[DIELECTRIC_OVER_
   { uint q = substrate_q_unorm(closures[0].roughness, 8u, dither);
     words[2] |= q << 8u; }
   // closure1.header (16 bits at 80)
-  { uint q = substrate_closure_header(0u, false, 2u, 0u);
+  { uint q = substrate_closure_header(0u, false, 2u, 0u, 0u);
     words[2] |= q << 16u; }
   // closure1.diffuse_albedo (20 bits at 96)
   { uint q = substrate_q_color20(closures[1].diffuseAlbedo, dither);

@@ -13,6 +13,7 @@
 #define SUBSTRATE_USE_GLINT 1
 #define SUBSTRATE_USE_SPECULAR_PROFILE 1
 #define SUBSTRATE_USE_EMISSIVE 0
+#define SUBSTRATE_USE_EXTRA_INTERFACES 0
 #define SUBSTRATE_DIFFUSE_MODEL 2
 #define ROW60_GLINT_CLOSURE_COUNT 2
 #define ROW60_GLINT_WORD_COUNT 14
@@ -123,7 +124,7 @@ void row60_glint_pack(SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], floa
   { uint q = substrate_material_header_multi(3u, 2u, 1u);
     words[0] |= q << 0u; }
   // closure0.header (16 bits at 16)
-  { uint q = substrate_closure_header(0u, true, 0u, 0u);
+  { uint q = substrate_closure_header(0u, true, 0u, 0u, 0u);
     words[0] |= q << 16u; }
   // closure0.diffuse_albedo (20 bits at 32)
   { uint q = substrate_q_color20(closures[0].diffuseAlbedo, dither);
@@ -136,7 +137,7 @@ void row60_glint_pack(SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], floa
   { uint q = substrate_q_unorm(closures[0].roughness, 8u, dither);
     words[2] |= q << 8u; }
   // closure1.header (16 bits at 80)
-  { uint q = substrate_closure_header(0u, false, 63u, 1u);
+  { uint q = substrate_closure_header(0u, false, 63u, 1u, 0u);
     words[2] |= q << 16u; }
   // closure1.diffuse_albedo (20 bits at 96)
   { uint q = substrate_q_color20(closures[1].diffuseAlbedo, dither);

@@ -13,6 +13,7 @@
 #define SUBSTRATE_USE_GLINT 0
 #define SUBSTRATE_USE_SPECULAR_PROFILE 0
 #define SUBSTRATE_USE_EMISSIVE 0
+#define SUBSTRATE_USE_EXTRA_INTERFACES 0
 #define SUBSTRATE_DIFFUSE_MODEL 2
 #define SILK_IN_PLASTIC_CLOSURE_COUNT 3
 #define SILK_IN_PLASTIC_WORD_COUNT 13
@@ -164,7 +165,7 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
   { uint q = substrate_material_header_multi(2u, 3u, 2u);
     words[0] |= q << 0u; }
   // closure0.header (16 bits at 16)
-  { uint q = substrate_closure_header(0u, true, 0u, 0u);
+  { uint q = substrate_closure_header(0u, true, 0u, 0u, 0u);
     words[0] |= q << 16u; }
   // closure0.diffuse_albedo (20 bits at 32)
   { uint q = substrate_q_color20(closures[0].diffuseAlbedo, dither);
@@ -177,7 +178,7 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
   { uint q = substrate_q_unorm(closures[0].roughness, 8u, dither);
     words[2] |= q << 8u; }
   // closure1.header (16 bits at 80)
-  { uint q = substrate_closure_header(0u, false, 74u, 0u);
+  { uint q = substrate_closure_header(0u, false, 74u, 0u, 0u);
     words[2] |= q << 16u; }
   // closure1.diffuse_albedo (20 bits at 96)
   { uint q = substrate_q_color20(closures[1].diffuseAlbedo, dither);
@@ -204,7 +205,7 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
   { uint q = substrate_q_anisotropy(closures[1].anisotropy, dither);
     words[6] |= q << 12u; }
   // closure2.header (16 bits at 212)
-  { uint q = substrate_closure_header(1u, false, 74u, 0u);
+  { uint q = substrate_closure_header(1u, false, 74u, 0u, 0u);
     words[6] |= q << 20u;
     words[7] |= q >> 12u; }
   // closure2.diffuse_albedo (20 bits at 228)

@@ -13,6 +13,7 @@
 #define SUBSTRATE_USE_GLINT 0
 #define SUBSTRATE_USE_SPECULAR_PROFILE 0
 #define SUBSTRATE_USE_EMISSIVE 0
+#define SUBSTRATE_USE_EXTRA_INTERFACES 0
 #define SUBSTRATE_DIFFUSE_MODEL 2
 #define WORKED_EXAMPLE_72_CLOSURE_COUNT 3
 #define WORKED_EXAMPLE_72_WORD_COUNT 17
@@ -188,7 +189,7 @@ void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_
   { uint q = substrate_material_header_multi(2u, 3u, 3u);
     words[0] |= q << 0u; }
   // closure0.header (16 bits at 16)
-  { uint q = substrate_closure_header(0u, true, 14u, 0u);
+  { uint q = substrate_closure_header(0u, true, 14u, 0u, 0u);
     words[0] |= q << 16u; }
   // closure0.diffuse_albedo (20 bits at 32)
   { uint q = substrate_q_color20(closures[0].diffuseAlbedo, dither);
@@ -210,7 +211,7 @@ void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_
   { uint q = substrate_q_anisotropy(closures[0].anisotropy, dither);
     words[4] |= q << 0u; }
   // closure1.header (16 bits at 136)
-  { uint q = substrate_closure_header(1u, false, 78u, 0u);
+  { uint q = substrate_closure_header(1u, false, 78u, 0u, 0u);
     words[4] |= q << 8u; }
   // closure1.diffuse_albedo (20 bits at 152)
   { uint q = substrate_q_color20(closures[1].diffuseAlbedo, dither);
@@ -240,7 +241,7 @@ void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_
   { uint q = substrate_q_anisotropy(closures[1].anisotropy, dither);
     words[8] |= q << 20u; }
   // closure2.header (16 bits at 284)
-  { uint q = substrate_closure_header(2u, false, 78u, 0u);
+  { uint q = substrate_closure_header(2u, false, 78u, 0u, 0u);
     words[8] |= q << 28u;
     words[9] |= q >> 4u; }
   // closure2.diffuse_albedo (20 bits at 300)

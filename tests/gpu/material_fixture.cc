@@ -102,6 +102,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.weight = static_cast<T>(c.weight);
   o.topTransmittance = arrayOf<T>(c.topTransmittance);
   o.coverageAbove = static_cast<T>(c.coverageAbove);
+  o.extraInterfaces = c.extraInterfaces;
   o.features = c.features;
   o.isTop = c.isTop;
   return o;
@@ -208,6 +209,7 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.coverageAbove = p[kClosureCoverageAbove];
   c.features = static_cast<uint32_t>(p[kClosureFeatures]);
   c.isTop = p[kClosureIsTop] != 0.0f;
+  c.extraInterfaces = static_cast<uint32_t>(p[kClosureExtraInterfaces]);
   return c;
 }
 

@@ -463,4 +463,97 @@ TEST(LayeringEnergy, RandomStacksNeverGainEnergyInTheGeneratedShaders) {
   ASSERT_GT(closures, cases);
 }
 
+TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
+  // The stored interface count on lavapipe: stacks whose closures lie under
+  // 2, 3, 4 and 5 interfaces (extraInterfaces 1 .. 3, and one interface folded
+  // at depth 6), lit by the forward kernel (compared with the reference's
+  // lighting of the material) and by the deferred one (its unpacker must read
+  // the count from closure header bits 14-15: compared with the reference's
+  // lighting of the closures it unpacked, and the count with the reference's).
+  // HLSL and GLSL share the runtime; GLSL only (CI time).
+  using namespace stackfurnace;
+  constexpr int kDiffuseModel = 2;  // EmitOptions' default (Chan 2024)
+  std::string error;
+  gpu::Context* ctx = gputest::sharedContext(&error);
+  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+  const std::vector<gpu::Sample> samples = gpu::makeSamples(kernel::kLocalSize, 0x57ac);
+  const auto sampleBytes = gpu::sampleBuffer(samples);
+  const gputest::Tolerance tol;
+  long compared = 0, stacked = 0, failed = 0;
+  double margin = 0;
+  std::string worst;
+  const std::pair<int, Shape> stacks[] = {{4, Shape::NestedBases}, {6, Shape::NestedBases}, {5, Shape::CoveredNestedBases}};
+  for (const auto& [depth, shape] : stacks) {
+    CompileOptions o;
+    o.budgetOverride = 4096;
+    o.maxClosuresOverride = 8;
+    const CompileResult r = compile(stackMaterial(depth, shape), o);
+    ASSERT_EQ(r.after.closures.size(), static_cast<std::size_t>(depth));
+    const int stride = gpu::resultStride(r);
+    ShaderValidation shaders[2];
+    decltype(ctx->createPipeline(shaders[0].spirv, &error)) pipelines[2];
+    for (int mode = 0; mode < 2; ++mode) {
+      shaders[mode] = compileKernel(r, Target::Glsl, mode == 0 ? KernelMode::Forward : KernelMode::Deferred);
+      ASSERT_TRUE(shaders[mode].ok) << shaders[mode].log;
+      pipelines[mode] = ctx->createPipeline(shaders[mode].spirv, &error);
+      ASSERT_NE(pipelines[mode], nullptr) << error;
+    }
+    std::vector<float> out[2];
+    Rng rng{0x7a0000u + static_cast<std::uint64_t>(depth)};
+    std::vector<Case> cases{whiteStack(depth, shape)};
+    for (int k = 0; k < 3; ++k) cases.push_back(randomCase(depth, shape, rng));
+    for (const Case& c : cases) {
+      for (int mode = 0; mode < 2; ++mode) {
+        gpu::Resources res = gputest::kernelResources(r.material, pipelines[mode]->reflection(), shaders[mode].spirv,
+                                                      c.inputs, sampleBytes,
+                                                      static_cast<std::size_t>(stride) * samples.size());
+        ASSERT_TRUE(ctx->dispatch(*pipelines[mode], res, static_cast<uint32_t>(samples.size()) / kernel::kLocalSize, 1,
+                                  1, &error))
+            << error;
+        out[mode] = gpu::floatsOf(res, 0, 7);
+      }
+      for (std::size_t i = 0; i < samples.size(); ++i) {
+        const gpu::Sample& s = samples[i];
+        const auto ref = gputest::shade<double>(r, s, c.inputs, kDiffuseModel);
+        const auto r32 = gputest::shade<float>(r, s, c.inputs, kDiffuseModel);
+        const float* fwd = &out[0][i * static_cast<std::size_t>(stride)];
+        const float* def = &out[1][i * static_cast<std::size_t>(stride)];
+        std::vector<reference::Closure<double>> unpacked;
+        const int count = static_cast<int>(def[kernel::kResultCount]);
+        for (int k = 0; k < count; ++k) {
+          const auto f = gputest::closureFromResults(out[0], stride, static_cast<int>(i), k);
+          const auto d = gputest::closureFromResults(out[1], stride, static_cast<int>(i), k);
+          const std::uint32_t want = ref.material.closures[static_cast<std::size_t>(k)].extraInterfaces;
+          EXPECT_EQ(f.extraInterfaces, want) << "forward closure " << k;
+          if (count == depth) EXPECT_EQ(d.extraInterfaces, want) << "deferred closure " << k;  // not dynamically simple
+          stacked += want > 0;
+          unpacked.push_back(d);
+        }
+        const auto dref = gputest::lightClosures<double>(unpacked, s, kDiffuseModel);
+        const auto d32 = gputest::lightClosures<float>(unpacked, s, kDiffuseModel);
+        auto check = [&](const char* what, double gpuValue, double r64, double r32v) {
+          ++compared;
+          const double allowed = tol.k * std::abs(r32v - r64) + tol.abs + tol.rel * std::abs(r64);
+          const double m = std::abs(gpuValue - r64) / allowed;
+          if (m > margin) margin = m, worst = fmt::format("depth {} ({}), {}, sample {}: {} gpu {} ref {}", depth,
+                                                          shapeName(shape), c.text, i, what, gpuValue, r64);
+          if (!tol.ok(gpuValue, r64, r32v)) ++failed;
+        };
+        for (int ch = 0; ch < 3; ++ch) {
+          check("forward direct", fwd[kernel::kResultDirect + ch], ref.direct[ch], r32.direct[ch]);
+          check("forward environment", fwd[kernel::kResultEnvironment + ch], ref.environment[ch], r32.environment[ch]);
+          check("deferred direct", def[kernel::kResultDirect + ch], dref.direct[ch], d32.direct[ch]);
+          check("deferred environment", def[kernel::kResultEnvironment + ch], dref.environment[ch], d32.environment[ch]);
+        }
+      }
+    }
+  }
+  std::printf("[ layering ] stacks forward and deferred on lavapipe: %ld values compared, %ld closures with extra "
+              "interfaces; largest error / allowed %.3f at %s\n",
+              compared, stacked, margin, worst.c_str());
+  EXPECT_EQ(failed, 0) << "largest at " << worst;
+  ASSERT_GT(compared, 0);
+  ASSERT_GT(stacked, 0);
+}
+
 }  // namespace

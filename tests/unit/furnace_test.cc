@@ -310,6 +310,43 @@ TEST(Furnace, RandomStacksOfTwoToEightSlabsNeverGainEnergy) {
   ASSERT_GT(closures, cases);
 }
 
+TEST(Furnace, StackClosuresCarryUpToFourInterfacesAndFoldTheRest) {
+  // Eight clear slabs (F0 0, thickness 0: every layer lets 1 through along the
+  // normal). Closure k lies under k interfaces: it stores min(k - 1, 3) extra
+  // ones, which the lighting applies as (1 - (1 - mu)^5)^(1 + extra), and its
+  // top transmittance carries Q = 0.91 (substrate_extra_interfaces) for each
+  // interface past the fourth only: 1, 1, 1, 1, 1, 0.91, 0.91^2, 0.91^3.
+  using namespace stackfurnace;
+  CompileOptions o;
+  o.budgetOverride = 4096;
+  o.maxClosuresOverride = 8;
+  Diagnostics d("stack.json");
+  auto r = compileText("stack.json", stackMaterial(8, Shape::NestedBases), o, d);
+  ASSERT_TRUE(r.has_value()) << d.formatAll();
+  ASSERT_EQ(r->after.closures.size(), 8u);
+  reference::Geometry g;
+  g.V = stackfurnace::viewAt(0.5);
+  const auto m = reference::evaluateMaterial<double>(*r, g, {}, {});
+  ASSERT_EQ(m.closures.size(), 8u);
+  int checked = 0;
+  for (int k = 0; k < 8; ++k) {
+    const auto& c = m.closures[static_cast<std::size_t>(k)];
+    const int extra = std::min(std::max(k - 1, 0), 3);
+    EXPECT_EQ(c.isTop, k == 0) << k;
+    EXPECT_EQ(c.extraInterfaces, static_cast<std::uint32_t>(extra)) << k;
+    EXPECT_EQ(r->after.closures[static_cast<std::size_t>(k)].extraInterfaces, extra) << k;
+    EXPECT_NEAR(c.topTransmittance[0], std::pow(0.91, std::max(k - 4, 0)), 1e-12) << k;
+    if (k > 0) {  // the lighting: the interface term to the power 1 + extra
+      const double mu = 0.3, gmu = 1 - std::pow(1 - mu, 5);
+      const double want = std::pow(c.topTransmittance[0], 1 / mu) * std::pow(gmu, 1 + extra);
+      EXPECT_NEAR(reference::viewThroughput<double>(c, mu)[0], want, 1e-9) << k;
+      EXPECT_NEAR(reference::lightThroughput<double>(c, mu)[0], want, 1e-9) << k;
+    }
+    ++checked;
+  }
+  ASSERT_EQ(checked, 8);
+}
+
 TEST(Furnace, StacksOfWhiteTransparentSlabsAtEveryDepth) {
   // The issue's own case: white slabs (albedo 1, F0 0, roughness ~0), every
   // one but the bottom transparent (sss_mfp 1e6, thickness 0), every closure

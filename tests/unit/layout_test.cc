@@ -245,6 +245,43 @@ TEST(Layout, CoverageAboveIsStoredUnderEveryLayerBelowAPartlyCoveringOne) {
   EXPECT_TRUE(p.layout.closures[2].storesCoverageAbove);
 }
 
+TEST(Layout, ClosuresCountTheInterfacesAboveThemUpToFourInTheirHeader) {
+  // The closure header's last two bits hold the interfaces above a closure
+  // beyond the first, up to 3 (docs/storage.md): the lighting applies the
+  // angular part of that many more. A top counts its slabs' interfaces on
+  // the longest path down (a vertical top its top and base, a mix its larger
+  // side); a top closure and one under a single interface store 0.
+  Priced p = price(material(R"(
+    "c0": {"kind": "slab", "roughness": 0.1, "sss_mfp": 10},
+    "c1": {"kind": "slab", "roughness": 0.2, "sss_mfp": 10},
+    "c2": {"kind": "slab", "roughness": 0.3, "sss_mfp": 10},
+    "m0": {"kind": "slab", "roughness": 0.4, "sss_mfp": 10},
+    "m1": {"kind": "slab", "roughness": 0.5, "sss_mfp": 10},
+    "base": {"kind": "slab", "roughness": 0.6},
+    "coats": {"kind": "vertical", "top": "c0", "base": {"kind": "vertical", "top": "c1", "base": "c2"}},
+    "root": {"kind": "vertical", "top": "coats",
+             "base": {"kind": "vertical", "top": {"kind": "horizontal", "background": "m0", "foreground": "m1", "mix": "$m"},
+                      "base": "base"}})",
+                            kInputs));
+  ASSERT_EQ(p.layout.closures.size(), 6u);
+  // Pre-order: c0 (top), c1 (under c0), c2 (under c0, c1), m0 and m1 (under
+  // the three coats), base (under the coats and the mix: 4 interfaces).
+  const int want[] = {0, 0, 1, 2, 2, 3};
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(p.layout.closures[k].extraInterfaces, want[k]) << "closure " << k;
+  expectConsistent(p.layout);
+  int headers = 0;
+  for (const auto& f : p.layout.fields)
+    if (f.name.ends_with(".header")) {
+      ++headers;
+      EXPECT_EQ(f.encoding, "basis id 3 | is top 1 | feature bits 8 | sss type 2 | extra interfaces 2");
+    }
+  EXPECT_EQ(headers, 6);
+  EXPECT_EQ(storedExtraInterfaces(0), 0);
+  EXPECT_EQ(storedExtraInterfaces(1), 0);
+  EXPECT_EQ(storedExtraInterfaces(4), 3);
+  EXPECT_EQ(storedExtraInterfaces(9), 3);
+}
+
 TEST(Layout, NoModify_NoCoverageAboveUnderFullyCoveringLayers) {
   // A horizontal of two slabs covers fully ((1-m)*1 + m*1); an add covers
   // fully when either side does; a vertical when either its top or base does.

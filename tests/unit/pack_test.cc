@@ -7,6 +7,7 @@
 #include "storage/pack.h"
 
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <bit>
@@ -588,6 +589,8 @@ void roundTrip(const StorageLayout& L, const Pixel& px, double u, const std::str
     EXPECT_EQ(m.layout.closures[i].storesWeight, c.storesWeight);
     EXPECT_EQ(m.layout.closures[i].storesCoverageAbove, c.storesCoverageAbove);
     EXPECT_EQ(m.layout.closures[i].storedFeatures, c.storedFeatures);
+    EXPECT_EQ(m.layout.closures[i].extraInterfaces, c.extraInterfaces);
+    EXPECT_EQ(got.extraInterfaces, static_cast<std::uint32_t>(c.extraInterfaces));
     EXPECT_EQ(got.basis, c.basis);
     EXPECT_EQ(got.isTop, c.isTop);
     EXPECT_EQ(got.features, closureHeaderFeatures(c));
@@ -796,6 +799,42 @@ TEST(PackMaterial, EightClosuresOnEightBasesWithEveryFeature) {
   Rng rng(17);
   for (int trial = 0; trial < 100; ++trial)
     for (double u : kDithers) roundTrip(L, randomPixel(L, rng), u, "eight");
+}
+
+TEST(PackMaterial, ClosureHeadersHoldTheExtraInterfacesAbove) {
+  // Six nested slabs: closure k lies under k interfaces and stores
+  // min(k - 1, 3) in closure header bits 14-15 (docs/storage.md).
+  std::string nodes;
+  for (int k = 0; k < 6; ++k)
+    nodes += fmt::format(R"("s{0}": {{"kind": "slab", "roughness": 0.{0}, "sss_mfp": 1e6}}, )", k);
+  for (int j = 1; j < 6; ++j)
+    nodes += fmt::format(R"({}"{}": {{"kind": "vertical", "top": "s{}", "base": "{}", "thickness": 0}})", j == 1 ? "" : ", ",
+                         j == 1 ? "root" : fmt::format("v{}", j), j - 1, j == 5 ? "s5" : fmt::format("v{}", j + 1));
+  auto r = compile("stack.json", document(nodes));
+  ASSERT_TRUE(r);
+  const StorageLayout& L = r->after;
+  ASSERT_EQ(L.closures.size(), 6u);
+  const int want[] = {0, 0, 1, 2, 3, 3};
+  Rng rng(21);
+  const Pixel px = randomPixel(L, rng);
+  const auto words = packMaterial(L, px.closures, px.bases, 0.5);
+  int checked = 0;
+  for (std::size_t i = 0; i < L.fields.size(); ++i) {
+    const LayoutField& f = L.fields[i];
+    if (f.closure < 0 || f.name != fmt::format("closure{}.header", f.closure)) continue;
+    std::size_t at = 0;
+    for (std::size_t j = 0; j < i; ++j) at += static_cast<std::size_t>(L.fields[j].bits);
+    EXPECT_EQ(L.closures[f.closure].extraInterfaces, want[f.closure]) << f.name;
+    EXPECT_EQ((readBits(words.data(), words.size(), at, 16) >> 14) & 3u, static_cast<std::uint32_t>(want[f.closure]))
+        << f.name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 6);
+  for (int trial = 0; trial < 20; ++trial)
+    for (double u : kDithers) roundTrip(L, randomPixel(L, rng), u, "stack");
+  StorageLayout bad = L;
+  bad.closures[5].extraInterfaces = 4;
+  EXPECT_THROW(packMaterial(bad, px.closures, px.bases, 0.5), std::invalid_argument);
 }
 
 TEST(PackMaterial, StructureComesFromTheLayout) {

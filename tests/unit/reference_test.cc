@@ -372,9 +372,9 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
   layerAbove(cover, through, 0.7, {t1[0] * 0.96, t1[1] * 0.96, t1[2] * 0.96});  // the root's top first
   const double coverMid = cover;
   const D3 throughMid = through;
-  // The second interface on the way down: its layer times SUBSTRATE_EXTRA_INTERFACE
-  // (substrate_extra_interfaces), the lighting applies the angular part of one.
-  layerAbove(cover, through, 1.0, {t2[0] * 0.96 * 0.91, t2[1] * 0.94 * 0.91, t2[2] * 0.92 * 0.91});
+  // The second interface on the way down is not folded (no SUBSTRATE_EXTRA_INTERFACE):
+  // the base stores one extra interface and the lighting applies the angular part of two.
+  layerAbove(cover, through, 1.0, {t2[0] * 0.96, t2[1] * 0.94, t2[2] * 0.92});
   MaterialResult<double> m = evaluateMaterial<double>(r, tiltedGeometry(), {}, {});
   const Closure<double>& base = m.closures[closureOf(r, "base")];
   EXPECT_NEAR(base.coverageAbove, cover, 1e-12);
@@ -385,6 +385,26 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
   EXPECT_V3_NEAR(mid.topTransmittance, throughMid, 1e-12);
   EXPECT_NEAR(mid.roughness, 0.3, 1e-9);  // nothing widens it
   EXPECT_NE(mid.features & kFeatureCoverageAbove, 0u);
+  EXPECT_EQ(base.extraInterfaces, 1u);
+  EXPECT_EQ(mid.extraInterfaces, 0u);
+  // The lighting: (1 - (1 - mu)^5)^(1 + extraInterfaces) along the view and the
+  // light (cover is 1 under the full inner coat, so the ratio is the term itself).
+  ASSERT_NEAR(cover, 1.0, 1e-12);
+  for (double mu : {1.0, 0.5, 0.1, 1e-3}) {
+    const double g = 1 - std::pow(1 - mu, 5);
+    Closure<double> one = base;
+    one.extraInterfaces = 0;
+    for (std::uint32_t k : {0u, 1u, 2u, 3u}) {
+      Closure<double> c = base;
+      c.extraInterfaces = k;
+      const auto a = viewThroughput<double>(c, mu), b = viewThroughput<double>(one, mu);
+      const auto l = lightThroughput<double>(c, mu), lb = lightThroughput<double>(one, mu);
+      for (int ch = 0; ch < 3; ++ch) {
+        EXPECT_NEAR(a[ch], b[ch] * std::pow(g, k), 1e-12) << "mu " << mu << ", k " << k;
+        EXPECT_NEAR(l[ch], lb[ch] * std::pow(g, k), 1e-12) << "mu " << mu << ", k " << k;
+      }
+    }
+  }
   const Closure<double>& top = m.closures[closureOf(r, "coat")];
   EXPECT_TRUE(top.isTop);
   EXPECT_NEAR(top.weight, 0.7, 1e-12);
@@ -444,6 +464,7 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.weight = static_cast<To>(c.weight);
   o.topTransmittance = v(c.topTransmittance);
   o.coverageAbove = static_cast<To>(c.coverageAbove);
+  o.extraInterfaces = c.extraInterfaces;
   o.features = c.features;
   o.isTop = c.isTop;
   return o;
