@@ -528,13 +528,20 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     float amount = saturate(c.fuzzAmount);
     float eFuzz = substrate_fuzz_albedo(NoV, c.fuzzRoughness);
     // The lobe is normalized where the model's albedo exceeds 1 (grazing,
-    // smooth fuzz); what it reflects no longer reaches the layers below.
+    // smooth fuzz); what it reflects no longer reaches the layers below, along
+    // the view and along the light alike: the layers below are scaled by
+    // 1 - amount min(max(E_fuzz(NoV), E_fuzz(NoL)), 1) (KHR_materials_sheen's
+    // min of the two albedo scalings). With the view's alone, light arriving at
+    // grazing was reflected by the fuzz and still fed the base whole: a white
+    // diffuse under fuzz returned up to 1.48 of a light at NoL 0.1.
     float3 fuzz = SUBSTRATE_SPLAT3(0.0);
+    float eCaught = eFuzz;
     if (lightFacing) {
       fuzz = saturate(c.fuzzColor) * (amount * substrate_charlie_sheen(c.fuzzRoughness, NoV, NoLc, NoH) /
                                       max(1.0, eFuzz));
+      eCaught = max(eFuzz, substrate_fuzz_albedo(NoLc, c.fuzzRoughness));
     }
-    result = result * (1.0 - amount * min(eFuzz, 1.0)) + fuzz;
+    result = result * (1.0 - amount * min(eCaught, 1.0)) + fuzz;
   }
 #endif
   return result;

@@ -181,7 +181,9 @@ float substrate_env_mip(float roughness, float mipCount) {
 // lighting (haze: lerped by weight), tinted by the specular profile at
 // (NoV, NoV); diffuse: albedo (1 - E_spec) E / pi (every diffuse model, wrap
 // included, uses albedo as its hemispherical albedo); fuzz: amount colour
-// min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1)).
+// min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1))
+// at NoV (the direct light's light-side term, E_fuzz(NoL), is not applied here:
+// the environment has no single light direction).
 // The layers above are crossed at NoV by the specular (its light comes from
 // the mirror direction) and at SUBSTRATE_DIFFUSE_MEAN_COS by the diffuse and fuzz.
 float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredRadiance, float3 irradiance) {

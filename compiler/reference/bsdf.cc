@@ -432,10 +432,15 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
     T eFuzz = fuzzAlbedo(NoV, c.fuzzRoughness);
     // The lobe is normalized where the model's albedo exceeds 1; what it
     // reflects no longer reaches the layers below.
+    // ... along the view and along the light alike (substrate_eval_closure):
+    // the layers below are scaled by 1 - amount min(max(E_fuzz(NoV), E_fuzz(NoL)), 1).
     V3<T> fuzz = zero;
-    if (lightFacing)
+    T eCaught = eFuzz;
+    if (lightFacing) {
       fuzz = saturate(c.fuzzColor) * (amount * charlieSheen(c.fuzzRoughness, NoV, NoLc, NoH) / std::max(T(1), eFuzz));
-    result = result * (T(1) - amount * std::min(eFuzz, T(1))) + fuzz;
+      eCaught = std::max(eFuzz, fuzzAlbedo(NoLc, c.fuzzRoughness));
+    }
+    result = result * (T(1) - amount * std::min(eCaught, T(1))) + fuzz;
   }
   return result;
 }

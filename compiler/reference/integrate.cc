@@ -6,7 +6,9 @@
 // rotation (drawn from the seed): GGX visible normals (Heitz 2018, "Sampling
 // the GGX Distribution of Visible Normals") of the primary lobe and, when it has
 // weight, of the haze lobe, at the lobes' clamped alphas (substrate_ggx_alpha);
-// the cosine-weighted hemisphere (diffuse, fuzz); the uniform sphere for SSS
+// the cosine-weighted hemisphere (diffuse, fuzz); the Charlie sheen distribution
+// (fuzz: its lobe lies along the horizon for smooth fuzz, where the cosine
+// strategy puts few points); the uniform sphere for SSS
 // wrap (lit from below the horizon). Every strategy contributes
 // f(x) / sum_k p_k(x) per point, averaged over its points: unbiased wherever one
 // strategy's density is positive, which covers every direction the closure
@@ -95,10 +97,45 @@ struct VisibleGgx {
   }
 };
 
-enum class Kind { Ggx, Cosine, Sphere };
+/// The Charlie sheen distribution of alpha a (substrate_charlie_d), sampled
+/// exactly: D(h) NoH is a density over the hemisphere of h whose sin(theta_h)
+/// has the CDF s^(2 + 1/a). The light is the view reflected about h; an h that
+/// faces away from the view yields no sample (the density below is then that
+/// of the directions it does yield, a sub-density, which the balance heuristic
+/// accepts).
+struct Sheen {
+  double a;
+  D3 Ve;
+
+  double D(double NoH) const {
+    const double inv = 1.0 / a;
+    return (2.0 + inv) * std::pow(std::max(1.0 - NoH * NoH, 0.0), 0.5 * inv) * (0.5 / kPi);
+  }
+  double pdf(const D3& l) const {
+    D3 hv = Ve + l;
+    double len = length(hv);
+    if (!(len > 1e-12)) return 0;
+    D3 h = hv / len;
+    const double VoH = dot(Ve, h);
+    if (VoH <= 0 || h[2] <= 0) return 0;
+    return D(h[2]) * h[2] / (4.0 * VoH);
+  }
+  D3 sample(double u1, double u2) const {
+    const double sinT = std::pow(u1, 1.0 / (2.0 + 1.0 / a));
+    const double cosT = std::sqrt(std::max(0.0, 1.0 - sinT * sinT));
+    const double phi = 2.0 * kPi * u2;
+    const D3 h{sinT * std::cos(phi), sinT * std::sin(phi), cosT};
+    const double VoH = dot(Ve, h);
+    if (!(VoH > 0)) return {0, 0, 0};
+    return h * (2.0 * VoH) - Ve;
+  }
+};
+
+enum class Kind { Ggx, Cosine, Sphere, Sheen };
 struct Strategy {
   Kind kind;
   VisibleGgx ggx;  // Kind::Ggx
+  Sheen sheen{1, {0, 0, 1}};  // Kind::Sheen
 };
 
 double pdfOf(const Strategy& s, const D3& l) {
@@ -106,6 +143,7 @@ double pdfOf(const Strategy& s, const D3& l) {
     case Kind::Ggx: return s.ggx.pdf(l);
     case Kind::Cosine: return l[2] > 0 ? l[2] / kPi : 0.0;
     case Kind::Sphere: return 1.0 / (4.0 * kPi);
+    case Kind::Sheen: return s.sheen.pdf(l);
   }
   return 0;
 }
@@ -121,6 +159,7 @@ D3 sampleOf(const Strategy& s, double u1, double u2) {
       double z = 1.0 - 2.0 * u1, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u2;
       return {r * std::cos(phi), r * std::sin(phi), z};
     }
+    case Kind::Sheen: return s.sheen.sample(u1, u2);
   }
   return {0, 0, 1};
 }
@@ -148,6 +187,13 @@ V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
   addGgx(c.roughness);
   if ((c.features & kFeatureHaze) && saturate(c.secondRoughnessWeight) > 0) addGgx(c.secondRoughness);
   strategies.push_back({Kind::Cosine, {}});
+  if ((c.features & kFeatureFuzz) && saturate(c.fuzzAmount) > 0) {
+    // The sheen lobe of smooth fuzz lies along the horizon, where the cosine
+    // strategy puts few points: sampled by its own distribution (a = max(r^2,
+    // 1e-3), substrate_charlie_sheen).
+    const double r = saturate(c.fuzzRoughness);
+    strategies.push_back({Kind::Sheen, {}, Sheen{std::max(r * r, 1e-3), Ve}});
+  }
   if (c.sssType == kSssWrap) strategies.push_back({Kind::Sphere, {}});
 
   std::uint64_t state = seed;

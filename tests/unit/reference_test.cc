@@ -665,7 +665,11 @@ TEST(ReferenceSplitSum, AgreesWithIntegrationUnderAUniformEnvironment) {
   // (substrate_lighting.h: a Lambertian albedo a reflects a E / pi).
   // Measured (8192 points per strategy), roughness 0.3..0.7, NoV 0.3..1, worst
   // relative difference, top closures: Lambert 0.17 %, EON 0.76 %, haze 0.15 %,
-  // fuzz 0.54 % (the tables are upper bounds); Chan 2024, whose albedo is not
+  // fuzz 7.7 % (the split sum scales the layers under the fuzz along the view
+  // only; the direct light, which the integration sums, along the light too
+  // since issue 16 — 0.54 % before — and a single cosine cannot stand for every
+  // light: the split sum is high, never above the white furnace's 1);
+  // Chan 2024, whose albedo is not
   // `albedo`, 5.1 %. Under layers:
   // ThroughLayersItsCosinesAreApproximations.
   struct Case {
@@ -677,7 +681,7 @@ TEST(ReferenceSplitSum, AgreesWithIntegrationUnderAUniformEnvironment) {
   const Case cases[] = {{"lambert", kDiffuseLambert, 0, 0.02},
                         {"eon", kDiffuseEon, 0, 0.02},
                         {"haze", kDiffuseLambert, kFeatureHaze, 0.02},
-                        {"fuzz", kDiffuseLambert, kFeatureFuzz, 0.02},
+                        {"fuzz", kDiffuseLambert, kFeatureFuzz, 0.08},
                         {"chan2024", kDiffuseChan2024, 0, 0.06}};
   const V3<double> one{1, 1, 1}, pi{M_PI, M_PI, M_PI};
   for (const Case& k : cases) {
