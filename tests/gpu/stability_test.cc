@@ -483,7 +483,10 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
   double margin = 0;
   std::string worst;
   const std::pair<int, Shape> stacks[] = {{4, Shape::NestedBases}, {6, Shape::NestedBases}, {5, Shape::CoveredNestedBases}};
-  for (const auto& [depth, shape] : stacks) {
+  for (const auto& stack : stacks) {
+    // Plain names, not a structured binding: the lambda below captures them (clang 14, the asan build).
+    const int depth = stack.first;
+    const Shape shape = stack.second;
     CompileOptions o;
     o.budgetOverride = 4096;
     o.maxClosuresOverride = 8;
