@@ -16,24 +16,41 @@ class Culler {
   /// Returns the node that replaces `i`, or -1 if the subtree is empty.
   /// `layer`: the thickness of the layer that holds `i` (TreeInfo::layerVertical:
   /// the nearest vertical whose top layer holds it; kNoValue: the surface thickness).
+  /// Kept lean: it recurses as deep as the tree (DeepTrees runs 512 levels on a
+  /// 1 MiB stack, under ASan too), so the notes and their strings live in the
+  /// helpers below, which are not inlined into this frame.
   int visit(int i, ValueId layer) {
-    TreeNode n = m_.nodes[i];  // copy: m_.nodes may grow
-    ValueDag& dag = m_.values;
-    auto drop = [&](int child, const std::string& why) {
-      if (child >= 0) note(m_.nodes[child].id, why);
-    };
+    const TreeNode& node = m_.nodes[i];
+    if (node.op == TreeOp::Slab) return i;
+    const TreeOp op = node.op;
+    const int left = node.left, right = node.right;
+    const ValueId a = node.a;
+    if (const int chosen = constantChoice(i); chosen != kNoChoice) return chosen < 0 ? -1 : visit(chosen, layer);
+    // A vertical's top is a layer of the vertical's thickness; its base stays in `layer`.
+    const int l = left >= 0 ? visit(left, op == TreeOp::Vertical ? a : layer) : -1;
+    const int r = right >= 0 ? visit(right, layer) : -1;
+    return rebuild(i, l, r, layer);
+  }
+
+ private:
+  static constexpr int kNoChoice = -2;
+
+  /// An operator whose constant weight or value decides it: the child that
+  /// replaces it (-1: removed with its subtree), with the notes; else kNoChoice.
+  [[gnu::noinline]] int constantChoice(int i) {
+    const TreeNode n = m_.nodes[i];
+    const ValueDag& dag = m_.values;
     switch (n.op) {
-      case TreeOp::Slab: return i;
       case TreeOp::Horizontal:
         if (dag.isConstEqual(n.a, 0)) {
           drop(n.right, fmt::format("foreground of horizontal '{}': mix is constant 0", n.id));
           note(n.id, "horizontal with constant mix 0 replaced by its background");
-          return visit(n.left, layer);
+          return n.left;
         }
         if (dag.isConstEqual(n.a, 1)) {
           drop(n.left, fmt::format("background of horizontal '{}': mix is constant 1", n.id));
           note(n.id, "horizontal with constant mix 1 replaced by its foreground");
-          return visit(n.right, layer);
+          return n.right;
         }
         break;
       case TreeOp::CoverageWeight:
@@ -44,7 +61,7 @@ class Culler {
         }
         if (dag.isConstEqual(n.a, 1)) {
           note(n.id, "coverage_weight with constant weight 1 removed (no effect)");
-          return visit(n.left, layer);
+          return n.left;
         }
         break;
       case TreeOp::Select:
@@ -54,14 +71,20 @@ class Culler {
                fmt::format("side {} of select '{}': the constant value always picks {}", pickA ? "b" : "a", n.id,
                            pickA ? "a" : "b"));
           note(n.id, fmt::format("select with a constant value replaced by side {}", pickA ? "a" : "b"));
-          return visit(pickA ? n.left : n.right, layer);
+          return pickA ? n.left : n.right;
         }
         break;
       default: break;
     }
-    // A vertical's top is a layer of the vertical's thickness; its base stays in `layer`.
-    int l = n.left >= 0 ? visit(n.left, n.op == TreeOp::Vertical ? n.a : layer) : -1;
-    int r = n.right >= 0 ? visit(n.right, layer) : -1;
+    return kNoChoice;
+  }
+
+  /// Operator `i` after its children became `l` and `r` (-1: empty): what
+  /// replaces it — its opaque top for a vertical that hides its base, the
+  /// other side for an operator left with one empty side, or `i` relinked.
+  [[gnu::noinline]] int rebuild(int i, int l, int r, ValueId layer) {
+    const TreeNode n = m_.nodes[i];  // copy: rewriteAsWeight changes the node
+    ValueDag& dag = m_.values;
     if (n.op == TreeOp::Vertical && l >= 0 && r >= 0) {
       const bool hidden = opaque(l, n.a, false);
       if (hidden || opaque(l, n.a, true)) warnHidden(n, l, hidden);
@@ -112,7 +135,9 @@ class Culler {
     }
   }
 
- private:
+  void drop(int child, const std::string& why) {
+    if (child >= 0) note(m_.nodes[child].id, why);
+  }
   int rewriteAsWeight(int i, int kept, ValueId w, const char* why) {
     TreeNode& node = m_.nodes[i];
     note(node.id, fmt::format(fmt::runtime(why), node.id));
