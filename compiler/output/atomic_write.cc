@@ -167,17 +167,37 @@ std::string writePathsAtomically(const std::vector<OutputPath>& files) {
 
 namespace {
 
-/// Creates a temporary beside `p` (and the directories it needs), then
-/// removes them all; "" or the error.
+/// Whether `p` could be written, without creating anything another process
+/// could see half-made: where its directory exists, a temporary is written
+/// beside it and removed (unique names: no race); where it does not, the
+/// nearest existing ancestor must be a directory this process may create
+/// entries in. A probe that created and then removed the missing directories
+/// raced with concurrent commands writing into the same new folder (two
+/// `compile`s of one CMake target's depfile folder: one removed the folder
+/// between the other's mkdir of it and of its child). "" or the error.
 std::string probe(const fs::path& p) {
-  std::vector<fs::path> created;
-  fs::path temp;
-  std::string error = makeDirectory(p, created);
-  if (error.empty()) error = writeTemporary(p, "", &temp);
-  std::error_code ignored;
-  if (!temp.empty()) fs::remove(temp, ignored);
-  for (auto it = created.rbegin(); it != created.rend(); ++it) fs::remove(*it, ignored);
-  return error;
+  const fs::path dir = dirOf(p);
+  std::error_code ec;
+  fs::path existing = dir;
+  while (!existing.empty() && !fs::exists(existing, ec)) {  // bounded by the path's depth
+    if (existing == existing.parent_path()) break;
+    existing = existing.parent_path();
+  }
+  if (existing.empty()) existing = ".";
+  if (existing == dir) {
+    if (!fs::is_directory(dir, ec))
+      return fmt::format("cannot write '{}': '{}' is not a directory", p.string(), dir.string());
+    fs::path temp;
+    std::string error = writeTemporary(p, "", &temp);
+    if (!temp.empty()) fs::remove(temp, ec);
+    return error;
+  }
+  if (!fs::is_directory(existing, ec))
+    return fmt::format("cannot write '{}': '{}' is not a directory", p.string(), existing.string());
+  if (::access(existing.c_str(), W_OK | X_OK) != 0)
+    return fmt::format("cannot write '{}': cannot create a directory in '{}': {}", p.string(), existing.string(),
+                       std::strerror(errno));
+  return "";
 }
 
 }  // namespace
