@@ -379,3 +379,38 @@ TEST(AllOrNone, WritePathsAtomicallyCommitsAcrossFoldersOrNothing) {
   EXPECT_EQ(slurp(dir / "a/kept.txt"), "new");
   EXPECT_EQ(slurp(dir / "b/new.txt"), "new");
 }
+
+namespace {
+
+// Probing a destination before the work creates nothing another process could
+// see: a probe that made a missing folder and removed it again raced with a
+// concurrent compile writing into that folder (two compiles of one CMake
+// target, their depfiles in one new folder: one lost its folder between two
+// mkdirs). The folder is made only by the all-or-none commit.
+TEST(AllOrNone, AProbeOfADestinationInAMissingFolderCreatesNothing) {
+  const fs::path dir = freshDir("probe_creates_nothing");
+  const fs::path file = dir / "a/b/x.d";
+  // A folder made and removed again leaves no entry, but it moves the
+  // parent's modification time: wait past the clock's tick, then compare.
+  auto mtime = [](const fs::path& p) {
+    struct stat st {};
+    ::stat(p.c_str(), &st);
+    return std::pair(st.st_mtim.tv_sec, st.st_mtim.tv_nsec);
+  };
+  ::usleep(50 * 1000);
+  const auto before = mtime(dir);
+  EXPECT_EQ(substratec::checkWritable({file.string()}), "");
+  EXPECT_FALSE(fs::exists(dir / "a")) << "the probe left the folder";
+  EXPECT_EQ(mtime(dir), before) << "the probe created (and removed) an entry in " << dir;
+  EXPECT_EQ(substratec::checkWritableDirectory((dir / "c/d").string()), "");
+  EXPECT_FALSE(fs::exists(dir / "c"));
+  // Where the folder exists, the probe's temporary is gone after it.
+  fs::create_directories(dir / "e");
+  EXPECT_EQ(substratec::checkWritable({(dir / "e/x.d").string()}), "");
+  EXPECT_TRUE(fs::is_empty(dir / "e"));
+  // A file where a folder is needed is still an error.
+  std::ofstream(dir / "f") << "x";
+  EXPECT_NE(substratec::checkWritable({(dir / "f/x.d").string()}).find("is not a directory"), std::string::npos);
+}
+
+}  // namespace
