@@ -1,7 +1,7 @@
 // The imported glTF corpus against the glTF 2.0 reference BRDF (issue 10):
 // every material of tests/import/corpus/gltf without textures, imported and
 // compiled (default budget), its direct light evaluated by Substrate's CPU
-// reference and by the oracle (compiler/reference/gltf_brdf.h) over the same
+// reference and by the oracle (compiler/tools/reference/gltf_brdf.h) over the same
 // 24 x 24 view/light pairs; rel_mse with the runtime's diffuse (chan2024) and
 // with Lambert. Prints the Markdown table of docs/import.md.
 //

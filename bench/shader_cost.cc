@@ -26,7 +26,7 @@
 //                 rel_mse, max |Δ| and max |Δ|/|f| of the half kernel's output
 //                 against float32's (docs/stability.md, "Half precision").
 //
-// Timing: the material's Throughput kernel (compiler/emit/kernel_emitter.h:
+// Timing: the material's Throughput kernel (compiler/core/emit/kernel_emitter.h:
 // each invocation hashes its own shading point, evaluates the material, lights
 // it with one light and a constant split-sum environment, writes one float4),
 // compiled as `substratec sweep` compiles it (compileKernel: glslang, SPIR-V as

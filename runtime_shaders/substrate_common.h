@@ -19,7 +19,7 @@ SUBSTRATE_CONST float SUBSTRATE_MIN_MFP = 1e-30;
 // Largest finite value the helpers return instead of +inf.
 SUBSTRATE_CONST float SUBSTRATE_FLT_MAX = 3.0e38;
 
-// pow with the compiler's constant-folding semantics (compiler/ir/value.cc,
+// pow with the compiler's constant-folding semantics (compiler/core/ir/value.cc,
 // Op::Pow): the base is clamped at 0; 0^y = 0 for y != 0 and 0^0 = 1. The pow()
 // intrinsic is never called with a zero base (undefined for y <= 0 on GPUs).
 // A result beyond the float range (e.g. (1e-30)^-2) is clamped to 3e38.
@@ -76,7 +76,7 @@ float3 substrate_safe_normalize(float3 v, float3 fallback) {
 
 // Branchless orthonormal basis around a unit N (Duff et al. 2017, "Building an
 // Orthonormal Basis, Revisited"), the frame the storage's tangent angle is
-// measured in (compiler/ir/helper_math.cc, rotationToTangent):
+// measured in (compiler/core/ir/helper_math.cc, rotationToTangent):
 //   s = sign(N.z) (copysign: -0 counts as negative, like the compiler),
 //   a = -1 / (s + N.z), b = N.x N.y a,
 //   T = (1 + s N.x^2 a, s b, -s N.x),  B = (b, s + N.y^2 a, -N.y).

@@ -4,7 +4,7 @@
 // deferred lighting pass is substrate_unpack.h. Common dialect: include
 // substrate_prelude.glsl or .hlsl, then this file (it needs nothing else).
 //
-// The CPU mirror is compiler/storage/pack.{h,cc} (tests/unit/pack_test.cc);
+// The CPU mirror is compiler/core/storage/pack.{h,cc} (tests/unit/pack_test.cc);
 // the two must agree bit for bit on every layout.
 //
 // Conventions (docs/storage.md):

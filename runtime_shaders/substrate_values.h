@@ -2,7 +2,7 @@
 // dialect (include substrate_prelude.glsl or .hlsl first).
 //
 // The compiler folds a value node whose pins are all constant on the CPU, in
-// double precision (compiler/ir/value.cc, evalConstOp; compiler/ir/helper_math.cc
+// double precision (compiler/core/ir/value.cc, evalConstOp; compiler/core/ir/helper_math.cc
 // for the helper nodes; formulas and guards in docs/value-nodes.md). Every
 // other node is computed here at run time, and must be the SAME function: same
 // formulas, same clamps, same constants, same results for the undefined cases

@@ -1,6 +1,6 @@
 // The floor of bench/shader_cost.cc: a hand-written minimal GGX + Lambert
 // compute kernel doing the job of the generated Throughput kernel
-// (compiler/emit/kernel_emitter.cc, throughputKernel) for a simple one-slab
+// (compiler/core/emit/kernel_emitter.cc, throughputKernel) for a simple one-slab
 // material (examples/row12_simple.json), with nothing a generic runtime adds.
 //
 //   * Shading point: the Throughput kernel's prologue, copied exactly (pcg3d

@@ -496,7 +496,7 @@ struct StabilityArgs {
   bool stressTextures = false;
 };
 
-/// The material on the hard-case grid (compiler/stability/stability.h): counts
+/// The material on the hard-case grid (compiler/tools/stability/stability.h): counts
 /// of non-finite values on the CPU reference and on lavapipe, and the white
 /// furnace. Exit 4 when anything is non-finite or the furnace exceeds 1.001.
 int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {

@@ -235,7 +235,7 @@ TEST(DeepTrees, JsonNestedDeeperThan128LevelsIsTheDocumentedError) {
   EXPECT_NE(deep.err.find("error: nesting is deeper than the limit of 128 levels"), std::string::npos) << deep.err;
   EXPECT_EQ(deep.out, "");
   // Far deeper (100,000 levels): the same error, from the linear pre-scan
-  // (compiler/format) before the document is parsed.
+  // (compiler/core/format) before the document is parsed.
   const CliRun deeper = runOnFile(inlineChainText(100000), "inline100000.json", {"report"});
   EXPECT_EQ(deeper.status, kExitBadInput) << deeper.err;
   EXPECT_NE(deeper.err.find("error: nesting is deeper than the limit of 128 levels"), std::string::npos);

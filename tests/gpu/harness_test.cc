@@ -1,5 +1,5 @@
-// Tests for the Vulkan compute harness (compiler/gpu/harness.h) and its SPIR-V
-// reflection (compiler/gpu/spirv_reflect.h), on lavapipe with the validation
+// Tests for the Vulkan compute harness (compiler/tools/gpu/harness.h) and its SPIR-V
+// reflection (compiler/tools/gpu/spirv_reflect.h), on lavapipe with the validation
 // layer on. Shaders are compiled by substratec's own in-process compiler. A
 // missing Vulkan device, lavapipe or validation layer is a failure, never a skip.
 #include "gpu/harness.h"

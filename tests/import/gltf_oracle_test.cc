@@ -1,4 +1,4 @@
-// The glTF 2.0 reference BRDF (compiler/reference/gltf_brdf.h), the oracle of
+// The glTF 2.0 reference BRDF (compiler/tools/reference/gltf_brdf.h), the oracle of
 // the imported glTF materials: values worked out by hand from the
 // specification's formulas, reciprocity, energy bounds; and the import
 // measured against it where both models agree (a dielectric, with Lambert).

@@ -1,4 +1,4 @@
-// The importers (compiler/import/), read like their specification
+// The importers (compiler/tools/import/), read like their specification
 // (docs/import.md): the .glb container, the glTF and MaterialX errors (each
 // located), and the mapping formulas, checked on the closures the CPU
 // reference evaluates from the imported material at its inputs' defaults.

@@ -1,7 +1,7 @@
 // Accuracy of parameter blending (docs/accuracy.md, "Parameter blending vs
 // plain lerp"): every example at every simplification step, the project's
 // blending rules against the plain-lerp baseline, measured with the CPU
-// reference (compiler/reference/blend_error.h). Prints the table of
+// reference (compiler/tools/reference/blend_error.h). Prints the table of
 // docs/accuracy.md:  build/bin/unit_tests --gtest_filter=BlendAccuracy.*
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// Tests for pass 4, build the Substrate tree (compiler/passes/build_tree.h):
+// Tests for pass 4, build the Substrate tree (compiler/core/passes/build_tree.h):
 // the Substrate graph is instanced into a tree from the output node. "A
 // Substrate node referenced twice is instanced twice in the tree (it is a
 // tree, not a DAG)"; instances after the first get a unique suffix; inline

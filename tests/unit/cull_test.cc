@@ -1,4 +1,4 @@
-// Tests for pass 5, static culling (compiler/passes/cull.h), in the Tint
+// Tests for pass 5, static culling (compiler/core/passes/cull.h), in the Tint
 // style: the IR dump of a small material before the pass, the pass, the dump
 // after it. Each rule of cull.h has its test; the NoModify_ tests show what
 // the pass must leave alone (anything whose weight is not a constant 0 or 1).

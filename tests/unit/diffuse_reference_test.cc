@@ -1,5 +1,5 @@
 // The Monte Carlo reference for rough diffuse reflection
-// (compiler/reference/diffuse_reference.h): a GGX Smith microsurface of
+// (compiler/tools/reference/diffuse_reference.h): a GGX Smith microsurface of
 // Lambertian facets with all orders of interreflection (Heitz et al. 2016's
 // random walk), alpha = r^2, and the runtime's four diffuse models measured
 // against it. Figures in the comments were measured with these seeds and

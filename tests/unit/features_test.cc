@@ -1,4 +1,4 @@
-// Tests for pass 6, feature analysis (compiler/passes/features.h), written as
+// Tests for pass 6, feature analysis (compiler/core/passes/features.h), written as
 // the format's rule: "Opt-in features ... are *used* only when their pin is
 // present and not a constant equal to the neutral default. A material pays
 // only for what it uses." Dump before the pass, the pass, dump after.

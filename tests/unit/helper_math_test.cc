@@ -1,4 +1,4 @@
-// Tests for the helper value nodes (compiler/ir/helper_math.h), written as the
+// Tests for the helper value nodes (compiler/core/ir/helper_math.h), written as the
 // specification of docs/value-nodes.md, "Helpers".
 #include "ir/helper_math.h"
 

@@ -1,4 +1,4 @@
-// Tests for the storage layout and its pricing (compiler/storage/layout.h):
+// Tests for the storage layout and its pricing (compiler/core/storage/layout.h):
 // the byte figures and layout classes of the SIGGRAPH course table (the
 // examples/row*.json materials), then each storage rule on a small document:
 // which fields a closure stores, when a basis normal is elided, and

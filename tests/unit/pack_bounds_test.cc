@@ -1,5 +1,5 @@
 // Pack/unpack bounds (issue 7, "Numerical stability on hard cases"): every
-// field quantizer of compiler/storage/pack.h, swept over its whole range — every
+// field quantizer of compiler/core/storage/pack.h, swept over its whole range — every
 // code, both sides of every code boundary (which move with the dither), 0 and 1
 // — under every dither in {0, 0.25, 0.5, 0.999999}, comes back within the bound
 // of docs/storage.md's field table; and the octahedral normals of both

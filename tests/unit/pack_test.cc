@@ -1,4 +1,4 @@
-// Tests for per-pixel packing (compiler/storage/pack.h, docs/storage.md):
+// Tests for per-pixel packing (compiler/core/storage/pack.h, docs/storage.md):
 // every encoding round-trips within the error the field table claims (exact
 // fields exactly) for many random values and the dither at 0, 0.5 and 0.999;
 // the dither is centred (the decoded mean converges to the input); every

@@ -1,4 +1,4 @@
-// The CPU side of `substratec preview` (compiler/preview): procedural
+// The CPU side of `substratec preview` (compiler/tools/preview): procedural
 // environments, the cube maps the runtime's split-sum lighting samples
 // (runtime_shaders/substrate_lighting.h), tone mapping and sRGB encoding, PNG
 // output, and labelled contact sheets.

@@ -1,4 +1,4 @@
-// The Monte Carlo ground truth for layered slabs (compiler/reference/random_walk.h).
+// The Monte Carlo ground truth for layered slabs (compiler/tools/reference/random_walk.h).
 // These tests read like its spec: each expectation is computed here from
 // textbook formulas (Fresnel, GGX, the layering closed form, van de Hulst's
 // albedo) or is a physical law (energy, reciprocity), never read back from the

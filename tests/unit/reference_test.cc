@@ -1,4 +1,4 @@
-// The CPU reference of the shading model (compiler/reference/): the oracle the
+// The CPU reference of the shading model (compiler/tools/reference/): the oracle the
 // GPU tests compare the generated shaders with. These tests read like its spec:
 // expected values are computed here, by hand, from the formulas in the runtime
 // headers (substrate_tree.h, substrate_values.h, substrate_common.h) and the

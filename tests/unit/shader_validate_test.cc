@@ -1,4 +1,4 @@
-// Tests for in-process shader validation (compiler/validate/shader_validate.h):
+// Tests for in-process shader validation (compiler/core/validate/shader_validate.h):
 // GLSL and HLSL through glslang -> SPIR-V 1.5 -> spirv-val -> spirv-opt, the
 // failure modes (syntax error, wrong HLSL entry point, link error, missing
 // include), #include through include dirs and relative to the including file,

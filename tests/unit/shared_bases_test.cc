@@ -1,4 +1,4 @@
-// Tests for pass 7, shared local bases (compiler/passes/shared_bases.h):
+// Tests for pass 7, shared local bases (compiler/core/passes/shared_bases.h):
 // slabs whose normal (and, when anisotropic, tangent) are the same value-DAG
 // node share one basis; isotropic slabs join the first basis with their
 // normal; bases are numbered in closure (pre-)order. Dump before the pass,

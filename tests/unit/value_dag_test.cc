@@ -1,4 +1,4 @@
-// Tests for the value DAG (compiler/ir/value.h), written as its specification:
+// Tests for the value DAG (compiler/core/ir/value.h), written as its specification:
 // every node is created through ValueDag::make, which (1) folds an op whose
 // arguments are all constant, with the guarded formulas of docs/value-nodes.md,
 // (2) applies algebraic identities, and (3) returns the existing node when an

@@ -58,7 +58,7 @@ struct BatchOptions {
   std::string cacheDir;      // --cache ("": none)
   /// Reads one input path into the text to compile, diagnostics into `diags`;
   /// unset: the file as it is (readSourceFile). The CLI imports .gltf, .glb,
-  /// .materials.json and .mtlx files here (compiler/import).
+  /// .materials.json and .mtlx files here (compiler/tools/import).
   std::function<std::optional<BatchSource>(const std::string& path, const ReadLimits& limits, Diagnostics& diags)>
       load;
 };

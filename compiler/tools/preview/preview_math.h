@@ -1,4 +1,4 @@
-// Internal to compiler/preview: the few vector helpers the environments and
+// Internal to compiler/tools/preview: the few vector helpers the environments and
 // the cube-map prefilter share (double precision, std::array based).
 #pragma once
 #include <array>

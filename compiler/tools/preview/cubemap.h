@@ -1,5 +1,5 @@
 // Cube maps for the runtime's split-sum environment lighting
-// (runtime_shaders/substrate_lighting.h, compiler/emit/entry_emitter.cc):
+// (runtime_shaders/substrate_lighting.h, compiler/core/emit/entry_emitter.cc):
 //  * envPrefiltered: mip i holds the environment prefiltered with GGX of
 //    perceptual roughness r_i = i / (mipCount - 1) (alpha = r_i^2), the
 //    inverse of substrate_env_mip(r, mipCount) = r (mipCount - 1); mip 0 is

@@ -1,4 +1,4 @@
-// Mirrors the generated <name>_evaluate (compiler/emit/material_emitter.cc,
+// Mirrors the generated <name>_evaluate (compiler/core/emit/material_emitter.cc,
 // docs/codegen.md "The material function") with the runtime's tree operators
 // (runtime_shaders/substrate_tree.h) and tree-walk helpers (the end of
 // runtime_shaders/substrate_values.h):

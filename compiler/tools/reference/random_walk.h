@@ -4,7 +4,7 @@
 // estimator structure of pbrt-v4's LayeredBxDF (f() evaluated stochastically:
 // next-event estimation through the interfaces, multiple importance sampling of
 // the exit, Russian roulette), generalized from two interfaces to N. It measures
-// the analytic layering of the runtime (compiler/reference/lighting.cc,
+// the analytic layering of the runtime (compiler/tools/reference/lighting.cc,
 // substrate_lighting.h): it is not a mirror of any shader.
 //
 // THE MODEL (per colour channel, channels independent)

@@ -2,7 +2,7 @@
 // and the dialect's intrinsics (saturate, lerp, normalize, ...), templated on the
 // scalar type, plus the small vector algebra the rest of the reference uses.
 // Every constant is written as T(...) so that the float instantiation never
-// computes in double. Internal to compiler/reference/.
+// computes in double. Internal to compiler/tools/reference/.
 #pragma once
 #include <algorithm>
 #include <array>

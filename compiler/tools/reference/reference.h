@@ -1,5 +1,5 @@
 // The CPU reference of the shading model: a second, independent implementation
-// of what the generated material function (compiler/emit/material_emitter.cc,
+// of what the generated material function (compiler/core/emit/material_emitter.cc,
 // docs/codegen.md) and the runtime library (runtime_shaders/) compute, templated
 // on the scalar type. It is the oracle of the GPU tests: ref64 (double) is the
 // value, and |ref32 - ref64| (float) measures how well conditioned a sample is.
@@ -9,7 +9,7 @@
 // fit) the reference mirrors it and cites the shader in a comment.
 //
 // Precision: the value DAG (inputs, textures, math and helper nodes) is always
-// evaluated in double (compiler/ir/value_eval.h); for T = float its results are
+// evaluated in double (compiler/core/ir/value_eval.h); for T = float its results are
 // rounded to float before the tree walk. Everything after the value DAG (slab
 // coverage and transmittance, the tree operators, the walk to the root, the
 // tangent frames, the BSDF, the energy tables and the lighting) runs in T.

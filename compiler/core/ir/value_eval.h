@@ -3,7 +3,7 @@
 // geometry a given frame, textures a given constant sample or, when a sampler
 // is set, that sampler at the node's uv. Used where the compiler must decide
 // something from typical values (which side of a mix dominates), by tests of
-// parameter blending, and by the CPU reference (compiler/reference/).
+// parameter blending, and by the CPU reference (compiler/tools/reference/).
 #pragma once
 #include <array>
 #include <functional>
