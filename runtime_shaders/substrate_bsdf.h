@@ -19,28 +19,7 @@
 #define SUBSTRATE_SPECULAR_PROFILE_SAMPLE(index, uv) SUBSTRATE_SPLAT3(1.0)
 #endif
 
-// Shading normals that face away from the eye by less than this (in NoV) are
-// shaded as grazing (NoV = 1e-4); beyond it the closure returns 0.
-#ifndef SUBSTRATE_NOV_BIAS
-#define SUBSTRATE_NOV_BIAS 1e-3
-#endif
-
-// SSS wrap: per-channel wrap amount w = mfp / (mfp + SCALE) (meters).
-#ifndef SUBSTRATE_SSS_WRAP_MFP_SCALE
-#define SUBSTRATE_SSS_WRAP_MFP_SCALE 0.005
-#endif
-
-// Glints: microfacet density per unit uv area is 2^lerp(MIN, MAX, glintValue);
-// the reflection cone half-angle (radians) is CONE_ANGLE.
-#ifndef SUBSTRATE_GLINT_LOG2_DENSITY_MIN
-#define SUBSTRATE_GLINT_LOG2_DENSITY_MIN 8.0
-#endif
-#ifndef SUBSTRATE_GLINT_LOG2_DENSITY_MAX
-#define SUBSTRATE_GLINT_LOG2_DENSITY_MAX 40.0
-#endif
-#ifndef SUBSTRATE_GLINT_CONE_ANGLE
-#define SUBSTRATE_GLINT_CONE_ANGLE 0.05
-#endif
+// SUBSTRATE_NOV_BIAS, SUBSTRATE_SSS_WRAP_MFP_SCALE, SUBSTRATE_GLINT_*: substrate_constants.h.
 
 // Smallest GGX alpha (Kulla-Conty clamp; scripts/gen_energy_lut.py uses the same).
 SUBSTRATE_CONST float SUBSTRATE_MIN_ALPHA = 1e-3;
@@ -68,6 +47,18 @@ void substrate_closure_frame(SubstrateClosure c, float3 N, out float3 T, out flo
   substrate_orthonormal_basis(N, t0, b0);
   T = substrate_safe_normalize(c.T - N * dot(N, c.T), t0);
   B = cross(N, T);
+}
+
+// The Fresnel ends of a closure: its reflectance at normal incidence, and at
+// grazing incidence (white unless it has the F90 feature).
+void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mfloat3 f90) {
+  f0 = SUBSTRATE_M3(saturate(c.f0));
+  f90 = SUBSTRATE_MSPLAT3(1.0);
+#if SUBSTRATE_USE_F90
+  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
+    f90 = SUBSTRATE_M3(saturate(c.f90));
+  }
+#endif
 }
 
 // ---------------------------------------------------------------------------
@@ -116,6 +107,20 @@ float substrate_ggx_vis_aniso(float2 alpha, float ToV, float BoV, float NoV, flo
   float gv = NoL * length(float3(alpha.x * ToV, alpha.y * BoV, NoV));
   float gl = NoV * length(float3(alpha.x * ToL, alpha.y * BoL, NoL));
   return 0.5 / max(gv + gl, 1e-30);
+}
+
+// GGX distribution D and visibility V of one lobe of roughness alpha: the
+// anisotropic forms (frame dot products ToH, BoH, ToV, BoV, ToL, BoL) when
+// `aniso`, else the isotropic ones with alpha.x.
+void substrate_ggx_d_vis(float2 alpha, bool aniso, float ToH, float BoH, float NoH, float ToV, float BoV, float NoV,
+                         float ToL, float BoL, float NoL, out float d, out float vis) {
+  if (aniso) {
+    d = substrate_ggx_d_aniso(alpha, ToH, BoH, NoH);
+    vis = substrate_ggx_vis_aniso(alpha, ToV, BoV, NoV, ToL, BoL, NoL);
+  } else {
+    d = substrate_ggx_d(alpha.x, NoH);
+    vis = substrate_ggx_vis(alpha.x, NoV, NoL);
+  }
 }
 
 // Schlick's Fresnel with an F90: F0 + (F90 - F0) (1 - VoH)^5 (the weight from
@@ -418,13 +423,9 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   float VoH = saturate(dot(V, H));
   float VoL = clamp(dot(V, L), -1.0, 1.0);
 
-  mfloat3 f0 = SUBSTRATE_M3(saturate(c.f0));
-  mfloat3 f90 = SUBSTRATE_MSPLAT3(1.0);
-#if SUBSTRATE_USE_F90
-  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90 = SUBSTRATE_M3(saturate(c.f90));
-  }
-#endif
+  mfloat3 f0;
+  mfloat3 f90;
+  substrate_closure_fresnel_ends(c, f0, f90);
   float roughness = saturate(c.roughness);
 
   float anisotropy = 0.0;
@@ -478,26 +479,14 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     float2 alpha1 = substrate_ggx_alpha(roughness, anisotropy);
     float d1;
     float vis1;
-    if (anisotropy != 0.0) {
-      d1 = substrate_ggx_d_aniso(alpha1, ToH, BoH, NoH);
-      vis1 = substrate_ggx_vis_aniso(alpha1, ToV, BoV, NoV, ToL, BoL, NoLc);
-    } else {
-      d1 = substrate_ggx_d(alpha1.x, NoH);
-      vis1 = substrate_ggx_vis(alpha1.x, NoV, NoLc);
-    }
+    substrate_ggx_d_vis(alpha1, anisotropy != 0.0, ToH, BoH, NoH, ToV, BoV, NoV, ToL, BoL, NoLc, d1, vis1);
     // The lobe in float: D reaches 1 / (pi 1e-6) = 3.2e5 at the smallest alpha.
     float3 lobe = SUBSTRATE_F3(w1) * (d1 * vis1 * NoLc);
     if (hazeWeight > 0.0) {
       float2 alpha2 = substrate_ggx_alpha(hazeRoughness, anisotropy);
       float d2;
       float vis2;
-      if (anisotropy != 0.0) {
-        d2 = substrate_ggx_d_aniso(alpha2, ToH, BoH, NoH);
-        vis2 = substrate_ggx_vis_aniso(alpha2, ToV, BoV, NoV, ToL, BoL, NoLc);
-      } else {
-        d2 = substrate_ggx_d(alpha2.x, NoH);
-        vis2 = substrate_ggx_vis(alpha2.x, NoV, NoLc);
-      }
+      substrate_ggx_d_vis(alpha2, anisotropy != 0.0, ToH, BoH, NoH, ToV, BoV, NoV, ToL, BoL, NoLc, d2, vis2);
       lobe = lerp(lobe, SUBSTRATE_F3(w2) * (d2 * vis2 * NoLc), hazeWeight);
     }
     spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, VoH)) * lobe;

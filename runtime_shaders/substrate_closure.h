@@ -8,27 +8,7 @@
 #ifndef SUBSTRATE_CLOSURE_H
 #define SUBSTRATE_CLOSURE_H 1
 
-// Feature bits of a closure, the same bits as the closure header's feature
-// field in docs/storage.md.
-#define SUBSTRATE_FEATURE_F90 1u
-#define SUBSTRATE_FEATURE_ANISOTROPY 2u
-#define SUBSTRATE_FEATURE_HAZE 4u
-#define SUBSTRATE_FEATURE_FUZZ 8u
-#define SUBSTRATE_FEATURE_GLINT 16u
-#define SUBSTRATE_FEATURE_SPECULAR_PROFILE 32u
-#define SUBSTRATE_FEATURE_WEIGHT 64u
-#define SUBSTRATE_FEATURE_COVERAGE_ABOVE 128u
-
-#define SUBSTRATE_SSS_NONE 0u
-#define SUBSTRATE_SSS_WRAP 1u
-#define SUBSTRATE_SSS_DIFFUSION 2u
-#define SUBSTRATE_SSS_SIMPLE_VOLUME 3u
-
-// Layout classes (material header bits 0-1).
-#define SUBSTRATE_LAYOUT_SIMPLE 0u
-#define SUBSTRATE_LAYOUT_SINGLE 1u
-#define SUBSTRATE_LAYOUT_COMPLEX 2u
-#define SUBSTRATE_LAYOUT_SPECIAL 3u
+#include "substrate_constants.h"  // feature bits, SSS types, layout classes
 
 #ifndef SUBSTRATE_MAX_CLOSURES
 #define SUBSTRATE_MAX_CLOSURES 8
@@ -120,7 +100,7 @@ struct SubstrateGeometry {
 #endif
 // Diffuse model: 0 Lambert, 1 Chan 2018, 2 Chan 2024, 3 EON (Portsmouth 2025).
 #ifndef SUBSTRATE_DIFFUSE_MODEL
-#define SUBSTRATE_DIFFUSE_MODEL 2
+#define SUBSTRATE_DIFFUSE_MODEL SUBSTRATE_DIFFUSE_MODEL_DEFAULT
 #endif
 
 // Every field set to its neutral value (no feature, weight 1, on top).

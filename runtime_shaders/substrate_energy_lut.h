@@ -79,15 +79,18 @@ void substrate_lut_coords(float x, float y, out int4 idx, out float2 f) {
 float substrate_lut_blend(float v00, float v10, float v01, float v11, float2 f) {
   return lerp(lerp(v00, v10, f.x), lerp(v01, v11, f.x), f.y);
 }
+// Table `t` (SUBSTRATE_LUT_E/B/FUZZ) blended between the four entries `i`
+// (substrate_lut_coords) with the weights `f`.
+#define SUBSTRATE_LUT_BILINEAR(t, i, f)                                                                  \
+  substrate_lut_blend(SUBSTRATE_LUT_FETCH(t, (i).x), SUBSTRATE_LUT_FETCH(t, (i).y), SUBSTRATE_LUT_FETCH(t, (i).z), \
+                      SUBSTRATE_LUT_FETCH(t, (i).w), f)
 
 // E(NoV, r): directional albedo of the GGX lobe with F = 1.
 float substrate_energy_albedo(float NoV, float roughness) {
   int4 i;
   float2 f;
   substrate_lut_coords(NoV, roughness, i, f);
-  return clamp(substrate_lut_blend(SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.y),
-                                   SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.w), f),
-               1e-3, 1.0);
+  return clamp(SUBSTRATE_LUT_BILINEAR(SUBSTRATE_LUT_E, i, f), 1e-3, 1.0);
 }
 
 // The split-sum DFG pair (E - B, B): the lobe's albedo is F0 * x + F90 * y.
@@ -100,11 +103,8 @@ float2 substrate_energy_dfg(float NoV, float roughness) {
   int4 i;
   float2 f;
   substrate_lut_coords(NoV, roughness, i, f);
-  float e = substrate_lut_blend(SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.y),
-                                SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_E, i.w), f);
-  float b = substrate_lut_blend(
-      SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.y),
-      SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_B, i.w), f);
+  float e = SUBSTRATE_LUT_BILINEAR(SUBSTRATE_LUT_E, i, f);
+  float b = SUBSTRATE_LUT_BILINEAR(SUBSTRATE_LUT_B, i, f);
   b = clamp(b, 0.0, 1.0);
   return float2(clamp(e - b, 0.0, 1.0), b);
 }
@@ -115,9 +115,7 @@ float substrate_fuzz_albedo(float NoV, float fuzzRoughness) {
   int4 i;
   float2 f;
   substrate_lut_coords(NoV, fuzzRoughness, i, f);
-  return max(substrate_lut_blend(SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_FUZZ, i.x), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_FUZZ, i.y),
-                                 SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_FUZZ, i.z), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_FUZZ, i.w), f),
-             0.0);
+  return max(SUBSTRATE_LUT_BILINEAR(SUBSTRATE_LUT_FUZZ, i, f), 0.0);
 }
 
 #endif

@@ -6,13 +6,7 @@
 #ifndef SUBSTRATE_LIGHTING_H
 #define SUBSTRATE_LIGHTING_H 1
 
-// The cosine at which the transmittance of the layers above is evaluated for
-// light arriving from the whole hemisphere (irradiance): the mean of 1/mu under
-// the cosine-weighted hemisphere is 2, so T^(1/0.5) is exact to first order in
-// the optical depth.
-#ifndef SUBSTRATE_DIFFUSE_MEAN_COS
-#define SUBSTRATE_DIFFUSE_MEAN_COS 0.5
-#endif
+// SUBSTRATE_DIFFUSE_MEAN_COS: substrate_constants.h.
 
 // The angular part of what an interface transmits, normalized to 1 at normal
 // incidence (where T_N already holds its 1 - F0): 1 - (1 - mu)^5, Schlick's
@@ -114,6 +108,26 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
   return sum;
 }
 
+// What a closure's interface reflects at cosine NoV (its directional albedo,
+// E_spec = (F0 (E - B) + F90 B) W): the primary lobe's, lerped toward the haze
+// lobe's by the haze weight. The environment and the translucency both remove
+// it from what reaches the diffuse or passes through.
+mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
+  mfloat3 f0;
+  mfloat3 f90;
+  substrate_closure_fresnel_ends(c, f0, f90);
+  mfloat3 specAlbedo;
+  substrate_specular_energy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
+#if SUBSTRATE_USE_HAZE
+  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
+    mfloat3 specAlbedo2;
+    substrate_specular_energy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
+    specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
+  }
+#endif
+  return specAlbedo;
+}
+
 // ---------------------------------------------------------------------------
 // Environment lighting (split sum, Karis 2013).
 
@@ -193,22 +207,7 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
     return SUBSTRATE_SPLAT3(0.0);
   }
   float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
-  mfloat3 f0 = SUBSTRATE_M3(saturate(c.f0));
-  mfloat3 f90 = SUBSTRATE_MSPLAT3(1.0);
-#if SUBSTRATE_USE_F90
-  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90 = SUBSTRATE_M3(saturate(c.f90));
-  }
-#endif
-  mfloat3 specAlbedo;
-  substrate_specular_energy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
-#if SUBSTRATE_USE_HAZE
-  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
-    mfloat3 specAlbedo2;
-    substrate_specular_energy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
-    specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
-  }
-#endif
+  mfloat3 specAlbedo = substrate_closure_specular_albedo(c, NoV);
   // Radiance (HDR) is float; the weights that multiply it are mfloat.
   float3 spec = SUBSTRATE_F3(specAlbedo) * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE
@@ -246,22 +245,7 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 void substrate_translucency(SubstrateClosure c, float NoV, out float coverage, out float3 transmittance) {
   coverage = saturate(c.weight);
   float mu = clamp(NoV, SUBSTRATE_MIN_COS, 1.0);
-  mfloat3 f0 = SUBSTRATE_M3(saturate(c.f0));
-  mfloat3 f90 = SUBSTRATE_MSPLAT3(1.0);
-#if SUBSTRATE_USE_F90
-  if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90 = SUBSTRATE_M3(saturate(c.f90));
-  }
-#endif
-  mfloat3 specAlbedo;
-  substrate_specular_energy(f0, f90, mu, saturate(c.roughness), specAlbedo);
-#if SUBSTRATE_USE_HAZE
-  if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
-    mfloat3 specAlbedo2;
-    substrate_specular_energy(f0, f90, mu, saturate(c.secondRoughness), specAlbedo2);
-    specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
-  }
-#endif
+  mfloat3 specAlbedo = substrate_closure_specular_albedo(c, mu);
   transmittance = SUBSTRATE_F3(substrate_closure_above_throughput(c, mu) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {

@@ -2,7 +2,8 @@
 // docs/storage.md (quantizers substrate_q_*, decoders substrate_dq_*) and a bit
 // reader/writer over the material buffer's words. The generic unpacker of the
 // deferred lighting pass is substrate_unpack.h. Common dialect: include
-// substrate_prelude.glsl or .hlsl, then this file (it needs nothing else).
+// substrate_prelude.glsl or .hlsl, then this file (it includes
+// substrate_common.h, which needs nothing else, for the tangent frame).
 //
 // The CPU mirror is compiler/core/storage/pack.{h,cc} (tests/unit/pack_test.cc);
 // the two must agree bit for bit on every layout.
@@ -17,11 +18,13 @@
 //    s = 2^(n-1) - 1;
 //  - material header bit 15 is 1 for the multi-closure header, 0 for the
 //    single-closure header (used by one closure, whatever the class);
-//  - the tangent angle is measured in the frame (substrate_pack_frame) of the
+//  - the tangent angle is measured in the frame (substrate_orthonormal_basis) of the
 //    normal *as stored*: pass substrate_normal_as_stored(N, dither), or, for a
 //    basis whose normal is elided, substrate_top_layer_normal_as_stored(N, dither).
 #ifndef SUBSTRATE_PACK_H
 #define SUBSTRATE_PACK_H 1
+
+#include "substrate_common.h"  // substrate_orthonormal_basis
 
 // Words of the material buffer the unpacker reads (a layout must fit).
 #ifndef SUBSTRATE_MAX_WORDS
@@ -294,24 +297,16 @@ float3 substrate_top_layer_normal_as_stored(float3 n, float dither) {
   return d;
 }
 
-// The canonical frame around a unit N (Duff et al. 2017), identical to
-// substrate_orthonormal_basis (substrate_common.h) and the compiler's
-// rotationToTangent: s = copysign(1, N.z), a = -1 / (s + N.z), b = N.x N.y a,
-// T0 = (1 + s N.x^2 a, s b, -s N.x), B0 = (b, s + N.y^2 a, -N.y).
-void substrate_pack_frame(float3 N, out float3 T0, out float3 B0) {
-  float s = (asuint(N.z) & 0x80000000u) != 0u ? -1.0 : 1.0;
-  float a = -1.0 / (s + N.z);
-  float b = N.x * N.y * a;
-  T0 = float3(1.0 + s * N.x * N.x * a, s * b, -s * N.x);
-  B0 = float3(b, s + N.y * N.y * a, -N.y);
-}
+// The canonical frame around a unit N (Duff et al. 2017) is
+// substrate_orthonormal_basis (substrate_common.h), as in the compiler's
+// rotationToTangent.
 
 // Tangent angle (14 bits): unorm14 of atan2(T.B0, T.T0) / 2pi in [0, 1), in the
 // frame of N, the normal as the unpacker decodes it (see the header comment).
 uint substrate_tangent_angle_encode(float3 T, float3 N, float dither) {
   float3 t0;
   float3 b0;
-  substrate_pack_frame(N, t0, b0);
+  substrate_orthonormal_basis(N, t0, b0);
   float y = dot(T, b0);
   float x = dot(T, t0);
   float angle = (x != 0.0 || y != 0.0) ? atan2(y, x) : 0.0;
@@ -324,7 +319,7 @@ uint substrate_tangent_angle_encode(float3 T, float3 N, float dither) {
 float3 substrate_tangent_angle_decode(uint code, float3 N) {
   float3 t0;
   float3 b0;
-  substrate_pack_frame(N, t0, b0);
+  substrate_orthonormal_basis(N, t0, b0);
   float angle = substrate_dq_unorm(code, SUBSTRATE_BITS_TANGENT_ANGLE) * SUBSTRATE_PACK_TWO_PI;
   return normalize(cos(angle) * t0 + sin(angle) * b0);
 }

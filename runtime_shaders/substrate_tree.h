@@ -7,7 +7,7 @@
 #ifndef SUBSTRATE_TREE_H
 #define SUBSTRATE_TREE_H 1
 
-#define SUBSTRATE_TREE_EPSILON 1e-6
+#include "substrate_constants.h"  // SUBSTRATE_EXTRA_INTERFACE, SUBSTRATE_TREE_EPSILON
 
 // Horizontal mix toward the foreground by w:
 //   C = (1-w)Cb + w Cf,  T = ((1-w)Cb Tb + w Cf Tf) / max(eps, C).
@@ -54,7 +54,7 @@ void substrate_layer_above(inout float c, inout float3 t, float cLayer, float3 t
 // With coverage the bound holds too: the pair (C, T) of substrate_layer_above
 // never lets through more than the product of the layers (Jensen: x^(1/mu) is
 // convex), and each covered path crosses at most the interfaces counted.
-#define SUBSTRATE_EXTRA_INTERFACE 0.91
+// Q is SUBSTRATE_EXTRA_INTERFACE (substrate_constants.h, via substrate_closure.h).
 float substrate_extra_interfaces(float n) {
   return pow(SUBSTRATE_EXTRA_INTERFACE, n);
 }

@@ -180,7 +180,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
     }
     float3 t0;
     float3 b0;
-    substrate_pack_frame(n, t0, b0);
+    substrate_orthonormal_basis(n, t0, b0);
     if (uint(b) < basisCount && basisAniso[b]) {
       t0 = substrate_tangent_angle_decode(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_TANGENT_ANGLE), n);
       pos += SUBSTRATE_BITS_TANGENT_ANGLE;
@@ -210,7 +210,7 @@ void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLa
   float topRoughness;
   substrate_dq_top_layer(topLayer, c.N, topRoughness);
   float3 b0;
-  substrate_pack_frame(c.N, c.T, b0);
+  substrate_orthonormal_basis(c.N, c.T, b0);
 #if SUBSTRATE_USE_ANISOTROPY
   if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
     c.T = substrate_tangent_angle_decode(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_TANGENT_ANGLE), c.N);

@@ -40,6 +40,13 @@
 // ---------------------------------------------------------------------------
 // Math nodes (evalConstOp).
 
+// The float2/3/4 overloads of a two-argument scalar function f, applied per
+// component.
+#define SUBSTRATE_VALUES_PER_COMPONENT2(f)                                                         \
+  float2 f(float2 a, float2 b) { return float2(f(a.x, b.x), f(a.y, b.y)); }                       \
+  float3 f(float3 a, float3 b) { return float3(f(a.x, b.x), f(a.y, b.y), f(a.z, b.z)); }          \
+  float4 f(float4 a, float4 b) { return float4(f(a.x, b.x), f(a.y, b.y), f(a.z, b.z), f(a.w, b.w)); }
+
 // divide: a / b per component, b == 0 gives 0.
 // float: an overflowing quotient (|a / b| > FLT_MAX) is clamped to +-FLT_MAX,
 // the float nearest to the CPU's double quotient.
@@ -54,16 +61,7 @@ float substrate_safe_div(float a, float b) {
   float q = clamp(a / (zero ? 1.0 : b), -SUBSTRATE_VALUES_FLT_MAX, SUBSTRATE_VALUES_FLT_MAX);
   return zero ? 0.0 : q;
 }
-float2 substrate_safe_div(float2 a, float2 b) {
-  return float2(substrate_safe_div(a.x, b.x), substrate_safe_div(a.y, b.y));
-}
-float3 substrate_safe_div(float3 a, float3 b) {
-  return float3(substrate_safe_div(a.x, b.x), substrate_safe_div(a.y, b.y), substrate_safe_div(a.z, b.z));
-}
-float4 substrate_safe_div(float4 a, float4 b) {
-  return float4(substrate_safe_div(a.x, b.x), substrate_safe_div(a.y, b.y), substrate_safe_div(a.z, b.z),
-                substrate_safe_div(a.w, b.w));
-}
+SUBSTRATE_VALUES_PER_COMPONENT2(substrate_safe_div)
 
 // pow: max(x, 0)^y per component; x^0 = 1 (0^0 included), 0^y = 0 for y != 0
 // (0 to a negative power is 0, not infinity).
@@ -76,16 +74,7 @@ float substrate_value_pow(float x, float y) {
   if (b == 0.0) return 0.0;
   return min(pow(b, y), SUBSTRATE_VALUES_FLT_MAX);
 }
-float2 substrate_value_pow(float2 x, float2 y) {
-  return float2(substrate_value_pow(x.x, y.x), substrate_value_pow(x.y, y.y));
-}
-float3 substrate_value_pow(float3 x, float3 y) {
-  return float3(substrate_value_pow(x.x, y.x), substrate_value_pow(x.y, y.y), substrate_value_pow(x.z, y.z));
-}
-float4 substrate_value_pow(float4 x, float4 y) {
-  return float4(substrate_value_pow(x.x, y.x), substrate_value_pow(x.y, y.y), substrate_value_pow(x.z, y.z),
-                substrate_value_pow(x.w, y.w));
-}
+SUBSTRATE_VALUES_PER_COMPONENT2(substrate_value_pow)
 
 // sqrt: sqrt(max(x, 0)) per component.
 float substrate_value_sqrt(float x) { return sqrt(max(x, 0.0)); }

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "report/dump.h"
+#include "substrate_constants.h"  // runtime_shaders/: SUBSTRATE_FEATURE_* bits
 
 namespace substratec {
 
@@ -47,10 +48,6 @@ std::string extraInterfacesDefine(const StorageLayout& layout) {
 }
 
 namespace {
-
-// Closure feature bits (runtime_shaders/substrate_closure.h, docs/storage.md).
-constexpr unsigned kBitF90 = 1, kBitAniso = 2, kBitHaze = 4, kBitFuzz = 8, kBitGlint = 16, kBitProfile = 32,
-                   kBitWeight = 64, kBitCoverageAbove = 128;
 
 class Emitter {
  public:
@@ -493,11 +490,11 @@ void Emitter::emitClosures() {
     unsigned bits = 0;
     const std::uint16_t f = s.features;
     if (f & kFeatF90) {
-      bits |= kBitF90;
+      bits |= SUBSTRATE_FEATURE_F90;
       line(fmt::format("{}.f90 = {};", c, expr(s.pin(SlabPin::F90))));
     }
     if (f & kFeatAnisotropy) {
-      bits |= kBitAniso;
+      bits |= SUBSTRATE_FEATURE_ANISOTROPY;
       line(fmt::format("{}.anisotropy = {};", c, expr(s.pin(SlabPin::Anisotropy))));
       line(fmt::format("{0}.T = substrate_orthogonal_tangent({0}.N, substrate_tangent_to_world({1}, g.N, g.T));", c,
                        expr(s.pin(SlabPin::Tangent))));
@@ -508,30 +505,30 @@ void Emitter::emitClosures() {
       line(fmt::format("{}.sssType = {}u;", c, static_cast<unsigned>(s.sssType)));
     }
     if (f & kFeatHaze) {
-      bits |= kBitHaze;
+      bits |= SUBSTRATE_FEATURE_HAZE;
       line(fmt::format("{}.secondRoughness = {};", c, expr(s.pin(SlabPin::SecondRoughness))));
       line(fmt::format("{}.secondRoughnessWeight = {};", c, expr(s.pin(SlabPin::SecondRoughnessWeight))));
     }
     if (f & kFeatFuzz) {
-      bits |= kBitFuzz;
+      bits |= SUBSTRATE_FEATURE_FUZZ;
       line(fmt::format("{}.fuzzAmount = {};", c, expr(s.pin(SlabPin::FuzzAmount))));
       line(fmt::format("{}.fuzzColor = {};", c, expr(s.pin(SlabPin::FuzzColor))));
       line(fmt::format("{}.fuzzRoughness = {};", c, expr(s.pin(SlabPin::FuzzRoughness))));
     }
     if (f & kFeatGlint) {
-      bits |= kBitGlint;
+      bits |= SUBSTRATE_FEATURE_GLINT;
       line(fmt::format("{}.glintValue = {};", c, expr(s.pin(SlabPin::GlintValue))));
       line(fmt::format("{}.glintUv = {};", c, expr(s.pin(SlabPin::GlintUv))));
       line(fmt::format("{}.glintUvDerivatives = g.uvDerivatives;", c));
     }
     if (f & kFeatSpecularProfile) {
-      bits |= kBitProfile;
+      bits |= SUBSTRATE_FEATURE_SPECULAR_PROFILE;
       line(fmt::format("{}.specularProfile = {}u;  // ${}", c, profileIndex_[s.specularProfileInput] + 1,
                        m_.inputs[s.specularProfileInput].name));
     }
     if (f & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
-    if (cl.storesWeight) bits |= kBitWeight;
-    if (cl.storesCoverageAbove) bits |= kBitCoverageAbove;
+    if (cl.storesWeight) bits |= SUBSTRATE_FEATURE_WEIGHT;
+    if (cl.storesCoverageAbove) bits |= SUBSTRATE_FEATURE_COVERAGE_ABOVE;
     if (!weight.empty()) line(fmt::format("{}.weight = {};", c, weight));
     if (!cl.isTop) {
       line(fmt::format("{}.topTransmittance = ta_{};", c, id));
@@ -557,7 +554,7 @@ std::string Emitter::run() {
   line("// What this material uses: the runtime compiles nothing else.");
   out_ += useDefines(all);
   out_ += extraInterfacesDefine(L_);
-  line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", opt_.diffuseModel));
+  line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", diffuseModelNumber(opt_.diffuseModel)));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));
   line(fmt::format("#define {}_WORD_COUNT {}", upper, L_.words()));
   line("#include \"substrate_closure.h\"");

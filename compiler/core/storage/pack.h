@@ -29,28 +29,30 @@
 #include <vector>
 
 #include "storage/layout.h"
+#include "substrate_constants.h"  // runtime_shaders/: the feature bits, SSS types
 
 namespace substratec {
 
 using Vec3d = std::array<double, 3>;
 
-/// Feature bits as stored in the headers (= SUBSTRATE_FEATURE_* of
-/// runtime_shaders/substrate_closure.h). SSS is not a bit: the header's SSS
+/// Feature bits as stored in the headers: SUBSTRATE_FEATURE_* of
+/// runtime_shaders/substrate_constants.h. SSS is not a bit: the header's SSS
 /// type is non-zero exactly when SSS data is stored.
 enum ClosureFeatureBit : std::uint32_t {
-  kClosureF90 = 1u,
-  kClosureAnisotropy = 2u,
-  kClosureHaze = 4u,
-  kClosureFuzz = 8u,
-  kClosureGlint = 16u,
-  kClosureSpecularProfile = 32u,
-  kClosureWeight = 64u,
-  kClosureCoverageAbove = 128u,
+  kClosureF90 = SUBSTRATE_FEATURE_F90,
+  kClosureAnisotropy = SUBSTRATE_FEATURE_ANISOTROPY,
+  kClosureHaze = SUBSTRATE_FEATURE_HAZE,
+  kClosureFuzz = SUBSTRATE_FEATURE_FUZZ,
+  kClosureGlint = SUBSTRATE_FEATURE_GLINT,
+  kClosureSpecularProfile = SUBSTRATE_FEATURE_SPECULAR_PROFILE,
+  kClosureWeight = SUBSTRATE_FEATURE_WEIGHT,
+  kClosureCoverageAbove = SUBSTRATE_FEATURE_COVERAGE_ABOVE,
 };
 
-/// SSS types as stored (= SUBSTRATE_SSS_*; the values of SssType).
-inline constexpr std::uint32_t kSssTypeNone = 0, kSssTypeWrap = 1, kSssTypeDiffusion = 2,
-                               kSssTypeSimpleVolume = 3;
+/// SSS types as stored (SUBSTRATE_SSS_*; the values of SssType).
+inline constexpr std::uint32_t kSssTypeNone = SUBSTRATE_SSS_NONE, kSssTypeWrap = SUBSTRATE_SSS_WRAP,
+                               kSssTypeDiffusion = SUBSTRATE_SSS_DIFFUSION,
+                               kSssTypeSimpleVolume = SUBSTRATE_SSS_SIMPLE_VOLUME;
 
 namespace packfmt {
 inline constexpr std::uint32_t kMultiClosureHeaderBit = 1u << 15;  // material header bit 15

@@ -8,6 +8,7 @@
 #pragma once
 #include "import/layered_surface.h"
 #include "import/material_writer.h"
+#include "substrate_constants.h"  // runtime_shaders/
 
 namespace substratec::import {
 
@@ -42,8 +43,9 @@ struct GltfPbr {
 /// The surface of `g` (may add value nodes to `w` for values used twice).
 LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w);
 
-/// The SUBSTRATE_SSS_WRAP_MFP_SCALE of the runtime (metres): wrap amount
-/// w = mfp / (mfp + scale), so mfp = scale · w / (1 − w).
-inline constexpr double kWrapMfpScale = 0.005;
+/// The SUBSTRATE_SSS_WRAP_MFP_SCALE of the runtime (metres,
+/// runtime_shaders/substrate_constants.h): wrap amount w = mfp / (mfp + scale),
+/// so mfp = scale · w / (1 − w).
+inline constexpr double kWrapMfpScale = SUBSTRATE_SSS_WRAP_MFP_SCALE;
 
 }  // namespace substratec::import

@@ -14,17 +14,19 @@
 
 #include "reference/common.h"
 #include "reference/energy_lut.h"
+#include "substrate_constants.h"  // runtime_shaders/
 
 namespace substratec::reference {
 using namespace detail;
 
 namespace {
 // substrate_bsdf.h constants and default macros.
-template <class T> constexpr T kNoVBias = T(1e-3);         // SUBSTRATE_NOV_BIAS
-template <class T> constexpr T kWrapMfpScale = T(0.005);   // SUBSTRATE_SSS_WRAP_MFP_SCALE
-template <class T> constexpr T kGlintLog2Min = T(8.0);     // SUBSTRATE_GLINT_LOG2_DENSITY_MIN
-template <class T> constexpr T kGlintLog2Max = T(40.0);    // SUBSTRATE_GLINT_LOG2_DENSITY_MAX
-template <class T> constexpr T kGlintCone = T(0.05);       // SUBSTRATE_GLINT_CONE_ANGLE
+// runtime_shaders/substrate_constants.h
+template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
+template <class T> constexpr T kWrapMfpScale = T(SUBSTRATE_SSS_WRAP_MFP_SCALE);
+template <class T> constexpr T kGlintLog2Min = T(SUBSTRATE_GLINT_LOG2_DENSITY_MIN);
+template <class T> constexpr T kGlintLog2Max = T(SUBSTRATE_GLINT_LOG2_DENSITY_MAX);
+template <class T> constexpr T kGlintCone = T(SUBSTRATE_GLINT_CONE_ANGLE);
 template <class T> constexpr T kMinAlpha = T(1e-3);        // SUBSTRATE_MIN_ALPHA
 template <class T> constexpr T kFuzzMinAlpha = T(1e-3);    // SUBSTRATE_FUZZ_MIN_ALPHA
 }  // namespace

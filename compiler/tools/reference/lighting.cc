@@ -9,6 +9,7 @@
 #include "reference/bsdf.h"
 #include "reference/common.h"
 #include "reference/energy_lut.h"
+#include "substrate_constants.h"  // runtime_shaders/
 #include "reference/reference.h"
 
 namespace substratec::reference {
@@ -16,8 +17,9 @@ using namespace detail;
 
 namespace {
 
-template <class T> constexpr T kDiffuseMeanCos = T(0.5);  // SUBSTRATE_DIFFUSE_MEAN_COS
-template <class T> constexpr T kNoVBias = T(1e-3);        // SUBSTRATE_NOV_BIAS
+// runtime_shaders/substrate_constants.h
+template <class T> constexpr T kDiffuseMeanCos = T(SUBSTRATE_DIFFUSE_MEAN_COS);
+template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
 
 // substrate_interface_transmission: 1 - (1 - sat(mu))^5.
 template <class T>

@@ -25,6 +25,7 @@
 #include <vector>
 
 #include "pipeline/pipeline.h"
+#include "substrate_constants.h"  // runtime_shaders/
 
 namespace substratec::reference {
 
@@ -32,14 +33,20 @@ template <class T> using V2 = std::array<T, 2>;
 template <class T> using V3 = std::array<T, 3>;
 template <class T> using V4 = std::array<T, 4>;
 
-// Closure feature bits (runtime_shaders/substrate_closure.h, SUBSTRATE_FEATURE_*).
-inline constexpr std::uint32_t kFeatureF90 = 1, kFeatureAnisotropy = 2, kFeatureHaze = 4, kFeatureFuzz = 8,
-                               kFeatureGlint = 16, kFeatureSpecularProfile = 32, kFeatureWeight = 64,
-                               kFeatureCoverageAbove = 128;
+// Closure feature bits: SUBSTRATE_FEATURE_* (runtime_shaders/substrate_constants.h).
+inline constexpr std::uint32_t kFeatureF90 = SUBSTRATE_FEATURE_F90, kFeatureAnisotropy = SUBSTRATE_FEATURE_ANISOTROPY,
+                               kFeatureHaze = SUBSTRATE_FEATURE_HAZE, kFeatureFuzz = SUBSTRATE_FEATURE_FUZZ,
+                               kFeatureGlint = SUBSTRATE_FEATURE_GLINT,
+                               kFeatureSpecularProfile = SUBSTRATE_FEATURE_SPECULAR_PROFILE,
+                               kFeatureWeight = SUBSTRATE_FEATURE_WEIGHT,
+                               kFeatureCoverageAbove = SUBSTRATE_FEATURE_COVERAGE_ABOVE;
 // sssType values (SUBSTRATE_SSS_*).
 inline constexpr std::uint32_t kSssNone = 0, kSssWrap = 1, kSssDiffusion = 2, kSssSimpleVolume = 3;
 // Diffuse models (SUBSTRATE_DIFFUSE_MODEL).
-inline constexpr int kDiffuseLambert = 0, kDiffuseChan2018 = 1, kDiffuseChan2024 = 2, kDiffuseEon = 3;
+inline constexpr int kDiffuseLambert = diffuseModelNumber(DiffuseModel::Lambert),
+                     kDiffuseChan2018 = diffuseModelNumber(DiffuseModel::Chan2018),
+                     kDiffuseChan2024 = diffuseModelNumber(DiffuseModel::Chan2024),
+                     kDiffuseEon = diffuseModelNumber(DiffuseModel::Eon);
 
 /// SubstrateClosure (substrate_closure.h): the same fields, names and neutral
 /// values (substrate_closure_init); the tangent is `T_`.

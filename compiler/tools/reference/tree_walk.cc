@@ -23,7 +23,7 @@ using namespace detail;
 
 namespace {
 
-template <class T> constexpr T kTreeEpsilon = T(1e-6);                 // SUBSTRATE_TREE_EPSILON
+template <class T> constexpr T kTreeEpsilon = T(SUBSTRATE_TREE_EPSILON);  // runtime_shaders/substrate_constants.h
 template <class T> constexpr T kFltMin = T(1.175494351e-38);           // SUBSTRATE_VALUES_FLT_MIN
 template <class T> constexpr T kValuesFltMax = T(3.402823466e+38);     // SUBSTRATE_VALUES_FLT_MAX
 
@@ -64,7 +64,7 @@ void layerAbove(T& c, V3<T>& t, T cLayer, const V3<T>& tLayer) {
 // n more interfaces above folded into a transmittance along the normal.
 template <class T>
 T extraInterfaces(int n) {
-  return std::pow(T(0.91), T(n));
+  return std::pow(T(SUBSTRATE_EXTRA_INTERFACE), T(n));
 }
 
 // --- substrate_values.h, tree-walk helpers
