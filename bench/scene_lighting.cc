@@ -143,7 +143,7 @@ BuiltScene builtScene(const std::string& source, const std::string& manifest) {
     shapes.push_back(summarize(*r).shape());
     s.materials.push_back(std::move(*r));
   }
-  s.shape = sceneShape(m->name, shapes, 2);
+  s.shape = sceneShape(m->name, shapes, kDefaultDiffuseModel);
   return s;
 }
 

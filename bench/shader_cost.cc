@@ -346,7 +346,7 @@ void partFloor(gpu::Context& ctx, const Args& a) {
   auto floorLut = floorKernel(Floor::Tables);
   auto floorModel = floorKernel(Floor::RuntimeModel);
   EmitOptions lambert;
-  lambert.diffuseModel = 0;
+  lambert.diffuseModel = DiffuseModel::Lambert;
   auto generated = generatedKernel(simple, {}, "generated `row12_simple` (default diffuse: Chan 2024)");
   auto generatedLambert = generatedKernel(simple, lambert, "generated `row12_simple`, `--diffuse lambert`");
   std::vector<Kernel*> group = {prologue.get(),   floorConst.get(), floorKaris.get(),       floorLut.get(),
@@ -622,12 +622,11 @@ void partExamples(gpu::Context& ctx, const Args& a) {
 void partDiffuse(gpu::Context& ctx, const Args& a) {
   const CompileResult r = compileOrDie("row12_simple.json", readAll(a.source + "/examples/row12_simple.json"), {});
   const char* names[4] = {"Lambert", "Chan 2018", "Chan 2024 (default)", "EON"};
-  const char* flags[4] = {"lambert", "chan2018", "chan2024", "eon"};
   std::vector<std::unique_ptr<Kernel>> kernels;
   std::vector<std::size_t> forward;
   for (int model = 0; model < 4; ++model) {
     EmitOptions e;
-    e.diffuseModel = model;
+    e.diffuseModel = static_cast<DiffuseModel>(model);
     forward.push_back(forwardInstructions(r, e));
     kernels.push_back(generatedKernel(r, e, fmt::format("row12_simple, diffuse {}", names[model])));
     prepare(ctx, *kernels.back(), r.material, a.pixels);
@@ -643,7 +642,7 @@ void partDiffuse(gpu::Context& ctx, const Args& a) {
   fmt::print("| diffuse model | `--diffuse` | forward instr. (optimized) | ns/pixel (median) | min–max | vs Lambert |\n");
   fmt::print("|---|---|---:|---:|---:|---:|\n");
   for (int model = 0; model < 4; ++model)
-    fmt::print("| {} | `{}` | {} | {:.2f} | {} | {:.3f} |\n", names[model], flags[model], forward[model],
+    fmt::print("| {} | `{}` | {} | {:.2f} | {} | {:.3f} |\n", names[model], diffuseModelName(static_cast<DiffuseModel>(model)), forward[model],
                kernels[model]->median(), spread(*kernels[model]), kernels[model]->median() / kernels[0]->median());
   fmt::print("\n");
 }

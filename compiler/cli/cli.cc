@@ -139,13 +139,8 @@ int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
   return status;
 }
 
-/// The SUBSTRATE_DIFFUSE_MODEL number of a --diffuse name.
-int diffuseModelOf(const std::string& name) {
-  static const char* const kModels[] = {"lambert", "chan2018", "chan2024", "eon"};
-  for (int i = 0; i < 4; ++i)
-    if (name == kModels[i]) return i;
-  return 2;
-}
+/// The model a --diffuse name selects (ir/enums.h; CLI11 has checked the name).
+DiffuseModel diffuseModelOf(const std::string& name) { return parseDiffuseModel(name).value_or(kDefaultDiffuseModel); }
 
 /// --precision (compile, preview, sweep, stability): the runtime's lighting in float32 or half.
 void addPrecisionOption(CLI::App* command, std::string& precision) {
@@ -161,7 +156,7 @@ struct CompileArgs {
   std::string material;
   std::string outDir;
   std::string target = "all";
-  std::string diffuse = "chan2024";
+  std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
   int budget = 0;
   int maxClosures = 0;
   bool fullSimplification = false;
@@ -329,7 +324,7 @@ struct PreviewArgs {
   std::string environment = preview::kDefaultEnvironment;
   bool sweep = false;
   std::string target = "glsl";
-  std::string diffuse = "chan2024";
+  std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
   double exposure = 0;
   std::size_t maxInputSize = 16u << 20;
   std::string precision = "float";
@@ -418,7 +413,7 @@ struct SweepArgs {
   double maxError = -1;
   int pixels = 1 << 20;
   int runs = 5;
-  std::string diffuse = "chan2024";
+  std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
   std::size_t maxInputSize = 16u << 20;
   int groundTruthProbes = 128;
   int groundTruthSamples = 1024;
@@ -690,7 +685,7 @@ struct SceneArgs {
   std::string platform;
   std::string platforms;
   std::string target = "all";
-  std::string diffuse = "chan2024";
+  std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
   int jobs = 0;
   int budget = 0;
   int maxClosures = 0;
@@ -758,7 +753,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   comp->add_option("-o,--output", compile.outDir, "Output directory")->required();
   comp->add_option("--target", compile.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}))->capture_default_str();
   comp->add_option("--diffuse", compile.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
+      ->check(CLI::IsMember(diffuseModelNames()))->capture_default_str();
   comp->add_option("--budget", compile.budget, "Bytes per pixel budget")->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
   comp->add_option("--max-closures", compile.maxClosures, "Closure budget")->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");
   comp->add_flag("--full-simplification", compile.fullSimplification, "Collapse everything into one closure");
@@ -792,7 +787,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   pre->add_option("--target", prev.target, "Which generated language renders: glsl or hlsl")
       ->check(CLI::IsMember({"glsl", "hlsl"}))->capture_default_str();
   pre->add_option("--diffuse", prev.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
+      ->check(CLI::IsMember(diffuseModelNames()))->capture_default_str();
   pre->add_option("--exposure", prev.exposure, "Exposure in stops before the tone curve")->transform(cli::inRange(-16.0, 16.0, "stops"))->capture_default_str();
   pre->add_option("--max-input-size", prev.maxInputSize, "Reject inputs larger than this many bytes")
       ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
@@ -811,7 +806,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
   swp->add_option("--runs", sw.runs, "Timed dispatches after the warm-up (the median is reported)")
       ->transform(cli::inRange(1, 100, "runs"))->capture_default_str();
   swp->add_option("--diffuse", sw.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
+      ->check(CLI::IsMember(diffuseModelNames()))->capture_default_str();
   swp->add_option("--max-input-size", sw.maxInputSize, "Reject inputs larger than this many bytes")
       ->transform(cli::inRange(std::size_t{1}, std::size_t{1} << 31, "bytes"))->capture_default_str();
   swp->add_option("--ground-truth-probes", sw.groundTruthProbes,
@@ -867,7 +862,7 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
       ->transform(cli::inRange(1, 256, "threads"))->default_str("the machine's threads");
   sce->add_option("--target", scn.target, "glsl, hlsl or all")->check(CLI::IsMember({"glsl", "hlsl", "all"}))->capture_default_str();
   sce->add_option("--diffuse", scn.diffuse, "Diffuse model")
-      ->check(CLI::IsMember({"lambert", "chan2018", "chan2024", "eon"}))->capture_default_str();
+      ->check(CLI::IsMember(diffuseModelNames()))->capture_default_str();
   sce->add_option("--budget", scn.budget, "Bytes per pixel budget of every material (the platform still caps it)")
       ->transform(cli::inRange(8, 1024, "bytes"))->default_str("the file's settings.bytes_per_pixel");
   sce->add_option("--max-closures", scn.maxClosures, "Closure budget of every material")->transform(cli::inRange(1, 8, "closures"))->default_str("the file's settings.max_closures");

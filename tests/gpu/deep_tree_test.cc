@@ -308,7 +308,7 @@ TEST(DeepTrees, TheDeepestLegalTreeCompilesAndEvaluatesOnA1MiBStack) {
 
 constexpr int kGeometries = 1024;
 constexpr int kInputSets = 2;
-constexpr int kDiffuseModel = 2;  // the default (Chan 2024)
+constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
 
 TEST(DeepTrees, ForwardKernelsMatchTheCpuReferenceOnLavapipe) {
   std::string error;

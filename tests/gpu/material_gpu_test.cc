@@ -37,7 +37,7 @@ using namespace kernel;
 
 constexpr int kGeometries = 1024;
 constexpr int kInputSets = 4;
-constexpr int kDiffuseModel = 2;  // the default (Chan 2024)
+constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
 
 struct Variant {
   const char* name;

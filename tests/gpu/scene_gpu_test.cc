@@ -43,7 +43,7 @@ namespace {
 namespace fs = std::filesystem;
 using namespace kernel;
 
-constexpr int kDiffuseModel = 2;
+constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
 
 std::string readFile(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -248,7 +248,7 @@ TEST_F(SceneOnGpu, TilesAreClassifiedAndEachClassLightsItsPixelsAsTheReference) 
     m[n] = compileSceneMaterial(n);
     shapes.push_back(summarize(m[n]).shape());
   }
-  const SceneShape shape = sceneShape("street", shapes, kDiffuseModel);
+  const SceneShape shape = sceneShape("street", shapes, kDefaultDiffuseModel);
   ASSERT_EQ(shape.classes.size(), 3u);  // simple, single, complex
   gpu::SceneFrame frame;
   frame.width = 20;  // 3 x 2 tiles, the last column and row partial

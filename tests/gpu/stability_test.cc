@@ -472,7 +472,7 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
   // lighting of the closures it unpacked, and the count with the reference's).
   // HLSL and GLSL share the runtime; GLSL only (CI time).
   using namespace stackfurnace;
-  constexpr int kDiffuseModel = 2;  // EmitOptions' default (Chan 2024)
+  constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
   std::string error;
   gpu::Context* ctx = gputest::sharedContext(&error);
   ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << error;

@@ -26,7 +26,7 @@ namespace substratec {
 enum class Precision { Float, Half };
 
 struct EmitOptions {
-  int diffuseModel = 2;          // 0 lambert, 1 chan2018, 2 chan2024, 3 eon
+  DiffuseModel diffuseModel = kDefaultDiffuseModel;  // SUBSTRATE_DIFFUSE_MODEL (ir/enums.h)
   Precision precision = Precision::Float;  // of the entries and kernels that light closures
   std::string sourceName;        // file name (no directory) for the header comment
   /// Declare the inputs as private globals instead of the uniform block: a

@@ -142,7 +142,7 @@ std::string tileClassName(LayoutClass cls) {
   return s;
 }
 
-SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& materials, int diffuseModel) {
+SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& materials, DiffuseModel diffuseModel) {
   SceneShape s;
   s.name = name;
   s.diffuseModel = diffuseModel;
@@ -197,7 +197,7 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
   s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
   // Extra interfaces are in closure headers only: a lone closure is on top.
   s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
-  s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", scene.diffuseModel);
+  s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", diffuseModelNumber(scene.diffuseModel));
   s += fmt::format("#define SUBSTRATE_MAX_CLOSURES {}\n", k.maxClosures);
   s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", k.maxWords);
   s += fmt::format("#define SUBSTRATE_SCENE_TILE_CLASS {}u  // this shader's tile list\n", rank(k.cls));

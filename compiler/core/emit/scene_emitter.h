@@ -39,6 +39,7 @@
 #include <vector>
 
 #include "emit/syntax.h"
+#include "ir/enums.h"
 #include "storage/layout.h"
 
 namespace substratec {
@@ -68,13 +69,13 @@ struct SceneShape {
   std::uint16_t storedFeatures = 0;         // union over the materials
   int maxWords = 2;
   int maxClosures = 1;
-  int diffuseModel = 2;
+  DiffuseModel diffuseModel = kDefaultDiffuseModel;
 };
 
 inline constexpr int kSceneTileSize = 8;
 
 /// The lighting shaders a scene of these materials needs.
-SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& materials, int diffuseModel);
+SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& materials, DiffuseModel diffuseModel);
 
 /// Material-buffer slices to allocate: words beyond the three render targets.
 inline int materialBufferSlices(const SceneShape& s) { return s.maxWords > 3 ? s.maxWords - 3 : 0; }

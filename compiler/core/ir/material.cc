@@ -4,17 +4,7 @@
 
 namespace substratec {
 
-std::string_view blendModeName(BlendMode m) {
-  switch (m) {
-    case BlendMode::Opaque: return "opaque";
-    case BlendMode::Masked: return "masked";
-    case BlendMode::TranslucentGrey: return "translucent_grey";
-    case BlendMode::TranslucentColored: return "translucent_colored";
-    case BlendMode::ColoredTransmittanceOnly: return "colored_transmittance_only";
-    case BlendMode::AlphaHoldout: return "alpha_holdout";
-  }
-  return "opaque";
-}
+std::string_view blendModeName(BlendMode m) { return enumName(kBlendModeNames, m, "opaque"); }
 
 namespace {
 constexpr double kInf = 1e300;
@@ -50,15 +40,7 @@ std::optional<SlabPin> slabPinByName(std::string_view name) {
   return std::nullopt;
 }
 
-std::string_view sssTypeName(SssType t) {
-  switch (t) {
-    case SssType::None: return "none";
-    case SssType::Wrap: return "wrap";
-    case SssType::Diffusion: return "diffusion";
-    case SssType::SimpleVolume: return "simple_volume";
-  }
-  return "none";
-}
+std::string_view sssTypeName(SssType t) { return enumName(kSssTypeNames, t, "none"); }
 
 std::string_view featureName(int bit) {
   static constexpr std::string_view names[kFeatureCount] = {
@@ -66,17 +48,7 @@ std::string_view featureName(int bit) {
   return bit >= 0 && bit < kFeatureCount ? names[bit] : "?";
 }
 
-std::string_view treeOpName(TreeOp op) {
-  switch (op) {
-    case TreeOp::Slab: return "SLAB";
-    case TreeOp::Horizontal: return "HORIZONTAL";
-    case TreeOp::Vertical: return "VERTICAL";
-    case TreeOp::Add: return "ADD";
-    case TreeOp::CoverageWeight: return "WEIGHT";
-    case TreeOp::Select: return "SELECT";
-  }
-  return "?";
-}
+std::string_view treeOpName(TreeOp op) { return enumName(kTreeOpNames, op, "?"); }
 
 int Material::inputIndex(std::string_view n) const {
   for (std::size_t i = 0; i < inputs.size(); ++i)

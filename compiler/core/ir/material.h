@@ -13,9 +13,6 @@
 
 namespace substratec {
 
-enum class BlendMode : std::uint8_t {
-  Opaque, Masked, TranslucentGrey, TranslucentColored, ColoredTransmittanceOnly, AlphaHoldout
-};
 std::string_view blendModeName(BlendMode m);
 
 struct Settings {
@@ -55,7 +52,6 @@ struct SlabPinInfo {
 const SlabPinInfo& slabPinInfo(SlabPin p);
 std::optional<SlabPin> slabPinByName(std::string_view name);
 
-enum class SssType : std::uint8_t { None, Wrap, Diffusion, SimpleVolume };
 std::string_view sssTypeName(SssType t);
 
 /// Opt-in features (bit flags). A feature is *used* when its gate pin is not a
@@ -92,7 +88,6 @@ struct Slab {
   ValueId& pin(SlabPin p) { return pins[static_cast<int>(p)]; }
 };
 
-enum class TreeOp : std::uint8_t { Slab, Horizontal, Vertical, Add, CoverageWeight, Select };
 std::string_view treeOpName(TreeOp op);
 
 /// One node of the Substrate tree. Operands: Horizontal (left = background,

@@ -35,18 +35,7 @@ std::string_view opName(Op op) {
 
 bool isHelper(Op op) { return op >= Op::MetalnessToDiffuseF0 && op < Op::Count_; }
 
-std::string_view geometryAttrName(GeometryAttr a) {
-  switch (a) {
-    case GeometryAttr::Normal: return "normal";
-    case GeometryAttr::Tangent: return "tangent";
-    case GeometryAttr::Uv0: return "uv0";
-    case GeometryAttr::Uv1: return "uv1";
-    case GeometryAttr::VertexColor: return "vertex_color";
-    case GeometryAttr::Position: return "position";
-    case GeometryAttr::View: return "view";
-  }
-  return "normal";
-}
+std::string_view geometryAttrName(GeometryAttr a) { return enumName(kGeometryAttrNames, a, "normal"); }
 
 VType geometryAttrType(GeometryAttr a) {
   switch (a) {

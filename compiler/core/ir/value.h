@@ -9,6 +9,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include "ir/enums.h"  // GeometryAttr (and the IR's other enums, with their names)
+
 namespace substratec {
 
 /// Value types. Colors are Vec3. Texture is only the type of a texture2d input.
@@ -47,7 +49,6 @@ enum class Op : std::uint8_t {
 std::string_view opName(Op op);
 bool isHelper(Op op);
 
-enum class GeometryAttr : std::uint16_t { Normal, Tangent, Uv0, Uv1, VertexColor, Position, View };
 std::string_view geometryAttrName(GeometryAttr a);
 VType geometryAttrType(GeometryAttr a);
 

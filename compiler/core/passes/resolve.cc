@@ -61,24 +61,20 @@ const std::vector<OpSpec>& opSpecs() {
                  Op::Sample,
                  {{"texture", PinKind::TextureRef, true, 0, -1}, {"uv", PinKind::Vec2, false, 0, G_UV0}},
                  {"rgb", "r", "g", "b", "a"}});
-    binary("add", Op::Add);
-    binary("subtract", Op::Subtract);
-    binary("multiply", Op::Multiply);
-    binary("divide", Op::Divide);
-    binary("min", Op::Min);
-    binary("max", Op::Max);
+    const std::pair<const char*, Op> binaries[] = {{"add", Op::Add}, {"subtract", Op::Subtract},
+                                                   {"multiply", Op::Multiply}, {"divide", Op::Divide},
+                                                   {"min", Op::Min}, {"max", Op::Max}};
+    for (const auto& [k, op] : binaries) binary(k, op);
     v.push_back({"lerp", Op::Lerp,
                  {{"a", PinKind::Value, true, 0, -1}, {"b", PinKind::Value, true, 0, -1},
                   {"t", PinKind::Value, true, 0, -1}}, {}});
     v.push_back({"clamp", Op::Clamp,
                  {{"x", PinKind::Value, true, 0, -1}, {"lo", PinKind::Value, true, 0, -1},
                   {"hi", PinKind::Value, true, 0, -1}}, {}});
-    unary("saturate", Op::Saturate);
-    unary("one_minus", Op::OneMinus);
-    unary("abs", Op::Abs);
-    unary("sqrt", Op::Sqrt);
-    unary("normalize", Op::Normalize);
-    unary("length", Op::Length);
+    const std::pair<const char*, Op> unaries[] = {{"saturate", Op::Saturate}, {"one_minus", Op::OneMinus},
+                                                  {"abs", Op::Abs}, {"sqrt", Op::Sqrt},
+                                                  {"normalize", Op::Normalize}, {"length", Op::Length}};
+    for (const auto& [k, op] : unaries) unary(k, op);
     v.push_back({"pow", Op::Pow, {{"x", PinKind::Value, true, 0, -1}, {"y", PinKind::Value, true, 0, -1}}, {}});
     v.push_back({"dot", Op::Dot, {{"a", PinKind::Value, true, 0, -1}, {"b", PinKind::Value, true, 0, -1}}, {}});
     v.push_back({"swizzle", Op::Swizzle,
@@ -219,6 +215,15 @@ std::string kindOf(const Json& node) {
   return k != node.end() && k->is_string() ? k->get<std::string>() : "";
 }
 
+/// The enumerator of `table` that the JSON string `v` names; otherwise the
+/// error "expected one of <the table's names, in order>; got <v's kind>" at `ptr`.
+template <class E, std::size_t N>
+std::optional<E> enumOfJson(const EnumName<E> (&table)[N], const Json& v, const std::string& ptr, Diagnostics& d) {
+  const std::optional<E> e = v.is_string() ? enumByName(table, v.get_ref<const std::string&>()) : std::nullopt;
+  if (!e) d.error(ptr, fmt::format("expected one of {}; got {}", enumNameList(table), kindOfJson(v)));
+  return e;
+}
+
 /// "a -> b -> c -> a", with long cycles shortened to their first and last
 /// nodes (a cycle through 20000 nodes must not make a megabyte-long line).
 std::string cycleChain(const std::vector<std::string>& names) {
@@ -270,12 +275,26 @@ class Resolver {
   // --- substrate
   int readSubstratePin(const Json& j, const std::string& ptr, const std::string& nameForInline);
   void fillSubstrateNode(int index, const Json& j, const std::string& ptr, TreeOp op);
+  /// The pins of an operator node (HORIZONTAL, VERTICAL, ADD, WEIGHT, SELECT) into `node`.
+  void fillOperatorNode(int index, const Json& j, const std::string& ptr, TreeOp op, SNode& node);
+  /// The pins, SSS type and specular profile of a slab node into `node`.
+  void fillSlabNode(int index, const Json& j, const std::string& ptr, SNode& node);
+  /// Slab pin `p` of slab node `index` (the node's JSON `j`) into `dst`: its default when absent.
+  void readSlabPin(int index, const Json& j, const std::string& ptr, int p, PinRef& dst);
   bool isSubstrateValue(const Json& j) const;
   void checkRange(const PinRef& pin, const Json& j, const std::string& ptr, double lo, double hi,
                   const char* what);
 
   // --- typing and cycles
   void typeValueNodes();
+  /// The type of what pin `p` reads: its own, or its value node's output.
+  VType valueOutputType(const PinRef& p) const;
+  /// Types value node i, whose arguments are typed (post-order); reports mismatches.
+  void typeValueNode(int i);
+  /// The output types of a math, geometry or texture node with typed pins.
+  void typeOperatorNode(VNode& v, const OpSpec* spec);
+  /// The output types of a helper node (its pins' kinds are checked here).
+  void typeHelperNode(VNode& v, const OpSpec* spec);
   void checkSubstrateCycles();
 
   bool isValueKindName(const std::string& id) const {
@@ -501,23 +520,7 @@ void Resolver::readSettings(const Json& s, const std::string& ptr) {
         d_.error(p, fmt::format("expected a thickness in meters >= 0, got {}", kindOfJson(v)));
       else st.surfaceThickness = v.get<double>();
     } else if (k == "blend_mode") {
-      static const std::pair<const char*, BlendMode> modes[] = {
-          {"opaque", BlendMode::Opaque},
-          {"masked", BlendMode::Masked},
-          {"translucent_grey", BlendMode::TranslucentGrey},
-          {"translucent_colored", BlendMode::TranslucentColored},
-          {"colored_transmittance_only", BlendMode::ColoredTransmittanceOnly},
-          {"alpha_holdout", BlendMode::AlphaHoldout}};
-      bool found = false;
-      if (v.is_string())
-        for (auto& [n, m] : modes)
-          if (v.get<std::string>() == n) {
-            st.blendMode = m;
-            found = true;
-          }
-      if (!found)
-        d_.error(p, fmt::format("expected one of opaque, masked, translucent_grey, translucent_colored, "
-                                "colored_transmittance_only, alpha_holdout; got {}", kindOfJson(v)));
+      if (auto m = enumOfJson(kBlendModeNames, v, p, d_)) st.blendMode = *m;
     } else {
       d_.error(p, fmt::format("unknown setting {} (expected bytes_per_pixel, max_closures, thin_surface, "
                               "surface_thickness or blend_mode)", quoteForDiagnostic(k)));
@@ -828,22 +831,9 @@ void Resolver::readValueNodeBody(int index, const Json& j, const std::string& pt
     const Json& v = *it;
     switch (ps.kind) {
       case PinKind::Attribute: {
-        static const std::pair<const char*, GeometryAttr> attrs[] = {
-            {"normal", GeometryAttr::Normal},   {"tangent", GeometryAttr::Tangent},
-            {"uv0", GeometryAttr::Uv0},         {"uv1", GeometryAttr::Uv1},
-            {"vertex_color", GeometryAttr::VertexColor}, {"position", GeometryAttr::Position},
-            {"view", GeometryAttr::View}};
-        bool found = false;
-        if (v.is_string())
-          for (auto& [n, a] : attrs)
-            if (v.get<std::string>() == n) {
-              attr = static_cast<std::uint16_t>(a);
-              found = true;
-            }
-        if (!found)
-          d_.error(pp, fmt::format("expected one of normal, tangent, uv0, uv1, vertex_color, position, view; got {}",
-                                   kindOfJson(v)));
-        pins[i].type = found ? geometryAttrType(static_cast<GeometryAttr>(attr)) : VType::Invalid;
+        const std::optional<GeometryAttr> a = enumOfJson(kGeometryAttrNames, v, pp, d_);
+        if (a) attr = static_cast<std::uint16_t>(*a);
+        pins[i].type = a ? geometryAttrType(*a) : VType::Invalid;
         break;
       }
       case PinKind::TextureRef: {
@@ -1122,9 +1112,20 @@ bool Resolver::expectPinType(PinRef& pin, PinKind kind, const std::string& ptr, 
 
 void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& ptr, TreeOp op) {
   out_.substrate[index].op = op;
-  const std::string id = out_.substrate[index].id;
-
   SNode node;  // filled locally: out_.substrate may reallocate during recursion
+  if (op == TreeOp::Slab)
+    fillSlabNode(index, j, ptr, node);
+  else
+    fillOperatorNode(index, j, ptr, op, node);
+  SNode& dst = out_.substrate[index];
+  node.op = dst.op;
+  node.id = dst.id;
+  node.pointer = dst.pointer;
+  dst = std::move(node);
+}
+
+void Resolver::fillOperatorNode(int index, const Json& j, const std::string& ptr, TreeOp op, SNode& node) {
+  const std::string id = out_.substrate[index].id;
   auto checkKeys = [&](std::initializer_list<const char*> keys) {
     for (auto it = j.begin(); it != j.end(); ++it) {
       const std::string& k = it.key();
@@ -1192,86 +1193,71 @@ void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& pt
       val("value", true, 0, -kBig, kBig, node.a);
       val("threshold", false, 0.5, -kBig, kBig, node.b);
       break;
-    case TreeOp::Slab: {
-      for (auto it = j.begin(); it != j.end(); ++it) {
-        const std::string& k = it.key();
-        if (k == "kind" || k == "comment" || k == "sss_type" || k == "specular_profile") continue;
-        if (!slabPinByName(k))
-          d_.error(ptr + "/" + pointerToken(k), fmt::format("unknown slab pin {}", quoteForDiagnostic(k)));
-      }
-      for (int p = 0; p < kSlabPinCount; ++p) {
-        const SlabPinInfo& info = slabPinInfo(static_cast<SlabPin>(p));
-        PinRef& dst = node.slabPins[p];
-        auto it = j.find(std::string(info.name));
-        if (it == j.end()) {
-          dst.tag = PinRef::Default;
-          if (info.geometryDefault >= 0) {
-            dst.index = info.geometryDefault;
-            dst.type = info.type;
-          } else {
-            dst.literal = {info.defaultValue, info.defaultValue, info.defaultValue, info.defaultValue};
-            dst.literalCount = componentCount(info.type);
-            dst.type = info.type;
-          }
-          continue;
-        }
-        std::string pp = ptr + "/" + std::string(info.name);
-        dst = readValuePin(*it, pp, std::string(info.name));
-        PinKind kind = info.color ? PinKind::Color
-                                  : info.type == VType::Float ? PinKind::Float
-                                  : info.type == VType::Vec2 ? PinKind::Vec2 : PinKind::Vec3;
-        if (dst.tag == PinRef::Node) deferred_.push_back({index, p, kind, pp});
-        if (expectPinType(dst, kind, pp)) {
-          const char* what = info.color ? "a color with components" : "a float";
-          if (info.type == VType::Vec3 && !info.color) what = "a vector with components";
-          if (info.type != VType::Vec2) checkRange(dst, *it, pp, info.lo, info.hi, what);
-          if (dst.tag == PinRef::Literal && info.type == VType::Vec3 && !info.color) {
-            double len2 = dst.literal[0] * dst.literal[0] + dst.literal[1] * dst.literal[1] +
-                          dst.literal[2] * dst.literal[2];
-            if (len2 < 1e-12) d_.error(pp, fmt::format("expected a non-zero direction, got {}", kindOfJson(*it)));
-          }
-        }
-      }
-      if (auto it = j.find("sss_type"); it != j.end()) {
-        static const std::pair<const char*, SssType> types[] = {{"none", SssType::None},
-                                                                {"wrap", SssType::Wrap},
-                                                                {"diffusion", SssType::Diffusion},
-                                                                {"simple_volume", SssType::SimpleVolume}};
-        bool found = false;
-        if (it->is_string())
-          for (auto& [n, t] : types)
-            if (it->get<std::string>() == n) {
-              node.sssType = t;
-              found = true;
-            }
-        if (!found)
-          d_.error(ptr + "/sss_type",
-                   fmt::format("expected one of none, wrap, diffusion, simple_volume; got {}", kindOfJson(*it)));
-        node.sssTypeExplicit = found;
-      }
-      if (auto it = j.find("specular_profile"); it != j.end()) {
-        std::string pp = ptr + "/specular_profile";
-        if (it->is_string() && !it->get<std::string>().empty() && it->get<std::string>()[0] == '$') {
-          auto f = inputIndex_.find(it->get<std::string>().substr(1));
-          if (f == inputIndex_.end())
-            d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic(it->get<std::string>())));
-          else if (out_.inputs[f->second].type != VType::Texture)
-            d_.error(pp, fmt::format("specular profile {} must be a texture2d input (a view/light LUT)",
-                                     quoteForDiagnostic(it->get<std::string>())));
-          else
-            node.specularProfileInput = f->second;
-        } else {
-          d_.error(pp, fmt::format("expected a texture2d input reference like \"$lut\", got {}", kindOfJson(*it)));
-        }
-      }
-      break;
+    case TreeOp::Slab: break;  // fillSlabNode
+  }
+}
+
+void Resolver::fillSlabNode(int index, const Json& j, const std::string& ptr, SNode& node) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& k = it.key();
+    if (k == "kind" || k == "comment" || k == "sss_type" || k == "specular_profile") continue;
+    if (!slabPinByName(k))
+      d_.error(ptr + "/" + pointerToken(k), fmt::format("unknown slab pin {}", quoteForDiagnostic(k)));
+  }
+  for (int p = 0; p < kSlabPinCount; ++p) readSlabPin(index, j, ptr, p, node.slabPins[p]);
+  if (auto it = j.find("sss_type"); it != j.end()) {
+    const std::optional<SssType> t = enumOfJson(kSssTypeNames, *it, ptr + "/sss_type", d_);
+    if (t) node.sssType = *t;
+    node.sssTypeExplicit = t.has_value();
+  }
+  if (auto it = j.find("specular_profile"); it != j.end()) {
+    std::string pp = ptr + "/specular_profile";
+    if (it->is_string() && !it->get<std::string>().empty() && it->get<std::string>()[0] == '$') {
+      auto f = inputIndex_.find(it->get<std::string>().substr(1));
+      if (f == inputIndex_.end())
+        d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic(it->get<std::string>())));
+      else if (out_.inputs[f->second].type != VType::Texture)
+        d_.error(pp, fmt::format("specular profile {} must be a texture2d input (a view/light LUT)",
+                                 quoteForDiagnostic(it->get<std::string>())));
+      else
+        node.specularProfileInput = f->second;
+    } else {
+      d_.error(pp, fmt::format("expected a texture2d input reference like \"$lut\", got {}", kindOfJson(*it)));
     }
   }
-  SNode& dst = out_.substrate[index];
-  node.op = dst.op;
-  node.id = dst.id;
-  node.pointer = dst.pointer;
-  dst = std::move(node);
+}
+
+void Resolver::readSlabPin(int index, const Json& j, const std::string& ptr, int p, PinRef& dst) {
+  const SlabPinInfo& info = slabPinInfo(static_cast<SlabPin>(p));
+  auto it = j.find(std::string(info.name));
+  if (it == j.end()) {
+    dst.tag = PinRef::Default;
+    if (info.geometryDefault >= 0) {
+      dst.index = info.geometryDefault;
+      dst.type = info.type;
+    } else {
+      dst.literal = {info.defaultValue, info.defaultValue, info.defaultValue, info.defaultValue};
+      dst.literalCount = componentCount(info.type);
+      dst.type = info.type;
+    }
+    return;
+  }
+  std::string pp = ptr + "/" + std::string(info.name);
+  dst = readValuePin(*it, pp, std::string(info.name));
+  PinKind kind = info.color ? PinKind::Color
+                            : info.type == VType::Float ? PinKind::Float
+                            : info.type == VType::Vec2 ? PinKind::Vec2 : PinKind::Vec3;
+  if (dst.tag == PinRef::Node) deferred_.push_back({index, p, kind, pp});
+  if (expectPinType(dst, kind, pp)) {
+    const char* what = info.color ? "a color with components" : "a float";
+    if (info.type == VType::Vec3 && !info.color) what = "a vector with components";
+    if (info.type != VType::Vec2) checkRange(dst, *it, pp, info.lo, info.hi, what);
+    if (dst.tag == PinRef::Literal && info.type == VType::Vec3 && !info.color) {
+      double len2 = dst.literal[0] * dst.literal[0] + dst.literal[1] * dst.literal[1] +
+                    dst.literal[2] * dst.literal[2];
+      if (len2 < 1e-12) d_.error(pp, fmt::format("expected a non-zero direction, got {}", kindOfJson(*it)));
+    }
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -1280,117 +1266,6 @@ void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& pt
 void Resolver::typeValueNodes() {
   const int n = static_cast<int>(out_.values.size());
   std::vector<std::uint8_t> state(n, 0);  // 0 new, 1 on stack, 2 done
-  auto pinType = [&](const PinRef& p) -> VType {
-    if (p.tag != PinRef::Node) return p.type;
-    const VNode& v = out_.values[p.index];
-    if (v.outputTypes.empty()) return VType::Invalid;
-    return v.outputTypes[std::min<std::size_t>(p.output, v.outputTypes.size() - 1)];
-  };
-  auto typeOne = [&](int i) {
-    VNode& v = out_.values[i];
-    const OpSpec* spec = nullptr;
-    for (const auto& s : opSpecs())
-      if (s.op == v.op) spec = &s;
-    for (auto& p : v.pins)
-      if (p.tag == PinRef::Node) p.type = pinType(p);
-    bool bad = false;
-    for (auto& p : v.pins)
-      if (p.type == VType::Invalid) bad = true;
-    if (bad) {
-      v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
-      return;
-    }
-    auto err = [&](const std::string& pin, const std::string& msg) {
-      d_.error(v.pointer + (pin.empty() ? "" : "/" + pin), msg);
-      v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
-    };
-    auto combine2 = [&](VType a, VType b, const char* pa, const char* pb, VType& outT) -> bool {
-      if (a == b || b == VType::Float) { outT = a; return true; }
-      if (a == VType::Float) { outT = b; return true; }
-      err("", fmt::format("cannot combine {} \"{}\" with {} \"{}\" (a float broadcasts; vectors must match)",
-                          typeName(a), pa, typeName(b), pb));
-      return false;
-    };
-    VType r = VType::Invalid;
-    switch (v.op) {
-      case Op::Geometry: r = geometryAttrType(static_cast<GeometryAttr>(v.attr)); break;
-      case Op::Sample:
-        if (v.pins[1].type != VType::Vec2) return err("uv", fmt::format("expected a vec2, got a {}", typeName(v.pins[1].type)));
-        v.outputTypes = {VType::Vec3, VType::Float, VType::Float, VType::Float, VType::Float};
-        return;
-      case Op::Add: case Op::Subtract: case Op::Multiply: case Op::Divide: case Op::Min: case Op::Max:
-        if (!combine2(v.pins[0].type, v.pins[1].type, "a", "b", r)) return;
-        break;
-      case Op::Pow:
-        if (!combine2(v.pins[0].type, v.pins[1].type, "x", "y", r)) return;
-        break;
-      case Op::Lerp: {
-        if (!combine2(v.pins[0].type, v.pins[1].type, "a", "b", r)) return;
-        VType t = v.pins[2].type;
-        if (t != VType::Float && t != r) return err("t", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(t)));
-        break;
-      }
-      case Op::Clamp:
-        r = v.pins[0].type;
-        for (int k = 1; k <= 2; ++k)
-          if (v.pins[k].type != VType::Float && v.pins[k].type != r)
-            return err(k == 1 ? "lo" : "hi", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(v.pins[k].type)));
-        break;
-      case Op::Saturate: case Op::OneMinus: case Op::Abs: case Op::Sqrt: case Op::Normalize:
-        r = v.pins[0].type;
-        break;
-      case Op::Length: r = VType::Float; break;
-      case Op::Dot:
-        if (v.pins[0].type != v.pins[1].type)
-          return err("", fmt::format("dot needs two values of one type, got {} and {}", typeName(v.pins[0].type),
-                                     typeName(v.pins[1].type)));
-        r = VType::Float;
-        break;
-      case Op::Swizzle: {
-        int count = v.attr >> 8;
-        int have = componentCount(v.pins[0].type);
-        for (int c = 0; c < count; ++c)
-          if (((v.attr >> (2 * c)) & 3) >= have)
-            return err("channels", fmt::format("channel out of range for a {}", typeName(v.pins[0].type)));
-        r = vectorType(count);
-        break;
-      }
-      case Op::Combine: {
-        int count = 0;
-        for (std::size_t k = 0; k < v.pins.size(); ++k) {
-          if (v.pins[k].tag == PinRef::Default && k >= 2) break;
-          if (v.pins[k].type != VType::Float)
-            return err(spec->pins[k].name, fmt::format("expected a float, got a {}", typeName(v.pins[k].type)));
-          ++count;
-        }
-        // z without w is fine; w without z is not.
-        if (v.pins.size() == 4 && v.pins[2].tag == PinRef::Default && v.pins[3].tag != PinRef::Default)
-          return err("w", "\"w\" given without \"z\"");
-        r = vectorType(count);
-        break;
-      }
-      default: {  // helpers: pin types were fixed by their PinKind
-        for (std::size_t k = 0; k < v.pins.size(); ++k) {
-          PinRef& p = v.pins[k];
-          if (!expectPinType(p, spec->pins[k].kind, v.pointer + "/" + spec->pins[k].name)) {
-            v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
-            return;
-          }
-        }
-        switch (v.op) {
-          case Op::MetalnessToDiffuseF0: v.outputTypes = {VType::Vec3, VType::Vec3}; return;
-          case Op::IorToF0: r = VType::Float; break;
-          case Op::HazinessToSecondRoughness: v.outputTypes = {VType::Float, VType::Float}; return;
-          case Op::TransmittanceToMfp: v.outputTypes = {VType::Vec3, VType::Float}; return;
-          case Op::ThinFilm: v.outputTypes = {VType::Vec3, VType::Vec3}; return;
-          case Op::RotationToTangent: r = VType::Vec3; break;
-          case Op::ViewDependentCoverage: r = VType::Float; break;
-          default: r = VType::Invalid;
-        }
-      }
-    }
-    v.outputTypes = {r};
-  };
   // Iterative post-order DFS; a back edge is a cycle.
   for (int start = 0; start < n; ++start) {
     if (state[start]) continue;
@@ -1421,12 +1296,135 @@ void Resolver::typeValueNodes() {
         }
         continue;
       }
-      typeOne(i);
+      typeValueNode(i);
       state[i] = 2;
       out_.valueOrder.push_back(i);
       stack.pop_back();
     }
   }
+}
+
+VType Resolver::valueOutputType(const PinRef& p) const {
+  if (p.tag != PinRef::Node) return p.type;
+  const VNode& v = out_.values[p.index];
+  if (v.outputTypes.empty()) return VType::Invalid;
+  return v.outputTypes[std::min<std::size_t>(p.output, v.outputTypes.size() - 1)];
+}
+
+void Resolver::typeValueNode(int i) {
+  VNode& v = out_.values[i];
+  const OpSpec* spec = nullptr;
+  for (const auto& s : opSpecs())
+    if (s.op == v.op) spec = &s;
+  for (auto& p : v.pins)
+    if (p.tag == PinRef::Node) p.type = valueOutputType(p);
+  bool bad = false;
+  for (auto& p : v.pins)
+    if (p.type == VType::Invalid) bad = true;
+  if (bad) {
+    v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
+    return;
+  }
+  typeOperatorNode(v, spec);
+}
+
+void Resolver::typeOperatorNode(VNode& v, const OpSpec* spec) {
+  auto err = [&](const std::string& pin, const std::string& msg) {
+    d_.error(v.pointer + (pin.empty() ? "" : "/" + pin), msg);
+    v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
+  };
+  auto combine2 = [&](VType a, VType b, const char* pa, const char* pb, VType& outT) -> bool {
+    if (a == b || b == VType::Float) { outT = a; return true; }
+    if (a == VType::Float) { outT = b; return true; }
+    err("", fmt::format("cannot combine {} \"{}\" with {} \"{}\" (a float broadcasts; vectors must match)",
+                        typeName(a), pa, typeName(b), pb));
+    return false;
+  };
+  VType r = VType::Invalid;
+  switch (v.op) {
+    case Op::Geometry: r = geometryAttrType(static_cast<GeometryAttr>(v.attr)); break;
+    case Op::Sample:
+      if (v.pins[1].type != VType::Vec2) return err("uv", fmt::format("expected a vec2, got a {}", typeName(v.pins[1].type)));
+      v.outputTypes = {VType::Vec3, VType::Float, VType::Float, VType::Float, VType::Float};
+      return;
+    case Op::Add: case Op::Subtract: case Op::Multiply: case Op::Divide: case Op::Min: case Op::Max:
+      if (!combine2(v.pins[0].type, v.pins[1].type, "a", "b", r)) return;
+      break;
+    case Op::Pow:
+      if (!combine2(v.pins[0].type, v.pins[1].type, "x", "y", r)) return;
+      break;
+    case Op::Lerp: {
+      if (!combine2(v.pins[0].type, v.pins[1].type, "a", "b", r)) return;
+      VType t = v.pins[2].type;
+      if (t != VType::Float && t != r) return err("t", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(t)));
+      break;
+    }
+    case Op::Clamp:
+      r = v.pins[0].type;
+      for (int k = 1; k <= 2; ++k)
+        if (v.pins[k].type != VType::Float && v.pins[k].type != r)
+          return err(k == 1 ? "lo" : "hi", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(v.pins[k].type)));
+      break;
+    case Op::Saturate: case Op::OneMinus: case Op::Abs: case Op::Sqrt: case Op::Normalize:
+      r = v.pins[0].type;
+      break;
+    case Op::Length: r = VType::Float; break;
+    case Op::Dot:
+      if (v.pins[0].type != v.pins[1].type)
+        return err("", fmt::format("dot needs two values of one type, got {} and {}", typeName(v.pins[0].type),
+                                   typeName(v.pins[1].type)));
+      r = VType::Float;
+      break;
+    case Op::Swizzle: {
+      int count = v.attr >> 8;
+      int have = componentCount(v.pins[0].type);
+      for (int c = 0; c < count; ++c)
+        if (((v.attr >> (2 * c)) & 3) >= have)
+          return err("channels", fmt::format("channel out of range for a {}", typeName(v.pins[0].type)));
+      r = vectorType(count);
+      break;
+    }
+    case Op::Combine: {
+      int count = 0;
+      for (std::size_t k = 0; k < v.pins.size(); ++k) {
+        if (v.pins[k].tag == PinRef::Default && k >= 2) break;
+        if (v.pins[k].type != VType::Float)
+          return err(spec->pins[k].name, fmt::format("expected a float, got a {}", typeName(v.pins[k].type)));
+        ++count;
+      }
+      // z without w is fine; w without z is not.
+      if (v.pins.size() == 4 && v.pins[2].tag == PinRef::Default && v.pins[3].tag != PinRef::Default)
+        return err("w", "\"w\" given without \"z\"");
+      r = vectorType(count);
+      break;
+    }
+    default:
+      return typeHelperNode(v, spec);
+  }
+  v.outputTypes = {r};
+}
+
+void Resolver::typeHelperNode(VNode& v, const OpSpec* spec) {
+  // helpers: pin types were fixed by their PinKind
+  VType r = VType::Invalid;
+  for (std::size_t k = 0; k < v.pins.size(); ++k) {
+    PinRef& p = v.pins[k];
+    if (!expectPinType(p, spec->pins[k].kind, v.pointer + "/" + spec->pins[k].name)) {
+      v.outputTypes.assign(std::max<std::size_t>(1, spec->outputs.size()), VType::Invalid);
+      return;
+    }
+  }
+  switch (v.op) {
+    case Op::MetalnessToDiffuseF0: v.outputTypes = {VType::Vec3, VType::Vec3}; return;
+    case Op::IorToF0: r = VType::Float; break;
+    case Op::HazinessToSecondRoughness: v.outputTypes = {VType::Float, VType::Float}; return;
+    case Op::TransmittanceToMfp: v.outputTypes = {VType::Vec3, VType::Float}; return;
+    case Op::ThinFilm: v.outputTypes = {VType::Vec3, VType::Vec3}; return;
+    case Op::RotationToTangent: r = VType::Vec3; break;
+    case Op::ViewDependentCoverage: r = VType::Float; break;
+    default: r = VType::Invalid;
+  }
+  v.outputTypes = {r};
 }
 
 /// Pins of Substrate nodes that reference value nodes can only be typed once

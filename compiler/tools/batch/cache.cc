@@ -97,7 +97,7 @@ std::string cacheKeyText(const std::string& path, const std::string& input, cons
       c.budgetOverride ? std::to_string(*c.budgetOverride) : "-",
       c.maxClosuresOverride ? std::to_string(*c.maxClosuresOverride) : "-", c.fullSimplification,
       static_cast<int>(c.blendRule), platform, o.generate.glsl ? "glsl" : "", o.generate.hlsl ? " hlsl" : "",
-      e.diffuseModel, static_cast<int>(e.precision), e.inputsPerInvocation, e.dynamicSimplification, o.validate, path, input.size(), hash128(input));
+      diffuseModelNumber(e.diffuseModel), static_cast<int>(e.precision), e.inputsPerInvocation, e.dynamicSimplification, o.validate, path, input.size(), hash128(input));
 }
 
 std::string MaterialCache::entryPath(const std::string& keyText) const {

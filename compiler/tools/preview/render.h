@@ -33,7 +33,7 @@ struct RenderOptions {
   int size = 256;                            // pixels, square
   std::string environment = "studio";        // preview/environment.h
   Target target = Target::Glsl;              // which generated language runs
-  int diffuseModel = 2;                      // SUBSTRATE_DIFFUSE_MODEL
+  DiffuseModel diffuseModel = kDefaultDiffuseModel;  // SUBSTRATE_DIFFUSE_MODEL
   Precision precision = Precision::Float;    // of the runtime's lighting (needs shaderFloat16 for Half)
   double exposure = 0;                       // stops, for the tone map
   PipelineCache* pipelines = nullptr;        // reuse pipelines across calls (null: build one per call)

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <set>
 #include <thread>
 
@@ -189,14 +190,13 @@ double deltaE2000Lab(const std::array<double, 3>& lab1, const std::array<double,
   // Sharma, Wu & Dalal 2005, "The CIEDE2000 color-difference formula".
   const auto [L1, a1, b1] = lab1;
   const auto [L2, a2, b2] = lab2;
-  const double kPi = 3.14159265358979323846;
   const double C1 = std::hypot(a1, b1), C2 = std::hypot(a2, b2), Cbar = 0.5 * (C1 + C2);
   const double G = 0.5 * (1 - std::sqrt(std::pow(Cbar, 7) / (std::pow(Cbar, 7) + std::pow(25.0, 7))));
   const double a1p = (1 + G) * a1, a2p = (1 + G) * a2;
   const double C1p = std::hypot(a1p, b1), C2p = std::hypot(a2p, b2);
   auto hue = [&](double b, double ap) {
     if (b == 0 && ap == 0) return 0.0;
-    double h = std::atan2(b, ap) * 180 / kPi;
+    double h = std::atan2(b, ap) * 180 / std::numbers::pi;
     return h < 0 ? h + 360 : h;
   };
   const double h1p = hue(b1, a1p), h2p = hue(b2, a2p);
@@ -207,14 +207,14 @@ double deltaE2000Lab(const std::array<double, 3>& lab1, const std::array<double,
     if (dhp > 180) dhp -= 360;
     if (dhp < -180) dhp += 360;
   }
-  const double dHp = 2 * std::sqrt(C1p * C2p) * std::sin(dhp * kPi / 360);
+  const double dHp = 2 * std::sqrt(C1p * C2p) * std::sin(dhp * std::numbers::pi / 360);
   const double Lbarp = 0.5 * (L1 + L2), Cbarp = 0.5 * (C1p + C2p);
   double hbarp = h1p + h2p;
   if (C1p * C2p != 0) {
     if (std::abs(h1p - h2p) <= 180) hbarp *= 0.5;
     else hbarp = h1p + h2p < 360 ? 0.5 * (h1p + h2p + 360) : 0.5 * (h1p + h2p - 360);
   }
-  const double rad = kPi / 180;
+  const double rad = std::numbers::pi / 180;
   const double T = 1 - 0.17 * std::cos((hbarp - 30) * rad) + 0.24 * std::cos(2 * hbarp * rad) +
                    0.32 * std::cos((3 * hbarp + 6) * rad) - 0.20 * std::cos((4 * hbarp - 63) * rad);
   const double dTheta = 30 * std::exp(-std::pow((hbarp - 275) / 25, 2));
@@ -273,7 +273,7 @@ bool simplificationSteps(const std::string& path, const std::string& text, const
 bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileResult& full, const Options& o,
              std::vector<Row>* rows, std::string* error) {
   const std::vector<gpu::Sample> probes = gpu::makeSamples(kProbes, kProbeSeed);
-  const std::vector<double> y = radiance(full, probes, o.diffuseModel, nullptr);
+  const std::vector<double> y = radiance(full, probes, diffuseModelNumber(o.diffuseModel), nullptr);
   const std::vector<std::size_t> chosen = groundTruthProbes(probes, o.groundTruthProbes);
   const std::vector<double> truth = groundTruthDirect(full, probes, chosen, o.groundTruthSamples);
   for (const Step& step : steps) {
@@ -294,7 +294,7 @@ bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileRes
     }
     std::vector<std::vector<reference::Closure<double>>> closures;
     std::vector<double> direct;
-    const std::vector<double> x = radiance(r, probes, o.diffuseModel, &closures, &direct);
+    const std::vector<double> x = radiance(r, probes, diffuseModelNumber(o.diffuseModel), &closures, &direct);
     std::vector<double> directChosen;
     for (std::size_t j : chosen) directChosen.insert(directChosen.end(), &direct[j * 3], &direct[j * 3] + 3);
     row.relMseVsGroundTruth = relMse(directChosen, truth);

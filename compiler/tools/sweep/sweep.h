@@ -60,7 +60,7 @@ struct Row {
 struct Options {
   int pixels = 1 << 20;  // shading points per timed dispatch
   int timedRuns = 5;     // after one untimed warm-up; the median is reported
-  int diffuseModel = 2;
+  DiffuseModel diffuseModel = kDefaultDiffuseModel;
   int groundTruthProbes = 128;    // probes walked (the first ones lit from above and seen from above)
   int groundTruthSamples = 1024;  // walks per probe and channel group
   Precision precision = Precision::Float;  // of the timed kernels and the counted forward shader
