@@ -25,6 +25,7 @@
 #include <fmt/format.h>
 
 #include "reference/reference.h"
+#include "util/random.h"
 
 namespace substratec::stackfurnace {
 
@@ -102,13 +103,8 @@ inline std::string stackMaterial(int depth, Shape shape) {
 /// standard library's distributions).
 struct Rng {
   std::uint64_t s;
-  std::uint64_t next() {
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-  }
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  std::uint64_t next() { return splitmix64(s); }  // util/random.h
+  double uniform() { return unitInterval(next()); }
   /// One of `hard` (each with probability pHard / hard.size()) or uniform in [lo, hi].
   double pick(std::initializer_list<double> hard, double pHard, double lo, double hi) {
     const double u = uniform();

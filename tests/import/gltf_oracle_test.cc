@@ -3,6 +3,7 @@
 // specification's formulas, reciprocity, energy bounds; and the import
 // measured against it where both models agree (a dielectric, with Lambert).
 #include <cmath>
+#include <numbers>
 
 #include <gtest/gtest.h>
 
@@ -17,7 +18,6 @@ using reference::Rgb;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 Rgb dir(double theta, double phi) {
   return {std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
@@ -29,11 +29,11 @@ double albedo(const GltfMaterial& m, const Rgb& V) {
   double e = 0;
   for (int i = 0; i < nt; ++i)
     for (int j = 0; j < np; ++j) {
-      const double mu = (i + 0.5) / nt, phi = 2 * kPi * (j + 0.5) / np;
+      const double mu = (i + 0.5) / nt, phi = 2 * std::numbers::pi * (j + 0.5) / np;
       const Rgb L{std::sqrt(1 - mu * mu) * std::cos(phi), std::sqrt(1 - mu * mu) * std::sin(phi), mu};
       e += reference::gltfReflectance(m, V, L)[0];
     }
-  return e * (1.0 / nt) * (2 * kPi / np);
+  return e * (1.0 / nt) * (2 * std::numbers::pi / np);
 }
 
 }  // namespace
@@ -46,11 +46,11 @@ TEST(GltfOracle, NormalIncidenceIsTheSpecificationsFormula) {
   const Rgb N{0, 0, 1};
   const Rgb f = reference::gltfReflectance(m, N, N);
   // V = L = N: VoH = 1, F = 0.04; D = 1 / (pi a²), V = 0.5 / (1 + 1); diffuse (1 − F) c / pi.
-  const double a = 0.25, spec = 0.04 / (kPi * a * a) * 0.25;
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], (1 - 0.04) * m.baseColor[k] / kPi + spec, 1e-12);
+  const double a = 0.25, spec = 0.04 / (std::numbers::pi * a * a) * 0.25;
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(f[k], (1 - 0.04) * m.baseColor[k] / std::numbers::pi + spec, 1e-12);
   m.metallic = 1;  // a metal: F0 = base colour, no diffuse
   const Rgb g = reference::gltfReflectance(m, N, N);
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(g[k], m.baseColor[k] / (kPi * a * a) * 0.25, 1e-12);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(g[k], m.baseColor[k] / (std::numbers::pi * a * a) * 0.25, 1e-12);
 }
 
 TEST(GltfOracle, TheCoreBrdfIsReciprocal) {
@@ -121,7 +121,7 @@ TEST(GltfOracle, ClearcoatMixesByItsFresnelAtTheView) {
     return Rgb{h[0] / n, h[1] / n, h[2] / n};
   }();
   const double a = 0.09, a2 = a * a;
-  const double D = a2 / (kPi * std::pow(H[2] * H[2] * (a2 - 1) + 1, 2));
+  const double D = a2 / (std::numbers::pi * std::pow(H[2] * H[2] * (a2 - 1) + 1, 2));
   const double Vis = 0.5 / (L[2] * std::sqrt(V[2] * V[2] * (1 - a2) + a2) + V[2] * std::sqrt(L[2] * L[2] * (1 - a2) + a2));
   const double w = 0.8 * (0.04 + 0.96 * std::pow(1 - V[2], 5));
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(coated[k], base[k] * (1 - w) + w * D * Vis * L[2], 1e-12);

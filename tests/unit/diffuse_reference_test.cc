@@ -5,6 +5,7 @@
 // against it. Figures in the comments were measured with these seeds and
 // sample counts (RelWithDebInfo).
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <algorithm>
 #include <cmath>
@@ -20,7 +21,6 @@ namespace substratec::reference {
 namespace {
 
 using D3 = V3<double>;
-constexpr double kPi = 3.14159265358979323846;
 
 D3 dir(double mu, double phi) {
   double s = std::sqrt(1.0 - mu * mu);
@@ -50,8 +50,8 @@ double hemisphericalIntegral(double albedo, double r, const D3& wo, int n, int s
   std::uint32_t seed = 100;
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j)
-      sum += microfacetDiffuse(albedo, r, wo, dir((i + 0.5) / n, kPi * (j + 0.5) / n), samples, seed++);
-  return sum * (1.0 / n) * (kPi / n) * 2.0;
+      sum += microfacetDiffuse(albedo, r, wo, dir((i + 0.5) / n, std::numbers::pi * (j + 0.5) / n), samples, seed++);
+  return sum * (1.0 / n) * (std::numbers::pi / n) * 2.0;
 }
 
 // ---------------------------------------------------------------------------
@@ -64,7 +64,7 @@ TEST(DiffuseReference, ZeroRoughnessIsExactlyLambert) {
     for (double muO : {1.0, 0.5, 0.05})
       for (double muI : {0.9, 0.3, 0.02}) {
         SCOPED_TRACE(testing::Message() << "rho " << rho << " muO " << muO << " muI " << muI);
-        EXPECT_NEAR(microfacetDiffuse(rho, 0.0, dir(muO, 0.0), dir(muI, 2.0), 16, 3), rho / kPi * muI, 1e-15);
+        EXPECT_NEAR(microfacetDiffuse(rho, 0.0, dir(muO, 0.0), dir(muI, 2.0), 16, 3), rho / std::numbers::pi * muI, 1e-15);
         EXPECT_NEAR(microfacetDiffuseAlbedo(rho, 0.0, dir(muO, 0.0), 16, 3), rho, 1e-15);
       }
 }
@@ -82,7 +82,7 @@ TEST(DiffuseReference, RoughnessToZeroConvergesToLambert) {
   double worst05 = 0.0, worst25 = 0.0;
   for (double muI : {1.0, 0.866, 0.1}) {
     D3 wi = dir(muI, 2.5);
-    double lambert = 1.0 / kPi * muI;
+    double lambert = 1.0 / std::numbers::pi * muI;
     Estimate e05 = estimate(1.0, 0.05, wo, wi, 8, 4000, 10);
     Estimate e25 = estimate(1.0, 0.25, wo, wi, 8, 4000, 20);
     double d05 = e05.mean / lambert - 1.0, d25 = e25.mean / lambert - 1.0;
@@ -193,7 +193,7 @@ TEST(DiffuseReference, SingleScatteringIsHeightCorrelatedSmith) {
     for (int k = 0; k < n; ++k) {
       double u1 = uniform(), u2 = uniform();
       double cz = 1.0 / std::sqrt(1.0 + alpha * alpha * u1 / (1.0 - u1));  // GGX: tan^2 = a^2 u / (1 - u)
-      D3 m = dir(cz, 2.0 * kPi * u2);
+      D3 m = dir(cz, 2.0 * std::numbers::pi * u2);
       double om = wo[0] * m[0] + wo[1] * m[1] + wo[2] * m[2];
       if (om <= 0.0) continue;
       D3 t = std::fabs(m[2]) < 0.999 ? D3{-m[1], m[0], 0.0} : D3{1.0, 0.0, 0.0};
@@ -201,7 +201,7 @@ TEST(DiffuseReference, SingleScatteringIsHeightCorrelatedSmith) {
       t = {t[0] / tl, t[1] / tl, t[2] / tl};
       D3 b{m[1] * t[2] - m[2] * t[1], m[2] * t[0] - m[0] * t[2], m[0] * t[1] - m[1] * t[0]};
       double v1 = uniform(), v2 = uniform();
-      double x = std::sqrt(v1) * std::cos(2.0 * kPi * v2), y = std::sqrt(v1) * std::sin(2.0 * kPi * v2),
+      double x = std::sqrt(v1) * std::cos(2.0 * std::numbers::pi * v2), y = std::sqrt(v1) * std::sin(2.0 * std::numbers::pi * v2),
              z = std::sqrt(1.0 - v1);
       double wiz = x * t[2] + y * b[2] + z * m[2];
       if (wiz <= 0.0) continue;

@@ -19,6 +19,7 @@
 // 8,192), hence samplesFor(). (Since issue 16 the sheen lobe has a strategy of
 // its own, its Charlie distribution; samplesFor() stays.)
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <algorithm>
 #include <chrono>
@@ -43,7 +44,6 @@ using D3 = V3<double>;
 constexpr double kTolerance = 1.001;       // "no more than 1.001 of the energy it receives"
 constexpr double kConductorFloor = 0.98;  // "a white rough conductor returns >= 0.98"
 constexpr int kSamples = 4096;             // per strategy (2 to 4 strategies)
-constexpr double kPi = 3.14159265358979323846;
 
 constexpr double kRoughness[] = {0, 1e-4, 0.02, 0.1, 0.25, 0.5, 0.75, 1};
 constexpr double kF0[] = {0, 0.04, 0.5, 1};
@@ -117,7 +117,7 @@ void addViews(std::vector<Config>& out, const std::string& axis, const Closure<d
               bool axesOnly = false) {
   const bool aniso = (c.features & kFeatureAnisotropy) && c.anisotropy != 0;
   std::vector<double> phis{0.3};
-  if (aniso) phis = axesOnly ? std::vector<double>{0.0, kPi / 2} : std::vector<double>{0.0, kPi / 4, kPi / 2};
+  if (aniso) phis = axesOnly ? std::vector<double>{0.0, std::numbers::pi / 2} : std::vector<double>{0.0, std::numbers::pi / 4, std::numbers::pi / 2};
   for (double NoV : kNoV)
     for (double phi : phis) out.push_back({axis, c, model, NoV, phi});
 }
@@ -454,7 +454,7 @@ TEST(Furnace, AnisotropicLobesNeverGainEnergyAtAnyAzimuth) {
   for (double A : {0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0})
     for (double r : {0.05, 0.25, 0.5, 0.75, 1.0})
       for (double NoV : {1.0, 0.5, 0.2, 0.1, 0.03, 1e-3})
-        for (double phi : {0.0, kPi / 8, kPi / 4, kPi / 2})
+        for (double phi : {0.0, std::numbers::pi / 8, std::numbers::pi / 4, std::numbers::pi / 2})
           for (auto [f0, albedo] : {std::pair{1.0, 0.0}, std::pair{0.04, 1.0}}) {
             Closure<double> c = whiteClosure(f0, albedo, r);
             c.features = kFeatureAnisotropy;
@@ -566,11 +566,11 @@ TEST(Furnace, FuzzTakesWhatItReflectsOfTheLightOutOfTheBase) {
     double sum = 0;
     for (int i = 0; i < kRings; ++i)
       for (int j = 0; j < kSectors; ++j) {
-        const double NoV = (i + 0.5) / kRings, phi = 2 * kPi * (j + 0.5) / kSectors;
+        const double NoV = (i + 0.5) / kRings, phi = 2 * std::numbers::pi * (j + 0.5) / kSectors;
         const D3 f = evalClosure(c, viewAt(NoV, phi), L, kDiffuseLambert);  // f NoL
         sum += f[0] / NoL * NoV;
       }
-    return sum * (1.0 / kRings) * (2 * kPi / kSectors);
+    return sum * (1.0 / kRings) * (2 * std::numbers::pi / kSectors);
   };
   int cases = 0, over = 0;
   double worstGain = -1;

@@ -3,6 +3,7 @@
 #include "ir/helper_math.h"
 
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <algorithm>
 #include <cfloat>
@@ -14,7 +15,6 @@
 namespace substratec::helpers {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 Vec3 grey(double v) { return {v, v, v}; }
 double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -324,7 +324,7 @@ TEST(RotationToTangent, CanonicalTangentOnPlusZIsPlusX) {
 }
 
 TEST(RotationToTangent, QuarterTurnIsCounterClockwiseAroundTheNormal) {
-  const Vec3 t = rotationToTangent(kPi / 2, {0, 0, 1});
+  const Vec3 t = rotationToTangent(std::numbers::pi / 2, {0, 0, 1});
   EXPECT_NEAR(t[0], 0.0, 1e-15);
   EXPECT_NEAR(t[1], 1.0, 1e-15);
   EXPECT_NEAR(t[2], 0.0, 1e-15);
@@ -354,7 +354,7 @@ TEST(RotationToTangent, ZeroNormalFallsBackToPlusZ) {
 }
 
 TEST(RotationToTangent, FullTurnIsIdentity) {
-  const Vec3 a = rotationToTangent(0.0, {0.1, 0.2, 0.9}), b = rotationToTangent(2 * kPi, {0.1, 0.2, 0.9});
+  const Vec3 a = rotationToTangent(0.0, {0.1, 0.2, 0.9}), b = rotationToTangent(2 * std::numbers::pi, {0.1, 0.2, 0.9});
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-15);
 }
 

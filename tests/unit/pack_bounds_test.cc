@@ -17,6 +17,7 @@
 // samples per material). tests/unit/pack_test.cc checks random values; this
 // file checks the edges.
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <algorithm>
 #include <array>
@@ -32,7 +33,6 @@
 namespace substratec {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDithers[] = {0.0, 0.25, 0.5, 0.999999};
 constexpr double kSlop = 1e-12;  // double rounding in the bound itself
 
@@ -244,7 +244,7 @@ Vec3d normalize(const Vec3d& v) {
 }
 double angleDeg(const Vec3d& a, const Vec3d& b) {
   const Vec3d c = cross(a, b);
-  return std::atan2(std::sqrt(dot(c, c)), dot(a, b)) * 180.0 / kPi;
+  return std::atan2(std::sqrt(dot(c, c)), dot(a, b)) * 180.0 / std::numbers::pi;
 }
 bool finite(const Vec3d& v) { return std::isfinite(v[0]) && std::isfinite(v[1]) && std::isfinite(v[2]); }
 
@@ -338,7 +338,7 @@ TEST(PackBounds, TangentAnglesAtPolesSeamsAndFoldsComeBackWithinTheirBound) {
         const Vec3d decoded = top ? unpackTopLayer(packTopLayer({n, 0.5}, u)).normal : dequantizeNormal(quantizeNormal(n, u));
         Vec3d t0, b0;
         orthonormalBasis(decoded, t0, b0);
-        for (double angle : {0.0, 1e-7, kPi / 2, kPi, 1.5 * kPi, 2 * kPi - 1e-7, 2.0})
+        for (double angle : {0.0, 1e-7, std::numbers::pi / 2, std::numbers::pi, 1.5 * std::numbers::pi, 2 * std::numbers::pi - 1e-7, 2.0})
           for (double sign : {1.0, -1.0}) {
             // A unit tangent of the decoded normal at `angle` from its canonical one.
             const double a = sign * angle;
@@ -364,7 +364,7 @@ TEST(PackBounds, NormalsOverTheWholeSphereStayWithinTheirBound) {
   // (face centre, one dithered step on both coordinates).
   Worst worst;
   const int count = 200000;
-  const double golden = kPi * (3 - std::sqrt(5.0));
+  const double golden = std::numbers::pi * (3 - std::sqrt(5.0));
   for (double u : kDithers)
     for (int i = 0; i < count; ++i) {
       const double z = 1 - (i + 0.5) * 2.0 / count;

@@ -6,8 +6,9 @@
 // unpacker recovers the layout and the values from the stream alone.
 #include "storage/pack.h"
 
-#include <gtest/gtest.h>
 #include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <numbers>
 
 #include <algorithm>
 #include <bit>
@@ -24,7 +25,6 @@
 namespace substratec {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDithers[] = {0.0, 0.5, 0.999};
 constexpr double kEps = 1e-9;
 
@@ -56,7 +56,7 @@ Vec3d normalize(const Vec3d& v) {
 double angleDeg(const Vec3d& a, const Vec3d& b) {
   // atan2 of |a x b| and a.b: accurate for tiny angles, unlike acos.
   const Vec3d c = cross(a, b);
-  return std::atan2(std::sqrt(dot(c, c)), dot(a, b)) * 180.0 / kPi;
+  return std::atan2(std::sqrt(dot(c, c)), dot(a, b)) * 180.0 / std::numbers::pi;
 }
 
 struct Rng {

@@ -3,6 +3,7 @@
 // (runtime_shaders/substrate_lighting.h), tone mapping and sRGB encoding, PNG
 // output, and labelled contact sheets.
 #include <gtest/gtest.h>
+#include <numbers>
 #include <png.h>
 #include <unistd.h>
 
@@ -26,7 +27,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using Vec3 = std::array<double, 3>;
-constexpr double kPi = 3.14159265358979323846;
 
 Vec3 normalized(Vec3 v) {
   double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
@@ -38,7 +38,7 @@ double luminance(const Vec3& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 
 /// n directions spread evenly over the sphere (Fibonacci lattice).
 std::vector<Vec3> sphereDirections(int n) {
   std::vector<Vec3> dirs;
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   for (int i = 0; i < n; ++i) {
     double y = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - y * y);
     dirs.push_back({r * std::cos(golden * i), y, r * std::sin(golden * i)});
@@ -61,7 +61,7 @@ Vec3 hemisphereIntegral(const Environment& env, const Vec3& n, double (*kernel)(
   Vec3 t, b;
   frame(n, t, b);
   const int np = 2 * nt;
-  const double dt = (kPi / 2) / nt, dp = 2 * kPi / np;
+  const double dt = (std::numbers::pi / 2) / nt, dp = 2 * std::numbers::pi / np;
   Vec3 sum{0, 0, 0};
   double ksum = 0.0;
   auto direction = [&](double theta, double phi) {
@@ -75,7 +75,7 @@ Vec3 hemisphereIntegral(const Environment& env, const Vec3& n, double (*kernel)(
       Vec3 l = direction((i + 0.5) * dt, (j + 0.5) * dp);
       bool nearHotspot = false;
       for (const Hotspot& h : env.hotspots())
-        nearHotspot |= std::acos(std::min(1.0, dot(l, h.direction))) < h.angularRadius + 2 * kPi / 180;
+        nearHotspot |= std::acos(std::min(1.0, dot(l, h.direction))) < h.angularRadius + 2 * std::numbers::pi / 180;
       const int sub = nearHotspot ? 48 : 1;
       for (int a = 0; a < sub; ++a)
         for (int c = 0; c < sub; ++c) {
@@ -95,7 +95,7 @@ double cosineKernel(double ct, double) { return ct; }
 double ggxKernel(double ct, double alpha) {
   double noh = std::sqrt((1.0 + ct) / 2.0), a2 = alpha * alpha;
   double d = (a2 - 1.0) * noh * noh + 1.0;
-  return a2 / (kPi * d * d) / 4.0 * ct;
+  return a2 / (std::numbers::pi * d * d) / 4.0 * ct;
 }
 
 // ---------------------------------------------------------------------------
@@ -120,7 +120,7 @@ TEST(PreviewEnvironment, RadianceIsFiniteAndNonNegativeEverywhere) {
   dirs.push_back(sun);
   for (double a = 0.1; a <= 3.0; a += 0.1)
     for (int k = 0; k < 16; ++k) {
-      double ang = a * skySunAngularRadius(), phi = 2 * kPi * k / 16;
+      double ang = a * skySunAngularRadius(), phi = 2 * std::numbers::pi * k / 16;
       Vec3 d;
       for (int c = 0; c < 3; ++c)
         d[c] = std::cos(ang) * sun[c] + std::sin(ang) * (std::cos(phi) * t[c] + std::sin(phi) * b[c]);
@@ -147,14 +147,14 @@ TEST(PreviewEnvironment, SkyHasASmallBrightFiniteSunAboveTheHorizon) {
   Environment env = makeEnvironment("sky");
   Vec3 sun = skySunDirection();
   EXPECT_GT(sun[1], 0.0);
-  EXPECT_NEAR(skySunAngularRadius() * 2 * 180 / kPi, 0.5, 1e-9);  // a 0.5 degree disc
+  EXPECT_NEAR(skySunAngularRadius() * 2 * 180 / std::numbers::pi, 0.5, 1e-9);  // a 0.5 degree disc
   double centre = luminance(env.radiance(sun));
   EXPECT_GT(centre, 1e3);
   EXPECT_LT(centre, 1e4);
   // One degree off the sun: sky and aureole only.
   Vec3 t, b;
   frame(sun, t, b);
-  double off = kPi / 180;
+  double off = std::numbers::pi / 180;
   Vec3 d;
   for (int c = 0; c < 3; ++c) d[c] = std::cos(off) * sun[c] + std::sin(off) * t[c];
   EXPECT_LT(luminance(env.radiance(d)), 10.0);
@@ -247,7 +247,7 @@ TEST(PreviewCube, TexelSolidAnglesCoverTheSphere) {
     double sum = 0.0;
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) sum += texelSolidAngle(n, x, y);
-    EXPECT_NEAR(6 * sum, 4 * kPi, 1e-12) << n;
+    EXPECT_NEAR(6 * sum, 4 * std::numbers::pi, 1e-12) << n;
   }
   EXPECT_GT(texelSolidAngle(8, 4, 4), 2.5 * texelSolidAngle(8, 0, 0));  // centres are bigger than corners
 }
@@ -299,7 +299,7 @@ TEST(PreviewPrefilter, WhiteIrradianceIsPi) {
   ASSERT_EQ(m.mipCount(), 1);
   EXPECT_EQ(m.size, 16);
   for (size_t i = 0; i < m.mips[0].size(); ++i)
-    ASSERT_NEAR(m.mips[0][i], i % 4 == 3 ? 1.0 : kPi, 1e-3) << "at " << i;
+    ASSERT_NEAR(m.mips[0][i], i % 4 == 3 ? 1.0 : std::numbers::pi, 1e-3) << "at " << i;
 }
 
 TEST(PreviewPrefilter, MirrorMipReproducesTheSkyAtTexelCentres) {
@@ -314,7 +314,7 @@ TEST(PreviewPrefilter, MirrorMipReproducesTheSkyAtTexelCentres) {
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         Vec3 d = cubeDirection(f, (x + 0.5) / n, (y + 0.5) / n);
-        if (std::acos(std::min(1.0, dot(d, skySunDirection()))) < 10 * kPi / 180) continue;
+        if (std::acos(std::min(1.0, dot(d, skySunDirection()))) < 10 * std::numbers::pi / 180) continue;
         const bool horizon = std::abs(d[1]) < 0.17;
         Vec3 want = env.radiance(d);
         if (horizon) {
@@ -347,7 +347,7 @@ TEST(PreviewPrefilter, MirrorMipKeepsTheSunsEnergy) {
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {
         Vec3 d = cubeDirection(f, (x + 0.5) / n, (y + 0.5) / n);
-        if (std::acos(std::min(1.0, dot(d, skySunDirection()))) > 3 * kPi / 180) continue;
+        if (std::acos(std::min(1.0, dot(d, skySunDirection()))) > 3 * std::numbers::pi / 180) continue;
         ++texels;
         double w = texelSolidAngle(n, x, y), sum = 0.0;
         for (int j = 0; j < k; ++j)
@@ -359,7 +359,7 @@ TEST(PreviewPrefilter, MirrorMipKeepsTheSunsEnergy) {
   // The disc's own energy: peak radiance x solid angle x 5/6 (the mean of the
   // limb darkening 1 - (1 - sqrt(1 - rho^2)) / 2).
   double rs = skySunAngularRadius();
-  double sunEnergy = luminance(env.radiance(skySunDirection())) * kPi * rs * rs * 5.0 / 6.0;
+  double sunEnergy = luminance(env.radiance(skySunDirection())) * std::numbers::pi * rs * rs * 5.0 / 6.0;
   EXPECT_GT(sunEnergy, 0.2 * ref);  // the sun matters here
   EXPECT_NEAR(got, ref, 0.03 * sunEnergy);
 }

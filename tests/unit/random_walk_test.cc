@@ -5,6 +5,7 @@
 // code under test. Sample counts are modest (the suite takes a few seconds); the
 // figures in the comments were measured with the counts written next to them.
 #include <gtest/gtest.h>
+#include <numbers>
 
 #include <algorithm>
 #include <array>
@@ -25,7 +26,6 @@ namespace {
 
 using namespace reference;
 using D3 = V3<double>;
-constexpr double kPi = 3.14159265358979323846;
 
 D3 dir(double mu, double phi) {
   double s = std::sqrt(std::max(0.0, 1 - mu * mu));
@@ -61,7 +61,7 @@ double hemisphericalFresnel(double n1, double n2) {
 /// Isotropic GGX, height-correlated Smith (Heitz 2014), alpha = roughness^2.
 double ggxD(double a, double cosH) {
   double a2 = a * a, d = cosH * cosH * (a2 - 1) + 1;
-  return a2 / (kPi * d * d);
+  return a2 / (std::numbers::pi * d * d);
 }
 double smithLambda(double a, double mu) {
   double t2 = (1 - mu * mu) / (mu * mu);
@@ -370,12 +370,12 @@ TEST(RandomWalkFurnace, RoughInterfacesLoseTheirMultipleScattering) {
   double E = 0;
   for (int i = 0; i < nt; ++i)
     for (int j = 0; j < np; ++j) {
-      double th = (i + 0.5) / nt * kPi / 2, ph = (j + 0.5) / np * 2 * kPi;
+      double th = (i + 0.5) / nt * std::numbers::pi / 2, ph = (j + 0.5) / np * 2 * std::numbers::pi;
       D3 wi = {std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th)};
       D3 h = {wo[0] + wi[0], wo[1] + wi[1], wo[2] + wi[2]};
       double l = std::sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
       double G = 1 / (1 + smithLambda(a, wo[2]) + smithLambda(a, wi[2]));
-      E += ggxD(a, h[2] / l) * G / (4 * mu) * std::sin(th) * (kPi / 2 / nt) * (2 * kPi / np);
+      E += ggxD(a, h[2] / l) * G / (4 * mu) * std::sin(th) * (std::numbers::pi / 2 / nt) * (2 * std::numbers::pi / np);
     }
   EXPECT_NEAR(E, 0.893, 0.002);
   WalkLayer white;
@@ -424,10 +424,10 @@ TEST(RandomWalkEval, IntegratesToTheForwardWalksAlbedo) {
     for (int i = 0; i < m; ++i)
       for (int j = 0; j < m; ++j) {
         double u1 = (i + 0.5) / m, u2 = (j + 0.5) / m;
-        D3 wi = dir(std::sqrt(1 - u1), 2 * kPi * u2);  // cosine-distributed: estimator pi f = pi eval / cos
+        D3 wi = dir(std::sqrt(1 - u1), 2 * std::numbers::pi * u2);  // cosine-distributed: estimator pi f = pi eval / cos
         if (k.smoothTop && wi[0] * mirror[0] + wi[1] * mirror[1] + wi[2] * mirror[2] > std::cos(0.05)) continue;
         D3 f = layeredEval(k.stack, wo, wi, opts(96, 100 + i * m + j));
-        for (int c = 0; c < 3; ++c) integral[c] += kPi * f[c] / wi[2] / (m * m);
+        for (int c = 0; c < 3; ++c) integral[c] += std::numbers::pi * f[c] / wi[2] / (m * m);
       }
     D3 albedo = layeredAlbedo(k.stack, wo, opts(40000, 15));
     const double r12 = k.smoothTop ? fresnel(wo[2], 1, 1.5) : 0;

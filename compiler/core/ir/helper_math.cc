@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <numbers>
 
 namespace substratec::helpers {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 
 /// Clamp that never returns NaN: NaN goes to `lo`, +-inf to the nearest bound.
 double clampSafe(double x, double lo, double hi) { return x > lo ? (x < hi ? x : hi) : lo; }
@@ -53,7 +53,7 @@ constexpr int kAiryOrders = 2;
 /// Normalized so that Y(0, 0) ~ 1.
 Vec3 xyzSensitivity(double opd, double shift) {
   // pos is a wavenumber (1 / wavelength, m^-1): pos * phase = 2 pi OPD / lambda.
-  const double phase = 2.0 * kPi * opd;
+  const double phase = 2.0 * std::numbers::pi * opd;
   struct Lobe {
     double val, pos, var;
   };
@@ -65,7 +65,7 @@ Vec3 xyzSensitivity(double opd, double shift) {
   auto lobe = [&](const Lobe& l) {
     const double g = std::exp(-phase * phase * l.var);  // phase is bounded: no overflow
     if (g == 0.0) return 0.0;
-    return l.val * std::sqrt(2.0 * kPi * l.var) * std::cos(l.pos * phase + shift) * g;
+    return l.val * std::sqrt(2.0 * std::numbers::pi * l.var) * std::cos(l.pos * phase + shift) * g;
   };
   constexpr double kNorm = 1.0685e-7;
   return {(lobe(kLobes[0]) + lobe(kLobes[3])) / kNorm, lobe(kLobes[1]) / kNorm, lobe(kLobes[2]) / kNorm};
@@ -124,7 +124,7 @@ double airyReflectance(const FilmInterface& film, double baseF0, double baseF90,
       clampSafe(fresnelDielectric(eta3 / film.eta2, film.cosTheta2) + (baseF90 - 1.0) * x5, 0.0, 1.0);
   // Phase: air -> film reflects with no shift (eta2 >= 1), so film -> air
   // (phi21) shifts by pi; film -> base shifts by pi if the base is less dense.
-  const double phi = kPi + (eta3 < film.eta2 ? kPi : 0.0);
+  const double phi = std::numbers::pi + (eta3 < film.eta2 ? std::numbers::pi : 0.0);
   // Compound terms.
   const double R123 = clampSafe(film.R12 * R23, 0.0, kR123Max);
   const double r123 = std::sqrt(R123);

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <numbers>
 
 #include <fmt/format.h>
 
@@ -13,7 +14,6 @@ namespace {
 
 constexpr int kMaxNodes = 256;            // nodes along one chain of connections
 constexpr int kMaxDepth = 2 * kMaxNodes;  // each node is two calls deep (its input, then itself)
-constexpr double kPi = 3.14159265358979323846;
 
 double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
 
@@ -462,7 +462,7 @@ MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind
       const Value pivot = in("pivot", "vector2", {0, 1});
       Value p = mul(sub(uvOr0(), pivot), scale);
       if (rotate != 0) {
-        const double a = rotate * kPi / 180, c = std::cos(a), s = std::sin(a);
+        const double a = rotate * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
         p = combine({sub(mul(swizzle(p, "x"), c), mul(swizzle(p, "y"), s)), add(mul(swizzle(p, "x"), s), mul(swizzle(p, "y"), c))});
       }
       uv = add(add(p, pivot), offset);
@@ -582,7 +582,7 @@ MtlxValues::Typed MtlxValues::bakeOrFold(pugi::xml_node node, const std::string&
   } else if (kind == "rotate2d") {
     auto x = c("in", "vector2", {0, 0}), a = c("amount", "float", {0});
     if (x && a) {
-      const double t = (*a)[0] * kPi / 180, cs = std::cos(t), sn = std::sin(t);
+      const double t = (*a)[0] * std::numbers::pi / 180, cs = std::cos(t), sn = std::sin(t);
       r = std::vector<double>{(*x)[0] * cs - (*x)[1] * sn, (*x)[0] * sn + (*x)[1] * cs};
     }
   }
@@ -780,7 +780,7 @@ MtlxValues::Typed MtlxValues::compute(pugi::xml_node node, const std::string& ki
     // uv' = R(rotate) · ((uv − pivot) / scale) + pivot − offset, R counter-clockwise in degrees.
     Value p = divide(sub(uv.is_null() ? geometry("uv0") : uv, pivot), scale);
     if ((*rotate)[0] != 0) {
-      const double a = (*rotate)[0] * kPi / 180, c = std::cos(a), s = std::sin(a);
+      const double a = (*rotate)[0] * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
       const Value pn = namedValue(w_, std::string(str(node, "name")) + "_scaled", p);
       p = combine({sub(mul(swizzle(pn, "x"), c), mul(swizzle(pn, "y"), s)), add(mul(swizzle(pn, "x"), s), mul(swizzle(pn, "y"), c))});
     }

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -109,7 +110,7 @@ struct LobeSample {
 
 /// lod = max(0, log2(omegaSample / omegaTexel) / 2 + 1), omegaSample = 1/(N pdf).
 double filteredLod(double pdf, int samples, int sourceSize) {
-  double omegaTexel = 4.0 * detail::kPi / (6.0 * sourceSize * sourceSize);
+  double omegaTexel = 4.0 * std::numbers::pi / (6.0 * sourceSize * sourceSize);
   double omegaSample = 1.0 / (samples * std::max(pdf, 1e-12));
   return std::max(0.0, 0.5 * std::log2(omegaSample / omegaTexel) + 1.0);
 }
@@ -121,7 +122,7 @@ std::vector<LobeSample> ggxLobe(double alpha, int samples, int sourceSize) {
   std::vector<LobeSample> lobe;
   double a2 = alpha * alpha;
   for (int i = 0; i < samples; ++i) {
-    double phi = 2.0 * detail::kPi * i / samples;
+    double phi = 2.0 * std::numbers::pi * i / samples;
     double xi = radicalInverse(static_cast<uint32_t>(i));
     double cosH = std::sqrt((1.0 - xi) / (1.0 + (a2 - 1.0) * xi));
     double sinH = std::sqrt(std::max(0.0, 1.0 - cosH * cosH));
@@ -129,7 +130,7 @@ std::vector<LobeSample> ggxLobe(double alpha, int samples, int sourceSize) {
     Vec3 L = 2.0 * cosH * H - Vec3{0.0, 0.0, 1.0};
     if (L[2] <= 0.0) continue;
     double d = (a2 - 1.0) * cosH * cosH + 1.0;
-    double D = a2 / (detail::kPi * d * d);
+    double D = a2 / (std::numbers::pi * d * d);
     lobe.push_back({L, L[2], filteredLod(D / 4.0, samples, sourceSize)});
   }
   return lobe;
@@ -233,8 +234,8 @@ std::vector<float> convolveDirect(const Texels& src, int n, Kernel kernel, doubl
   // N . centroid is below them.
   std::vector<double> belowCos, farCos;
   for (const Tile& tile : src.tiles) {
-    belowCos.push_back(tile.radius >= detail::kPi / 2 ? -2.0 : -std::sin(tile.radius));
-    farCos.push_back(nearAngle + tile.radius >= detail::kPi ? -2.0 : std::cos(nearAngle + tile.radius));
+    belowCos.push_back(tile.radius >= std::numbers::pi / 2 ? -2.0 : -std::sin(tile.radius));
+    farCos.push_back(nearAngle + tile.radius >= std::numbers::pi ? -2.0 : std::cos(nearAngle + tile.radius));
   }
   std::vector<float> out(static_cast<size_t>(6) * n * n * 4);
   float* p = out.data();
@@ -360,16 +361,16 @@ CubeMap prefilterRadiance(const Environment& env, int baseSize, int mipCount, in
     // about 2 % of the GGX lobe's weight lies further out) tiles of 8 x 8
     // texels stand for their texels.
     int sourceLevel = 0;
-    double needed = std::max(16.0, detail::kPi / (1.2 * alpha));
+    double needed = std::max(16.0, std::numbers::pi / (1.2 * alpha));
     for (int j = src.mipCount() - 1; j >= 0; --j)
       if (src.mipSize(j) >= needed) {
         sourceLevel = j;
         break;
       }
     double nearAngle = 2.0 * std::atan(7.0 * alpha);
-    if (nearAngle > detail::kPi / 3) nearAngle = detail::kPi;  // broad lobes: every texel
+    if (nearAngle > std::numbers::pi / 3) nearAngle = std::numbers::pi;  // broad lobes: every texel
     double m = src.mipSize(sourceLevel), tiles = 6.0 * std::ceil(m / 8) * std::ceil(m / 8);
-    double nearShare = nearAngle >= detail::kPi ? 1.0 : 0.5 * (1.0 - std::cos(std::min(detail::kPi, nearAngle + 0.25)));
+    double nearShare = nearAngle >= std::numbers::pi ? 1.0 : 0.5 * (1.0 - std::cos(std::min(std::numbers::pi, nearAngle + 0.25)));
     double cost = 6.0 * n * n * (tiles + nearShare * 6.0 * m * m);
     if (cost <= kDirectBudget)
       out.mips.push_back(convolveDirect(gatherTexels(src, sourceLevel, 8), n, Kernel{alpha * alpha}, 1.0, nearAngle));
@@ -387,7 +388,7 @@ CubeMap irradianceMap(const Environment& env, int size, int sourceSize) {
   CubeMap out;
   out.size = size;
   // E = integral of L cos = pi * (the cosine-weighted mean of L).
-  out.mips.push_back(convolveDirect(gatherTexels(src, 0, 8), size, Kernel{}, detail::kPi, detail::kPi));
+  out.mips.push_back(convolveDirect(gatherTexels(src, 0, 8), size, Kernel{}, std::numbers::pi, std::numbers::pi));
   return out;
 }
 
@@ -410,7 +411,7 @@ std::array<double, 3> meanRadiance(const CubeMap& map, int level) {
         const float* p = map.texel(level, face, x, y);
         sum = sum + Vec3{p[0], p[1], p[2]} * texelSolidAngle(n, x, y);
       }
-  return sum * (1.0 / (4.0 * detail::kPi));
+  return sum * (1.0 / (4.0 * std::numbers::pi));
 }
 
 }  // namespace substratec::preview

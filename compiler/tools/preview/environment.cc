@@ -4,6 +4,7 @@
 #include "preview/environment.h"
 
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include "preview/preview_math.h"
@@ -70,10 +71,10 @@ Vec3 studioRadiance(const Vec3& d) {
 
 // "sky": sun 30 degrees high, 40 degrees left of +Z toward -X.
 const Vec3 kSunDirection = [] {
-  double el = 30.0 * detail::kPi / 180.0, az = 40.0 * detail::kPi / 180.0;
+  double el = 30.0 * std::numbers::pi / 180.0, az = 40.0 * std::numbers::pi / 180.0;
   return detail::normalize(Vec3{-std::sin(az) * std::cos(el), std::sin(el), std::cos(az) * std::cos(el)});
 }();
-constexpr double kSunAngularRadius = 0.25 * detail::kPi / 180.0;  // a 0.5 degree disc
+constexpr double kSunAngularRadius = 0.25 * std::numbers::pi / 180.0;  // a 0.5 degree disc
 constexpr double kSunRadiance = 2.0e3;
 constexpr Vec3 kSunColour{1.20, 0.96, 0.75};  // about 4800 K, luminance ~1
 

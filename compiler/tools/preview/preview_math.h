@@ -3,12 +3,11 @@
 #pragma once
 #include <array>
 #include <cmath>
+#include <numbers>
 
 namespace substratec::preview::detail {
 
 using Vec3 = std::array<double, 3>;
-
-inline constexpr double kPi = 3.14159265358979323846;
 
 inline Vec3 operator+(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 inline Vec3 operator-(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }

@@ -1,6 +1,7 @@
 #include "reference/blend_error.h"
 
 #include <cmath>
+#include <numbers>
 
 #include "reference/reference.h"
 
@@ -11,8 +12,7 @@ namespace {
 using D3 = std::array<double, 3>;
 
 constexpr int kPoints = 64;
-constexpr int kDiffuseModel = 2;  // SUBSTRATE_DIFFUSE_MODEL's default (substrate_closure.h)
-constexpr double kPi = 3.14159265358979323846;
+constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
 
 D3 cross3(const D3& a, const D3& b) {
   return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
@@ -40,7 +40,7 @@ std::array<double, 4> blendProbeTexture(int inputIndex, double u, double v) {
   const double i = inputIndex;
   // r, g in [0.25, 0.75] and b in [0.75, 0.95]: read as a tangent-space normal
   // map, a plausible one (tilts up to ~35 degrees, never below the surface).
-  return {0.5 + 0.25 * std::sin(2 * kPi * 1.3 * u + i), 0.5 + 0.25 * std::cos(2 * kPi * 0.9 * v + 0.5 * i),
+  return {0.5 + 0.25 * std::sin(2 * std::numbers::pi * 1.3 * u + i), 0.5 + 0.25 * std::cos(2 * std::numbers::pi * 0.9 * v + 0.5 * i),
           0.85 + 0.1 * std::sin(3 * (u + v) + 2 * i), 0.5 + 0.4 * std::sin(2 * (u - v) + 3 * i)};
 }
 
@@ -52,7 +52,7 @@ std::vector<double> blendProbeRadiance(const CompileResult& r) {
   for (int i = 0; i < kPoints; ++i) {
     // Fibonacci sphere: normals all around.
     const double z = 1 - (2 * i + 1) / double(kPoints);
-    const double rho = std::sqrt(1 - z * z), phi = 2 * kPi * golden * i;
+    const double rho = std::sqrt(1 - z * z), phi = 2 * std::numbers::pi * golden * i;
     Geometry g;
     g.N = {rho * std::cos(phi), rho * std::sin(phi), z};
     const D3 helper = std::fabs(g.N[2]) < 0.9 ? D3{0, 0, 1} : D3{1, 0, 0};
@@ -70,7 +70,7 @@ std::vector<double> blendProbeRadiance(const CompileResult& r) {
       for (const Closure<double>& c : m.closures) {
         const double NoV = c.N[0] * V[0] + c.N[1] * V[1] + c.N[2] * V[2];
         const V3<double> vt = viewThroughput(c, NoV);
-        const V3<double> env = envSplitSum(c, V, {0.5, 0.5, 0.5}, {0.5 * kPi, 0.5 * kPi, 0.5 * kPi}, kDiffuseModel);
+        const V3<double> env = envSplitSum(c, V, {0.5, 0.5, 0.5}, {0.5 * std::numbers::pi, 0.5 * std::numbers::pi, 0.5 * std::numbers::pi}, kDiffuseModel);
         for (int k = 0; k < 3; ++k) ambient[k] += vt[k] * (env[k] + c.emissive[k]);
       }
       for (std::size_t l = 0; l < kLightCos.size(); ++l) {

@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "reference/bsdf.h"
 #include "reference/common.h"
 #include "reference/reference.h"
+#include "util/random.h"
 
 namespace substratec::reference {
 using namespace detail;
@@ -19,22 +21,13 @@ using namespace detail;
 namespace {
 
 using D3 = V3<double>;
-constexpr double kPi = 3.14159265358979323846;
 constexpr int kMaxHits = 4096;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-// splitmix64 (Steele et al. 2014): one stream per call, seeded from `seed`.
-struct Rng {
-  std::uint64_t s;
-  explicit Rng(std::uint32_t seed) : s(0x243F6A8885A308D3ull ^ (static_cast<std::uint64_t>(seed) << 17u)) {}
-  double next() {  // [0, 1)
-    std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return static_cast<double>(z >> 11) * (1.0 / 9007199254740992.0);
-  }
-};
+// A splitmix64 stream (util/random.h) per call, seeded from `seed`.
+SplitMix64 diffuseStream(std::uint32_t seed) {
+  return SplitMix64{0x243F6A8885A308D3ull ^ (static_cast<std::uint64_t>(seed) << 17u)};
+}
 
 /// Smith's Lambda of isotropic GGX for a direction of cosine z (any sign):
 /// (-1 + sqrt(1 + a^2 tan^2))/2 above the horizon (written without
@@ -62,7 +55,7 @@ double g1(double alpha, const D3& w, double t) {
 /// normals are normalize(c + v) with c uniform on the spherical cap z > -v.z.
 D3 sampleVisibleNormal(double alpha, const D3& v, double u1, double u2) {
   D3 s = normalize(D3{alpha * v[0], alpha * v[1], v[2]});
-  double phi = 2.0 * kPi * u1;
+  double phi = 2.0 * std::numbers::pi * u1;
   double z = (1.0 - u2) * (1.0 + s[2]) - s[2];
   double sinT = std::sqrt(std::max(0.0, 1.0 - z * z));
   D3 h{sinT * std::cos(phi) + s[0], sinT * std::sin(phi) + s[1], z + s[2]};
@@ -77,7 +70,7 @@ D3 sampleCosine(const D3& m, double u1, double u2) {
   D3 t, b;
   orthonormalBasis(m, t, b);
   double r = std::sqrt(u1);
-  double phi = 2.0 * kPi * u2;
+  double phi = 2.0 * std::numbers::pi * u2;
   double z = std::sqrt(std::max(0.0, 1.0 - u1));
   return t * (r * std::cos(phi)) + b * (r * std::sin(phi)) + m * z;
 }
@@ -103,20 +96,20 @@ struct Walk {
 
 /// One walk entering from wo: the next-event estimate of f(wo, wi) cos(wi)
 /// (wi non-null) and/or the escaped throughput (the albedo estimate).
-void walk(const Walk& w, const D3& wo, const D3* wi, Rng& rng, double& nee, double& escaped) {
+void walk(const Walk& w, const D3& wo, const D3* wi, SplitMix64& rng, double& nee, double& escaped) {
   double t = 0.0;  // ln C1 at the top of the microsurface
   D3 dir = -wo;    // travel direction
   double thr = 1.0;
   for (int hit = 0; hit < kMaxHits; ++hit) {
-    t = flight(w.alpha, dir, t, rng.next());
+    t = flight(w.alpha, dir, t, rng.uniform());
     if (std::isinf(t)) {
       escaped += thr;
       return;
     }
-    double u1 = rng.next(), u2 = rng.next();
+    double u1 = rng.uniform(), u2 = rng.uniform();
     D3 m = sampleVisibleNormal(w.alpha, -dir, u1, u2);
-    if (wi) nee += thr * w.rho / kPi * std::max(0.0, dot(*wi, m)) * g1(w.alpha, *wi, t);
-    double u3 = rng.next(), u4 = rng.next();
+    if (wi) nee += thr * w.rho / std::numbers::pi * std::max(0.0, dot(*wi, m)) * g1(w.alpha, *wi, t);
+    double u3 = rng.uniform(), u4 = rng.uniform();
     dir = sampleCosine(m, u3, u4);
     thr *= w.rho;
     if (thr == 0.0) return;
@@ -134,7 +127,7 @@ double microfacetDiffuse(double albedo, double roughness, const D3& wo, const D3
                          std::uint32_t seed) {
   if (!(wo[2] > 0) || !(wi[2] > 0) || samples <= 0) return 0.0;
   Walk w = makeWalk(albedo, roughness);
-  Rng rng(seed);
+  SplitMix64 rng = diffuseStream(seed);
   double nee = 0.0, escaped = 0.0;
   for (int i = 0; i < samples; ++i) walk(w, wo, &wi, rng, nee, escaped);
   return nee / samples;
@@ -143,7 +136,7 @@ double microfacetDiffuse(double albedo, double roughness, const D3& wo, const D3
 double microfacetDiffuseAlbedo(double albedo, double roughness, const D3& wo, int samples, std::uint32_t seed) {
   if (!(wo[2] > 0) || samples <= 0) return 0.0;
   Walk w = makeWalk(albedo, roughness);
-  Rng rng(seed);
+  SplitMix64 rng = diffuseStream(seed);
   double nee = 0.0, escaped = 0.0;
   for (int i = 0; i < samples; ++i) walk(w, wo, nullptr, rng, nee, escaped);
   return escaped / samples;
@@ -172,11 +165,11 @@ double modelAlbedo(const Closure<double>& c, const D3& wo, int model) {
     double mu = (i + 0.5) / n;
     double s = std::sqrt(1.0 - mu * mu);
     for (int j = 0; j < n; ++j) {
-      double phi = kPi * (j + 0.5) / n;
+      double phi = std::numbers::pi * (j + 0.5) / n;
       sum += evalClosure(c, wo, D3{s * std::cos(phi), s * std::sin(phi), mu}, model)[0];
     }
   }
-  return sum * (1.0 / n) * (kPi / n) * 2.0;  // d(mu) d(phi), both halves
+  return sum * (1.0 / n) * (std::numbers::pi / n) * 2.0;  // d(mu) d(phi), both halves
 }
 
 }  // namespace
@@ -187,7 +180,7 @@ std::vector<DiffuseModelError> diffuseModelErrors(const std::vector<double>& rou
   for (int m = 0; m < kModels; ++m) out.push_back(DiffuseModelError{m, 0.0, 0.0, 0.0});
   std::vector<double> sq(kModels, 0.0);
   long count = 0;
-  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  const double golden = std::numbers::pi * (3.0 - std::sqrt(5.0));
   std::uint32_t seed = 1;
   for (double r : roughnesses) {
     Closure<double> c = pureDiffuse(albedo, r);

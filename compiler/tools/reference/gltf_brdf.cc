@@ -4,6 +4,7 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <numbers>
 
 #include "reference/reference.h"
 
@@ -11,7 +12,6 @@ namespace substratec::reference {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kMinAlpha = 1e-3;
 
 double dot(const Rgb& a, const Rgb& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
@@ -24,7 +24,7 @@ Rgb normalized(const Rgb& a) {
 /// visibility V = G / (4 NoL NoV) (specification B.3.2).
 double ggxD(double a, double NoH) {
   const double a2 = a * a, d = NoH * NoH * (a2 - 1) + 1;
-  return a2 / (kPi * d * d);
+  return a2 / (std::numbers::pi * d * d);
 }
 double smithV(double a, double NoV, double NoL) {
   const double a2 = a * a;
@@ -37,7 +37,7 @@ double ggxDAniso(double at, double ab, double ToH, double BoH, double NoH) {
   const double a2 = at * ab;
   const Rgb f{ab * ToH, at * BoH, a2 * NoH};
   const double w2 = a2 / dot(f, f);
-  return a2 * w2 * w2 / kPi;
+  return a2 * w2 * w2 / std::numbers::pi;
 }
 double smithVAniso(double at, double ab, double ToV, double BoV, double NoV, double ToL, double BoL, double NoL) {
   const double gv = NoL * std::sqrt(at * ToV * at * ToV + ab * BoV * ab * BoV + NoV * NoV);
@@ -49,7 +49,7 @@ double smithVAniso(double at, double ab, double ToV, double BoV, double NoV, dou
 double charlieD(double r, double NoH) {
   const double a = std::max(r * r, 1e-12), inv = 1 / a;
   const double sin2 = std::max(1 - NoH * NoH, 0.0);
-  return (2 + inv) * std::pow(sin2, 0.5 * inv) / (2 * kPi);
+  return (2 + inv) * std::pow(sin2, 0.5 * inv) / (2 * std::numbers::pi);
 }
 double sheenLambdaFit(double x, double a) {
   const double t = (1 - a) * (1 - a);
@@ -87,13 +87,13 @@ double gltfSheenAlbedo(double mu, double r) {
   for (int i = 0; i < nt; ++i) {
     const double NoL = (i + 0.5) / nt, s = std::sqrt(1 - NoL * NoL);
     for (int j = 0; j < np; ++j) {
-      const double phi = kPi * (j + 0.5) / np;  // symmetric in phi: half the circle, twice
+      const double phi = std::numbers::pi * (j + 0.5) / np;  // symmetric in phi: half the circle, twice
       const Rgb L{s * std::cos(phi), s * std::sin(phi), NoL};
       const Rgb H = normalized({V[0] + L[0], V[1] + L[1], V[2] + L[2]});
       e += charlieD(r, H[2]) * sheenV(r, mu, NoL) * NoL;
     }
   }
-  e *= (1.0 / nt) * (2 * kPi / (2 * np)) * 2;
+  e *= (1.0 / nt) * (2 * std::numbers::pi / (2 * np)) * 2;
   std::lock_guard<std::mutex> lock(mutex);
   cache[{mu, r}] = e;
   return e;
@@ -127,7 +127,7 @@ Rgb gltfReflectance(const GltfMaterial& m, const Rgb& V, const Rgb& L) {
   const double diffuseScale = (1 - m.transmission) * (1 - m.diffuseTransmission) * (1 - m.specular * max3(fr));
   Rgb f;
   for (int k = 0; k < 3; ++k) {
-    const double dielectric = diffuseScale * m.baseColor[k] / kPi + m.specular * fr[k] * vd;
+    const double dielectric = diffuseScale * m.baseColor[k] / std::numbers::pi + m.specular * fr[k] * vd;
     const double metal = schlick(m.baseColor[k], VoH) * vd;
     f[k] = dielectric + (metal - dielectric) * m.metallic;
   }
@@ -212,7 +212,7 @@ const std::vector<Rgb>& gltfProbeDirections() {
     const double golden = (std::sqrt(5.0) - 1) / 2;
     for (int i = 0; i < n; ++i) {
       const double z = 0.1 + 0.9 * (i + 0.5) / n;  // cos theta in [0.1, 1]: above the surface, not grazing
-      const double s = std::sqrt(1 - z * z), phi = 2 * kPi * golden * i;
+      const double s = std::sqrt(1 - z * z), phi = 2 * std::numbers::pi * golden * i;
       d.push_back({s * std::cos(phi), s * std::sin(phi), z});
     }
     return d;

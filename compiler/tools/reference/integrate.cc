@@ -15,11 +15,13 @@
 // reflects (NoL > 0, and NoL > -w for wrap).
 #include <cmath>
 #include <cstdint>
+#include <numbers>
 #include <vector>
 
 #include "reference/bsdf.h"
 #include "reference/common.h"
 #include "reference/reference.h"
+#include "util/random.h"
 
 namespace substratec::reference {
 using namespace detail;
@@ -27,7 +29,6 @@ using namespace detail;
 namespace {
 
 using D3 = V3<double>;
-constexpr double kPi = 3.14159265358979323846;
 
 double radicalInverse(std::uint32_t i) {
   i = (i << 16u) | (i >> 16u);
@@ -38,14 +39,6 @@ double radicalInverse(std::uint32_t i) {
   return static_cast<double>(i) * (1.0 / 4294967296.0);
 }
 
-// splitmix64: the rotations from the seed.
-std::uint64_t splitmix(std::uint64_t& s) {
-  std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
-double unitOf(std::uint64_t x) { return static_cast<double>(x >> 11) * (1.0 / 9007199254740992.0); }
 
 double fract(double x) { return x - std::floor(x); }
 
@@ -67,7 +60,7 @@ struct VisibleGgx {
     if (h[2] <= 0) return 0;
     double x = h[0] / ax, y = h[1] / ay, z = h[2];
     double k = x * x + y * y + z * z;
-    return 1.0 / (kPi * ax * ay * k * k);
+    return 1.0 / (std::numbers::pi * ax * ay * k * k);
   }
   double G1() const {
     double s = (ax * ax * Ve[0] * Ve[0] + ay * ay * Ve[1] * Ve[1]) / (Ve[2] * Ve[2]);
@@ -87,7 +80,7 @@ struct VisibleGgx {
     double lensq = vh[0] * vh[0] + vh[1] * vh[1];
     D3 t1 = lensq > 0 ? D3{-vh[1], vh[0], 0} / std::sqrt(lensq) : D3{1, 0, 0};
     D3 t2 = cross(vh, t1);
-    double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
+    double r = std::sqrt(u1), phi = 2.0 * std::numbers::pi * u2;
     double p1 = r * std::cos(phi), p2 = r * std::sin(phi);
     double s = 0.5 * (1.0 + vh[2]);
     p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * p2;
@@ -109,7 +102,7 @@ struct Sheen {
 
   double D(double NoH) const {
     const double inv = 1.0 / a;
-    return (2.0 + inv) * std::pow(std::max(1.0 - NoH * NoH, 0.0), 0.5 * inv) * (0.5 / kPi);
+    return (2.0 + inv) * std::pow(std::max(1.0 - NoH * NoH, 0.0), 0.5 * inv) * (0.5 / std::numbers::pi);
   }
   double pdf(const D3& l) const {
     D3 hv = Ve + l;
@@ -123,7 +116,7 @@ struct Sheen {
   D3 sample(double u1, double u2) const {
     const double sinT = std::pow(u1, 1.0 / (2.0 + 1.0 / a));
     const double cosT = std::sqrt(std::max(0.0, 1.0 - sinT * sinT));
-    const double phi = 2.0 * kPi * u2;
+    const double phi = 2.0 * std::numbers::pi * u2;
     const D3 h{sinT * std::cos(phi), sinT * std::sin(phi), cosT};
     const double VoH = dot(Ve, h);
     if (!(VoH > 0)) return {0, 0, 0};
@@ -141,8 +134,8 @@ struct Strategy {
 double pdfOf(const Strategy& s, const D3& l) {
   switch (s.kind) {
     case Kind::Ggx: return s.ggx.pdf(l);
-    case Kind::Cosine: return l[2] > 0 ? l[2] / kPi : 0.0;
-    case Kind::Sphere: return 1.0 / (4.0 * kPi);
+    case Kind::Cosine: return l[2] > 0 ? l[2] / std::numbers::pi : 0.0;
+    case Kind::Sphere: return 1.0 / (4.0 * std::numbers::pi);
     case Kind::Sheen: return s.sheen.pdf(l);
   }
   return 0;
@@ -152,11 +145,11 @@ D3 sampleOf(const Strategy& s, double u1, double u2) {
   switch (s.kind) {
     case Kind::Ggx: return s.ggx.sample(u1, u2);
     case Kind::Cosine: {
-      double r = std::sqrt(u1), phi = 2.0 * kPi * u2;
+      double r = std::sqrt(u1), phi = 2.0 * std::numbers::pi * u2;
       return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1.0 - u1))};
     }
     case Kind::Sphere: {
-      double z = 1.0 - 2.0 * u1, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * kPi * u2;
+      double z = 1.0 - 2.0 * u1, r = std::sqrt(std::max(0.0, 1.0 - z * z)), phi = 2.0 * std::numbers::pi * u2;
       return {r * std::cos(phi), r * std::sin(phi), z};
     }
     case Kind::Sheen: return s.sheen.sample(u1, u2);
@@ -198,7 +191,8 @@ V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
 
   std::uint64_t state = seed;
   for (const Strategy& s : strategies) {
-    const double r1 = unitOf(splitmix(state)), r2 = unitOf(splitmix(state));
+    // the rotations from the seed (splitmix64, util/random.h)
+    const double r1 = unitInterval(splitmix64(state)), r2 = unitInterval(splitmix64(state));
     D3 acc{0, 0, 0};
     for (int j = 0; j < samples; ++j) {
       const double u1 = fract((j + 0.5) / samples + r1);

@@ -16,10 +16,12 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <numbers>
 #include <vector>
 
 #include "ir/value_eval.h"
 #include "reference/common.h"
+#include "util/random.h"
 
 namespace substratec::reference {
 using namespace detail;
@@ -27,8 +29,7 @@ using namespace detail;
 namespace {
 
 using V = V3<double>;
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kInvPi = 1.0 / kPi;
+constexpr double kInvPi = 1.0 / std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kMinAlpha = 1e-3;   // alpha = max(roughness^2, 1e-3)
 constexpr double kMaxF0 = 0.99;      // eta <= 398
@@ -38,25 +39,11 @@ constexpr double kMaxG = 0.99;       // |HG g|
 // ---------------------------------------------------------------------------
 // 1. Random numbers.
 
-std::uint64_t splitmix64(std::uint64_t& s) {
-  std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
+/// The splitmix64 stream (util/random.h) of one purpose of one walk seed.
+SplitMix64 walkStream(std::uint32_t seed, std::uint64_t stream) {
+  std::uint64_t h = (static_cast<std::uint64_t>(seed) << 32) ^ (stream * 0xD1B54A32D192ED03ull);
+  return SplitMix64{splitmix64(h)};
 }
-
-class Rng {
- public:
-  Rng(std::uint32_t seed, std::uint64_t stream) : s_(0) {
-    std::uint64_t h = (static_cast<std::uint64_t>(seed) << 32) ^ (stream * 0xD1B54A32D192ED03ull);
-    s_ = splitmix64(h);
-  }
-  /// Uniform in [0, 1) with 53 bits.
-  double uniform() { return static_cast<double>(splitmix64(s_) >> 11) * (1.0 / 9007199254740992.0); }
-
- private:
-  std::uint64_t s_;
-};
 
 double sq(double x) { return x * x; }
 V neg(const V& v) { return {-v[0], -v[1], -v[2]}; }
@@ -82,7 +69,7 @@ struct Ggx {
     if (m[2] <= 0) return 0;
     double a2 = a * a;
     double d = a2 * m[2] * m[2] + (m[0] * m[0] + m[1] * m[1]);
-    return a2 / (kPi * d * d);
+    return a2 / (std::numbers::pi * d * d);
   }
   double lambda(const V& w) const {
     double c2 = w[2] * w[2];
@@ -103,7 +90,7 @@ struct Ggx {
     if (wh[2] < 0) wh = neg(wh);
     V t1 = wh[2] < 0.99999 ? normalize(cross(V{0, 0, 1}, wh)) : V{1, 0, 0};
     V t2 = cross(wh, t1);
-    double r = std::sqrt(u1), phi = 2 * kPi * u2;
+    double r = std::sqrt(u1), phi = 2 * std::numbers::pi * u2;
     double px = r * std::cos(phi), py = r * std::sin(phi);
     double h = std::sqrt(std::max(0.0, 1 - px * px));
     double s = 0.5 * (1 + wh[2]);
@@ -229,7 +216,7 @@ double bsdfPdf(const Interface& I, const V& wo, const V& wi, int flags) {
 
 /// Samples wi from wo (visible normals, then reflection or transmission by
 /// Fresnel among the allowed ones). Not for pass-through interfaces.
-bool bsdfSample(const Interface& I, const V& wo, Rng& rng, Mode mode, int flags, BsdfSample& s) {
+bool bsdfSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
   const double uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
   if (wo[2] == 0) return false;
   if (I.kind == Interface::Kind::Conductor) {
@@ -278,7 +265,7 @@ bool bsdfSample(const Interface& I, const V& wo, Rng& rng, Mode mode, int flags,
 /// Henyey-Greenstein phase function of the angle between travel directions.
 double hg(double mu, double g) {
   double d = 1 + g * g - 2 * g * mu;
-  return (1 - g * g) / (4 * kPi * d * std::sqrt(d));
+  return (1 - g * g) / (4 * std::numbers::pi * d * std::sqrt(d));
 }
 
 V sampleHg(const V& w, double g, double u1, double u2) {
@@ -290,14 +277,14 @@ V sampleHg(const V& w, double g, double u1, double u2) {
     mu = (1 + g * g - s * s) / (2 * g);
   }
   mu = std::clamp(mu, -1.0, 1.0);
-  double st = std::sqrt(std::max(0.0, 1 - mu * mu)), phi = 2 * kPi * u2;
+  double st = std::sqrt(std::max(0.0, 1 - mu * mu)), phi = 2 * std::numbers::pi * u2;
   V t1, t2;
   orthonormalBasis(w, t1, t2);
   return t1 * (st * std::cos(phi)) + t2 * (st * std::sin(phi)) + w * mu;
 }
 
 V sampleCosine(double u1, double u2) {
-  double r = std::sqrt(u1), phi = 2 * kPi * u2;
+  double r = std::sqrt(u1), phi = 2 * std::numbers::pi * u2;
   return {r * std::cos(phi), r * std::sin(phi), std::sqrt(std::max(0.0, 1 - u1))};
 }
 
@@ -450,7 +437,7 @@ double maxMasked(const V& v, const std::array<bool, 3>& mask) {
 }
 
 /// Russian roulette (pbrt's LayeredBxDF): false when the walk ends.
-bool roulette(V& beta, int depth, const std::array<bool, 3>& mask, Rng& rng) {
+bool roulette(V& beta, int depth, const std::array<bool, 3>& mask, SplitMix64& rng) {
   double mb = maxMasked(beta, mask);
   if (!(mb > 0)) return false;
   if (depth > 3 && mb < 0.25) {
@@ -465,7 +452,7 @@ bool roulette(V& beta, int depth, const std::array<bool, 3>& mask, Rng& rng) {
 /// vertex (returns true, t = its depth) or to the boundary it heads to
 /// (returns false, t = 0 or tau; beta attenuated when the medium does not
 /// scatter). `alive` false: absorbed.
-bool propagate(const Medium& M, const V& w, double& t, V& beta, Rng& rng, bool& alive) {
+bool propagate(const Medium& M, const V& w, double& t, V& beta, SplitMix64& rng, bool& alive) {
   alive = true;
   if (M.scatters) {
     double dist = -std::log(1 - rng.uniform());
@@ -487,7 +474,7 @@ bool propagate(const Medium& M, const V& w, double& t, V& beta, Rng& rng, bool& 
 }
 
 /// layeredEval for one group: sum over the walks of f(wo, wi) (no cosine), divided by the count.
-V evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, Rng& rng) {
+V evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, SplitMix64& rng) {
   const Resolved& s = grp.stack;
   const Interface& top = s.ifc[0];
   const V topReflection = bsdfF(top, wo, wi, Mode::Importance);
@@ -655,7 +642,7 @@ V evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, Rn
 }
 
 /// layeredAlbedo for one group: the mean weight with which forward walks leave the top.
-V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, Rng& rng) {
+V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& rng) {
   const Resolved& s = grp.stack;
   const int n = static_cast<int>(s.ifc.size());
   V sum{0, 0, 0};
@@ -747,7 +734,7 @@ V perGroup(const std::vector<WalkLayer>& stack, const WalkOptions& o, std::uint6
   if (stack.empty()) return out;
   std::vector<Group> gs = groups(stack, o.albedoSeenThroughInterface, o.absoluteIor);
   for (std::size_t gi = 0; gi < gs.size(); ++gi) {
-    Rng rng(o.seed, purpose * 8 + gi);
+    SplitMix64 rng = walkStream(o.seed, purpose * 8 + gi);
     V v = walk(gs[gi], rng);
     for (int c = 0; c < 3; ++c)
       if (gs[gi].mask[c]) out[c] = v[c];
@@ -819,14 +806,14 @@ V3<double> layeredEval(const std::vector<WalkLayer>& stack, const V3<double>& wo
                        const WalkOptions& options) {
   if (!(wo[2] > 0) || !(wi[2] > 0)) return {0, 0, 0};
   const V o = unitOr(wo, V{0, 0, 1}), i = unitOr(wi, V{0, 0, 1});
-  V f = perGroup(stack, options, 1, [&](const Group& g, Rng& rng) { return evalGroup(g, o, i, options, rng); });
+  V f = perGroup(stack, options, 1, [&](const Group& g, SplitMix64& rng) { return evalGroup(g, o, i, options, rng); });
   return f * i[2];
 }
 
 V3<double> layeredAlbedo(const std::vector<WalkLayer>& stack, const V3<double>& wo, const WalkOptions& options) {
   if (!(wo[2] > 0)) return {0, 0, 0};
   const V o = unitOr(wo, V{0, 0, 1});
-  return perGroup(stack, options, 2, [&](const Group& g, Rng& rng) { return albedoGroup(g, o, options, rng); });
+  return perGroup(stack, options, 2, [&](const Group& g, SplitMix64& rng) { return albedoGroup(g, o, options, rng); });
 }
 
 // ---------------------------------------------------------------------------

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <numbers>
 #include <set>
 
 #include <fmt/format.h>
@@ -20,10 +21,9 @@ namespace {
 using json = nlohmann::ordered_json;
 using V3 = std::array<double, 3>;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr std::size_t kMaxCases = 16;
 constexpr std::size_t kFurnaceConfigurations = 128;  // white-furnace configurations (4,096-point integrals each, 3 views)
-constexpr int kDiffuseModel = reference::kDiffuseChan2024;  // the default model (EmitOptions::diffuseModel)
+constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
 
 /// The forced values of each kind (docs/stability.md), smallest first.
 const std::vector<std::pair<std::string, std::vector<double>>>& kindTable() {
@@ -261,7 +261,7 @@ std::string evaluate(const CompileResult& r, const Point& p, const reference::In
   const auto m = reference::evaluateMaterial<T>(r, p.g, in, textures);
   if (!std::isfinite(m.coverage)) return *value = m.coverage, "coverage";
   if (!finite3(m.transmittance)) return *value = m.transmittance[0], "transmittance";
-  const auto V = toT<T>(p.g.V), L = toT<T>(p.light), one = toT<T>({1, 1, 1}), pi = toT<T>({kPi, kPi, kPi});
+  const auto V = toT<T>(p.g.V), L = toT<T>(p.light), one = toT<T>({1, 1, 1}), pi = toT<T>({std::numbers::pi, std::numbers::pi, std::numbers::pi});
   for (std::size_t k = 0; k < m.closures.size(); ++k) {
     const auto& c = m.closures[k];
     if (std::string f = badField(c); !f.empty()) return *value = NAN, fmt::format("closure {} {}", k, f);
@@ -328,7 +328,7 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
         samples[j].light = p.light;
         samples[j].radiance = {1, 1, 1};
         samples[j].prefiltered = {1, 1, 1};
-        samples[j].irradiance = {kPi, kPi, kPi};
+        samples[j].irradiance = {std::numbers::pi, std::numbers::pi, std::numbers::pi};
         const reference::InputValues in = inputsOf(r.material, grid, grid.at(config));
         int slot = 0;
         for (std::size_t i = 0; i < r.material.inputs.size(); ++i) {
