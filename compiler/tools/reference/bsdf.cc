@@ -20,8 +20,7 @@ namespace substratec::reference {
 using namespace detail;
 
 namespace {
-// substrate_bsdf.h constants and default macros.
-// runtime_shaders/substrate_constants.h
+// substrate_bsdf.h constants and default macros (the macros: runtime_shaders/substrate_constants.h).
 template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
 template <class T> constexpr T kWrapMfpScale = T(SUBSTRATE_SSS_WRAP_MFP_SCALE);
 template <class T> constexpr T kGlintLog2Min = T(SUBSTRATE_GLINT_LOG2_DENSITY_MIN);

@@ -31,7 +31,7 @@ namespace {
 using V = V3<double>;
 constexpr double kInvPi = 1.0 / std::numbers::pi;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr double kMinAlpha = 1e-3;   // alpha = max(roughness^2, 1e-3)
+constexpr double kWalkMinAlpha = 1e-3;  // alpha = max(roughness^2, 1e-3) (bsdf.cc: kMinAlpha)
 constexpr double kMaxF0 = 0.99;      // eta <= 398
 constexpr double kMinMfp = 1e-30;    // as SUBSTRATE_MIN_MFP
 constexpr double kMaxG = 0.99;       // |HG g|
@@ -63,7 +63,7 @@ double powerHeuristic(double a, double b) {
 
 /// Isotropic GGX (Trowbridge-Reitz) with height-correlated Smith masking.
 struct Ggx {
-  double a = kMinAlpha;
+  double a = kWalkMinAlpha;
 
   double D(const V& m) const {
     if (m[2] <= 0) return 0;
@@ -328,7 +328,7 @@ Resolved resolve(const std::vector<WalkLayer>& stack, const std::vector<V>& albe
     const bool bottom = i + 1 == stack.size() || L.opaqueBase;
     Interface I;
     double rough = saturate1(L.roughness);
-    I.ggx.a = std::max(rough * rough, kMinAlpha);
+    I.ggx.a = std::max(rough * rough, kWalkMinAlpha);
     const bool conductor = L.opaqueBase && L.diffuseAlbedo[0] <= 0 && L.diffuseAlbedo[1] <= 0 && L.diffuseAlbedo[2] <= 0;
     if (conductor) {
       I.kind = Interface::Kind::Conductor;
