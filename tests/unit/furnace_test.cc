@@ -49,7 +49,6 @@ constexpr double kRoughness[] = {0, 1e-4, 0.02, 0.1, 0.25, 0.5, 0.75, 1};
 constexpr double kF0[] = {0, 0.04, 0.5, 1};
 constexpr double kNoV[] = {1, 0.5, 0.1, 1e-3};
 constexpr int kModels[] = {kDiffuseLambert, kDiffuseChan2018, kDiffuseChan2024, kDiffuseEon};
-constexpr const char* kModelNames[] = {"lambert", "chan2018", "chan2024", "eon"};
 
 double elapsedSeconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -83,7 +82,7 @@ struct Config {
 
 std::string describe(const Config& k) {
   const Closure<double>& c = k.c;
-  std::string s = fmt::format("{} [{}] r={} F0={} albedo={}", k.axis, kModelNames[k.model], c.roughness, c.f0[0],
+  std::string s = fmt::format("{} [{}] r={} F0={} albedo={}", k.axis, diffuseModelName(static_cast<DiffuseModel>(k.model)), c.roughness, c.f0[0],
                               c.diffuseAlbedo[0]);
   if (c.features & kFeatureF90) s += fmt::format(" F90={}", c.f90[0]);
   if (c.features & kFeatureAnisotropy) s += fmt::format(" A={}", c.anisotropy);
@@ -437,7 +436,7 @@ TEST(Furnace, DiffuseModelsNeverReturnMoreThanTheirAlbedo) {
         EXPECT_LE(a, kTolerance) << describe(k);
         if (a > worst) worst = a, where = describe(k);
       }
-    std::printf("[ furnace  ] %-8s alone: largest albedo %.5f  %s\n", kModelNames[model], worst, where.c_str());
+    std::printf("[ furnace  ] %-8s alone: largest albedo %.5f  %s\n", diffuseModelName(static_cast<DiffuseModel>(model)).data(), worst, where.c_str());
   }
   std::printf("[ furnace  ] diffuse sweep: %.1f s\n", elapsedSeconds(t0));
 }
