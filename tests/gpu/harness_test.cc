@@ -54,10 +54,10 @@ class GpuHarness : public ::testing::Test {
   static void SetUpTestSuite() {
     Context::Options options;
     options.shaderCacheDir = SUBSTRATEC_GPU_CACHE_DIR;
-    context_ = Context::create(options, &createError_);
+    context_ = Context::create(options, createError_);
   }
   static void TearDownTestSuite() { context_.reset(); }
-  void SetUp() override { ASSERT_NE(context_, nullptr) << createError_; }
+  void SetUp() override { ASSERT_NE(context_, nullptr) << createError_.errorMessages(); }
   /// No test leaves validation messages behind (the one provoking them takes them).
   void TearDown() override {
     if (!context_) return;
@@ -76,10 +76,10 @@ class GpuHarness : public ::testing::Test {
   }
 
   static std::unique_ptr<Context> context_;
-  static std::string createError_;
+  static Diagnostics createError_;
 };
 std::unique_ptr<Context> GpuHarness::context_;
-std::string GpuHarness::createError_;
+Diagnostics GpuHarness::createError_("GPU harness");
 
 constexpr const char* kGlslDouble = R"(#version 450
 layout(local_size_x = 16) in;
