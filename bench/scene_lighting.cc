@@ -106,9 +106,9 @@ Compiled compile(gpu::Context& ctx, const std::string& name, const std::string& 
   ShaderValidation v = compileAndValidate(src, {.optimize = true});
   if (!v.ok) die(name + " does not validate:\n" + v.log);
   Compiled c;
-  std::string error;
-  c.pipeline = ctx.createPipeline(v.spirv, &error);
-  if (!c.pipeline) die("pipeline of " + name + ": " + error);
+  Diagnostics diags("bench");
+  c.pipeline = ctx.createPipeline(v.spirv, diags);
+  if (!c.pipeline) die("pipeline of " + name + ": " + diags.errorMessages());
   c.spirv = std::move(v.spirv);
   c.instructions = v.instructionCount;
   c.optimizedInstructions = v.optimizedInstructionCount;
@@ -199,9 +199,9 @@ int main(int argc, char** argv) {
     else die("usage: scene_lighting [--size N] [--runs N] [--source DIR] [--dump DIR] [--extra DIR]");
   }
   if (size < 8 || size > 4096 || runs < 1) die("--size in [8, 4096], --runs >= 1");
-  std::string error;
-  auto ctx = gpu::Context::create({}, &error);
-  if (!ctx) die("lavapipe: " + error);
+  Diagnostics diags("bench");
+  auto ctx = gpu::Context::create({}, diags);
+  if (!ctx) die("lavapipe: " + diags.errorMessages());
   std::printf("device: %s, %s\n\n", ctx->deviceName().c_str(), ctx->driverInfo().c_str());
 
   gpu::SceneFrame frame;
@@ -237,8 +237,8 @@ int main(int argc, char** argv) {
   const std::string specialFile = sceneLightingFileName(all.shape, LayoutClass::Special, glsl);
 
   gpu::TileLists allLists;
-  if (!gpu::classifyTiles(*ctx, *shaders[classifyFile].pipeline, frame, allG, &allLists, &error))
-    die("classification: " + error);
+  if (!gpu::classifyTiles(*ctx, *shaders[classifyFile].pipeline, frame, allG, &allLists, diags))
+    die("classification: " + diags.errorMessages());
 
   std::vector<std::unique_ptr<Timed>> kernels;
   auto timed = [&](const std::string& label, const Compiled& c) {
@@ -319,8 +319,8 @@ int main(int argc, char** argv) {
       double sum = 0;
       for (Timed::Dispatch& d : k.dispatches) {
         double ns = 0;
-        if (!ctx->dispatch(*d.pipeline, d.resources, d.groupsX, d.groupsY, 1, &error, &ns))
-          die("dispatch of " + k.label + ": " + error);
+        if (!ctx->dispatch(*d.pipeline, d.resources, d.groupsX, d.groupsY, 1, diags, &ns))
+          die("dispatch of " + k.label + ": " + diags.errorMessages());
         sum += ns;
       }
       if (round > 0) k.ns.push_back(sum / k.pixels);

@@ -204,9 +204,9 @@ std::size_t forwardInstructions(const CompileResult& r, const EmitOptions& emit)
 
 /// Builds the kernel's pipeline and resources (`m` supplies the inputs block).
 void prepare(gpu::Context& ctx, Kernel& k, const Material& m, int pixels) {
-  std::string error;
-  k.pipeline = ctx.createPipeline(k.spirv, &error);
-  if (!k.pipeline) die("pipeline for " + k.label + ": " + error);
+  Diagnostics diags("bench");
+  k.pipeline = ctx.createPipeline(k.spirv, diags);
+  if (!k.pipeline) die("pipeline for " + k.label + ": " + diags.errorMessages());
   k.resources = gpu::kernelResources(m, k.pipeline->reflection(), k.spirv, {}, {},
                                      static_cast<std::size_t>(paddedPixels(pixels)) * 4);
 }
@@ -219,10 +219,10 @@ void timeGroup(gpu::Context& ctx, const std::vector<Kernel*>& group, int pixels,
   for (int round = 0; round <= runs; ++round)
     for (std::size_t j = 0; j < group.size(); ++j) {
       Kernel* k = group[round % 2 ? group.size() - 1 - j : j];
-      std::string error;
+      Diagnostics diags("bench");
       double t = 0;
-      if (!ctx.dispatch(*k->pipeline, k->resources, static_cast<uint32_t>(n / kernel::kLocalSize), 1, 1, &error, &t))
-        die("dispatch of " + k->label + ": " + error);
+      if (!ctx.dispatch(*k->pipeline, k->resources, static_cast<uint32_t>(n / kernel::kLocalSize), 1, 1, diags, &t))
+        die("dispatch of " + k->label + ": " + diags.errorMessages());
       if (round > 0) k->nsPerPixel.push_back(t / n);
     }
 }
@@ -235,7 +235,7 @@ void timeGroup(gpu::Context& ctx, const std::vector<Kernel*>& group, int pixels,
 void countInstructions(gpu::Context& ctx, const std::vector<Kernel*>& group, int pixels) {
   const int n = paddedPixels(pixels);
   for (Kernel* k : group) {
-    std::string error;
+    Diagnostics diags("bench");
     for (int run = 0; run < 2; ++run) {
 #if SHADER_COST_HAVE_CALLGRIND
       if (run == 1) {
@@ -243,8 +243,8 @@ void countInstructions(gpu::Context& ctx, const std::vector<Kernel*>& group, int
         CALLGRIND_START_INSTRUMENTATION;
       }
 #endif
-      if (!ctx.dispatch(*k->pipeline, k->resources, static_cast<uint32_t>(n / kernel::kLocalSize), 1, 1, &error))
-        die("dispatch of " + k->label + ": " + error);
+      if (!ctx.dispatch(*k->pipeline, k->resources, static_cast<uint32_t>(n / kernel::kLocalSize), 1, 1, diags))
+        die("dispatch of " + k->label + ": " + diags.errorMessages());
 #if SHADER_COST_HAVE_CALLGRIND
       if (run == 1) {
         CALLGRIND_STOP_INSTRUMENTATION;
@@ -726,9 +726,9 @@ int main(int argc, char** argv) {
     } else die("unknown argument " + arg);
   }
   if (a.callgrind) a.parts.erase(std::remove(a.parts.begin(), a.parts.end(), '3'), a.parts.end());
-  std::string error;
-  auto ctx = gpu::Context::create({}, &error);
-  if (!ctx) die("no lavapipe: " + error);
+  Diagnostics diags("bench");
+  auto ctx = gpu::Context::create({}, diags);
+  if (!ctx) die("no lavapipe: " + diags.errorMessages());
   const auto t0 = std::chrono::steady_clock::now();
   fmt::print("# shader_cost: {} pixels per dispatch, {} timed runs (median), device {} ({})\n\n",
              paddedPixels(a.pixels), a.runs, ctx->deviceName(), ctx->driverInfo());

@@ -347,11 +347,11 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   if (int status = outputs.check(err); status != kExitOk) return status;  // its includes too, before rendering
   const std::string& text = source->text;
   std::vector<sweep::Step> entries;
-  std::string error;
+  Diagnostics failure(source->displayName);  // what a tool reports (printed below, in the command's own words)
   if (a.sweep) {
     CompileResult full;
-    if (!sweep::simplificationSteps(source->displayName, text, o, &entries, &full, &error)) {
-      err << error;
+    if (!sweep::simplificationSteps(source->displayName, text, o, &entries, &full, failure)) {
+      err << failure.formatAll();
       return compileFailure(*source, err);
     }
   } else {
@@ -362,9 +362,9 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
     entries.push_back({std::move(*r), "", 0});
   }
   gpu::Context::Options go;
-  auto ctx = gpu::Context::create(go, &error);
-  if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
-    err << "substratec: error: preview renders on Vulkan (Mesa lavapipe): " << error << "\n";
+  auto ctx = gpu::Context::create(go, failure);
+  if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), failure)) {
+    err << "substratec: error: preview renders on Vulkan (Mesa lavapipe): " << failure.errorMessages() << "\n";
     return kExitBadInput;
   }
   preview::RenderOptions ro;
@@ -378,8 +378,8 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   std::vector<std::string> labels;
   for (const auto& e : entries) {
     preview::Image hdr;
-    if (!preview::renderSphere(*ctx, e.result, ro, &hdr, &error)) {
-      err << "substratec: internal compiler error: " << error << "\n";
+    if (!preview::renderSphere(*ctx, e.result, ro, &hdr, failure)) {
+      err << "substratec: internal compiler error: " << failure.errorMessages() << "\n";
       return kExitInternal;
     }
     tiles.push_back(preview::tonemap(hdr, a.exposure));
@@ -394,8 +394,8 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
     return kExitInternal;
   }
   std::vector<uint8_t> png;
-  if (!preview::encodePng(image.width, image.height, srgb.rgba, png, &error)) {
-    err << "substratec: internal compiler error: cannot encode the PNG: " << error << "\n";
+  if (!preview::encodePng(image.width, image.height, srgb.rgba, png, failure)) {
+    err << "substratec: internal compiler error: cannot encode the PNG: " << failure.errorMessages() << "\n";
     return kExitInternal;
   }
   if (int status = outputs.commit({{a.output, std::string(png.begin(), png.end())}}, err); status != kExitOk)
@@ -435,14 +435,15 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   if (int status = outputs.check(err); status != kExitOk) return status;  // its includes too, before measuring
   std::vector<sweep::Step> steps;
   CompileResult full;
-  std::string error;
-  if (!sweep::simplificationSteps(source->displayName, source->text, o, &steps, &full, &error)) {
-    err << error;
+  Diagnostics failure(source->displayName);  // what a tool reports (printed in the command's own words)
+  if (!sweep::simplificationSteps(source->displayName, source->text, o, &steps, &full, failure)) {
+    err << failure.formatAll();
     return compileFailure(*source, err);
   }
-  auto ctx = gpu::Context::create(gpu::Context::Options{}, &error);
-  if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
-    err << "substratec: error: sweep times the generated code on Vulkan (Mesa lavapipe): " << error << "\n";
+  auto ctx = gpu::Context::create(gpu::Context::Options{}, failure);
+  if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), failure)) {
+    err << "substratec: error: sweep times the generated code on Vulkan (Mesa lavapipe): " << failure.errorMessages()
+        << "\n";
     return kExitBadInput;
   }
   sweep::Options so;
@@ -453,8 +454,8 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   so.groundTruthSamples = a.groundTruthSamples;
   so.precision = precisionOf(a.precision);
   std::vector<sweep::Row> rows;
-  if (!sweep::measure(*ctx, steps, full, so, &rows, &error)) {
-    err << "substratec: internal compiler error: " << error << "\n";
+  if (!sweep::measure(*ctx, steps, full, so, &rows, failure)) {
+    err << "substratec: internal compiler error: " << failure.errorMessages() << "\n";
     return kExitInternal;
   }
   const std::string& name = full.material.name;
@@ -509,13 +510,13 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
   err << loadDiags.formatAll();
   if (!sources) return kExitBadInput;
   if (int status = outputs.check(err); status != kExitOk) return status;  // the includes read, too
-  std::string error;
   std::unique_ptr<gpu::Context> ctx;
   if (!a.noGpu) {
-    ctx = gpu::Context::create(gpu::Context::Options{}, &error);
-    if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), &error)) {
+    Diagnostics failure(a.file);
+    ctx = gpu::Context::create(gpu::Context::Options{}, failure);
+    if (!ctx || !gpu::canRun(*ctx, precisionOf(a.precision), failure)) {
       err << "substratec: error: stability runs the generated code on Vulkan (Mesa lavapipe; --no-gpu skips it): "
-          << error << "\n";
+          << failure.errorMessages() << "\n";
       return kExitBadInput;
     }
   }
@@ -540,8 +541,9 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
     }
     std::string forceable;
     std::vector<stability::ForcedKind> kinds;
-    if (!stability::forceableText(text, &forceable, &kinds, &error)) {
-      err << "substratec: error: " << source.displayName << ": " << error << "\n";
+    Diagnostics failure(source.displayName);
+    if (!stability::forceableText(text, &forceable, &kinds, failure)) {
+      err << "substratec: error: " << source.displayName << ": " << failure.errorMessages() << "\n";
       status = std::max(status, static_cast<int>(kExitBadInput));
       continue;
     }
@@ -554,8 +556,8 @@ int runStability(const StabilityArgs& a, std::ostream& out, std::ostream& err) {
       return kExitInternal;
     }
     stability::Report report;
-    if (!stability::run(*r, kinds, so, ctx.get(), &report, &error)) {
-      err << "substratec: internal compiler error: " << error << "\n";
+    if (!stability::run(*r, kinds, so, ctx.get(), &report, failure)) {
+      err << "substratec: internal compiler error: " << failure.errorMessages() << "\n";
       return kExitInternal;
     }
     if (a.json) {

@@ -311,9 +311,9 @@ constexpr int kInputSets = 2;
 constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
 
 TEST(DeepTrees, ForwardKernelsMatchTheCpuReferenceOnLavapipe) {
-  std::string error;
-  gpu::Context* ctx = sharedContext(&error);
-  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+  Diagnostics gpuDiags("test");
+  gpu::Context* ctx = sharedContext(gpuDiags);
+  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << gpuDiags.errorMessages();
   const Tolerance tol;
   for (const DeepMaterial& g : legalMaterials()) {
     for (const Variant& v : kVariants) {
@@ -324,8 +324,8 @@ TEST(DeepTrees, ForwardKernelsMatchTheCpuReferenceOnLavapipe) {
       ASSERT_TRUE(r.has_value()) << diags;
       const ShaderValidation kernel = compileKernel(*r, Target::Glsl, KernelMode::Forward);
       ASSERT_TRUE(kernel.ok) << kernel.log;
-      auto pipeline = ctx->createPipeline(kernel.spirv, &error);
-      ASSERT_NE(pipeline, nullptr) << error;
+      auto pipeline = ctx->createPipeline(kernel.spirv, gpuDiags);
+      ASSERT_NE(pipeline, nullptr) << gpuDiags.errorMessages();
       const auto samples = makeSamples(kGeometries, 0xdee9u + static_cast<uint32_t>(g.treeNodes));
       const auto sampleBytes = sampleBuffer(samples);
       const auto inputSets = makeInputSets(r->material, kInputSets, 0x1a9u);
@@ -339,7 +339,8 @@ TEST(DeepTrees, ForwardKernelsMatchTheCpuReferenceOnLavapipe) {
       for (int set = 0; set < kInputSets; ++set) {
         gpu::Resources res = kernelResources(r->material, pipeline->reflection(), kernel.spirv, inputSets[set],
                                              sampleBytes, static_cast<std::size_t>(stride) * kGeometries);
-        ASSERT_TRUE(ctx->dispatch(*pipeline, res, kGeometries / kLocalSize, 1, 1, &error)) << error;
+        ASSERT_TRUE(ctx->dispatch(*pipeline, res, kGeometries / kLocalSize, 1, 1, gpuDiags))
+            << gpuDiags.errorMessages();
         const std::vector<float> out = floatsOf(res, 0, 7);
         for (float x : out) nonFinite += std::isfinite(x) ? 0 : 1;
         for (int i = 0; i < kGeometries; ++i) {

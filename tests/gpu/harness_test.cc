@@ -54,10 +54,10 @@ class GpuHarness : public ::testing::Test {
   static void SetUpTestSuite() {
     Context::Options options;
     options.shaderCacheDir = SUBSTRATEC_GPU_CACHE_DIR;
-    context_ = Context::create(options, &createError_);
+    context_ = Context::create(options, createError_);
   }
   static void TearDownTestSuite() { context_.reset(); }
-  void SetUp() override { ASSERT_NE(context_, nullptr) << createError_; }
+  void SetUp() override { ASSERT_NE(context_, nullptr) << createError_.errorMessages(); }
   /// No test leaves validation messages behind (the one provoking them takes them).
   void TearDown() override {
     if (!context_) return;
@@ -66,20 +66,20 @@ class GpuHarness : public ::testing::Test {
 
   /// Builds the pipeline and runs one dispatch; false (with a test failure) if either fails.
   static bool run(const std::vector<uint32_t>& spirv, Resources& resources, uint32_t x, uint32_t y = 1, uint32_t z = 1) {
-    std::string error;
-    auto pipeline = context_->createPipeline(spirv, &error);
-    EXPECT_NE(pipeline, nullptr) << error;
+    Diagnostics diags("test");
+    auto pipeline = context_->createPipeline(spirv, diags);
+    EXPECT_NE(pipeline, nullptr) << diags.errorMessages();
     if (!pipeline) return false;
-    const bool ok = context_->dispatch(*pipeline, resources, x, y, z, &error);
-    EXPECT_TRUE(ok) << error;
+    const bool ok = context_->dispatch(*pipeline, resources, x, y, z, diags);
+    EXPECT_TRUE(ok) << diags.errorMessages();
     return ok;
   }
 
   static std::unique_ptr<Context> context_;
-  static std::string createError_;
+  static Diagnostics createError_;
 };
 std::unique_ptr<Context> GpuHarness::context_;
-std::string GpuHarness::createError_;
+Diagnostics GpuHarness::createError_("GPU harness");
 
 constexpr const char* kGlslDouble = R"(#version 450
 layout(local_size_x = 16) in;
@@ -117,8 +117,8 @@ void main() {
 }
 )");
   ShaderReflection r;
-  std::string error;
-  ASSERT_TRUE(reflectSpirv(glsl, &r, &error)) << error;
+  Diagnostics diags("test");
+  ASSERT_TRUE(reflectSpirv(glsl, &r, diags)) << diags.errorMessages();
   EXPECT_EQ(r.entryPoint, "main");
   EXPECT_EQ(r.localSize[0], 8u);
   EXPECT_EQ(r.localSize[1], 4u);
@@ -151,7 +151,7 @@ void main(uint3 id : SV_DispatchThreadID) {
   result[id.x] = albedo.SampleLevel(linearClamp, float2(0.5, 0.5), 0) * scale;
 }
 )");
-  ASSERT_TRUE(reflectSpirv(hlsl, &r, &error)) << error;
+  ASSERT_TRUE(reflectSpirv(hlsl, &r, diags)) << diags.errorMessages();
   EXPECT_EQ(r.localSize[0], 64u);
   ASSERT_EQ(r.bindings.size(), 4u);
   expect(0, 0, 0, "", DescriptorKind::UniformBuffer, ImageDim::None);  // a cbuffer's variable has no name
@@ -283,22 +283,25 @@ void main() {
 }
 
 TEST_F(GpuHarness, ResourceMismatchesFailNamingTheBinding) {
-  std::string error;
-  auto pipeline = context_->createPipeline(compile(ShaderLanguage::Glsl, kGlslDouble), &error);
-  ASSERT_NE(pipeline, nullptr) << error;
+  Diagnostics diags("test");
+  auto pipeline = context_->createPipeline(compile(ShaderLanguage::Glsl, kGlslDouble), diags);
+  ASSERT_NE(pipeline, nullptr) << diags.errorMessages();
   Resources missing{{{0, 0}, BufferResource{bytesOf(ramp(16))}}};
-  EXPECT_FALSE(context_->dispatch(*pipeline, missing, 1, 1, 1, &error));
-  EXPECT_NE(error.find("no resource for set 0 binding 1 ('dst', StorageBuffer)"), std::string::npos) << error;
+  EXPECT_FALSE(context_->dispatch(*pipeline, missing, 1, 1, 1, diags));
+  EXPECT_NE(diags.errorMessages().find("no resource for set 0 binding 1 ('dst', StorageBuffer)"), std::string::npos)
+      << diags.errorMessages();
 
   Resources wrongKind{{{0, 0}, BufferResource{bytesOf(ramp(16))}}, {{0, 1}, SamplerResource{}}};
-  EXPECT_FALSE(context_->dispatch(*pipeline, wrongKind, 1, 1, 1, &error));
-  EXPECT_NE(error.find("set 0 binding 1 ('dst', StorageBuffer) needs a BufferResource, got a SamplerResource"),
+  EXPECT_FALSE(context_->dispatch(*pipeline, wrongKind, 1, 1, 1, diags));
+  EXPECT_NE(diags.errorMessages().find(
+                "set 0 binding 1 ('dst', StorageBuffer) needs a BufferResource, got a SamplerResource"),
             std::string::npos)
-      << error;
+      << diags.errorMessages();
 
   Resources extra{{{0, 0}, BufferResource{bytesOf(ramp(16))}}, {{0, 1}, outputBuffer(64)}, {{3, 7}, outputBuffer(4)}};
-  EXPECT_FALSE(context_->dispatch(*pipeline, extra, 1, 1, 1, &error));
-  EXPECT_NE(error.find("set 3 binding 7 is not used"), std::string::npos) << error;
+  EXPECT_FALSE(context_->dispatch(*pipeline, extra, 1, 1, 1, diags));
+  EXPECT_NE(diags.errorMessages().find("set 3 binding 7 is not used"), std::string::npos)
+      << diags.errorMessages();
 }
 
 TEST_F(GpuHarness, InterfaceViolationIsReportedByTheValidationLayerAndFailsTheDispatch) {
@@ -313,19 +316,21 @@ void main() { imageStore(color, ivec2(0, 0), vec4(1.0)); }
   wrong.width = wrong.height = 1;
   wrong.format = StorageFormat::R32Uint;
   Resources res{{{0, 0}, wrong}};
-  std::string error;
-  auto pipeline = context_->createPipeline(spirv, &error);
-  ASSERT_NE(pipeline, nullptr) << error;
-  EXPECT_FALSE(context_->dispatch(*pipeline, res, 1, 1, 1, &error));
-  EXPECT_NE(error.find("the validation layer reported"), std::string::npos) << error;
-  EXPECT_NE(error.find("VUID-vkCmdDispatch-format-"), std::string::npos) << error;  // "-07753" in layer 1.3.239
+  Diagnostics diags("test");
+  auto pipeline = context_->createPipeline(spirv, diags);
+  ASSERT_NE(pipeline, nullptr) << diags.errorMessages();
+  EXPECT_FALSE(context_->dispatch(*pipeline, res, 1, 1, 1, diags));
+  EXPECT_NE(diags.errorMessages().find("the validation layer reported"), std::string::npos)
+      << diags.errorMessages();
+  EXPECT_NE(diags.errorMessages().find("VUID-vkCmdDispatch-format-"), std::string::npos)
+      << diags.errorMessages();  // "-07753" in layer 1.3.239
   const auto messages = context_->takeMessages();
   ASSERT_FALSE(messages.empty());
   EXPECT_EQ(messages[0].rfind("ERROR [validation]", 0), 0u) << messages[0];
 
   // The same pipeline with the right format runs clean afterwards.
   res = Resources{{{0, 0}, StorageImageResource{1, 1, 1, StorageFormat::R32G32B32A32Sfloat, {}}}};
-  EXPECT_TRUE(context_->dispatch(*pipeline, res, 1, 1, 1, &error)) << error;
+  EXPECT_TRUE(context_->dispatch(*pipeline, res, 1, 1, 1, diags)) << diags.errorMessages();
   EXPECT_EQ(valuesOf<float>(std::get<StorageImageResource>(res.at({0, 0})).data), std::vector<float>(4, 1.0f));
 }
 
@@ -348,13 +353,13 @@ void main() {
     img.mips.emplace_back();
     for (uint32_t i = 0; i < size * size * 4; ++i) img.mips.back().push_back(std::fmod(0.731f * float(i + size), 1.0f));
   }
-  std::string error;
-  auto pipeline = context_->createPipeline(spirv, &error);
-  ASSERT_NE(pipeline, nullptr) << error;
+  Diagnostics diags("test");
+  auto pipeline = context_->createPipeline(spirv, diags);
+  ASSERT_NE(pipeline, nullptr) << diags.errorMessages();
   std::vector<std::byte> first;
   for (int round = 0; round < 2; ++round) {
     Resources res{{{0, 0}, img}, {{0, 1}, outputBuffer(256 * 4 * sizeof(float))}};
-    ASSERT_TRUE(context_->dispatch(*pipeline, res, 2, 2, 1, &error)) << error;
+    ASSERT_TRUE(context_->dispatch(*pipeline, res, 2, 2, 1, diags)) << diags.errorMessages();
     const auto& bytes = std::get<BufferResource>(res.at({0, 1})).data;
     for (float f : valuesOf<float>(bytes)) ASSERT_FALSE(std::isnan(f));
     if (round == 0) first = bytes;
@@ -383,12 +388,12 @@ uint32_t xorshift(uint32_t iterations) {
 // A fact about the driver, not the harness: llvmpipe (gallivm's loop limiter) silently ends any loop
 // after 65535 iterations. Shaders meant for lavapipe must keep their loops below that.
 TEST_F(GpuHarness, LavapipeEndsLoopsAfter65535Iterations) {
-  std::string error;
-  auto pipeline = context_->createPipeline(compile(ShaderLanguage::Glsl, kXorshiftLoop), &error);
-  ASSERT_NE(pipeline, nullptr) << error;
+  Diagnostics diags("test");
+  auto pipeline = context_->createPipeline(compile(ShaderLanguage::Glsl, kXorshiftLoop), diags);
+  ASSERT_NE(pipeline, nullptr) << diags.errorMessages();
   for (uint32_t iterations : {1000u, 65535u, 65536u, 100000u}) {
     Resources res{{{0, 0}, BufferResource{bytesOf(std::vector<uint32_t>{iterations})}}, {{0, 1}, outputBuffer(4)}};
-    ASSERT_TRUE(context_->dispatch(*pipeline, res, 1, 1, 1, &error)) << error;
+    ASSERT_TRUE(context_->dispatch(*pipeline, res, 1, 1, 1, diags)) << diags.errorMessages();
     EXPECT_EQ(valuesOf<uint32_t>(std::get<BufferResource>(res.at({0, 1})).data)[0],
               xorshift(std::min(iterations, 65535u)))
         << iterations << " iterations";
@@ -401,17 +406,19 @@ TEST(GpuHarnessTimeout, AFenceTimeoutFailsTheDispatchInsteadOfHanging) {
   Context::Options options;
   options.shaderCacheDir = SUBSTRATEC_GPU_CACHE_DIR;
   options.fenceTimeoutNs = 100'000'000;
-  std::string error;
-  auto context = Context::create(options, &error);
-  ASSERT_NE(context, nullptr) << error;
-  auto pipeline = context->createPipeline(compile(ShaderLanguage::Glsl, kXorshiftLoop), &error);
-  ASSERT_NE(pipeline, nullptr) << error;
+  Diagnostics diags("test");
+  auto context = Context::create(options, diags);
+  ASSERT_NE(context, nullptr) << diags.errorMessages();
+  auto pipeline = context->createPipeline(compile(ShaderLanguage::Glsl, kXorshiftLoop), diags);
+  ASSERT_NE(pipeline, nullptr) << diags.errorMessages();
   const uint32_t groups = 10000;
   Resources res{{{0, 0}, BufferResource{bytesOf(std::vector<uint32_t>{60000u})}}, {{0, 1}, outputBuffer(4 * groups)}};
-  EXPECT_FALSE(context->dispatch(*pipeline, res, groups, 1, 1, &error));
-  EXPECT_NE(error.find("vkWaitForFences timed out after 100 ms"), std::string::npos) << error;
-  EXPECT_FALSE(context->dispatch(*pipeline, res, 1, 1, 1, &error));
-  EXPECT_NE(error.find("unusable"), std::string::npos) << error;
+  EXPECT_FALSE(context->dispatch(*pipeline, res, groups, 1, 1, diags));
+  EXPECT_NE(diags.errorMessages().find("vkWaitForFences timed out after 100 ms"), std::string::npos)
+      << diags.errorMessages();
+  EXPECT_FALSE(context->dispatch(*pipeline, res, 1, 1, 1, diags));
+  EXPECT_NE(diags.errorMessages().find("unusable"), std::string::npos)
+      << diags.errorMessages();
   EXPECT_TRUE(context->takeMessages().empty());
 }
 

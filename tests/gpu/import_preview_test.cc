@@ -16,9 +16,9 @@
 using namespace substratec;
 
 TEST(ImportCorpusPreview, EveryMaterialRendersOnLavapipe) {
-  std::string error;
-  gpu::Context* ctx = gputest::sharedContext(&error);
-  ASSERT_NE(ctx, nullptr) << error;
+  Diagnostics diags("test");
+  gpu::Context* ctx = gputest::sharedContext(diags);
+  ASSERT_NE(ctx, nullptr) << diags.errorMessages();
   preview::PipelineCache pipelines;
   preview::RenderOptions ro;
   ro.size = 32;
@@ -36,7 +36,7 @@ TEST(ImportCorpusPreview, EveryMaterialRendersOnLavapipe) {
       auto c = compileText(m.name, doc.dump(), CompileOptions{}, diags);
       ASSERT_TRUE(c.has_value()) << diags.formatAll();
       preview::Image image;
-      ASSERT_TRUE(preview::renderSphere(*ctx, *c, ro, &image, &error)) << error;
+      ASSERT_TRUE(preview::renderSphere(*ctx, *c, ro, &image, diags)) << diags.errorMessages();
       std::size_t nonFinite = 0;
       for (float v : image.rgba) nonFinite += !std::isfinite(v);
       EXPECT_EQ(nonFinite, 0u);

@@ -213,18 +213,18 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   return c;
 }
 
-gpu::Context* sharedContext(std::string* error) {
+gpu::Context* sharedContext(Diagnostics& diags) {
   static std::once_flag once;
   static std::unique_ptr<gpu::Context> context;
-  static std::string failure;
+  static Diagnostics failure("GPU harness");
   std::call_once(once, [] {
     gpu::Context::Options o;
 #ifdef SUBSTRATEC_GPU_CACHE_DIR
     o.shaderCacheDir = SUBSTRATEC_GPU_CACHE_DIR;
 #endif
-    context = gpu::Context::create(o, &failure);
+    context = gpu::Context::create(o, failure);
   });
-  if (!context && error) *error = failure;
+  if (!context) diags.fail(failure.errorMessages());
   return context.get();
 }
 

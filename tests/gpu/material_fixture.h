@@ -76,7 +76,7 @@ struct Tolerance {
   }
 };
 
-/// The process's lavapipe context (created once; null with `error` set).
-gpu::Context* sharedContext(std::string* error);
+/// The process's lavapipe context (created once; null, with its creation's error reported).
+gpu::Context* sharedContext(Diagnostics& diags);
 
 }  // namespace substratec::gputest

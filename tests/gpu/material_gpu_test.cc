@@ -77,9 +77,9 @@ struct Worst {
 class MaterialOnGpu : public ::testing::TestWithParam<std::tuple<std::string, Variant>> {
  protected:
   void SetUp() override {
-    std::string error;
-    ctx_ = sharedContext(&error);
-    ASSERT_NE(ctx_, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+    Diagnostics gpuSetup("test");
+    ctx_ = sharedContext(gpuSetup);
+    ASSERT_NE(ctx_, nullptr) << "lavapipe is required (GPU tests never skip): " << gpuSetup.errorMessages();
     const auto& [stem, variant] = GetParam();
     const fs::path path = fs::path(SUBSTRATEC_SOURCE_DIR) / "examples" / (stem + ".json");
     CompileOptions o;
@@ -111,16 +111,16 @@ class MaterialOnGpu : public ::testing::TestWithParam<std::tuple<std::string, Va
     ShaderValidation v = compileKernel(*r_, target, mode);
     EXPECT_TRUE(v.ok) << v.log;
     if (!v.ok) return k.results;
-    std::string error;
-    auto pipeline = ctx_->createPipeline(v.spirv, &error);
-    EXPECT_NE(pipeline, nullptr) << error;
+    Diagnostics diags("test");
+    auto pipeline = ctx_->createPipeline(v.spirv, diags);
+    EXPECT_NE(pipeline, nullptr) << diags.errorMessages();
     if (!pipeline) return k.results;
     std::vector<std::vector<float>> out;
     const std::size_t floats = static_cast<std::size_t>(resultStride(*r_)) * kGeometries;
     for (const auto& inputs : inputSets_) {
       gpu::Resources res = kernelResources(r_->material, pipeline->reflection(), v.spirv, inputs, sampleBytes_, floats);
-      const bool ok = ctx_->dispatch(*pipeline, res, kGeometries / kLocalSize, 1, 1, &error);
-      EXPECT_TRUE(ok) << error;
+      const bool ok = ctx_->dispatch(*pipeline, res, kGeometries / kLocalSize, 1, 1, diags);
+      EXPECT_TRUE(ok) << diags.errorMessages();
       if (!ok) return k.results;
       out.push_back(floatsOf(res, 0, 7));
     }
@@ -325,13 +325,13 @@ void MaterialOnGpu::theSameDispatchTwiceGivesIdenticalBits() {
     const auto& before = run(Target::Glsl, mode);
     ASSERT_FALSE(before.empty());
     const Kernel& k = kernels_.at({Target::Glsl, mode});
-    std::string error;
+    Diagnostics diags("test");
     const std::size_t floats = static_cast<std::size_t>(resultStride(*r_)) * kGeometries;
     std::vector<std::vector<float>> runs;
     for (int i = 0; i < 2; ++i) {
       gpu::Resources res =
           kernelResources(r_->material, k.pipeline->reflection(), k.spirv, inputSets_[1], sampleBytes_, floats);
-      ASSERT_TRUE(ctx_->dispatch(*k.pipeline, res, kGeometries / kLocalSize, 1, 1, &error)) << error;
+      ASSERT_TRUE(ctx_->dispatch(*k.pipeline, res, kGeometries / kLocalSize, 1, 1, diags)) << diags.errorMessages();
       runs.push_back(floatsOf(res, 0, 7));
     }
     const char* what = mode == KernelMode::Forward ? "forward" : "deferred";

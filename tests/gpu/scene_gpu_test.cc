@@ -88,9 +88,9 @@ double angleDegrees(const std::array<double, 3>& a, const std::array<double, 3>&
 class SceneOnGpu : public ::testing::Test {
  protected:
   void SetUp() override {
-    std::string error;
-    ctx_ = sharedContext(&error);
-    ASSERT_NE(ctx_, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+    Diagnostics diags("test");
+    ctx_ = sharedContext(diags);
+    ASSERT_NE(ctx_, nullptr) << "lavapipe is required (GPU tests never skip): " << diags.errorMessages();
   }
 
   /// The Deferred kernel of `r`, compiled and ready to dispatch.
@@ -105,9 +105,9 @@ class SceneOnGpu : public ::testing::Test {
     EXPECT_TRUE(v.ok) << v.log;
     Kernel k;
     if (!v.ok) return k;
-    std::string error;
-    k.pipeline = ctx_->createPipeline(v.spirv, &error);
-    EXPECT_NE(k.pipeline, nullptr) << error;
+    Diagnostics diags("test");
+    k.pipeline = ctx_->createPipeline(v.spirv, diags);
+    EXPECT_NE(k.pipeline, nullptr) << diags.errorMessages();
     k.spirv = std::move(v.spirv);
     return k;
   }
@@ -119,9 +119,9 @@ class SceneOnGpu : public ::testing::Test {
     const std::size_t floats = static_cast<std::size_t>(resultStride(r)) * samples.size();
     gpu::Resources res =
         kernelResources(r.material, k.pipeline->reflection(), k.spirv, inputs, sampleBuffer(samples), floats);
-    std::string error;
-    const bool ok = ctx_->dispatch(*k.pipeline, res, static_cast<uint32_t>(samples.size() / kLocalSize), 1, 1, &error);
-    EXPECT_TRUE(ok) << error;
+    Diagnostics diags("test");
+    const bool ok = ctx_->dispatch(*k.pipeline, res, static_cast<uint32_t>(samples.size() / kLocalSize), 1, 1, diags);
+    EXPECT_TRUE(ok) << diags.errorMessages();
     return ok ? floatsOf(res, 0, 7) : std::vector<float>{};
   }
 
@@ -307,17 +307,17 @@ TEST_F(SceneOnGpu, TilesAreClassifiedAndEachClassLightsItsPixelsAsTheReference) 
       for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
       ShaderValidation v = compileAndValidate(src);
       EXPECT_TRUE(v.ok) << name << "\n" << v.log;
-      std::string error;
-      auto p = v.ok ? ctx_->createPipeline(v.spirv, &error) : nullptr;
-      EXPECT_TRUE(p) << error;
+      Diagnostics diags("test");
+      auto p = v.ok ? ctx_->createPipeline(v.spirv, diags) : nullptr;
+      EXPECT_TRUE(p) << diags.errorMessages();
       return p;
     };
     // 1. Classification: every tile listed once, under the class of its most complex pixel.
     auto classify = compile(tileClassificationFileName(shape, syn), emitTileClassification(shape, syn));
     ASSERT_TRUE(classify);
     gpu::TileLists lists;
-    std::string error;
-    ASSERT_TRUE(gpu::classifyTiles(*ctx_, *classify, frame, gbuffer, &lists, &error)) << error;
+    Diagnostics diags("test");
+    ASSERT_TRUE(gpu::classifyTiles(*ctx_, *classify, frame, gbuffer, &lists, diags)) << diags.errorMessages();
     std::size_t listed = 0;
     for (const auto& [tile, cls] : expected) {
       const auto& l = lists.tiles[static_cast<int>(cls)];
@@ -334,7 +334,8 @@ TEST_F(SceneOnGpu, TilesAreClassifiedAndEachClassLightsItsPixelsAsTheReference) 
       auto light = compile(sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn));
       ASSERT_TRUE(light);
       gpu::Resources res = gpu::lightingResources(*light, frame, gbuffer, lists);
-      ASSERT_TRUE(ctx_->dispatch(*light, res, static_cast<uint32_t>(tiles.size()), 1, 1, &error)) << error;
+      ASSERT_TRUE(ctx_->dispatch(*light, res, static_cast<uint32_t>(tiles.size()), 1, 1, diags))
+          << diags.errorMessages();
       const auto& out = std::get<gpu::StorageImageResource>(res[{0, 8}]).data;
       std::vector<float> lit(W * H * 4);
       std::memcpy(lit.data(), out.data(), lit.size() * 4);

@@ -118,9 +118,9 @@ constexpr double kHalfAbs = 1e-3, kHalfRel = 5e-3;
 /// meets the same rule on the first input set.
 void expectHalfAgreesWithFloat32(const std::string& name) {
   SCOPED_TRACE(name);
-  std::string error;
-  gpu::Context* ctx = gputest::sharedContext(&error);
-  ASSERT_NE(ctx, nullptr) << error;
+  Diagnostics diags("test");
+  gpu::Context* ctx = gputest::sharedContext(diags);
+  ASSERT_NE(ctx, nullptr) << diags.errorMessages();
   const std::string stem = fs::path(name).stem().string();
   const CompileResult r = compile(readFile(example(name)));
   const auto samples =
@@ -144,7 +144,8 @@ void expectHalfAgreesWithFloat32(const std::string& name) {
   };
   for (std::size_t set = 0; set < inputSets.size(); ++set) {
     sweep::BothPrecisions both;
-    ASSERT_TRUE(sweep::runBothPrecisions(*ctx, r, Target::Glsl, samples, inputSets[set].values, &both, &error)) << error;
+    ASSERT_TRUE(sweep::runBothPrecisions(*ctx, r, Target::Glsl, samples, inputSets[set].values, &both, diags))
+        << diags.errorMessages();
     ASSERT_EQ(both.float32.size(), both.half.size());
     const sweep::PrecisionError e = sweep::precisionError(both, stride);
     relMseSum += e.relMse;
@@ -163,8 +164,8 @@ void expectHalfAgreesWithFloat32(const std::string& name) {
       half.precision = Precision::Half;
       std::vector<float> hlsl;
       ASSERT_TRUE(gpu::runSampleKernel(*ctx, r, Target::Hlsl, KernelMode::Forward, half, samples, inputSets[0].values,
-                                       &hlsl, &error))
-          << error;
+                                       &hlsl, diags))
+          << diags.errorMessages();
       checkLit(both.float32, hlsl, "HLSL");
     }
   }
@@ -301,9 +302,10 @@ TEST(Stability, ForcingInputsLeaveTheMaterialAsItWasWhenOff) {
   for (const std::string& name : exampleNames()) {
     SCOPED_TRACE(name);
     const std::string text = readFile(example(name));
-    std::string rewritten, error;
+    std::string rewritten;
+    Diagnostics diags("test");
     std::vector<stability::ForcedKind> kinds;
-    ASSERT_TRUE(stability::forceableText(text, &rewritten, &kinds, &error)) << error;
+    ASSERT_TRUE(stability::forceableText(text, &rewritten, &kinds, diags)) << diags.errorMessages();
     EXPECT_FALSE(kinds.empty());
     CompileOptions o;
     o.budgetOverride = 1024;
@@ -401,9 +403,9 @@ TEST(LayeringEnergy, RandomStacksNeverGainEnergyInTheGeneratedShaders) {
   // kernel per stack shape, every case an input set of one dispatch (CI time:
   // three pipelines).
   using namespace stackfurnace;
-  std::string error;
-  gpu::Context* ctx = gputest::sharedContext(&error);
-  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+  Diagnostics diags("test");
+  gpu::Context* ctx = gputest::sharedContext(diags);
+  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << diags.errorMessages();
   constexpr int kCasesPerStack = 12;
   const std::pair<int, Shape> stacks[] = {{3, Shape::NestedBases}, {5, Shape::CoveredNestedBases}, {8, Shape::NestedTops}};
   // The views, padded to one work group with head-on views.
@@ -422,8 +424,8 @@ TEST(LayeringEnergy, RandomStacksNeverGainEnergyInTheGeneratedShaders) {
     ASSERT_EQ(r.after.closures.size(), static_cast<std::size_t>(depth));
     const ShaderValidation shader = compileKernel(r, Target::Glsl, KernelMode::Forward);
     ASSERT_TRUE(shader.ok) << shader.log;
-    auto pipeline = ctx->createPipeline(shader.spirv, &error);
-    ASSERT_NE(pipeline, nullptr) << error;
+    auto pipeline = ctx->createPipeline(shader.spirv, diags);
+    ASSERT_NE(pipeline, nullptr) << diags.errorMessages();
     const int stride = gpu::resultStride(r);
     Rng rng{0x6e0000u + static_cast<std::uint64_t>(depth)};
     for (int k = 0; k < kCasesPerStack; ++k) {
@@ -433,8 +435,8 @@ TEST(LayeringEnergy, RandomStacksNeverGainEnergyInTheGeneratedShaders) {
       gpu::Resources res = gputest::kernelResources(r.material, pipeline->reflection(), shader.spirv, c.inputs,
                                                     sampleBytes, static_cast<std::size_t>(stride) * samples.size());
       ASSERT_TRUE(ctx->dispatch(*pipeline, res, static_cast<uint32_t>(samples.size()) / kernel::kLocalSize, 1, 1,
-                                &error))
-          << error;
+                                diags))
+          << diags.errorMessages();
       const std::vector<float> out = gpu::floatsOf(res, 0, 7);
       for (std::size_t i = 0; i < std::size(kNoV); ++i) {
         std::vector<reference::Closure<double>> gpuClosures;
@@ -473,9 +475,9 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
   // HLSL and GLSL share the runtime; GLSL only (CI time).
   using namespace stackfurnace;
   constexpr int kDiffuseModel = diffuseModelNumber(kDefaultDiffuseModel);
-  std::string error;
-  gpu::Context* ctx = gputest::sharedContext(&error);
-  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << error;
+  Diagnostics diags("test");
+  gpu::Context* ctx = gputest::sharedContext(diags);
+  ASSERT_NE(ctx, nullptr) << "lavapipe is required (GPU tests never skip): " << diags.errorMessages();
   const std::vector<gpu::Sample> samples = gpu::makeSamples(kernel::kLocalSize, 0x57ac);
   const auto sampleBytes = gpu::sampleBuffer(samples);
   const gputest::Tolerance tol;
@@ -494,12 +496,12 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
     ASSERT_EQ(r.after.closures.size(), static_cast<std::size_t>(depth));
     const int stride = gpu::resultStride(r);
     ShaderValidation shaders[2];
-    decltype(ctx->createPipeline(shaders[0].spirv, &error)) pipelines[2];
+    decltype(ctx->createPipeline(shaders[0].spirv, diags)) pipelines[2];
     for (int mode = 0; mode < 2; ++mode) {
       shaders[mode] = compileKernel(r, Target::Glsl, mode == 0 ? KernelMode::Forward : KernelMode::Deferred);
       ASSERT_TRUE(shaders[mode].ok) << shaders[mode].log;
-      pipelines[mode] = ctx->createPipeline(shaders[mode].spirv, &error);
-      ASSERT_NE(pipelines[mode], nullptr) << error;
+      pipelines[mode] = ctx->createPipeline(shaders[mode].spirv, diags);
+      ASSERT_NE(pipelines[mode], nullptr) << diags.errorMessages();
     }
     std::vector<float> out[2];
     Rng rng{0x7a0000u + static_cast<std::uint64_t>(depth)};
@@ -511,8 +513,8 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
                                                       c.inputs, sampleBytes,
                                                       static_cast<std::size_t>(stride) * samples.size());
         ASSERT_TRUE(ctx->dispatch(*pipelines[mode], res, static_cast<uint32_t>(samples.size()) / kernel::kLocalSize, 1,
-                                  1, &error))
-            << error;
+                                  1, diags))
+            << diags.errorMessages();
         out[mode] = gpu::floatsOf(res, 0, 7);
       }
       for (std::size_t i = 0; i < samples.size(); ++i) {

@@ -556,8 +556,8 @@ TEST_F(PreviewPng, ReadsBackToTheSamePixels) {
   const int w = 7, h = 5;
   std::vector<uint8_t> px = pattern(w, h);
   fs::path file = dir_ / "out.png";
-  std::string error;
-  ASSERT_TRUE(writePng(file.string(), w, h, px, &error)) << error;
+  Diagnostics diags("test");
+  ASSERT_TRUE(writePng(file.string(), w, h, px, diags)) << diags.errorMessages();
   EXPECT_EQ(entries(), std::vector<fs::path>{file});  // no temporary left
 
   png_image image;
@@ -582,38 +582,38 @@ TEST_F(PreviewPng, ReadsBackToTheSamePixels) {
 
 TEST_F(PreviewPng, SameInputsGiveByteIdenticalFiles) {
   std::vector<uint8_t> px = pattern(16, 9);
-  std::string error;
-  ASSERT_TRUE(writePng((dir_ / "a.png").string(), 16, 9, px, &error)) << error;
-  ASSERT_TRUE(writePng((dir_ / "b.png").string(), 16, 9, px, &error)) << error;
+  Diagnostics diags("test");
+  ASSERT_TRUE(writePng((dir_ / "a.png").string(), 16, 9, px, diags)) << diags.errorMessages();
+  ASSERT_TRUE(writePng((dir_ / "b.png").string(), 16, 9, px, diags)) << diags.errorMessages();
   std::vector<uint8_t> a = fileBytes(dir_ / "a.png");
   EXPECT_FALSE(a.empty());
   EXPECT_EQ(a, fileBytes(dir_ / "b.png"));
   std::vector<uint8_t> mem;
-  ASSERT_TRUE(encodePng(16, 9, px, mem, &error)) << error;
+  ASSERT_TRUE(encodePng(16, 9, px, mem, diags)) << diags.errorMessages();
   EXPECT_EQ(mem, a);
 }
 
 TEST_F(PreviewPng, FailedWriteLeavesNothingBehind) {
   std::vector<uint8_t> px = pattern(4, 4);
-  std::string error;
+  Diagnostics diags("test");
   // The directory does not exist.
-  EXPECT_FALSE(writePng((dir_ / "missing" / "out.png").string(), 4, 4, px, &error));
-  EXPECT_NE(error.find("out.png"), std::string::npos) << error;
+  EXPECT_FALSE(writePng((dir_ / "missing" / "out.png").string(), 4, 4, px, diags));
+  EXPECT_NE(diags.errorMessages().find("out.png"), std::string::npos) << diags.errorMessages();
   EXPECT_FALSE(fs::exists(dir_ / "missing"));
   EXPECT_TRUE(entries().empty());
   // The temporary is written but cannot replace a directory: it is removed.
   fs::create_directory(dir_ / "taken.png");
-  error.clear();
-  EXPECT_FALSE(writePng((dir_ / "taken.png").string(), 4, 4, px, &error));
-  EXPECT_FALSE(error.empty());
+  diags = Diagnostics("test");
+  EXPECT_FALSE(writePng((dir_ / "taken.png").string(), 4, 4, px, diags));
+  EXPECT_TRUE(diags.hasErrors());
   EXPECT_EQ(entries(), std::vector<fs::path>{dir_ / "taken.png"});
   EXPECT_TRUE(fs::is_directory(dir_ / "taken.png"));
   // Too few pixels: nothing is written, an existing file is untouched.
-  ASSERT_TRUE(writePng((dir_ / "keep.png").string(), 4, 4, px, &error)) << error;
+  ASSERT_TRUE(writePng((dir_ / "keep.png").string(), 4, 4, px, diags)) << diags.errorMessages();
   std::vector<uint8_t> before = fileBytes(dir_ / "keep.png");
-  error.clear();
-  EXPECT_FALSE(writePng((dir_ / "keep.png").string(), 5, 4, px, &error));
-  EXPECT_FALSE(error.empty());
+  diags = Diagnostics("test");
+  EXPECT_FALSE(writePng((dir_ / "keep.png").string(), 5, 4, px, diags));
+  EXPECT_TRUE(diags.hasErrors());
   EXPECT_EQ(fileBytes(dir_ / "keep.png"), before);
   EXPECT_EQ(entries().size(), 2u);
 }

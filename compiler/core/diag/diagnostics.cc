@@ -83,6 +83,23 @@ void Diagnostics::warning(std::string pointer, std::string message) {
   push(std::move(d));
 }
 
+void Diagnostics::fail(std::string message) {
+  Diagnostic d;
+  d.file = file_;
+  d.message = std::move(message);
+  push(std::move(d));
+}
+
+std::string Diagnostics::errorMessages() const {
+  std::string out;
+  for (const auto& d : list_) {
+    if (d.severity != Severity::Error) continue;
+    if (!out.empty()) out += '\n';
+    out += d.message;
+  }
+  return out;
+}
+
 std::string Diagnostics::formatAll() const {
   std::string out;
   for (const auto& d : list_) {

@@ -37,6 +37,9 @@ class Diagnostics {
   void error(std::string pointer, std::string message);
   void warning(std::string pointer, std::string message);
   void warningAt(int line, int column, std::string message);
+  /// An error located nowhere in a document: a tool or a Vulkan call failed ("GPU harness:
+  /// vkCreateDevice failed: ..."). Prints like any unlocated diagnostic (`file: error: msg`).
+  void fail(std::string message);
 
   bool hasErrors() const { return errorCount_ > 0; }
   std::size_t errorCount() const { return errorCount_; }
@@ -46,6 +49,9 @@ class Diagnostics {
 
   /// All diagnostics, one per line, plus a "too many errors" line if cut.
   std::string formatAll() const;
+  /// The errors' messages alone (no file, no severity), joined by newlines: for a caller that puts
+  /// a tool's failure into its own sentence ("substratec: error: preview renders on Vulkan ...: <it>").
+  std::string errorMessages() const;
 
  private:
   void push(Diagnostic d);

@@ -4,37 +4,12 @@
 #include <cstring>
 #include <map>
 
+#include "gpu/spirv_words.h"
+
 namespace substratec::gpu {
 
-namespace {
-
-// SPIR-V opcodes and decorations used here.
-enum : uint32_t {
-  kOpMemberName = 6,
-  kOpTypePointer = 32,
-  kOpVariable = 59,
-  kOpDecorate = 71,
-  kOpMemberDecorate = 72,
-  kDecorationBinding = 33,
-  kDecorationDescriptorSet = 34,
-  kDecorationOffset = 35,
-};
-
-/// A literal string operand (nul-terminated, packed little-endian into words).
-std::string literalString(const uint32_t* w, std::size_t words) {
-  std::string s;
-  for (std::size_t i = 0; i < words; ++i)
-    for (int b = 0; b < 4; ++b) {
-      const char c = static_cast<char>((w[i] >> (8 * b)) & 0xffu);
-      if (c == '\0') return s;
-      s += c;
-    }
-  return s;
-}
-
-}  // namespace
-
 std::vector<BlockMember> blockMembers(const std::vector<uint32_t>& w, uint32_t set, uint32_t binding) {
+  using namespace spirv;
   std::map<uint32_t, uint32_t> setOf, bindingOf, pointee, varType;
   std::map<uint32_t, std::map<uint32_t, BlockMember>> members;  // struct id -> member index -> member
   for (std::size_t i = 5; i < w.size();) {

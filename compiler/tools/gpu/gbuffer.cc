@@ -12,31 +12,38 @@ namespace substratec::gpu {
 
 namespace {
 
+/// Copies the fields a reference closure and the packer's ClosureValues share (either way:
+/// closureValues packs a closure, closureOf reads one back).
+template <class From, class To>
+void copySharedFields(const From& from, To& to) {
+  to.diffuseAlbedo = from.diffuseAlbedo;
+  to.f0 = from.f0;
+  to.f90 = from.f90;
+  to.roughness = from.roughness;
+  to.anisotropy = from.anisotropy;
+  to.sssMfp = from.sssMfp;
+  to.sssPhaseAnisotropy = from.sssPhaseAnisotropy;
+  to.sssType = from.sssType;
+  to.secondRoughness = from.secondRoughness;
+  to.secondRoughnessWeight = from.secondRoughnessWeight;
+  to.fuzzAmount = from.fuzzAmount;
+  to.fuzzColor = from.fuzzColor;
+  to.fuzzRoughness = from.fuzzRoughness;
+  to.glintValue = from.glintValue;
+  to.glintUv = from.glintUv;
+  to.glintUvDerivatives = from.glintUvDerivatives;
+  to.specularProfile = from.specularProfile;
+  to.weight = from.weight;
+  to.topTransmittance = from.topTransmittance;
+  to.coverageAbove = from.coverageAbove;
+  to.extraInterfaces = from.extraInterfaces;
+}
+
 }  // namespace
 
 ClosureValues closureValues(const reference::Closure<double>& c) {
   ClosureValues v;
-  v.diffuseAlbedo = c.diffuseAlbedo;
-  v.f0 = c.f0;
-  v.f90 = c.f90;
-  v.roughness = c.roughness;
-  v.anisotropy = c.anisotropy;
-  v.sssMfp = c.sssMfp;
-  v.sssPhaseAnisotropy = c.sssPhaseAnisotropy;
-  v.sssType = c.sssType;
-  v.secondRoughness = c.secondRoughness;
-  v.secondRoughnessWeight = c.secondRoughnessWeight;
-  v.fuzzAmount = c.fuzzAmount;
-  v.fuzzColor = c.fuzzColor;
-  v.fuzzRoughness = c.fuzzRoughness;
-  v.glintValue = c.glintValue;
-  v.glintUv = c.glintUv;
-  v.glintUvDerivatives = c.glintUvDerivatives;
-  v.specularProfile = c.specularProfile;
-  v.weight = c.weight;
-  v.topTransmittance = c.topTransmittance;
-  v.coverageAbove = c.coverageAbove;
-  v.extraInterfaces = c.extraInterfaces;
+  copySharedFields(c, v);
   return v;
 }
 
@@ -44,29 +51,9 @@ namespace {
 
 reference::Closure<double> closureOf(const ClosureValues& v, const BasisValues& b) {
   reference::Closure<double> c;
-  c.diffuseAlbedo = v.diffuseAlbedo;
-  c.f0 = v.f0;
-  c.f90 = v.f90;
-  c.roughness = v.roughness;
-  c.anisotropy = v.anisotropy;
+  copySharedFields(v, c);
   c.N = b.normal;
   c.T_ = b.tangent;
-  c.sssMfp = v.sssMfp;
-  c.sssPhaseAnisotropy = v.sssPhaseAnisotropy;
-  c.sssType = v.sssType;
-  c.secondRoughness = v.secondRoughness;
-  c.secondRoughnessWeight = v.secondRoughnessWeight;
-  c.fuzzAmount = v.fuzzAmount;
-  c.fuzzColor = v.fuzzColor;
-  c.fuzzRoughness = v.fuzzRoughness;
-  c.glintValue = v.glintValue;
-  c.glintUv = v.glintUv;
-  c.glintUvDerivatives = v.glintUvDerivatives;
-  c.specularProfile = v.specularProfile;
-  c.weight = v.weight;
-  c.topTransmittance = v.topTransmittance;
-  c.coverageAbove = v.coverageAbove;
-  c.extraInterfaces = v.extraInterfaces;
   c.features = v.features;
   c.isTop = v.isTop;
   return c;
@@ -195,7 +182,7 @@ StorageImageResource Gbuffer::materialBufferImage() const {
 }
 
 bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFrame& f, const Gbuffer& gbuffer,
-                   TileLists* out, std::string* error) {
+                   TileLists* out, Diagnostics& diags) {
   Resources res;
   res[{0, 0}] = frameBlock(f);
   res[{0, 6}] = gbuffer.gbufferImage();
@@ -209,7 +196,7 @@ bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFra
   args.data = bytesOf(init);
   args.output = args.initialized = true;
   res[{0, 9}] = args;
-  if (!ctx.dispatch(classify, res, f.tilesX(), f.tilesY(), 1, error)) return false;
+  if (!ctx.dispatch(classify, res, f.tilesX(), f.tilesY(), 1, diags)) return false;
   std::vector<uint32_t> counts(16);
   std::memcpy(counts.data(), std::get<BufferResource>(res[{0, 9}]).data.data(), 64);
   out->raw.resize(std::size_t{4} * f.tiles());
@@ -217,7 +204,7 @@ bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFra
   for (int c = 0; c < 4; ++c) {
     out->tiles[c].clear();
     if (counts[c * 4] > f.tiles() || counts[c * 4 + 1] != 1 || counts[c * 4 + 2] != 1) {
-      *error = "classification wrote bad dispatch arguments for class " + std::to_string(c);
+      diags.fail("classification wrote bad dispatch arguments for class " + std::to_string(c));
       return false;
     }
     for (uint32_t t = 0; t < counts[c * 4]; ++t) {

@@ -73,9 +73,9 @@ struct TileLists {
   std::vector<uint32_t> raw;  // the list buffer as written (what the lighting reads)
 };
 
-/// Runs a classification pipeline over `gbuffer`; false with `error` on failure.
+/// Runs a classification pipeline over `gbuffer`; false, with errors reported, on failure.
 bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFrame& f, const Gbuffer& gbuffer,
-                   TileLists* out, std::string* error);
+                   TileLists* out, Diagnostics& diags);
 
 /// The resources of one lighting dispatch (its reflection says which it uses);
 /// the colour target (binding 8) is an RGBA32F output of the frame's size.

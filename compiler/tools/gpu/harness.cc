@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <type_traits>
 
 #include "gpu/vulkan_loader.h"
 
@@ -60,10 +61,16 @@ std::string driverHint() {
          ", VK_ICD_FILENAMES=" + (icds ? icds : "<unset>") + "; Debian: mesa-vulkan-drivers)";
 }
 
-/// Sets `*error` to "<call> failed: <VkResult>" unless `result` is VK_SUCCESS.
-bool succeeded(VkResult result, const std::string& call, std::string* error) {
+/// Reports `message` as an error; false (for `return fail(...)`).
+bool fail(Diagnostics& diags, std::string message) {
+  diags.fail(std::move(message));
+  return false;
+}
+
+/// Reports "<call> failed: <VkResult>" unless `result` is VK_SUCCESS.
+bool succeeded(VkResult result, const std::string& call, Diagnostics& diags) {
   if (result == VK_SUCCESS) return true;
-  *error = call + " failed: " + vkResultName(result);
+  diags.fail(call + " failed: " + vkResultName(result));
   return false;
 }
 
@@ -133,6 +140,61 @@ struct Readback {
   VkBufferImageCopy region{};
 };
 
+/// What one dispatch binds, fills and reads back. The info vectors are reserved for every binding up
+/// front and never reallocate: the writes point into them.
+struct Bindings {
+  std::vector<VkDescriptorSet> sets;  // index = set number
+  std::vector<VkDescriptorBufferInfo> bufferInfos;
+  std::vector<VkDescriptorImageInfo> imageInfos;
+  std::vector<VkWriteDescriptorSet> writes;
+  std::vector<ImageUpload> uploads;
+  std::vector<Readback> readbacks;
+};
+
+/// A layout transition of all `mips` and `layers` of a colour image.
+VkImageMemoryBarrier imageBarrier(VkImage image, uint32_t layers, uint32_t mips, VkImageLayout from, VkImageLayout to,
+                                  VkAccessFlags srcAccess, VkAccessFlags dstAccess) {
+  VkImageMemoryBarrier barrier{};
+  barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
+  barrier.srcAccessMask = srcAccess;
+  barrier.dstAccessMask = dstAccess;
+  barrier.oldLayout = from;
+  barrier.newLayout = to;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = image;
+  barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, layers};
+  return barrier;
+}
+
+/// Every binding of `refl` has a resource of its kind in `resources`, and every resource is used;
+/// otherwise false, reporting the first mismatch.
+bool resourcesMatch(const ShaderReflection& refl, const Resources& resources, Diagnostics& diags) {
+  for (const DescriptorBinding& b : refl.bindings) {
+    auto it = resources.find({b.set, b.binding});
+    if (it == resources.end()) {
+      diags.fail("dispatch: no resource for " + describe(b) + " of entry point '" + refl.entryPoint + "'");
+      return false;
+    }
+    const size_t want = resourceIndexFor(b.kind);
+    if (it->second.index() != want) {
+      diags.fail("dispatch: " + describe(b) + " needs a " + kResourceNames[want] + ", got a " +
+                 kResourceNames[it->second.index()]);
+      return false;
+    }
+  }
+  for (const auto& [key, resource] : resources) {
+    if (std::none_of(refl.bindings.begin(), refl.bindings.end(), [&key = key](const DescriptorBinding& b) {
+          return b.set == key.first && b.binding == key.second;
+        })) {
+      diags.fail("dispatch: the " + std::string(kResourceNames[resource.index()]) + " for set " +
+                 std::to_string(key.first) + " binding " + std::to_string(key.second) +
+                 " is not used by entry point '" + refl.entryPoint + "'");
+      return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 struct Context::Impl {
@@ -171,37 +233,76 @@ struct Context::Impl {
     return log->messages.size();
   }
 
-  /// Appends the messages recorded since `start` to `*out` (after a newline if it is not empty); false if
-  /// there were any.
-  bool noMessagesSince(size_t start, const std::string& during, std::string* out) {
+  /// Reports the messages recorded since `start` as one error ("the validation layer reported N
+  /// message(s) during <during>:", a line each); false if there were any.
+  bool noMessagesSince(size_t start, const std::string& during, Diagnostics& diags) {
     std::lock_guard<std::mutex> lock(log->mutex);
     if (log->messages.size() <= start) return true;
     std::string text = "the validation layer reported " + std::to_string(log->messages.size() - start) +
                        " message(s) during " + during + ":";
     for (size_t i = start; i < log->messages.size(); ++i) text += "\n  " + log->messages[i];
-    *out = out->empty() ? text : *out + "\n" + text;
+    diags.fail(std::move(text));
     return false;
   }
 
   /// Loads libvulkan, pins lavapipe, creates the instance with the validation layer and the messenger.
-  bool createInstance(std::string* error);
+  bool createInstance(Diagnostics& diags);
   /// Picks lavapipe, creates the device with one compute queue (and shaderFloat16 when it has it) and the
   /// command pool.
-  bool createDevice(std::string* error);
+  bool createDevice(Diagnostics& diags);
   /// Allocates memory for `req` (host-visible + coherent and mapped when `hostVisible`), owned by `objs`.
   bool allocate(const VkMemoryRequirements& req, bool hostVisible, DispatchObjects& objs, VkDeviceMemory* out,
-                void** mapped, std::string* error);
+                void** mapped, Diagnostics& diags);
+  /// Gives `object` (a VkBuffer or VkImage) memory of its own, owned by `objs`: host-visible, coherent
+  /// and mapped into `*mapped` when `mapped` is set.
+  template <class Object>
+  bool bindMemory(Object object, DispatchObjects& objs, void** mapped, Diagnostics& diags) {
+    constexpr bool isBuffer = std::is_same_v<Object, VkBuffer>;
+    VkMemoryRequirements req;
+    if constexpr (isBuffer) vk.vkGetBufferMemoryRequirements(device, object, &req);
+    else vk.vkGetImageMemoryRequirements(device, object, &req);
+    VkDeviceMemory mem;
+    if (!allocate(req, mapped != nullptr, objs, &mem, mapped, diags)) return false;
+    if constexpr (isBuffer) return succeeded(vk.vkBindBufferMemory(device, object, mem, 0), "vkBindBufferMemory", diags);
+    else return succeeded(vk.vkBindImageMemory(device, object, mem, 0), "vkBindImageMemory", diags);
+  }
   /// A host-visible, mapped buffer owned by `objs`.
   bool createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, DispatchObjects& objs, VkBuffer* buffer,
-                    void** mapped, std::string* error);
+                    void** mapped, Diagnostics& diags);
   /// An optimal-tiling 2D image (cube-compatible when `cube`) with its memory and one view, owned by `objs`.
   bool createImage(VkFormat format, uint32_t width, uint32_t height, uint32_t layers, uint32_t mips, bool cube,
                    VkImageUsageFlags usage, VkImageViewType viewType, DispatchObjects& objs, VkImage* image,
-                   VkImageView* view, std::string* error);
+                   VkImageView* view, Diagnostics& diags);
   /// A sampler (filter for min/mag/mips, one address mode for u/v/w, no LOD clamp) owned by `objs`.
-  bool createSampler(Filter filter, Address address, DispatchObjects& objs, VkSampler* sampler, std::string* error);
+  bool createSampler(Filter filter, Address address, DispatchObjects& objs, VkSampler* sampler, Diagnostics& diags);
   /// Destroys everything in `objs` (only once the device no longer uses it).
   void destroy(DispatchObjects& objs);
+
+  // The steps of one dispatch, in order (Context::dispatch runs them; each sets `*why` on failure).
+  /// The descriptor pool and one set per layout of `p` (empty layouts included) into `b.sets`.
+  bool allocateSets(const ComputePipeline::Impl& p, const ShaderReflection& refl, DispatchObjects& objs, Bindings& b,
+                    Diagnostics& diags);
+  /// Creates and fills the Vulkan object of every binding and writes the descriptor sets; `*why` names the binding.
+  bool bindResources(const ShaderReflection& refl, Resources& resources, DispatchObjects& objs, Bindings& b,
+                     Diagnostics& diags);
+  /// A uniform or storage buffer: uploaded, NaN-filled or both read back (BufferResource's contract).
+  bool bindBuffer(const DescriptorBinding& binding, BufferResource& buf, DispatchObjects& objs, Bindings& b,
+                  VkWriteDescriptorSet& w, Diagnostics& diags);
+  /// A sampled texture with all its mips staged for upload (and its sampler when combined).
+  bool bindImage(const DescriptorBinding& binding, const ImageResource& img, DispatchObjects& objs, Bindings& b,
+                 VkWriteDescriptorSet& w, Diagnostics& diags);
+  /// A storage image: cleared or staged for upload, and copied out for read-back.
+  bool bindStorageImage(const DescriptorBinding& binding, StorageImageResource& si, DispatchObjects& objs, Bindings& b,
+                        VkWriteDescriptorSet& w, Diagnostics& diags);
+  /// One command buffer: fill images, dispatch (between timestamps when `timed`), copy storage images out,
+  /// make everything host-visible.
+  bool record(const ComputePipeline::Impl& p, const Bindings& b, const uint32_t groups[3], bool timed,
+              DispatchObjects& objs, Diagnostics& diags);
+  /// Submits `objs.commandBuffer` and waits for its fence (at most Options::fenceTimeoutNs; after that the
+  /// Context is lost).
+  bool submitAndWait(DispatchObjects& objs, Diagnostics& diags);
+  /// Copies the outputs into their resources, and the dispatch's time into `*dispatchNs` when timed.
+  bool readBack(const Bindings& b, DispatchObjects& objs, double* dispatchNs, Diagnostics& diags);
 };
 
 struct ComputePipeline::Impl {
@@ -211,14 +312,14 @@ struct ComputePipeline::Impl {
   VkPipeline pipeline = VK_NULL_HANDLE;
 };
 
-bool Context::Impl::createInstance(std::string* error) {
-  if (!loadGlobalFunctions(&vk, error)) return false;
+bool Context::Impl::createInstance(Diagnostics& diags) {
+  if (!loadGlobalFunctions(&vk, diags)) return false;
   // Pin the loader to lavapipe unless the caller chose drivers (an empty variable counts as unset: the
   // loader would find no driver at all). Other ICDs (intel, radeon) must never be picked.
   auto unset = [](const char* name) { return !getenv(name) || !*getenv(name); };
   if (unset("VK_DRIVER_FILES") && unset("VK_ICD_FILENAMES")) {
     if (!std::filesystem::exists(kLavapipeIcd)) {
-      *error = std::string("lavapipe's ICD file ") + kLavapipeIcd + " is missing (Debian: mesa-vulkan-drivers)";
+      diags.fail(std::string("lavapipe's ICD file ") + kLavapipeIcd + " is missing (Debian: mesa-vulkan-drivers)");
       return false;
     }
     setenv("VK_DRIVER_FILES", kLavapipeIcd, 1);
@@ -230,16 +331,16 @@ bool Context::Impl::createInstance(std::string* error) {
   }
 
   uint32_t count = 0;
-  if (!succeeded(vk.vkEnumerateInstanceLayerProperties(&count, nullptr), "vkEnumerateInstanceLayerProperties", error))
+  if (!succeeded(vk.vkEnumerateInstanceLayerProperties(&count, nullptr), "vkEnumerateInstanceLayerProperties", diags))
     return false;
   std::vector<VkLayerProperties> layers(count);
   if (!succeeded(vk.vkEnumerateInstanceLayerProperties(&count, layers.data()), "vkEnumerateInstanceLayerProperties",
-                 error))
+                 diags))
     return false;
   if (std::none_of(layers.begin(), layers.begin() + count,
                    [](const VkLayerProperties& l) { return std::strcmp(l.layerName, kValidationLayer) == 0; })) {
-    *error = std::string("the Vulkan validation layer ") + kValidationLayer +
-             " is not installed (Debian: vulkan-validationlayers); GPU results are not trusted without it";
+    diags.fail(std::string("the Vulkan validation layer ") + kValidationLayer +
+               " is not installed (Debian: vulkan-validationlayers); GPU results are not trusted without it");
     return false;
   }
 
@@ -267,25 +368,25 @@ bool Context::Impl::createInstance(std::string* error) {
   info.enabledExtensionCount = 2;
   info.ppEnabledExtensionNames = extensionNames;
   const VkResult created = vk.vkCreateInstance(&info, nullptr, &instance);
-  if (!succeeded(created, "vkCreateInstance (with " + std::string(kValidationLayer) + ", VK_EXT_debug_utils, " +
-                              VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME + ")",
-                 error)) {
-    if (created == VK_ERROR_INCOMPATIBLE_DRIVER) *error += driverHint();
+  if (created != VK_SUCCESS) {
+    diags.fail("vkCreateInstance (with " + std::string(kValidationLayer) + ", VK_EXT_debug_utils, " +
+               VK_EXT_VALIDATION_FEATURES_EXTENSION_NAME + ") failed: " + vkResultName(created) +
+               (created == VK_ERROR_INCOMPATIBLE_DRIVER ? driverHint() : ""));
     return false;
   }
-  if (!loadInstanceFunctions(&vk, instance, error)) return false;
+  if (!loadInstanceFunctions(&vk, instance, diags)) return false;
   return succeeded(vk.vkCreateDebugUtilsMessengerEXT(instance, &debugInfo, nullptr, &messenger),
-                   "vkCreateDebugUtilsMessengerEXT", error);
+                   "vkCreateDebugUtilsMessengerEXT", diags);
 }
 
-bool Context::Impl::createDevice(std::string* error) {
+bool Context::Impl::createDevice(Diagnostics& diags) {
   uint32_t count = 0;
-  if (!succeeded(vk.vkEnumeratePhysicalDevices(instance, &count, nullptr), "vkEnumeratePhysicalDevices", error)) {
-    *error += driverHint();
+  if (const VkResult listed = vk.vkEnumeratePhysicalDevices(instance, &count, nullptr); listed != VK_SUCCESS) {
+    diags.fail("vkEnumeratePhysicalDevices failed: " + vkResultName(listed) + driverHint());
     return false;
   }
   std::vector<VkPhysicalDevice> devices(count);
-  if (!succeeded(vk.vkEnumeratePhysicalDevices(instance, &count, devices.data()), "vkEnumeratePhysicalDevices", error))
+  if (!succeeded(vk.vkEnumeratePhysicalDevices(instance, &count, devices.data()), "vkEnumeratePhysicalDevices", diags))
     return false;
   std::string seen;
   for (uint32_t i = 0; i < count && !physical; ++i) {
@@ -305,8 +406,8 @@ bool Context::Impl::createDevice(std::string* error) {
     timestampPeriodNs = props.properties.limits.timestampPeriod;
   }
   if (!physical) {
-    *error = "no lavapipe (VK_DRIVER_ID_MESA_LLVMPIPE) device among: " + (seen.empty() ? std::string("none") : seen) +
-             driverHint();
+    diags.fail("no lavapipe (VK_DRIVER_ID_MESA_LLVMPIPE) device among: " +
+               (seen.empty() ? std::string("none") : seen) + driverHint());
     return false;
   }
   vk.vkGetPhysicalDeviceMemoryProperties(physical, &memory);
@@ -317,7 +418,7 @@ bool Context::Impl::createDevice(std::string* error) {
   auto family = std::find_if(families.begin(), families.end(),
                              [](const VkQueueFamilyProperties& f) { return f.queueFlags & VK_QUEUE_COMPUTE_BIT; });
   if (family == families.end()) {
-    *error = "lavapipe reports no compute queue family";
+    diags.fail("lavapipe reports no compute queue family");
     return false;
   }
   queueFamily = static_cast<uint32_t>(family - families.begin());
@@ -345,55 +446,51 @@ bool Context::Impl::createDevice(std::string* error) {
   info.pNext = &enable12;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queueInfo;
-  if (!succeeded(vk.vkCreateDevice(physical, &info, nullptr, &device), "vkCreateDevice (lavapipe)", error)) return false;
-  if (!loadDeviceFunctions(&vk, device, error)) return false;
+  if (!succeeded(vk.vkCreateDevice(physical, &info, nullptr, &device), "vkCreateDevice (lavapipe)", diags)) return false;
+  if (!loadDeviceFunctions(&vk, device, diags)) return false;
   vk.vkGetDeviceQueue(device, queueFamily, 0, &queue);
   VkCommandPoolCreateInfo poolInfo{};
   poolInfo.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
   poolInfo.queueFamilyIndex = queueFamily;
-  return succeeded(vk.vkCreateCommandPool(device, &poolInfo, nullptr, &commandPool), "vkCreateCommandPool", error);
+  return succeeded(vk.vkCreateCommandPool(device, &poolInfo, nullptr, &commandPool), "vkCreateCommandPool", diags);
 }
 
 bool Context::Impl::allocate(const VkMemoryRequirements& req, bool hostVisible, DispatchObjects& objs,
-                             VkDeviceMemory* out, void** mapped, std::string* error) {
+                             VkDeviceMemory* out, void** mapped, Diagnostics& diags) {
   const VkMemoryPropertyFlags need =
       hostVisible ? VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT : 0;
   uint32_t type = memory.memoryTypeCount;
   for (uint32_t i = 0; i < memory.memoryTypeCount && type == memory.memoryTypeCount; ++i)
     if ((req.memoryTypeBits & (1u << i)) && (memory.memoryTypes[i].propertyFlags & need) == need) type = i;
   if (type == memory.memoryTypeCount) {
-    *error = "no memory type fits (type bits " + std::to_string(req.memoryTypeBits) +
-             (hostVisible ? ", host-visible and coherent)" : ")");
+    diags.fail("no memory type fits (type bits " + std::to_string(req.memoryTypeBits) +
+               (hostVisible ? ", host-visible and coherent)" : ")"));
     return false;
   }
   VkMemoryAllocateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
   info.allocationSize = req.size;
   info.memoryTypeIndex = type;
-  if (!succeeded(vk.vkAllocateMemory(device, &info, nullptr, out), "vkAllocateMemory", error)) return false;
+  if (!succeeded(vk.vkAllocateMemory(device, &info, nullptr, out), "vkAllocateMemory", diags)) return false;
   objs.memories.push_back(*out);
-  return !mapped || succeeded(vk.vkMapMemory(device, *out, 0, VK_WHOLE_SIZE, 0, mapped), "vkMapMemory", error);
+  return !mapped || succeeded(vk.vkMapMemory(device, *out, 0, VK_WHOLE_SIZE, 0, mapped), "vkMapMemory", diags);
 }
 
 bool Context::Impl::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, DispatchObjects& objs, VkBuffer* buffer,
-                                 void** mapped, std::string* error) {
+                                 void** mapped, Diagnostics& diags) {
   VkBufferCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
   info.size = size;
   info.usage = usage;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  if (!succeeded(vk.vkCreateBuffer(device, &info, nullptr, buffer), "vkCreateBuffer", error)) return false;
+  if (!succeeded(vk.vkCreateBuffer(device, &info, nullptr, buffer), "vkCreateBuffer", diags)) return false;
   objs.buffers.push_back(*buffer);
-  VkMemoryRequirements req;
-  vk.vkGetBufferMemoryRequirements(device, *buffer, &req);
-  VkDeviceMemory mem;
-  return allocate(req, true, objs, &mem, mapped, error) &&
-         succeeded(vk.vkBindBufferMemory(device, *buffer, mem, 0), "vkBindBufferMemory", error);
+  return bindMemory(*buffer, objs, mapped, diags);
 }
 
 bool Context::Impl::createImage(VkFormat format, uint32_t width, uint32_t height, uint32_t layers, uint32_t mips,
                                 bool cube, VkImageUsageFlags usage, VkImageViewType viewType, DispatchObjects& objs,
-                                VkImage* image, VkImageView* view, std::string* error) {
+                                VkImage* image, VkImageView* view, Diagnostics& diags) {
   VkImageCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO;
   info.flags = cube ? VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT : 0;
@@ -407,27 +504,22 @@ bool Context::Impl::createImage(VkFormat format, uint32_t width, uint32_t height
   info.usage = usage;
   info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  if (!succeeded(vk.vkCreateImage(device, &info, nullptr, image), "vkCreateImage", error)) return false;
+  if (!succeeded(vk.vkCreateImage(device, &info, nullptr, image), "vkCreateImage", diags)) return false;
   objs.images.push_back(*image);
-  VkMemoryRequirements req;
-  vk.vkGetImageMemoryRequirements(device, *image, &req);
-  VkDeviceMemory mem;
-  if (!allocate(req, false, objs, &mem, nullptr, error) ||
-      !succeeded(vk.vkBindImageMemory(device, *image, mem, 0), "vkBindImageMemory", error))
-    return false;
+  if (!bindMemory(*image, objs, nullptr, diags)) return false;
   VkImageViewCreateInfo viewInfo{};
   viewInfo.sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO;
   viewInfo.image = *image;
   viewInfo.viewType = viewType;
   viewInfo.format = format;
   viewInfo.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, layers};
-  if (!succeeded(vk.vkCreateImageView(device, &viewInfo, nullptr, view), "vkCreateImageView", error)) return false;
+  if (!succeeded(vk.vkCreateImageView(device, &viewInfo, nullptr, view), "vkCreateImageView", diags)) return false;
   objs.views.push_back(*view);
   return true;
 }
 
 bool Context::Impl::createSampler(Filter filter, Address address, DispatchObjects& objs, VkSampler* sampler,
-                                  std::string* error) {
+                                  Diagnostics& diags) {
   const VkFilter f = filter == Filter::Linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
   const VkSamplerAddressMode a =
       address == Address::Repeat ? VK_SAMPLER_ADDRESS_MODE_REPEAT : VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
@@ -437,7 +529,7 @@ bool Context::Impl::createSampler(Filter filter, Address address, DispatchObject
   info.mipmapMode = filter == Filter::Linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
   info.addressModeU = info.addressModeV = info.addressModeW = a;
   info.maxLod = VK_LOD_CLAMP_NONE;
-  if (!succeeded(vk.vkCreateSampler(device, &info, nullptr, sampler), "vkCreateSampler", error)) return false;
+  if (!succeeded(vk.vkCreateSampler(device, &info, nullptr, sampler), "vkCreateSampler", diags)) return false;
   objs.samplers.push_back(*sampler);
   return true;
 }
@@ -471,12 +563,12 @@ ComputePipeline::~ComputePipeline() {
 Context::Context(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 Context::~Context() = default;
 
-std::unique_ptr<Context> Context::create(const Options& options, std::string* error) {
+std::unique_ptr<Context> Context::create(const Options& options, Diagnostics& diags) {
   auto impl = std::make_unique<Impl>();
   impl->options = options;
-  std::string why;
-  if (!impl->createInstance(&why) || !impl->createDevice(&why) || !impl->noMessagesSince(0, "device setup", &why)) {
-    *error = "GPU harness: " + why;
+  Diagnostics setup(diags.file());
+  if (!impl->createInstance(setup) || !impl->createDevice(setup) || !impl->noMessagesSince(0, "device setup", setup)) {
+    diags.fail("GPU harness: " + setup.errorMessages());
     return nullptr;
   }
   return std::unique_ptr<Context>(new Context(std::move(impl)));
@@ -491,22 +583,22 @@ std::vector<std::string> Context::takeMessages() {
   return std::exchange(impl_->log->messages, {});
 }
 
-std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint32_t>& spirv, std::string* error) {
+std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint32_t>& spirv, Diagnostics& diags) {
   Impl& c = *impl_;
   const VulkanFunctions& vk = c.vk;
   if (c.lost) {
-    *error = "GPU harness: the Context is unusable after an earlier timeout or device loss";
+    diags.fail("GPU harness: the Context is unusable after an earlier timeout or device loss");
     return nullptr;
   }
   ShaderReflection reflection;
-  if (!reflectSpirv(spirv, &reflection, error)) return nullptr;
+  if (!reflectSpirv(spirv, &reflection, diags)) return nullptr;
   if (reflection.executionModel != kExecutionModelGLCompute) {
-    *error = "createPipeline: entry point '" + reflection.entryPoint + "' is not a GLCompute entry point";
+    diags.fail("createPipeline: entry point '" + reflection.entryPoint + "' is not a GLCompute entry point");
     return nullptr;
   }
   for (const DescriptorBinding& b : reflection.bindings) {
     if (b.count != 1) {
-      *error = "createPipeline: descriptor arrays are not supported (" + describe(b) + ")";
+      diags.fail("createPipeline: descriptor arrays are not supported (" + describe(b) + ")");
       return nullptr;
     }
   }
@@ -527,14 +619,14 @@ std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint3
     info.bindingCount = static_cast<uint32_t>(bindings.size());
     info.pBindings = bindings.data();
     if (!succeeded(vk.vkCreateDescriptorSetLayout(c.device, &info, nullptr, &p.setLayouts[set]),
-                   "vkCreateDescriptorSetLayout (set " + std::to_string(set) + ")", error))
+                   "vkCreateDescriptorSetLayout (set " + std::to_string(set) + ")", diags))
       return nullptr;
   }
   VkPipelineLayoutCreateInfo layoutInfo{};
   layoutInfo.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
   layoutInfo.setLayoutCount = setCount;
   layoutInfo.pSetLayouts = p.setLayouts.data();
-  if (!succeeded(vk.vkCreatePipelineLayout(c.device, &layoutInfo, nullptr, &p.layout), "vkCreatePipelineLayout", error))
+  if (!succeeded(vk.vkCreatePipelineLayout(c.device, &layoutInfo, nullptr, &p.layout), "vkCreatePipelineLayout", diags))
     return nullptr;
 
   VkShaderModuleCreateInfo moduleInfo{};
@@ -542,7 +634,7 @@ std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint3
   moduleInfo.codeSize = spirv.size() * sizeof(uint32_t);
   moduleInfo.pCode = spirv.data();
   VkShaderModule module = VK_NULL_HANDLE;
-  if (!succeeded(vk.vkCreateShaderModule(c.device, &moduleInfo, nullptr, &module), "vkCreateShaderModule", error))
+  if (!succeeded(vk.vkCreateShaderModule(c.device, &moduleInfo, nullptr, &module), "vkCreateShaderModule", diags))
     return nullptr;
   VkComputePipelineCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
@@ -553,325 +645,316 @@ std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint3
   info.layout = p.layout;
   const VkResult r = vk.vkCreateComputePipelines(c.device, VK_NULL_HANDLE, 1, &info, nullptr, &p.pipeline);
   vk.vkDestroyShaderModule(c.device, module, nullptr);
-  if (!succeeded(r, "vkCreateComputePipelines", error)) return nullptr;
-  std::string messages;
-  if (!c.noMessagesSince(start, "createPipeline", &messages)) {
-    *error = messages;
-    return nullptr;
-  }
+  if (!succeeded(r, "vkCreateComputePipelines", diags)) return nullptr;
+  if (!c.noMessagesSince(start, "createPipeline", diags)) return nullptr;
   return pipeline;
 }
 
+bool Context::Impl::allocateSets(const ComputePipeline::Impl& p, const ShaderReflection& refl, DispatchObjects& objs,
+                                 Bindings& b, Diagnostics& diags) {
+  b.sets.assign(p.setLayouts.size(), VK_NULL_HANDLE);
+  if (b.sets.empty()) return true;
+  std::map<VkDescriptorType, uint32_t> typeCounts;
+  for (const DescriptorBinding& binding : refl.bindings) ++typeCounts[descriptorType(binding.kind)];
+  std::vector<VkDescriptorPoolSize> sizes;
+  for (const auto& [type, count] : typeCounts) sizes.push_back({type, count});
+  VkDescriptorPoolCreateInfo poolInfo{};
+  poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
+  poolInfo.maxSets = static_cast<uint32_t>(b.sets.size());
+  poolInfo.poolSizeCount = static_cast<uint32_t>(sizes.size());
+  poolInfo.pPoolSizes = sizes.data();
+  if (!succeeded(vk.vkCreateDescriptorPool(device, &poolInfo, nullptr, &objs.descriptorPool), "vkCreateDescriptorPool",
+                 diags))
+    return false;
+  VkDescriptorSetAllocateInfo alloc{};
+  alloc.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
+  alloc.descriptorPool = objs.descriptorPool;
+  alloc.descriptorSetCount = static_cast<uint32_t>(b.sets.size());
+  alloc.pSetLayouts = p.setLayouts.data();
+  return succeeded(vk.vkAllocateDescriptorSets(device, &alloc, b.sets.data()), "vkAllocateDescriptorSets", diags);
+}
+
+bool Context::Impl::bindResources(const ShaderReflection& refl, Resources& resources, DispatchObjects& objs,
+                                  Bindings& b, Diagnostics& diags) {
+  b.bufferInfos.reserve(refl.bindings.size());
+  b.imageInfos.reserve(refl.bindings.size());
+  for (const DescriptorBinding& binding : refl.bindings) {
+    Resource& resource = resources.at({binding.set, binding.binding});
+    VkWriteDescriptorSet w{};
+    w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    w.dstSet = b.sets[binding.set];
+    w.dstBinding = binding.binding;
+    w.descriptorCount = 1;
+    w.descriptorType = descriptorType(binding.kind);
+    Diagnostics failure(diags.file());  // the binding's failure, reported below naming the binding
+    bool bound = true;
+    if (auto* buf = std::get_if<BufferResource>(&resource)) {
+      bound = bindBuffer(binding, *buf, objs, b, w, failure);
+    } else if (auto* img = std::get_if<ImageResource>(&resource)) {
+      bound = bindImage(binding, *img, objs, b, w, failure);
+    } else if (auto* smp = std::get_if<SamplerResource>(&resource)) {
+      VkSampler sampler;
+      bound = createSampler(smp->filter, smp->address, objs, &sampler, failure);
+      if (bound) {
+        b.imageInfos.push_back({sampler, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED});
+        w.pImageInfo = &b.imageInfos.back();
+      }
+    } else {
+      bound = bindStorageImage(binding, std::get<StorageImageResource>(resource), objs, b, w, failure);
+    }
+    if (!bound) {
+      diags.fail(describe(binding) + ": " + failure.errorMessages());
+      return false;
+    }
+    b.writes.push_back(w);
+  }
+  if (!b.writes.empty())
+    vk.vkUpdateDescriptorSets(device, static_cast<uint32_t>(b.writes.size()), b.writes.data(), 0, nullptr);
+  return true;
+}
+
+bool Context::Impl::bindBuffer(const DescriptorBinding& binding, BufferResource& buf, DispatchObjects& objs,
+                               Bindings& b, VkWriteDescriptorSet& w, Diagnostics& diags) {
+  if (buf.data.empty()) return fail(diags, "BufferResource::data is empty (it gives the buffer's size)");
+  VkBuffer buffer;
+  void* mapped;
+  const VkBufferUsageFlags usage = binding.kind == DescriptorKind::UniformBuffer ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
+                                                                                : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  if (!createBuffer(buf.data.size(), usage, objs, &buffer, &mapped, diags)) return false;
+  if (buf.output && buf.initialized) {
+    std::memcpy(mapped, buf.data.data(), buf.data.size());
+    b.readbacks.push_back({&buf.data, mapped, buf.data.size()});
+  } else if (buf.output) {
+    auto* bytes = static_cast<unsigned char*>(mapped);
+    for (size_t i = 0; i < buf.data.size(); ++i) bytes[i] = static_cast<unsigned char>(kQuietNan >> (8 * (i % 4)));
+    b.readbacks.push_back({&buf.data, mapped, buf.data.size()});
+  } else {
+    std::memcpy(mapped, buf.data.data(), buf.data.size());
+  }
+  b.bufferInfos.push_back({buffer, 0, VK_WHOLE_SIZE});
+  w.pBufferInfo = &b.bufferInfos.back();
+  return true;
+}
+
+bool Context::Impl::bindImage(const DescriptorBinding& binding, const ImageResource& img, DispatchObjects& objs,
+                              Bindings& b, VkWriteDescriptorSet& w, Diagnostics& diags) {
+  const bool cube = binding.dim == ImageDim::Cube;
+  if (img.width == 0 || img.height == 0 || img.layers == 0 || img.mips.empty())
+    return fail(diags, "ImageResource needs a non-zero size, layers and at least one mip level");
+  if (cube && (binding.arrayed || img.layers != 6 || img.width != img.height))
+    return fail(diags, "a cube map needs layers == 6, width == height (cube arrays are not supported)");
+  if (!cube && (binding.dim != ImageDim::Dim2D || (!binding.arrayed && img.layers != 1)))
+    return fail(diags, "only 2D, 2D array and cube images are supported (a non-arrayed 2D image has one layer)");
+  const uint32_t levels = static_cast<uint32_t>(img.mips.size());
+  if (levels > 32 || (std::max(img.width, img.height) >> (levels - 1)) == 0)
+    return fail(diags, "too many mip levels (" + std::to_string(levels) + ") for the image size");
+  ImageUpload up{VK_NULL_HANDLE, img.layers, levels, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
+  size_t totalFloats = 0;
+  for (uint32_t l = 0; l < levels; ++l) {
+    const uint32_t width = std::max(1u, img.width >> l), height = std::max(1u, img.height >> l);
+    const size_t want = size_t{width} * height * img.layers * 4;
+    if (img.mips[l].size() != want)
+      return fail(diags, "mip " + std::to_string(l) + " has " + std::to_string(img.mips[l].size()) +
+                             " floats, expected " + std::to_string(want) + " (" + std::to_string(width) + "x" +
+                             std::to_string(height) + "x" + std::to_string(img.layers) + " RGBA)");
+    VkBufferImageCopy region{};
+    region.bufferOffset = totalFloats * sizeof(float);
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, img.layers};
+    region.imageExtent = {width, height, 1};
+    up.regions.push_back(region);
+    totalFloats += img.mips[l].size();
+  }
+  void* mapped;
+  VkImageView view;
+  const VkImageViewType viewType =
+      cube ? VK_IMAGE_VIEW_TYPE_CUBE : binding.arrayed ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
+  if (!createBuffer(totalFloats * sizeof(float), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, objs, &up.staging, &mapped, diags) ||
+      !createImage(VK_FORMAT_R32G32B32A32_SFLOAT, img.width, img.height, img.layers, levels, cube,
+                   VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT, viewType, objs, &up.image, &view, diags))
+    return false;
+  for (uint32_t l = 0; l < levels; ++l)
+    std::memcpy(static_cast<char*>(mapped) + up.regions[l].bufferOffset, img.mips[l].data(),
+                img.mips[l].size() * sizeof(float));
+  b.uploads.push_back(std::move(up));
+  VkSampler sampler = VK_NULL_HANDLE;
+  if (binding.kind == DescriptorKind::CombinedImageSampler &&
+      !createSampler(img.filter, img.address, objs, &sampler, diags))
+    return false;
+  b.imageInfos.push_back({sampler, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
+  w.pImageInfo = &b.imageInfos.back();
+  return true;
+}
+
+bool Context::Impl::bindStorageImage(const DescriptorBinding& binding, StorageImageResource& si, DispatchObjects& objs,
+                                     Bindings& b, VkWriteDescriptorSet& w, Diagnostics& diags) {
+  if (si.width == 0 || si.height == 0 || si.layers == 0)
+    return fail(diags, "StorageImageResource needs a non-zero size");
+  if (binding.dim != ImageDim::Dim2D || (!binding.arrayed && si.layers != 1))
+    return fail(diags, "only 2D and 2D array storage images are supported (a non-arrayed one has one layer)");
+  const bool uint = si.format == StorageFormat::R32Uint;
+  const size_t texel = uint ? 4 : 16;
+  ImageUpload up{VK_NULL_HANDLE, si.layers, 1, VK_IMAGE_LAYOUT_GENERAL};
+  for (int i = 0; i < 4; ++i) up.clear.uint32[i] = uint ? 0xffffffffu : kQuietNan;  // NaN bits for float
+  Readback rb{&si.data, nullptr, size_t{si.width} * si.height * si.layers * texel};
+  VkImageView view;
+  void* mapped;
+  const VkImageViewType viewType = binding.arrayed ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D;
+  if (!createImage(uint ? VK_FORMAT_R32_UINT : VK_FORMAT_R32G32B32A32_SFLOAT, si.width, si.height, si.layers, 1, false,
+                   VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                   viewType, objs, &up.image, &view, diags) ||
+      !createBuffer(rb.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, objs, &rb.buffer, &mapped, diags))
+    return false;
+  if (si.upload) {  // the image's contents come from `data`, through a staging buffer
+    if (si.data.size() != rb.size)
+      return fail(diags, "StorageImageResource::data has " + std::to_string(si.data.size()) +
+                             " bytes, expected " + std::to_string(rb.size));
+    void* staged;
+    if (!createBuffer(rb.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, objs, &up.staging, &staged, diags)) return false;
+    std::memcpy(staged, si.data.data(), rb.size);
+    VkBufferImageCopy region{};
+    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, si.layers};
+    region.imageExtent = {si.width, si.height, 1};
+    up.regions.push_back(region);
+  }
+  rb.mapped = mapped;
+  rb.image = up.image;
+  rb.region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, si.layers};
+  rb.region.imageExtent = {si.width, si.height, 1};
+  b.uploads.push_back(std::move(up));
+  b.readbacks.push_back(rb);
+  b.imageInfos.push_back({VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL});
+  w.pImageInfo = &b.imageInfos.back();
+  return true;
+}
+
+bool Context::Impl::record(const ComputePipeline::Impl& p, const Bindings& b, const uint32_t groups[3], bool timed,
+                           DispatchObjects& objs, Diagnostics& diags) {
+  VkCommandBufferAllocateInfo cbInfo{};
+  cbInfo.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
+  cbInfo.commandPool = commandPool;
+  cbInfo.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cbInfo.commandBufferCount = 1;
+  if (!succeeded(vk.vkAllocateCommandBuffers(device, &cbInfo, &objs.commandBuffer), "vkAllocateCommandBuffers", diags))
+    return false;
+  const VkCommandBuffer cmd = objs.commandBuffer;
+  VkCommandBufferBeginInfo begin{};
+  begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  if (!succeeded(vk.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer", diags)) return false;
+  auto barriers = [&](VkPipelineStageFlags src, VkPipelineStageFlags dst,
+                      const std::vector<VkImageMemoryBarrier>& list) {
+    if (!list.empty())
+      vk.vkCmdPipelineBarrier(cmd, src, dst, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(list.size()),
+                              list.data());
+  };
+  std::vector<VkImageMemoryBarrier> before, after, out;
+  for (const ImageUpload& up : b.uploads) {
+    before.push_back(imageBarrier(up.image, up.layers, up.mipLevels, VK_IMAGE_LAYOUT_UNDEFINED,
+                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT));
+    after.push_back(imageBarrier(up.image, up.layers, up.mipLevels, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                 up.finalLayout, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                 VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT));
+  }
+  barriers(VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, before);
+  for (const ImageUpload& up : b.uploads) {
+    if (up.staging) {
+      vk.vkCmdCopyBufferToImage(cmd, up.staging, up.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                                static_cast<uint32_t>(up.regions.size()), up.regions.data());
+    } else {
+      const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, up.layers};
+      vk.vkCmdClearColorImage(cmd, up.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &up.clear, 1, &range);
+    }
+  }
+  barriers(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, after);
+  vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+  if (!b.sets.empty())
+    vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, static_cast<uint32_t>(b.sets.size()),
+                               b.sets.data(), 0, nullptr);
+  if (timed) {
+    VkQueryPoolCreateInfo q{};
+    q.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
+    q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    q.queryCount = 2;
+    if (!succeeded(vk.vkCreateQueryPool(device, &q, nullptr, &objs.timestamps), "vkCreateQueryPool", diags)) return false;
+    vk.vkCmdResetQueryPool(cmd, objs.timestamps, 0, 2);
+    vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, objs.timestamps, 0);
+  }
+  vk.vkCmdDispatch(cmd, groups[0], groups[1], groups[2]);
+  if (timed) vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, objs.timestamps, 1);
+  for (const Readback& rb : b.readbacks)
+    if (rb.image)
+      out.push_back(imageBarrier(rb.image, rb.region.imageSubresource.layerCount, 1, VK_IMAGE_LAYOUT_GENERAL,
+                                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
+                                 VK_ACCESS_TRANSFER_READ_BIT));
+  barriers(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, out);
+  for (const Readback& rb : b.readbacks)
+    if (rb.image)
+      vk.vkCmdCopyImageToBuffer(cmd, rb.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, rb.buffer, 1, &rb.region);
+  VkMemoryBarrier toHost{};
+  toHost.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
+  toHost.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+  toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                          VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0, nullptr);
+  return succeeded(vk.vkEndCommandBuffer(cmd), "vkEndCommandBuffer", diags);
+}
+
+bool Context::Impl::submitAndWait(DispatchObjects& objs, Diagnostics& diags) {
+  VkFenceCreateInfo fenceInfo{};
+  fenceInfo.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
+  if (!succeeded(vk.vkCreateFence(device, &fenceInfo, nullptr, &objs.fence), "vkCreateFence", diags)) return false;
+  VkSubmitInfo submit{};
+  submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &objs.commandBuffer;
+  if (!succeeded(vk.vkQueueSubmit(queue, 1, &submit, objs.fence), "vkQueueSubmit", diags)) return false;
+  const VkResult waited = vk.vkWaitForFences(device, 1, &objs.fence, VK_TRUE, options.fenceTimeoutNs);
+  if (waited == VK_SUCCESS) return true;
+  lost = true;  // the work may still be running: its objects are leaked, the Context is done
+  return fail(diags, waited == VK_TIMEOUT ? "vkWaitForFences timed out after " +
+                                               std::to_string(options.fenceTimeoutNs / 1000000) +
+                                               " ms (the Context is unusable now)"
+                                         : "vkWaitForFences failed: " + vkResultName(waited));
+}
+
+bool Context::Impl::readBack(const Bindings& b, DispatchObjects& objs, double* dispatchNs, Diagnostics& diags) {
+  for (const Readback& rb : b.readbacks) {
+    rb.target->resize(rb.size);
+    std::memcpy(rb.target->data(), rb.mapped, rb.size);
+  }
+  if (!dispatchNs) return true;
+  uint64_t t[2] = {0, 0};
+  if (!succeeded(vk.vkGetQueryPoolResults(device, objs.timestamps, 0, 2, sizeof t, t, sizeof(uint64_t),
+                                          VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                 "vkGetQueryPoolResults", diags))
+    return false;
+  *dispatchNs = static_cast<double>(t[1] - t[0]) * timestampPeriodNs;
+  return true;
+}
+
 bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, uint32_t groupsX, uint32_t groupsY,
-                       uint32_t groupsZ, std::string* error, double* dispatchNs) {
+                       uint32_t groupsZ, Diagnostics& diags, double* dispatchNs) {
   Impl& c = *impl_;
-  const VulkanFunctions& vk = c.vk;
   const ShaderReflection& refl = pipeline.reflection();
   const ComputePipeline::Impl& p = *pipeline.impl_;
   if (c.lost || p.context != &c) {
-    *error = c.lost ? "dispatch: the Context is unusable after an earlier timeout or device loss"
-                    : "dispatch: the pipeline belongs to another Context";
+    diags.fail(c.lost ? "dispatch: the Context is unusable after an earlier timeout or device loss"
+                      : "dispatch: the pipeline belongs to another Context");
     return false;
   }
-  // Every binding gets a resource of its kind, and every resource is used.
-  for (const DescriptorBinding& b : refl.bindings) {
-    auto it = resources.find({b.set, b.binding});
-    if (it == resources.end()) {
-      *error = "dispatch: no resource for " + describe(b) + " of entry point '" + refl.entryPoint + "'";
-      return false;
-    }
-    const size_t want = resourceIndexFor(b.kind);
-    if (it->second.index() != want) {
-      *error = "dispatch: " + describe(b) + " needs a " + kResourceNames[want] + ", got a " +
-               kResourceNames[it->second.index()];
-      return false;
-    }
-  }
-  for (const auto& [key, resource] : resources) {
-    if (std::none_of(refl.bindings.begin(), refl.bindings.end(), [&key = key](const DescriptorBinding& b) {
-          return b.set == key.first && b.binding == key.second;
-        })) {
-      *error = "dispatch: the " + std::string(kResourceNames[resource.index()]) + " for set " + std::to_string(key.first) +
-               " binding " + std::to_string(key.second) + " is not used by entry point '" + refl.entryPoint + "'";
-      return false;
-    }
-  }
-
+  if (!resourcesMatch(refl, resources, diags)) return false;
   const size_t start = c.messageCount();
   DispatchObjects objs;
-  std::string why;
-  const bool ran = [&]() -> bool {
-    // Descriptor pool and one set per layout (empty layouts included).
-    std::vector<VkDescriptorSet> sets(p.setLayouts.size(), VK_NULL_HANDLE);
-    if (!sets.empty()) {
-      std::map<VkDescriptorType, uint32_t> typeCounts;
-      for (const DescriptorBinding& b : refl.bindings) ++typeCounts[descriptorType(b.kind)];
-      std::vector<VkDescriptorPoolSize> sizes;
-      for (const auto& [type, count] : typeCounts) sizes.push_back({type, count});
-      VkDescriptorPoolCreateInfo poolInfo{};
-      poolInfo.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
-      poolInfo.maxSets = static_cast<uint32_t>(sets.size());
-      poolInfo.poolSizeCount = static_cast<uint32_t>(sizes.size());
-      poolInfo.pPoolSizes = sizes.data();
-      if (!succeeded(vk.vkCreateDescriptorPool(c.device, &poolInfo, nullptr, &objs.descriptorPool),
-                     "vkCreateDescriptorPool", &why))
-        return false;
-      VkDescriptorSetAllocateInfo alloc{};
-      alloc.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-      alloc.descriptorPool = objs.descriptorPool;
-      alloc.descriptorSetCount = static_cast<uint32_t>(sets.size());
-      alloc.pSetLayouts = p.setLayouts.data();
-      if (!succeeded(vk.vkAllocateDescriptorSets(c.device, &alloc, sets.data()), "vkAllocateDescriptorSets", &why))
-        return false;
-    }
-
-    // Resources and descriptor writes (the info vectors never reallocate: pointers into them stay valid).
-    std::vector<VkDescriptorBufferInfo> bufferInfos;
-    std::vector<VkDescriptorImageInfo> imageInfos;
-    bufferInfos.reserve(refl.bindings.size());
-    imageInfos.reserve(refl.bindings.size());
-    std::vector<VkWriteDescriptorSet> writes;
-    std::vector<ImageUpload> uploads;
-    std::vector<Readback> readbacks;
-    for (const DescriptorBinding& b : refl.bindings) {
-      Resource& resource = resources.at({b.set, b.binding});
-      const std::string where = describe(b) + ": ";
-      auto fail = [&](const std::string& what) { return why = where + what, false; };
-      VkWriteDescriptorSet w{};
-      w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
-      w.dstSet = sets[b.set];
-      w.dstBinding = b.binding;
-      w.descriptorCount = 1;
-      w.descriptorType = descriptorType(b.kind);
-      if (auto* buf = std::get_if<BufferResource>(&resource)) {
-        if (buf->data.empty()) return fail("BufferResource::data is empty (it gives the buffer's size)");
-        VkBuffer buffer;
-        void* mapped;
-        const VkBufferUsageFlags usage = b.kind == DescriptorKind::UniformBuffer ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT
-                                                                                  : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-        if (!c.createBuffer(buf->data.size(), usage, objs, &buffer, &mapped, &why)) return fail(why);
-        if (buf->output && buf->initialized) {
-          std::memcpy(mapped, buf->data.data(), buf->data.size());
-          readbacks.push_back({&buf->data, mapped, buf->data.size()});
-        } else if (buf->output) {
-          auto* bytes = static_cast<unsigned char*>(mapped);
-          for (size_t i = 0; i < buf->data.size(); ++i) bytes[i] = static_cast<unsigned char>(kQuietNan >> (8 * (i % 4)));
-          readbacks.push_back({&buf->data, mapped, buf->data.size()});
-        } else {
-          std::memcpy(mapped, buf->data.data(), buf->data.size());
-        }
-        bufferInfos.push_back({buffer, 0, VK_WHOLE_SIZE});
-        w.pBufferInfo = &bufferInfos.back();
-      } else if (auto* img = std::get_if<ImageResource>(&resource)) {
-        const bool cube = b.dim == ImageDim::Cube;
-        if (img->width == 0 || img->height == 0 || img->layers == 0 || img->mips.empty())
-          return fail("ImageResource needs a non-zero size, layers and at least one mip level");
-        if (cube && (b.arrayed || img->layers != 6 || img->width != img->height))
-          return fail("a cube map needs layers == 6, width == height (cube arrays are not supported)");
-        if (!cube && (b.dim != ImageDim::Dim2D || (!b.arrayed && img->layers != 1)))
-          return fail("only 2D, 2D array and cube images are supported (a non-arrayed 2D image has one layer)");
-        const uint32_t levels = static_cast<uint32_t>(img->mips.size());
-        if (levels > 32 || (std::max(img->width, img->height) >> (levels - 1)) == 0)
-          return fail("too many mip levels (" + std::to_string(levels) + ") for the image size");
-        ImageUpload up{VK_NULL_HANDLE, img->layers, levels, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
-        size_t totalFloats = 0;
-        for (uint32_t l = 0; l < levels; ++l) {
-          const uint32_t w = std::max(1u, img->width >> l), h = std::max(1u, img->height >> l);
-          if (img->mips[l].size() != size_t{w} * h * img->layers * 4)
-            return fail("mip " + std::to_string(l) + " has " + std::to_string(img->mips[l].size()) + " floats, expected " +
-                        std::to_string(size_t{w} * h * img->layers * 4) + " (" + std::to_string(w) + "x" +
-                        std::to_string(h) + "x" + std::to_string(img->layers) + " RGBA)");
-          VkBufferImageCopy region{};
-          region.bufferOffset = totalFloats * sizeof(float);
-          region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, l, 0, img->layers};
-          region.imageExtent = {w, h, 1};
-          up.regions.push_back(region);
-          totalFloats += img->mips[l].size();
-        }
-        void* mapped;
-        VkImageView view;
-        if (!c.createBuffer(totalFloats * sizeof(float), VK_BUFFER_USAGE_TRANSFER_SRC_BIT, objs, &up.staging, &mapped,
-                            &why) ||
-            !c.createImage(VK_FORMAT_R32G32B32A32_SFLOAT, img->width, img->height, img->layers, levels, cube,
-                           VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                           cube ? VK_IMAGE_VIEW_TYPE_CUBE : b.arrayed ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
-                           objs, &up.image, &view, &why))
-          return fail(why);
-        for (uint32_t l = 0; l < levels; ++l)
-          std::memcpy(static_cast<char*>(mapped) + up.regions[l].bufferOffset, img->mips[l].data(),
-                      img->mips[l].size() * sizeof(float));
-        uploads.push_back(std::move(up));
-        VkSampler sampler = VK_NULL_HANDLE;
-        if (b.kind == DescriptorKind::CombinedImageSampler &&
-            !c.createSampler(img->filter, img->address, objs, &sampler, &why))
-          return fail(why);
-        imageInfos.push_back({sampler, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
-        w.pImageInfo = &imageInfos.back();
-      } else if (auto* smp = std::get_if<SamplerResource>(&resource)) {
-        VkSampler sampler;
-        if (!c.createSampler(smp->filter, smp->address, objs, &sampler, &why)) return fail(why);
-        imageInfos.push_back({sampler, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED});
-        w.pImageInfo = &imageInfos.back();
-      } else {
-        auto& si = std::get<StorageImageResource>(resource);
-        if (si.width == 0 || si.height == 0 || si.layers == 0) return fail("StorageImageResource needs a non-zero size");
-        if (b.dim != ImageDim::Dim2D || (!b.arrayed && si.layers != 1))
-          return fail("only 2D and 2D array storage images are supported (a non-arrayed one has one layer)");
-        const bool uint = si.format == StorageFormat::R32Uint;
-        const size_t texel = uint ? 4 : 16;
-        ImageUpload up{VK_NULL_HANDLE, si.layers, 1, VK_IMAGE_LAYOUT_GENERAL};
-        for (int i = 0; i < 4; ++i) up.clear.uint32[i] = uint ? 0xffffffffu : kQuietNan;  // NaN bits for float
-        Readback rb{&si.data, nullptr, size_t{si.width} * si.height * si.layers * texel};
-        VkImageView view;
-        void* mapped;
-        if (!c.createImage(uint ? VK_FORMAT_R32_UINT : VK_FORMAT_R32G32B32A32_SFLOAT, si.width, si.height, si.layers, 1,
-                           false,
-                           VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
-                           b.arrayed ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D, objs, &up.image, &view, &why) ||
-            !c.createBuffer(rb.size, VK_BUFFER_USAGE_TRANSFER_DST_BIT, objs, &rb.buffer, &mapped, &why))
-          return fail(why);
-        if (si.upload) {  // the image's contents come from `data`, through a staging buffer
-          if (si.data.size() != rb.size)
-            return fail("StorageImageResource::data has " + std::to_string(si.data.size()) + " bytes, expected " +
-                        std::to_string(rb.size));
-          void* staged;
-          if (!c.createBuffer(rb.size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, objs, &up.staging, &staged, &why))
-            return fail(why);
-          std::memcpy(staged, si.data.data(), rb.size);
-          VkBufferImageCopy region{};
-          region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, si.layers};
-          region.imageExtent = {si.width, si.height, 1};
-          up.regions.push_back(region);
-        }
-        rb.mapped = mapped;
-        rb.image = up.image;
-        rb.region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, si.layers};
-        rb.region.imageExtent = {si.width, si.height, 1};
-        uploads.push_back(std::move(up));
-        readbacks.push_back(rb);
-        imageInfos.push_back({VK_NULL_HANDLE, view, VK_IMAGE_LAYOUT_GENERAL});
-        w.pImageInfo = &imageInfos.back();
-      }
-      writes.push_back(w);
-    }
-    if (!writes.empty())
-      vk.vkUpdateDescriptorSets(c.device, static_cast<uint32_t>(writes.size()), writes.data(), 0, nullptr);
-
-    // One command buffer: fill images, dispatch, copy storage images out, make everything host-visible.
-    VkCommandBufferAllocateInfo cbInfo{};
-    cbInfo.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO;
-    cbInfo.commandPool = c.commandPool;
-    cbInfo.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
-    cbInfo.commandBufferCount = 1;
-    if (!succeeded(vk.vkAllocateCommandBuffers(c.device, &cbInfo, &objs.commandBuffer), "vkAllocateCommandBuffers", &why))
-      return false;
-    const VkCommandBuffer cmd = objs.commandBuffer;
-    VkCommandBufferBeginInfo begin{};
-    begin.sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO;
-    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-    if (!succeeded(vk.vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer", &why)) return false;
-    auto transition = [](VkImage image, uint32_t layers, uint32_t mips, VkImageLayout from, VkImageLayout to,
-                         VkAccessFlags srcAccess, VkAccessFlags dstAccess) {
-      VkImageMemoryBarrier barrier{};
-      barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-      barrier.srcAccessMask = srcAccess;
-      barrier.dstAccessMask = dstAccess;
-      barrier.oldLayout = from;
-      barrier.newLayout = to;
-      barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-      barrier.image = image;
-      barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, layers};
-      return barrier;
-    };
-    auto barriers = [&](VkPipelineStageFlags src, VkPipelineStageFlags dst, const std::vector<VkImageMemoryBarrier>& b) {
-      if (!b.empty()) vk.vkCmdPipelineBarrier(cmd, src, dst, 0, 0, nullptr, 0, nullptr, static_cast<uint32_t>(b.size()), b.data());
-    };
-    std::vector<VkImageMemoryBarrier> before, after, out;
-    for (const ImageUpload& up : uploads) {
-      before.push_back(transition(up.image, up.layers, up.mipLevels, VK_IMAGE_LAYOUT_UNDEFINED,
-                                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT));
-      after.push_back(transition(up.image, up.layers, up.mipLevels, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, up.finalLayout,
-                                 VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT));
-    }
-    barriers(VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, before);
-    for (const ImageUpload& up : uploads) {
-      if (up.staging) {
-        vk.vkCmdCopyBufferToImage(cmd, up.staging, up.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                                  static_cast<uint32_t>(up.regions.size()), up.regions.data());
-      } else {
-        const VkImageSubresourceRange range{VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, up.layers};
-        vk.vkCmdClearColorImage(cmd, up.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &up.clear, 1, &range);
-      }
-    }
-    barriers(VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, after);
-    vk.vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-    if (!sets.empty())
-      vk.vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, static_cast<uint32_t>(sets.size()),
-                                 sets.data(), 0, nullptr);
-    if (dispatchNs) {
-      VkQueryPoolCreateInfo q{};
-      q.sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO;
-      q.queryType = VK_QUERY_TYPE_TIMESTAMP;
-      q.queryCount = 2;
-      if (!succeeded(vk.vkCreateQueryPool(c.device, &q, nullptr, &objs.timestamps), "vkCreateQueryPool", &why))
-        return false;
-      vk.vkCmdResetQueryPool(cmd, objs.timestamps, 0, 2);
-      vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, objs.timestamps, 0);
-    }
-    vk.vkCmdDispatch(cmd, groupsX, groupsY, groupsZ);
-    if (dispatchNs) vk.vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, objs.timestamps, 1);
-    for (const Readback& rb : readbacks)
-      if (rb.image)
-        out.push_back(transition(rb.image, rb.region.imageSubresource.layerCount, 1, VK_IMAGE_LAYOUT_GENERAL,
-                                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
-                                 VK_ACCESS_TRANSFER_READ_BIT));
-    barriers(VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, out);
-    for (const Readback& rb : readbacks)
-      if (rb.image)
-        vk.vkCmdCopyImageToBuffer(cmd, rb.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, rb.buffer, 1, &rb.region);
-    VkMemoryBarrier toHost{};
-    toHost.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
-    toHost.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
-    toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-    vk.vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
-                            VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0, nullptr);
-    if (!succeeded(vk.vkEndCommandBuffer(cmd), "vkEndCommandBuffer", &why)) return false;
-
-    // Submit, wait (bounded), read back.
-    VkFenceCreateInfo fenceInfo{};
-    fenceInfo.sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO;
-    if (!succeeded(vk.vkCreateFence(c.device, &fenceInfo, nullptr, &objs.fence), "vkCreateFence", &why)) return false;
-    VkSubmitInfo submit{};
-    submit.sType = VK_STRUCTURE_TYPE_SUBMIT_INFO;
-    submit.commandBufferCount = 1;
-    submit.pCommandBuffers = &cmd;
-    if (!succeeded(vk.vkQueueSubmit(c.queue, 1, &submit, objs.fence), "vkQueueSubmit", &why)) return false;
-    const VkResult waited = vk.vkWaitForFences(c.device, 1, &objs.fence, VK_TRUE, c.options.fenceTimeoutNs);
-    if (waited != VK_SUCCESS) {
-      c.lost = true;  // the work may still be running: its objects are leaked, the Context is done
-      why = waited == VK_TIMEOUT ? "vkWaitForFences timed out after " + std::to_string(c.options.fenceTimeoutNs / 1000000) +
-                                       " ms (the Context is unusable now)"
-                                 : "vkWaitForFences failed: " + vkResultName(waited);
-      return false;
-    }
-    for (const Readback& rb : readbacks) {
-      rb.target->resize(rb.size);
-      std::memcpy(rb.target->data(), rb.mapped, rb.size);
-    }
-    if (dispatchNs) {
-      uint64_t t[2] = {0, 0};
-      if (!succeeded(vk.vkGetQueryPoolResults(c.device, objs.timestamps, 0, 2, sizeof t, t, sizeof(uint64_t),
-                                              VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-                     "vkGetQueryPoolResults", &why))
-        return false;
-      *dispatchNs = static_cast<double>(t[1] - t[0]) * c.timestampPeriodNs;
-    }
-    return true;
-  }();
+  Bindings bindings;
+  const uint32_t groups[3] = {groupsX, groupsY, groupsZ};
+  Diagnostics failure(diags.file());  // the failed step's, reported below as the dispatch's
+  const bool ran = c.allocateSets(p, refl, objs, bindings, failure) &&
+                   c.bindResources(refl, resources, objs, bindings, failure) &&
+                   c.record(p, bindings, groups, dispatchNs != nullptr, objs, failure) &&
+                   c.submitAndWait(objs, failure) && c.readBack(bindings, objs, dispatchNs, failure);
   if (!c.lost) c.destroy(objs);
-  std::string message = ran ? std::string() : "dispatch: " + why;
-  const bool quiet = c.noMessagesSince(start, "dispatch of entry point '" + refl.entryPoint + "'", &message);
-  if (!ran || !quiet) *error = message;
+  if (!ran) diags.fail("dispatch: " + failure.errorMessages());
+  const bool quiet = c.noMessagesSince(start, "dispatch of entry point '" + refl.entryPoint + "'", diags);
   return ran && quiet;
 }
 

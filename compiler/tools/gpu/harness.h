@@ -20,6 +20,7 @@
 #include <variant>
 #include <vector>
 
+#include "diag/diagnostics.h"
 #include "gpu/spirv_reflect.h"
 
 namespace substratec::gpu {
@@ -101,8 +102,8 @@ class Context {
   /// the messenger also watches vkCreateInstance itself) and a device on lavapipe with one
   /// compute queue (and shaderFloat16 when the device has it). Sets VK_DRIVER_FILES to lavapipe's ICD
   /// unless VK_DRIVER_FILES or VK_ICD_FILENAMES is set non-empty (setenv: call before starting threads).
-  /// Null with `*error` set when anything is missing.
-  static std::unique_ptr<Context> create(const Options& options, std::string* error);
+  /// Null, with an error reported ("GPU harness: ..."), when anything is missing.
+  static std::unique_ptr<Context> create(const Options& options, Diagnostics& diags);
   ~Context();
   Context(const Context&) = delete;
   Context& operator=(const Context&) = delete;
@@ -113,20 +114,20 @@ class Context {
   /// shaders (SPIR-V capability Float16, `--precision half`). Lavapipe has it.
   bool shaderFloat16() const;
 
-  /// Reflects `spirv` (a GLCompute entry point is required) and builds its pipeline. Null with
-  /// `*error` set on a reflection or Vulkan failure, or when the validation layer reported anything.
-  std::unique_ptr<ComputePipeline> createPipeline(const std::vector<uint32_t>& spirv, std::string* error);
+  /// Reflects `spirv` (a GLCompute entry point is required) and builds its pipeline. Null, with an
+  /// error reported, on a reflection or Vulkan failure, or when the validation layer reported anything.
+  std::unique_ptr<ComputePipeline> createPipeline(const std::vector<uint32_t>& spirv, Diagnostics& diags);
 
   /// Binds `resources` (checked against the reflection: a missing, unused or incompatible resource
   /// is an error naming set, binding and variable), records and submits one dispatch of
   /// groupsX*groupsY*groupsZ workgroups, waits for it (at most Options::fenceTimeoutNs) and reads the
-  /// outputs back into `resources`. False with `*error` set on any failed Vulkan call (with its
+  /// outputs back into `resources`. False, with errors reported, on any failed Vulkan call (with its
   /// VkResult), a timeout, or any validation message recorded meanwhile (all of them listed). After a
   /// timeout the Context is unusable: its objects may still be in use and are leaked, never waited on.
   /// With `dispatchNs`, two timestamp queries around the dispatch give its execution time in ns
   /// (uploads, clears and read-backs excluded).
   bool dispatch(const ComputePipeline& pipeline, Resources& resources, uint32_t groupsX, uint32_t groupsY,
-                uint32_t groupsZ, std::string* error, double* dispatchNs = nullptr);
+                uint32_t groupsZ, Diagnostics& diags, double* dispatchNs = nullptr);
 
   /// Every message recorded so far ("ERROR [validation] Validation Error: [ VUID-... ] ..."); clears the list.
   std::vector<std::string> takeMessages();

@@ -280,26 +280,34 @@ std::vector<float> floatsOf(const Resources& resources, uint32_t set, uint32_t b
   return f;
 }
 
-bool canRun(const Context& ctx, Precision precision, std::string* error) {
+bool canRun(const Context& ctx, Precision precision, Diagnostics& diags) {
   if (precision == Precision::Float || ctx.shaderFloat16()) return true;
-  *error = "half precision needs a Vulkan device with shaderFloat16 (" + ctx.deviceName() + " has none)";
+  diags.fail("half precision needs a Vulkan device with shaderFloat16 (" + ctx.deviceName() + " has none)");
   return false;
+}
+
+std::unique_ptr<ComputePipeline> kernelPipeline(Context& ctx, const CompileResult& r, Target target, KernelMode mode,
+                                                const EmitOptions& emit, const char* what, std::vector<uint32_t>* spirv,
+                                                Diagnostics& diags) {
+  ShaderValidation v = compileKernel(r, target, mode, emit);
+  if (!v.ok) {
+    diags.fail(std::string("internal compiler error: the ") + what + " kernel does not validate\n" + v.log);
+    return nullptr;
+  }
+  *spirv = std::move(v.spirv);
+  return ctx.createPipeline(*spirv, diags);
 }
 
 bool runSampleKernel(Context& ctx, const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit,
                      const std::vector<Sample>& samples, const std::vector<std::array<double, 4>>& inputValues,
-                     std::vector<float>* results, std::string* error) {
-  if (!canRun(ctx, emit.precision, error)) return false;
-  const ShaderValidation v = compileKernel(r, target, mode, emit);
-  if (!v.ok) {
-    *error = "internal compiler error: the sample kernel does not validate\n" + v.log;
-    return false;
-  }
-  auto pipeline = ctx.createPipeline(v.spirv, error);
+                     std::vector<float>* results, Diagnostics& diags) {
+  if (!canRun(ctx, emit.precision, diags)) return false;
+  std::vector<uint32_t> spirv;
+  auto pipeline = kernelPipeline(ctx, r, target, mode, emit, "sample", &spirv, diags);
   if (!pipeline) return false;
-  Resources res = kernelResources(r.material, pipeline->reflection(), v.spirv, inputValues, sampleBuffer(samples),
+  Resources res = kernelResources(r.material, pipeline->reflection(), spirv, inputValues, sampleBuffer(samples),
                                   samples.size() * static_cast<std::size_t>(resultStride(r)));
-  if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(samples.size() / kLocalSize), 1, 1, error)) return false;
+  if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(samples.size() / kLocalSize), 1, 1, diags)) return false;
   *results = floatsOf(res, 0, 7);
   return true;
 }

@@ -7,6 +7,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -87,17 +88,25 @@ int resultStride(const CompileResult& r);
 /// Reads a float result buffer back from a BufferResource.
 std::vector<float> floatsOf(const Resources& resources, uint32_t set, uint32_t binding);
 
-/// False with `*error` when kernels of `precision` cannot run on `ctx`: Half
+/// False, reporting why, when kernels of `precision` cannot run on `ctx`: Half
 /// needs shaderFloat16.
-bool canRun(const Context& ctx, Precision precision, std::string* error);
+bool canRun(const Context& ctx, Precision precision, Diagnostics& diags);
+
+/// Compiles the material's `mode` kernel for `target` with `emit` (compileKernel)
+/// into `*spirv` and builds its pipeline. Null, reporting "internal compiler
+/// error: the <what> kernel does not validate" and the log (a compiler bug) or
+/// the pipeline's failure.
+std::unique_ptr<ComputePipeline> kernelPipeline(Context& ctx, const CompileResult& r, Target target, KernelMode mode,
+                                                const EmitOptions& emit, const char* what, std::vector<uint32_t>* spirv,
+                                                Diagnostics& diags);
 
 /// Compiles the material's `mode` sample kernel (Forward or Deferred) for
-/// `target` with `emit` (compileKernel) and runs it once over `samples` (a
+/// `target` with `emit` (kernelPipeline) and runs it once over `samples` (a
 /// multiple of kernel::kLocalSize) with `inputValues` (empty: defaults):
-/// `*results` holds resultStride(r) floats per sample. False with `*error` when
-/// the kernel does not validate (a compiler bug) or the dispatch fails.
+/// `*results` holds resultStride(r) floats per sample. False, with errors
+/// reported, when the kernel does not validate or the dispatch fails.
 bool runSampleKernel(Context& ctx, const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit,
                      const std::vector<Sample>& samples, const std::vector<std::array<double, 4>>& inputValues,
-                     std::vector<float>* results, std::string* error);
+                     std::vector<float>* results, Diagnostics& diags);
 
 }  // namespace substratec::gpu

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "diag/diagnostics.h"
+
 namespace substratec::gpu {
 
 /// The Vulkan descriptor type a binding needs.
@@ -45,8 +47,8 @@ struct ShaderReflection {
 
 /// Reflects the first OpEntryPoint of `words`. For SPIR-V >= 1.4 only variables in its interface
 /// are listed (earlier versions list interface-less globals, so every decorated variable is).
-/// False with a message on a malformed module or a descriptor the harness cannot describe.
-bool reflectSpirv(const std::vector<uint32_t>& words, ShaderReflection* out, std::string* error);
+/// False, with an error reported, on a malformed module or a descriptor the harness cannot describe.
+bool reflectSpirv(const std::vector<uint32_t>& words, ShaderReflection* out, Diagnostics& diags);
 
 /// "UniformBuffer", "StorageImage", ...
 const char* descriptorKindName(DescriptorKind kind);

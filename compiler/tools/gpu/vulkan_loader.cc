@@ -35,49 +35,50 @@ const Library& library() {
   return lib;
 }
 
+/// Resolves one entry point through `get` (vkGetInstanceProcAddr or vkGetDeviceProcAddr on a handle);
+/// false, reporting "<how>, \"<name>\") returned NULL", when the driver does not have it.
+template <class Fn, class Get>
+bool resolve(Fn* slot, const char* name, Get get, const char* how, Diagnostics& diags) {
+  *slot = reinterpret_cast<Fn>(get(name));
+  if (*slot) return true;
+  diags.fail(std::string(how) + ", \"" + name + "\") returned NULL");
+  return false;
+}
+
 }  // namespace
 
-bool loadGlobalFunctions(VulkanFunctions* fns, std::string* error) {
+// Each loader resolves its X-macro list of functions through a local `get`, labelled `how`.
+#define SUBSTRATEC_VK_LOAD(name) \
+  if (!resolve(&fns->name, #name, get, how, diags)) return false;
+
+bool loadGlobalFunctions(VulkanFunctions* fns, Diagnostics& diags) {
   const Library& lib = library();
   if (!lib.getInstanceProcAddr) {
-    *error = lib.error;
+    diags.fail(lib.error);
     return false;
   }
   fns->vkGetInstanceProcAddr = lib.getInstanceProcAddr;
-#define SUBSTRATEC_VK_LOAD(name)                                                               \
-  fns->name = reinterpret_cast<PFN_##name>(fns->vkGetInstanceProcAddr(VK_NULL_HANDLE, #name)); \
-  if (!fns->name) {                                                                            \
-    *error = std::string("vkGetInstanceProcAddr(NULL, \"" #name "\") returned NULL");          \
-    return false;                                                                              \
-  }
+  auto get = [fns](const char* name) { return fns->vkGetInstanceProcAddr(VK_NULL_HANDLE, name); };
+  const char* how = "vkGetInstanceProcAddr(NULL";
   SUBSTRATEC_VK_GLOBAL_FUNCTIONS(SUBSTRATEC_VK_LOAD)
-#undef SUBSTRATEC_VK_LOAD
   return true;
 }
 
-bool loadInstanceFunctions(VulkanFunctions* fns, VkInstance instance, std::string* error) {
-#define SUBSTRATEC_VK_LOAD(name)                                                          \
-  fns->name = reinterpret_cast<PFN_##name>(fns->vkGetInstanceProcAddr(instance, #name)); \
-  if (!fns->name) {                                                                       \
-    *error = std::string("vkGetInstanceProcAddr(instance, \"" #name "\") returned NULL"); \
-    return false;                                                                         \
-  }
+bool loadInstanceFunctions(VulkanFunctions* fns, VkInstance instance, Diagnostics& diags) {
+  auto get = [fns, instance](const char* name) { return fns->vkGetInstanceProcAddr(instance, name); };
+  const char* how = "vkGetInstanceProcAddr(instance";
   SUBSTRATEC_VK_INSTANCE_FUNCTIONS(SUBSTRATEC_VK_LOAD)
-#undef SUBSTRATEC_VK_LOAD
   return true;
 }
 
-bool loadDeviceFunctions(VulkanFunctions* fns, VkDevice device, std::string* error) {
-#define SUBSTRATEC_VK_LOAD(name)                                                      \
-  fns->name = reinterpret_cast<PFN_##name>(fns->vkGetDeviceProcAddr(device, #name)); \
-  if (!fns->name) {                                                                   \
-    *error = std::string("vkGetDeviceProcAddr(device, \"" #name "\") returned NULL"); \
-    return false;                                                                     \
-  }
+bool loadDeviceFunctions(VulkanFunctions* fns, VkDevice device, Diagnostics& diags) {
+  auto get = [fns, device](const char* name) { return fns->vkGetDeviceProcAddr(device, name); };
+  const char* how = "vkGetDeviceProcAddr(device";
   SUBSTRATEC_VK_DEVICE_FUNCTIONS(SUBSTRATEC_VK_LOAD)
-#undef SUBSTRATEC_VK_LOAD
   return true;
 }
+
+#undef SUBSTRATEC_VK_LOAD
 
 std::string vkResultName(VkResult result) {
   switch (result) {

@@ -13,6 +13,8 @@
 
 #include <string>
 
+#include "diag/diagnostics.h"
+
 namespace substratec::gpu {
 
 // X-macro lists of the entry points used, by the level they are loaded at.
@@ -98,14 +100,15 @@ struct VulkanFunctions {
 };
 
 /// dlopens libvulkan.so.1 (once per process; never closed) and loads vkGetInstanceProcAddr and the
-/// global functions. False with a message naming what is missing.
-bool loadGlobalFunctions(VulkanFunctions* fns, std::string* error);
+/// global functions. False, reporting what is missing.
+bool loadGlobalFunctions(VulkanFunctions* fns, Diagnostics& diags);
 
-/// Loads the instance-level functions (including VK_EXT_debug_utils') through vkGetInstanceProcAddr.
-bool loadInstanceFunctions(VulkanFunctions* fns, VkInstance instance, std::string* error);
+/// Loads the instance-level functions (including VK_EXT_debug_utils') through vkGetInstanceProcAddr;
+/// false, reporting the first one missing.
+bool loadInstanceFunctions(VulkanFunctions* fns, VkInstance instance, Diagnostics& diags);
 
-/// Loads the device-level functions through vkGetDeviceProcAddr.
-bool loadDeviceFunctions(VulkanFunctions* fns, VkDevice device, std::string* error);
+/// Loads the device-level functions through vkGetDeviceProcAddr; false, reporting the first one missing.
+bool loadDeviceFunctions(VulkanFunctions* fns, VkDevice device, Diagnostics& diags);
 
 /// The enumerator's name of a VkResult ("VK_ERROR_DEVICE_LOST"), or "VkResult(<n>)".
 std::string vkResultName(VkResult result);

@@ -39,8 +39,8 @@ uint8_t quantize(float value, bool srgb) {
   return static_cast<uint8_t>(std::floor(v * 255.0 + 0.5));
 }
 
-bool fail(std::string* error, const std::string& message) {
-  if (error) *error = message;
+bool fail(Diagnostics& diags, std::string message) {
+  diags.fail(std::move(message));
   return false;
 }
 
@@ -72,9 +72,9 @@ Srgb8 encodeSrgb8(const Image& img) {
   return out;
 }
 
-bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint8_t>& png, std::string* error) {
+bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint8_t>& png, Diagnostics& diags) {
   if (w < 1 || h < 1 || rgba8.size() != static_cast<size_t>(w) * h * 4)
-    return fail(error, "PNG of " + std::to_string(w) + "x" + std::to_string(h) + " pixels needs " +
+    return fail(diags, "PNG of " + std::to_string(w) + "x" + std::to_string(h) + " pixels needs " +
                            std::to_string(static_cast<size_t>(w > 0 ? w : 0) * (h > 0 ? h : 0) * 4) + " bytes, got " +
                            std::to_string(rgba8.size()));
   // libpng's simplified API: 8-bit sRGB output writes an sRGB chunk and never
@@ -87,24 +87,25 @@ bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint
   image.format = PNG_FORMAT_RGBA;
   png_alloc_size_t size = 0;
   if (!png_image_write_to_memory(&image, nullptr, &size, 0, rgba8.data(), 0, nullptr))
-    return fail(error, std::string("libpng: ") + image.message);
+    return fail(diags, std::string("libpng: ") + image.message);
   png.resize(size);
   if (!png_image_write_to_memory(&image, png.data(), &size, 0, rgba8.data(), 0, nullptr))
-    return fail(error, std::string("libpng: ") + image.message);
+    return fail(diags, std::string("libpng: ") + image.message);
   png.resize(size);
   return true;
 }
 
-bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba8, std::string* error) {
+bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba8, Diagnostics& diags) {
   std::vector<uint8_t> png;
-  std::string why;
-  if (!encodePng(w, h, rgba8, png, &why)) return fail(error, "cannot encode '" + path + "': " + why);
+  Diagnostics encoding(path);
+  if (!encodePng(w, h, rgba8, png, encoding))
+    return fail(diags, "cannot encode '" + path + "': " + encoding.errorMessages());
   namespace fs = std::filesystem;
   fs::path target(path);
   fs::path dir = target.parent_path();
   std::string tmpl = ((dir.empty() ? fs::path(".") : dir) / ("." + target.filename().string() + ".tmpXXXXXX")).string();
   int fd = ::mkstemp(tmpl.data());
-  if (fd < 0) return fail(error, "cannot write '" + path + "': " + std::strerror(errno));
+  if (fd < 0) return fail(diags, "cannot write '" + path + "': " + std::strerror(errno));
   // mkstemp creates 0600; a PNG is an ordinary readable file.
   ::fchmod(fd, 0644);
   size_t done = 0;
@@ -115,19 +116,19 @@ bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>&
       std::string message = std::strerror(n < 0 ? errno : EIO);
       ::close(fd);
       ::unlink(tmpl.c_str());
-      return fail(error, "cannot write '" + path + "': " + message);
+      return fail(diags, "cannot write '" + path + "': " + message);
     }
     done += static_cast<size_t>(n);
   }
   if (::close(fd) != 0) {
     std::string message = std::strerror(errno);
     ::unlink(tmpl.c_str());
-    return fail(error, "cannot write '" + path + "': " + message);
+    return fail(diags, "cannot write '" + path + "': " + message);
   }
   if (::rename(tmpl.c_str(), path.c_str()) != 0) {
     std::string message = std::strerror(errno);
     ::unlink(tmpl.c_str());
-    return fail(error, "cannot rename into '" + path + "': " + message);
+    return fail(diags, "cannot rename into '" + path + "': " + message);
   }
   return true;
 }

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "diag/diagnostics.h"
+
 namespace substratec::preview {
 
 /// Linear RGBA32F pixels, row-major, top row first.
@@ -40,13 +42,13 @@ struct Srgb8 {
 Srgb8 encodeSrgb8(const Image& img);
 
 /// A PNG (8-bit RGBA, sRGB chunk, no time chunk: the same pixels always give
-/// the same bytes) of w x h pixels `rgba8`. Returns false (and an error
-/// message) for a size mismatch or a libpng failure.
-bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint8_t>& png, std::string* error);
+/// the same bytes) of w x h pixels `rgba8`. Returns false, reporting why, for
+/// a size mismatch or a libpng failure.
+bool encodePng(int w, int h, const std::vector<uint8_t>& rgba8, std::vector<uint8_t>& png, Diagnostics& diags);
 
 /// encodePng written to `path` through a temporary file in the same directory
 /// renamed into place: on failure nothing is left behind and an existing file
-/// at `path` is untouched. Returns false and sets `*error` (if non-null).
-bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba8, std::string* error);
+/// at `path` is untouched. Returns false, reporting why.
+bool writePng(const std::string& path, int w, int h, const std::vector<uint8_t>& rgba8, Diagnostics& diags);
 
 }  // namespace substratec::preview

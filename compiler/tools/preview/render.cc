@@ -89,30 +89,30 @@ std::vector<float> previewTexture(int size) {
   return t;
 }
 
-gpu::ComputePipeline* PipelineCache::get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, std::string* error) {
+gpu::ComputePipeline* PipelineCache::get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, Diagnostics& diags) {
   auto it = pipelines_.find(spirv);
   if (it != pipelines_.end()) return it->second.get();
-  auto pipeline = gpu.createPipeline(spirv, error);
+  auto pipeline = gpu.createPipeline(spirv, diags);
   if (!pipeline) return nullptr;
   return pipelines_.emplace(spirv, std::move(pipeline)).first->second.get();
 }
 
-bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions& o, Image* out, std::string* error) {
+bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions& o, Image* out, Diagnostics& diags) {
   EmitOptions emit;
   emit.diffuseModel = o.diffuseModel;
   emit.precision = o.precision;
-  if (!gpu::canRun(ctx, o.precision, error)) return false;
+  if (!gpu::canRun(ctx, o.precision, diags)) return false;
   ShaderValidation v = compileKernel(r, o.target, KernelMode::Preview, emit);
   if (!v.ok) {
-    *error = "internal compiler error: the preview kernel does not validate\n" + v.log;
+    diags.fail("internal compiler error: the preview kernel does not validate\n" + v.log);
     return false;
   }
   std::unique_ptr<gpu::ComputePipeline> own;
   gpu::ComputePipeline* pipeline = nullptr;
   if (o.pipelines) {
-    pipeline = o.pipelines->get(ctx, v.spirv, error);
+    pipeline = o.pipelines->get(ctx, v.spirv, diags);
   } else {
-    own = ctx.createPipeline(v.spirv, error);
+    own = ctx.createPipeline(v.spirv, diags);
     pipeline = own.get();
   }
   if (!pipeline) return false;
@@ -164,7 +164,7 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
     }
   }
   const uint32_t groups = static_cast<uint32_t>((o.size + 7) / 8);
-  if (!ctx.dispatch(*pipeline, res, groups, groups, 1, error)) return false;
+  if (!ctx.dispatch(*pipeline, res, groups, groups, 1, diags)) return false;
   const auto& buf = std::get<gpu::BufferResource>(res.at({0, 7}));
   *out = Image(o.size, o.size);
   std::memcpy(out->rgba.data(), buf.data.data(), out->rgba.size() * sizeof(float));

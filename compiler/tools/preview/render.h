@@ -22,8 +22,8 @@ namespace substratec::preview {
 /// their inputs' values, compiled under one name, share a kernel).
 class PipelineCache {
  public:
-  /// The pipeline of `spirv`, built on first use. Null with `*error` on failure.
-  gpu::ComputePipeline* get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, std::string* error);
+  /// The pipeline of `spirv`, built on first use. Null, with errors reported, on failure.
+  gpu::ComputePipeline* get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, Diagnostics& diags);
 
  private:
   std::map<std::vector<uint32_t>, std::unique_ptr<gpu::ComputePipeline>> pipelines_;
@@ -39,10 +39,10 @@ struct RenderOptions {
   PipelineCache* pipelines = nullptr;        // reuse pipelines across calls (null: build one per call)
 };
 
-/// Renders `r` (linear HDR, background = the environment). False with `*error`
-/// on a kernel that does not validate (a compiler bug) or a failed dispatch.
+/// Renders `r` (linear HDR, background = the environment). False, with errors
+/// reported, on a kernel that does not validate (a compiler bug) or a failed dispatch.
 bool renderSphere(gpu::Context& gpu, const CompileResult& r, const RenderOptions& options, Image* out,
-                  std::string* error);
+                  Diagnostics& diags);
 
 /// The procedural texture bound to every texture input of a preview: a soft
 /// 8 x 8 checker around mid grey (a mask, a colour or a normal map all show

@@ -298,23 +298,19 @@ std::string resultName(int at) {
 
 bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& points,
             const std::vector<std::pair<long, int>>& work, gpu::TextureSet textures, gpu::Context& ctx, Report* report,
-            std::string* error) {
+            Diagnostics& diags) {
   EmitOptions emit;
   emit.inputsPerInvocation = true;
   emit.precision = report->precision;
-  if (!gpu::canRun(ctx, emit.precision, error)) return false;
+  if (!gpu::canRun(ctx, emit.precision, diags)) return false;
   int inputCount = 0;
   for (const Input& in : r.material.inputs) inputCount += in.type != VType::Texture;
   const int stride = gpu::resultStride(r);
   constexpr std::size_t kChunk = 16384;
   for (KernelMode mode : {KernelMode::Forward, KernelMode::Deferred}) {
     const char* where = mode == KernelMode::Forward ? "gpu forward" : "gpu deferred";
-    ShaderValidation v = compileKernel(r, Target::Glsl, mode, emit);
-    if (!v.ok) {
-      *error = "internal compiler error: the stability kernel does not validate\n" + v.log;
-      return false;
-    }
-    auto pipeline = ctx.createPipeline(v.spirv, error);
+    std::vector<uint32_t> spirv;
+    auto pipeline = gpu::kernelPipeline(ctx, r, Target::Glsl, mode, emit, "stability", &spirv, diags);
     if (!pipeline) return false;
     for (std::size_t start = 0; start < work.size(); start += kChunk) {
       const std::size_t n = std::min(kChunk, work.size() - start);
@@ -338,7 +334,7 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
           ++slot;
         }
       }
-      gpu::Resources res = gpu::kernelResources(r.material, pipeline->reflection(), v.spirv, {},
+      gpu::Resources res = gpu::kernelResources(r.material, pipeline->reflection(), spirv, {},
                                                 gpu::sampleBuffer(samples), padded * stride, textures);
       if (inputCount > 0) {
         gpu::BufferResource buf;
@@ -346,7 +342,7 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
         std::memcpy(buf.data.data(), inputs.data(), buf.data.size());
         res[{0, 8}] = buf;
       }
-      if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(padded / kernel::kLocalSize), 1, 1, error)) return false;
+      if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(padded / kernel::kLocalSize), 1, 1, diags)) return false;
       const std::vector<float> out = gpu::floatsOf(res, 0, 7);
       for (std::size_t j = 0; j < n; ++j) {
         ++report->gpuEvaluations;
@@ -439,10 +435,10 @@ CompileOptions forcingOptions(const CompileOptions& base, const std::vector<Forc
 }
 
 bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
-                   std::string* error) {
+                   Diagnostics& diags) {
   json doc = json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_object()) {
-    *error = "the material is not a JSON object";
+    diags.fail("the material is not a JSON object");
     return false;
   }
   if (!doc.contains("inputs") || !doc["inputs"].is_object()) doc["inputs"] = json::object();
@@ -470,7 +466,7 @@ bool forceableText(const std::string& text, std::string* rewritten, std::vector<
 }
 
 bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Options& o, gpu::Context* gpu,
-         Report* report, std::string* error) {
+         Report* report, Diagnostics& diags) {
   Grid grid;
   grid.kinds = kinds;
   grid.inputSets = hasRange(r.material, kinds) ? 3 : 1;
@@ -512,7 +508,7 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
         report->worst.push_back({where, bad, grid.describe(cfg), points[point].label, value});
     }
   }
-  if (o.gpu && !runGpu(r, grid, points, work, o.textures, *gpu, report, error)) return false;
+  if (o.gpu && !runGpu(r, grid, points, work, o.textures, *gpu, report, diags)) return false;
   if (o.cpu) furnace(r, grid, o.furnaceSamples, textures, report);
   report->furnaceJudged = o.cpu;
   // `add` sums two pieces of matter: more light than arrives, by construction.

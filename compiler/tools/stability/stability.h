@@ -76,10 +76,10 @@ struct ForcedKind {
 };
 
 /// The material rewritten so that its slab parameters can be forced (see
-/// above), and the kinds it has. False with `*error` if the text is not a
+/// above), and the kinds it has. False, reporting it, if the text is not a
 /// JSON object (the caller compiled it first: its diagnostics come from there).
 bool forceableText(const std::string& text, std::string* rewritten, std::vector<ForcedKind>* kinds,
-                   std::string* error);
+                   Diagnostics& diags);
 
 /// The options forceableText's output compiles with: `base`, with the input-
 /// and node-count limits raised by exactly what the rewrite added (two inputs
@@ -126,10 +126,10 @@ struct Report {
 };
 
 /// Runs the grid on `r` (compiled from forceableText's output; `kinds` from it).
-/// `gpu` may be null when options.gpu is false. False with `*error` when a
-/// kernel does not compile or a dispatch fails.
+/// `gpu` may be null when options.gpu is false. False, with errors reported,
+/// when a kernel does not compile or a dispatch fails.
 bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Options& options, gpu::Context* gpu,
-         Report* report, std::string* error);
+         Report* report, Diagnostics& diags);
 
 /// False when the CPU part ran and no furnace evaluation returned any light.
 bool furnaceExercised(const Report& report);

@@ -9,13 +9,13 @@
 namespace substratec::sweep {
 
 bool runBothPrecisions(gpu::Context& ctx, const CompileResult& r, Target target, const std::vector<gpu::Sample>& samples,
-                       const std::vector<std::array<double, 4>>& inputValues, BothPrecisions* out, std::string* error) {
+                       const std::vector<std::array<double, 4>>& inputValues, BothPrecisions* out, Diagnostics& diags) {
   EmitOptions emit;
   emit.precision = Precision::Float;
-  if (!gpu::runSampleKernel(ctx, r, target, KernelMode::Forward, emit, samples, inputValues, &out->float32, error))
+  if (!gpu::runSampleKernel(ctx, r, target, KernelMode::Forward, emit, samples, inputValues, &out->float32, diags))
     return false;
   emit.precision = Precision::Half;
-  return gpu::runSampleKernel(ctx, r, target, KernelMode::Forward, emit, samples, inputValues, &out->half, error);
+  return gpu::runSampleKernel(ctx, r, target, KernelMode::Forward, emit, samples, inputValues, &out->half, diags);
 }
 
 std::vector<double> litRadiance(const std::vector<float>& results, int stride) {

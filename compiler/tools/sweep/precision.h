@@ -25,10 +25,10 @@ struct BothPrecisions {
 
 /// Runs the forward kernel of `r` for `target` in both precisions over
 /// `samples` (a multiple of kernel::kLocalSize) with `inputValues` (empty:
-/// defaults). False with `*error` (a kernel that does not validate, a failed
+/// defaults). False, with errors reported (a kernel that does not validate, a failed
 /// dispatch, or a device without shaderFloat16).
 bool runBothPrecisions(gpu::Context& ctx, const CompileResult& r, Target target, const std::vector<gpu::Sample>& samples,
-                       const std::vector<std::array<double, 4>>& inputValues, BothPrecisions* out, std::string* error);
+                       const std::vector<std::array<double, 4>>& inputValues, BothPrecisions* out, Diagnostics& diags);
 
 /// Per sample and channel, the radiance the forward pass writes: direct +
 /// environment + emissive (kResultDirect, kResultEnvironment, kResultEmissive).

@@ -56,7 +56,7 @@ std::vector<double> radiance(const CompileResult& r, const std::vector<gpu::Samp
 }
 
 /// The forward shader's SPIR-V instruction count after the performance passes.
-bool forwardInstructions(const CompileResult& r, const Options& options, std::size_t* count, std::string* error) {
+bool forwardInstructions(const CompileResult& r, const Options& options, std::size_t* count, Diagnostics& diags) {
   GenerateOptions o;
   o.hlsl = false;
   o.emit.diffuseModel = options.diffuseModel;
@@ -64,7 +64,7 @@ bool forwardInstructions(const CompileResult& r, const Options& options, std::si
   Generated g = generateFiles(r, o);
   validateGenerated(g, {.optimize = true});
   if (!g.valid) {
-    *error = "internal compiler error: generated code does not validate\n" + g.failure;
+    diags.fail("internal compiler error: generated code does not validate\n" + g.failure);
     return false;
   }
   for (const EntryReport& e : g.entries)
@@ -73,24 +73,21 @@ bool forwardInstructions(const CompileResult& r, const Options& options, std::si
 }
 
 /// Median lavapipe time per shading point of the throughput kernel.
-bool nsPerPixel(gpu::Context& ctx, const CompileResult& r, const Options& o, double* ns, std::string* error) {
+bool nsPerPixel(gpu::Context& ctx, const CompileResult& r, const Options& o, double* ns, Diagnostics& diags) {
   EmitOptions emit;
   emit.diffuseModel = o.diffuseModel;  // the model the errors are measured with
   emit.precision = o.precision;
-  ShaderValidation v = compileKernel(r, Target::Glsl, KernelMode::Throughput, emit);
-  if (!v.ok) {
-    *error = "internal compiler error: the throughput kernel does not validate\n" + v.log;
-    return false;
-  }
-  auto pipeline = ctx.createPipeline(v.spirv, error);
+  std::vector<uint32_t> spirv;
+  auto pipeline = gpu::kernelPipeline(ctx, r, Target::Glsl, KernelMode::Throughput, emit, "throughput", &spirv, diags);
   if (!pipeline) return false;
   const int pixels = (o.pixels + kernel::kLocalSize - 1) / kernel::kLocalSize * kernel::kLocalSize;
   std::vector<double> times;
   for (int run = 0; run <= o.timedRuns; ++run) {  // run 0 warms up (JIT, caches)
     gpu::Resources res =
-        gpu::kernelResources(r.material, pipeline->reflection(), v.spirv, {}, {}, static_cast<std::size_t>(pixels) * 4);
+        gpu::kernelResources(r.material, pipeline->reflection(), spirv, {}, {}, static_cast<std::size_t>(pixels) * 4);
     double t = 0;
-    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(pixels / kernel::kLocalSize), 1, 1, error, &t)) return false;
+    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(pixels / kernel::kLocalSize), 1, 1, diags, &t))
+      return false;
     if (run > 0) times.push_back(t / pixels);
   }
   std::sort(times.begin(), times.end());
@@ -227,11 +224,11 @@ double deltaE2000Lab(const std::array<double, 3>& lab1, const std::array<double,
 }
 
 bool simplificationSteps(const std::string& path, const std::string& text, const CompileOptions& base,
-                         std::vector<Step>* steps, CompileResult* full, std::string* error) {
+                         std::vector<Step>* steps, CompileResult* full, Diagnostics& diags) {
   auto compile = [&](const CompileOptions& o) -> std::optional<CompileResult> {
-    Diagnostics diags(path);
-    auto r = compileText(path, text, o, diags);
-    if (!r && error) *error = diags.formatAll();
+    Diagnostics own(path);
+    auto r = compileText(path, text, o, own);
+    if (!r) diags = std::move(own);  // the last compile that failed is the one reported
     return r;
   };
   CompileOptions unsimplified = base;
@@ -259,8 +256,8 @@ bool simplificationSteps(const std::string& path, const std::string& text, const
     o.fullSimplification = false;
     o.budgetOverride = std::max(s.bytesAfter, 8);
     o.maxClosuresOverride = std::max(s.closuresAfter, 1);
-    Diagnostics diags(path);
-    auto r = compileText(path, text, o, diags);
+    Diagnostics ignored(path);
+    auto r = compileText(path, text, o, ignored);
     if (!r) continue;  // only full simplification gets there (below the smallest budget)
     if (!seen.insert({r->after.bytes(), static_cast<int>(r->after.closures.size())}).second) continue;
     steps->push_back({*r, fmt::format("step {}", i + 1), *o.budgetOverride});
@@ -271,7 +268,7 @@ bool simplificationSteps(const std::string& path, const std::string& text, const
 }
 
 bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileResult& full, const Options& o,
-             std::vector<Row>* rows, std::string* error) {
+             std::vector<Row>* rows, Diagnostics& diags) {
   const std::vector<gpu::Sample> probes = gpu::makeSamples(kProbes, kProbeSeed);
   const std::vector<double> y = radiance(full, probes, diffuseModelNumber(o.diffuseModel), nullptr);
   const std::vector<std::size_t> chosen = groundTruthProbes(probes, o.groundTruthProbes);
@@ -283,11 +280,11 @@ bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileRes
     row.budget = step.budget;
     row.bytes = r.after.bytes();
     row.closures = static_cast<int>(r.after.closures.size());
-    if (!forwardInstructions(r, o, &row.spirvInstructions, error)) return false;
-    if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, error)) return false;
+    if (!forwardInstructions(r, o, &row.spirvInstructions, diags)) return false;
+    if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, diags)) return false;
     if (o.precision == Precision::Half) {
       BothPrecisions both;
-      if (!runBothPrecisions(ctx, r, Target::Glsl, probes, {}, &both, error)) return false;
+      if (!runBothPrecisions(ctx, r, Target::Glsl, probes, {}, &both, diags)) return false;
       const PrecisionError e = precisionError(both, gpu::resultStride(r));
       row.relMseVsFloat32 = e.relMse;
       row.maxAbsVsFloat32 = e.maxAbs;

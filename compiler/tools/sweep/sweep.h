@@ -30,9 +30,9 @@ struct Step {
 /// changes its size (compiled with that step's bytes and closures as the
 /// budget: simplification is deterministic, deepest first, so it stops
 /// there), and fully simplified. Also the unsimplified material (`*full`), the
-/// reference of the errors. False with the diagnostics in `*error`.
+/// reference of the errors. False with the diagnostics of the (last) compile that failed in `diags`.
 bool simplificationSteps(const std::string& path, const std::string& text, const CompileOptions& base,
-                         std::vector<Step>* steps, CompileResult* full, std::string* error);
+                         std::vector<Step>* steps, CompileResult* full, Diagnostics& diags);
 
 struct Row {
   std::string label;
@@ -72,9 +72,9 @@ struct Options {
 /// enough walks for bright media (maxDepth 1024), deterministic seeds.
 reference::WalkOptions groundTruthOptions(int samples);
 
-/// Measures every step. `gpu` runs the timing kernels. False with `*error`.
+/// Measures every step. `gpu` runs the timing kernels. False, with errors reported, on a failure.
 bool measure(gpu::Context& gpu, const std::vector<Step>& steps, const CompileResult& full, const Options& options,
-             std::vector<Row>* rows, std::string* error);
+             std::vector<Row>* rows, Diagnostics& diags);
 
 /// The cheapest row (fewest bytes, then fewest ns per pixel) whose rel_mse is
 /// at most `maxError`, if any.
