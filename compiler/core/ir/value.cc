@@ -145,6 +145,8 @@ double componentOf(const std::array<double, 4>& a, VType t, int i) {
 
 }  // namespace
 
+// long: one case per Op, the folding table of the value ops (a switch the
+// compiler checks for every Op); split, the table would be read in pieces.
 bool evalConstOp(Op op, std::uint16_t attr, VType rt, const std::array<double, 4>* a,
                  const VType* at, int n, std::array<double, 4>& out) {
   out = {0, 0, 0, 0};

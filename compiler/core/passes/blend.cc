@@ -82,8 +82,10 @@ void setDiffuseEnergy(Material& m, Slab& r, ValueId target) {
   r.pin(SlabPin::DiffuseAlbedo) = e.sat(d);
 }
 
-/// Lerps every blendable pin of two slabs by t (normals/tangents renormalized).
-Slab lerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
+/// The plain-lerp baseline (BlendRule::PlainLerp): every pin (the fuzz colour
+/// and the diffuse included, as they are) and the thickness lerped by t,
+/// normals and tangents renormalized; coverage and features are the caller's.
+Slab plainLerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
   Ex e(m.values);
   Slab r = a;
   for (int p = 0; p < kSlabPinCount; ++p) {
@@ -96,6 +98,14 @@ Slab lerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
     r.thickness = e.lerp(thicknessOf(m, a), thicknessOf(m, b), t);
   else
     r.thickness = kNoValue;
+  return r;
+}
+
+/// Lerps every blendable pin of two slabs by t (normals/tangents renormalized):
+/// the plain lerp, then the fuzz colour and the diffuse energy-preserving.
+Slab lerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
+  Slab r = plainLerpSlabs(m, a, b, t);
+  Ex e(m.values);
   // Fuzz colour premultiplied by the amount, so amount·colour blends linearly.
   r.pin(SlabPin::FuzzColor) = e.safeDiv(
       e.lerp(e.mul(pin(a, SlabPin::FuzzAmount), pin(a, SlabPin::FuzzColor)),
@@ -117,25 +127,6 @@ void takeDiscrete(Slab& r, const Slab& a, const Slab& b, bool bWins) {
   r.sssTypeExplicit = sss.sssTypeExplicit;
   bool aGlint = a.features & kFeatGlint, bGlint = b.features & kFeatGlint;
   r.pin(SlabPin::GlintUv) = pick(aGlint, bGlint) ? b.pin(SlabPin::GlintUv) : a.pin(SlabPin::GlintUv);
-}
-
-/// The plain-lerp baseline (BlendRule::PlainLerp): every pin (the fuzz colour
-/// and the diffuse included, as they are) and the thickness lerped by t,
-/// normals and tangents renormalized; coverage and features are the caller's.
-Slab plainLerpSlabs(Material& m, const Slab& a, const Slab& b, ValueId t) {
-  Ex e(m.values);
-  Slab r = a;
-  for (int p = 0; p < kSlabPinCount; ++p) {
-    SlabPin sp = static_cast<SlabPin>(p);
-    ValueId v = e.lerp(pin(a, sp), pin(b, sp), t);
-    if (sp == SlabPin::Normal || sp == SlabPin::Tangent) v = e.normalize(v);
-    r.pin(sp) = v;
-  }
-  if (a.thickness != kNoValue || b.thickness != kNoValue)
-    r.thickness = e.lerp(thicknessOf(m, a), thicknessOf(m, b), t);
-  else
-    r.thickness = kNoValue;
-  return r;
 }
 
 }  // namespace

@@ -295,10 +295,9 @@ void writeGlint(std::vector<std::uint32_t>& w, std::size_t& pos, const ClosureVa
   put(32, floatToHalf(d[2]) | (static_cast<std::uint32_t>(floatToHalf(d[3])) << 16));
 }
 
-}  // namespace
-
-std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::vector<ClosureValues>& closures,
-                                        const std::vector<BasisValues>& bases, double dither) {
+/// Throws std::invalid_argument unless the layout and the values can be packed.
+void checkPackArguments(const StorageLayout& layout, const std::vector<ClosureValues>& closures,
+                        const std::vector<BasisValues>& bases) {
   const int count = static_cast<int>(layout.closures.size());
   if (count < 1 || count > packfmt::kMaxClosures)
     throw std::invalid_argument(fmt::format("packMaterial: {} closures (the format holds 1 to 8)", count));
@@ -315,6 +314,74 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
     throw std::invalid_argument("packMaterial: fewer BasisValues than layout bases");
   for (const auto& c : layout.closures)
     if (c.basis < 0 || c.basis >= layout.basisCount) throw std::invalid_argument("packMaterial: closure basis out of range");
+}
+
+/// A closure field of plain bits: its name (after "closureN."), width and encoding.
+struct PackedClosureField {
+  std::string_view name;
+  int bits;
+  std::uint32_t (*encode)(const ClosureValues& v, double dither);
+};
+
+const PackedClosureField kPackedClosureFields[] = {
+    {"diffuse_albedo", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.diffuseAlbedo, d); }},
+    {"f0", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.f0, d); }},
+    {"roughness", bits::kRoughness, [](const ClosureValues& v, double d) { return quantizeUnorm(v.roughness, 8, d); }},
+    {"weight", bits::kGreyWeight, [](const ClosureValues& v, double d) { return quantizeUnorm(v.weight, 8, d); }},
+    {"top_transmittance", bits::kColor,
+     [](const ClosureValues& v, double d) { return quantizeColor(v.topTransmittance, d); }},
+    {"coverage_above", bits::kCoverageAbove,
+     [](const ClosureValues& v, double d) { return quantizeUnorm(v.coverageAbove, 8, d); }},
+    {"f90", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.f90, d); }},
+    {"sss", bits::kSss, [](const ClosureValues& v, double d) { return quantizeSss(v.sssMfp, v.sssPhaseAnisotropy, d); }},
+    {"haze", bits::kHaze,
+     [](const ClosureValues& v, double d) {
+       return quantizeUnorm(v.secondRoughness, 8, d) | (quantizeUnorm(v.secondRoughnessWeight, 8, d) << 8);
+     }},
+    {"fuzz", bits::kFuzz,
+     [](const ClosureValues& v, double d) {
+       return quantizeUnorm(v.fuzzAmount, 6, d) | (quantizeColor(v.fuzzColor, d) << 6) |
+              (quantizeUnorm(v.fuzzRoughness, 6, d) << 26);
+     }},
+    {"anisotropy", bits::kAnisotropy, [](const ClosureValues& v, double d) { return quantizeSnorm(v.anisotropy, 8, d); }},
+    {"specular_profile", bits::kSpecularProfile,
+     [](const ClosureValues& v, double) {
+       return v.specularProfile == 0 ? 0u : std::min<std::uint32_t>(v.specularProfile - 1, 255u);
+     }},
+};
+
+/// The plain closure field `f` names (its width checked); throws for an unknown one.
+const PackedClosureField& packedClosureField(const LayoutField& f) {
+  const std::string_view what = fieldSuffix(f.name);
+  for (const PackedClosureField& pf : kPackedClosureFields)
+    if (pf.name == what) {
+      expectBits(f, pf.bits);
+      return pf;
+    }
+  throw std::invalid_argument(fmt::format("packMaterial: unknown field '{}'", f.name));
+}
+
+/// A closure's header (several closures): basis, top, features, SSS type, extra interfaces.
+template <class Put>
+void putClosureHeader(const LayoutField& f, const ClosureLayout& c, const ClosureValues& v, Put& put) {
+  expectBits(f, bits::kClosureHeader);
+  if (c.extraInterfaces < 0 || c.extraInterfaces > kMaxStoredExtraInterfaces)
+    throw std::invalid_argument(fmt::format("packMaterial: closure {} has {} extra interfaces (0 to 3)",
+                                            f.closure, c.extraInterfaces));
+  std::uint32_t h = static_cast<std::uint32_t>(c.basis) | (c.isTop ? 8u : 0u);
+  h |= closureHeaderFeatures(c) << 4;
+  h |= headerSssType(c, v) << 12;
+  h |= static_cast<std::uint32_t>(c.extraInterfaces) << 14;
+  put(bits::kClosureHeader, h);
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::vector<ClosureValues>& closures,
+                                        const std::vector<BasisValues>& bases, double dither) {
+  checkPackArguments(layout, closures, bases);
+  const int count = static_cast<int>(layout.closures.size());
+  const bool multi = count > 1;
 
   // The normal of each basis as the unpacker will see it (tangent angles are
   // measured in its frame).
@@ -349,58 +416,13 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
       if (f.closure >= count) throw std::invalid_argument(fmt::format("packMaterial: field '{}' names no closure", f.name));
       const ClosureLayout& c = layout.closures[f.closure];
       const ClosureValues& v = closures[f.closure];
-      if (what == "header") {
-        expectBits(f, bits::kClosureHeader);
-        if (c.extraInterfaces < 0 || c.extraInterfaces > kMaxStoredExtraInterfaces)
-          throw std::invalid_argument(fmt::format("packMaterial: closure {} has {} extra interfaces (0 to 3)",
-                                                  f.closure, c.extraInterfaces));
-        std::uint32_t h = static_cast<std::uint32_t>(c.basis) | (c.isTop ? 8u : 0u);
-        h |= closureHeaderFeatures(c) << 4;
-        h |= headerSssType(c, v) << 12;
-        h |= static_cast<std::uint32_t>(c.extraInterfaces) << 14;
-        put(16, h);
-      } else if (what == "diffuse_albedo") {
-        expectBits(f, bits::kColor);
-        put(20, quantizeColor(v.diffuseAlbedo, dither));
-      } else if (what == "f0") {
-        expectBits(f, bits::kColor);
-        put(20, quantizeColor(v.f0, dither));
-      } else if (what == "roughness") {
-        expectBits(f, bits::kRoughness);
-        put(8, quantizeUnorm(v.roughness, 8, dither));
-      } else if (what == "weight") {
-        expectBits(f, bits::kGreyWeight);
-        put(8, quantizeUnorm(v.weight, 8, dither));
-      } else if (what == "top_transmittance") {
-        expectBits(f, bits::kColor);
-        put(20, quantizeColor(v.topTransmittance, dither));
-      } else if (what == "coverage_above") {
-        expectBits(f, bits::kCoverageAbove);
-        put(8, quantizeUnorm(v.coverageAbove, 8, dither));
-      } else if (what == "f90") {
-        expectBits(f, bits::kColor);
-        put(20, quantizeColor(v.f90, dither));
-      } else if (what == "sss") {
-        expectBits(f, bits::kSss);
-        put(28, quantizeSss(v.sssMfp, v.sssPhaseAnisotropy, dither));
-      } else if (what == "haze") {
-        expectBits(f, bits::kHaze);
-        put(16, quantizeUnorm(v.secondRoughness, 8, dither) | (quantizeUnorm(v.secondRoughnessWeight, 8, dither) << 8));
-      } else if (what == "fuzz") {
-        expectBits(f, bits::kFuzz);
-        put(32, quantizeUnorm(v.fuzzAmount, 6, dither) | (quantizeColor(v.fuzzColor, dither) << 6) |
-                    (quantizeUnorm(v.fuzzRoughness, 6, dither) << 26));
-      } else if (what == "anisotropy") {
-        expectBits(f, bits::kAnisotropy);
-        put(8, quantizeSnorm(v.anisotropy, 8, dither));
-      } else if (what == "specular_profile") {
-        expectBits(f, bits::kSpecularProfile);
-        put(8, v.specularProfile == 0 ? 0u : std::min<std::uint32_t>(v.specularProfile - 1, 255u));
-      } else if (what == "glint") {
+      if (what == "header") putClosureHeader(f, c, v, put);
+      else if (what == "glint") {
         expectBits(f, bits::kGlint);
         writeGlint(words, pos, v, dither);
       } else {
-        throw std::invalid_argument(fmt::format("packMaterial: unknown field '{}'", f.name));
+        const PackedClosureField& pf = packedClosureField(f);
+        put(pf.bits, pf.encode(v, dither));
       }
       continue;
     }
@@ -442,12 +464,18 @@ std::optional<int> runtimeSimpleClosure(const Material& m, const StorageLayout& 
   return std::nullopt;
 }
 
-UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, std::uint32_t topLayer) {
-  UnpackedMaterial out;
-  StorageLayout& L = out.layout;
+namespace {
+
+/// The cursor of unpackMaterial over the stream: each field read is recorded
+/// in the layout it rebuilds.
+struct FieldReader {
+  const std::uint32_t* words;
+  std::size_t count;
+  StorageLayout& L;
   std::size_t pos = 0;
-  // Records a field of `n` bits at the cursor and returns its start.
-  auto take = [&](std::string name, int n, int closure = -1, int basis = -1) -> std::size_t {
+
+  /// Records a field of `n` bits at the cursor and returns its start.
+  std::size_t take(std::string name, int n, int closure = -1, int basis = -1) {
     if (pos + static_cast<std::size_t>(n) > count * 32)
       throw std::runtime_error(fmt::format("unpackMaterial: field '{}' runs past the {} words of the stream", name, count));
     const std::size_t start = pos;
@@ -455,13 +483,98 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
     L.fields.push_back({std::move(name), n, std::string(), closure, basis});
     L.totalBits += n;
     return start;
-  };
-  auto field = [&](std::string name, int n, int closure = -1, int basis = -1) -> std::uint32_t {
+  }
+  std::uint32_t field(std::string name, int n, int closure = -1, int basis = -1) {
     return readBits(words, count, take(std::move(name), n, closure, basis), n);
-  };
+  }
+};
+
+/// Closure i's layout from its header (several closures) or the material header (one).
+ClosureLayout unpackClosureHeader(FieldReader& r, int i, std::uint32_t header, bool multi, int basisCount,
+                                  std::uint32_t& feats, std::uint32_t& sss) {
+  ClosureLayout c;
+  if (multi) {
+    const std::uint32_t h = r.field(fmt::format("closure{}.", i) + "header", bits::kClosureHeader, i);
+    c.basis = static_cast<int>(h & 7u);
+    c.isTop = (h >> 3) & 1u;
+    feats = (h >> 4) & 0xffu;
+    sss = (h >> 12) & 3u;
+    c.extraInterfaces = static_cast<int>((h >> 14) & 3u);
+    if (c.basis >= basisCount)
+      throw std::runtime_error(fmt::format("unpackMaterial: closure {} uses basis {} of {}", i, c.basis, basisCount));
+  } else {
+    c.basis = 0;
+    c.isTop = true;
+    feats = (header >> 2) & 0x7fu;
+    sss = (header >> 10) & 3u;
+  }
+  c.storesWeight = feats & kClosureWeight;
+  c.storesCoverageAbove = feats & kClosureCoverageAbove;
+  c.storedFeatures = featuresFromHeader(feats, sss);
+  return c;
+}
+
+/// The glint field (writeGlint's parts) starting at bit `start`.
+void unpackGlint(const std::uint32_t* words, std::size_t count, std::size_t start, ClosureValues& v) {
+  auto part = [&](std::size_t off, int n) { return readBits(words, count, start + off, n); };
+  v.glintValue = dequantizeUnorm(part(0, 8), 8);
+  v.glintUv = {std::bit_cast<float>(part(8, 32)), std::bit_cast<float>(part(40, 32))};
+  const std::uint32_t dx = part(72, 32), dy = part(104, 32);
+  v.glintUvDerivatives = {halfToFloat(static_cast<std::uint16_t>(dx & 0xffffu)),
+                          halfToFloat(static_cast<std::uint16_t>(dx >> 16)),
+                          halfToFloat(static_cast<std::uint16_t>(dy & 0xffffu)),
+                          halfToFloat(static_cast<std::uint16_t>(dy >> 16))};
+}
+
+/// Closure i's values: its header, then each field its features store.
+void unpackClosure(FieldReader& r, int i, std::uint32_t header, bool multi, int basisCount, UnpackedMaterial& out) {
+  const std::string p = fmt::format("closure{}.", i);
+  std::uint32_t feats = 0, sss = 0;
+  const ClosureLayout c = unpackClosureHeader(r, i, header, multi, basisCount, feats, sss);
+  ClosureValues v;
+  v.features = feats;
+  v.isTop = c.isTop;
+  v.basis = c.basis;
+  v.sssType = sss;
+  v.extraInterfaces = static_cast<std::uint32_t>(c.extraInterfaces);
+  if (!c.isTop) v.coverageAbove = 1;  // below layers of static coverage 1 unless stored
+
+  v.diffuseAlbedo = dequantizeColor(r.field(p + "diffuse_albedo", bits::kColor, i));
+  v.f0 = dequantizeColor(r.field(p + "f0", bits::kColor, i));
+  v.roughness = dequantizeUnorm(r.field(p + "roughness", bits::kRoughness, i), 8);
+  if (c.storesWeight) v.weight = dequantizeUnorm(r.field(p + "weight", bits::kGreyWeight, i), 8);
+  if (!c.isTop) v.topTransmittance = dequantizeColor(r.field(p + "top_transmittance", bits::kColor, i));
+  if (c.storesCoverageAbove) v.coverageAbove = dequantizeUnorm(r.field(p + "coverage_above", bits::kCoverageAbove, i), 8);
+  if (feats & kClosureF90) v.f90 = dequantizeColor(r.field(p + "f90", bits::kColor, i));
+  if (sss != kSssTypeNone) dequantizeSss(r.field(p + "sss", bits::kSss, i), v.sssMfp, v.sssPhaseAnisotropy);
+  if (feats & kClosureHaze) {
+    const std::uint32_t h = r.field(p + "haze", bits::kHaze, i);
+    v.secondRoughness = dequantizeUnorm(h & 0xffu, 8);
+    v.secondRoughnessWeight = dequantizeUnorm(h >> 8, 8);
+  }
+  if (feats & kClosureFuzz) {
+    const std::uint32_t z = r.field(p + "fuzz", bits::kFuzz, i);
+    v.fuzzAmount = dequantizeUnorm(z & 0x3fu, 6);
+    v.fuzzColor = dequantizeColor((z >> 6) & 0xfffffu);
+    v.fuzzRoughness = dequantizeUnorm(z >> 26, 6);
+  }
+  if (feats & kClosureAnisotropy) v.anisotropy = dequantizeSnorm(r.field(p + "anisotropy", bits::kAnisotropy, i), 8);
+  if (feats & kClosureSpecularProfile)
+    v.specularProfile = r.field(p + "specular_profile", bits::kSpecularProfile, i) + 1;
+  if (feats & kClosureGlint) unpackGlint(r.words, r.count, r.take(p + "glint", bits::kGlint, i), v);
+  r.L.closures.push_back(c);
+  out.closures.push_back(v);
+}
+
+}  // namespace
+
+UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, std::uint32_t topLayer) {
+  UnpackedMaterial out;
+  StorageLayout& L = out.layout;
+  FieldReader r{words, count, L};
 
   out.topLayer = unpackTopLayer(topLayer);
-  const std::uint32_t header = field("header", bits::kHeader);
+  const std::uint32_t header = r.field("header", bits::kHeader);
   out.cls = static_cast<LayoutClass>(header & 3u);
   L.layoutClass = out.cls;
   const bool multi = (header & packfmt::kMultiClosureHeaderBit) != 0;
@@ -474,73 +587,7 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
       throw std::runtime_error(fmt::format("unpackMaterial: basis count {} (1 to 8)", basisCount));
   }
   L.basisCount = basisCount;
-
-  for (int i = 0; i < closureCount; ++i) {
-    const std::string p = fmt::format("closure{}.", i);
-    ClosureValues v;
-    ClosureLayout c;
-    std::uint32_t feats = 0, sss = 0;
-    if (multi) {
-      const std::uint32_t h = field(p + "header", bits::kClosureHeader, i);
-      c.basis = static_cast<int>(h & 7u);
-      c.isTop = (h >> 3) & 1u;
-      feats = (h >> 4) & 0xffu;
-      sss = (h >> 12) & 3u;
-      c.extraInterfaces = static_cast<int>((h >> 14) & 3u);
-      if (c.basis >= basisCount)
-        throw std::runtime_error(fmt::format("unpackMaterial: closure {} uses basis {} of {}", i, c.basis, basisCount));
-    } else {
-      c.basis = 0;
-      c.isTop = true;
-      feats = (header >> 2) & 0x7fu;
-      sss = (header >> 10) & 3u;
-    }
-    c.storesWeight = feats & kClosureWeight;
-    c.storesCoverageAbove = feats & kClosureCoverageAbove;
-    c.storedFeatures = featuresFromHeader(feats, sss);
-    v.features = feats;
-    v.isTop = c.isTop;
-    v.basis = c.basis;
-    v.sssType = sss;
-    v.extraInterfaces = static_cast<std::uint32_t>(c.extraInterfaces);
-    if (!c.isTop) v.coverageAbove = 1;  // below layers of static coverage 1 unless stored
-
-    v.diffuseAlbedo = dequantizeColor(field(p + "diffuse_albedo", bits::kColor, i));
-    v.f0 = dequantizeColor(field(p + "f0", bits::kColor, i));
-    v.roughness = dequantizeUnorm(field(p + "roughness", bits::kRoughness, i), 8);
-    if (c.storesWeight) v.weight = dequantizeUnorm(field(p + "weight", bits::kGreyWeight, i), 8);
-    if (!c.isTop) v.topTransmittance = dequantizeColor(field(p + "top_transmittance", bits::kColor, i));
-    if (c.storesCoverageAbove) v.coverageAbove = dequantizeUnorm(field(p + "coverage_above", bits::kCoverageAbove, i), 8);
-    if (feats & kClosureF90) v.f90 = dequantizeColor(field(p + "f90", bits::kColor, i));
-    if (sss != kSssTypeNone) dequantizeSss(field(p + "sss", bits::kSss, i), v.sssMfp, v.sssPhaseAnisotropy);
-    if (feats & kClosureHaze) {
-      const std::uint32_t h = field(p + "haze", bits::kHaze, i);
-      v.secondRoughness = dequantizeUnorm(h & 0xffu, 8);
-      v.secondRoughnessWeight = dequantizeUnorm(h >> 8, 8);
-    }
-    if (feats & kClosureFuzz) {
-      const std::uint32_t z = field(p + "fuzz", bits::kFuzz, i);
-      v.fuzzAmount = dequantizeUnorm(z & 0x3fu, 6);
-      v.fuzzColor = dequantizeColor((z >> 6) & 0xfffffu);
-      v.fuzzRoughness = dequantizeUnorm(z >> 26, 6);
-    }
-    if (feats & kClosureAnisotropy) v.anisotropy = dequantizeSnorm(field(p + "anisotropy", bits::kAnisotropy, i), 8);
-    if (feats & kClosureSpecularProfile)
-      v.specularProfile = field(p + "specular_profile", bits::kSpecularProfile, i) + 1;
-    if (feats & kClosureGlint) {
-      const std::size_t start = take(p + "glint", bits::kGlint, i);
-      auto part = [&](std::size_t off, int n) { return readBits(words, count, start + off, n); };
-      v.glintValue = dequantizeUnorm(part(0, 8), 8);
-      v.glintUv = {std::bit_cast<float>(part(8, 32)), std::bit_cast<float>(part(40, 32))};
-      const std::uint32_t dx = part(72, 32), dy = part(104, 32);
-      v.glintUvDerivatives = {halfToFloat(static_cast<std::uint16_t>(dx & 0xffffu)),
-                              halfToFloat(static_cast<std::uint16_t>(dx >> 16)),
-                              halfToFloat(static_cast<std::uint16_t>(dy & 0xffffu)),
-                              halfToFloat(static_cast<std::uint16_t>(dy >> 16))};
-    }
-    L.closures.push_back(c);
-    out.closures.push_back(v);
-  }
+  for (int i = 0; i < closureCount; ++i) unpackClosure(r, i, header, multi, basisCount, out);
 
   bool topShare = true;
   for (const auto& c : L.closures)
@@ -553,10 +600,10 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
       if (c.basis == b && (c.storedFeatures & kFeatAnisotropy)) anisotropic = true;
     const bool elided = !multi || (b == 0 && topShare);
     BasisValues bv;
-    bv.normal = elided ? out.topLayer.normal : dequantizeNormal(field(p + "normal", bits::kNormal, -1, b));
+    bv.normal = elided ? out.topLayer.normal : dequantizeNormal(r.field(p + "normal", bits::kNormal, -1, b));
     Vec3d b0;
     orthonormalBasis(bv.normal, bv.tangent, b0);
-    if (anisotropic) bv.tangent = decodeTangentAngle(field(p + "tangent_angle", bits::kTangentAngle, -1, b), bv.normal);
+    if (anisotropic) bv.tangent = decodeTangentAngle(r.field(p + "tangent_angle", bits::kTangentAngle, -1, b), bv.normal);
     out.bases.push_back(bv);
   }
   return out;

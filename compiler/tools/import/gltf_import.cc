@@ -12,6 +12,7 @@ namespace substratec::import {
 namespace {
 
 constexpr int kRepeat = 10497;
+constexpr double kBig = 1e30;  // no upper bound on a factor
 
 std::string wrapName(int mode) {
   switch (mode) {
@@ -54,9 +55,35 @@ class MaterialReader {
                  MaterialWriter& w)
       : doc_(doc), m_(material), ptr_(std::move(pointer)), label_(std::move(label)), d_(d), w_(w) {}
 
+  /// Reads the core material, then each extension by its reader.
   bool read(GltfPbr& g);
 
  private:
+  /// An extension's reader: (extension object, its pointer, its name, into).
+  using ExtensionReader = void (MaterialReader::*)(const Json&, const std::string&, const std::string&, GltfPbr&);
+  static const std::map<std::string, ExtensionReader>& extensionReaders();
+  void readAlpha(GltfPbr& g);
+  /// pbrMetallicRoughness, the normal and occlusion textures and the emissive factor.
+  void readCore(GltfPbr& g);
+  void readEmissiveStrength(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readIor(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readSpecular(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readClearcoat(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readSheen(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readTransmission(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readVolume(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readIridescence(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readAnisotropy(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readDispersion(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readDiffuseTransmission(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readUnlit(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readCoat(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readFuzz(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  void readDiffuseRoughness(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g);
+  /// factor times the `channel` of the textureInfo ext[key] when it is given.
+  Value textured(const Value& factor, const Json& ext, const char* key, const std::string& xp, bool srgb,
+                 const char* channel);
+
   void warn(const std::string& pointer, const std::string& what) {
     d_.warning(pointer, fmt::format("material {}: {}", label_, what));
   }
@@ -278,12 +305,29 @@ Value MaterialReader::normalFrom(const Json& parent, const char* key, const std:
 }
 
 bool MaterialReader::read(GltfPbr& g) {
-  static const double kBig = 1e30;
-  const Json empty = Json::object();
-  const Json* pbr = object(m_, "pbrMetallicRoughness", ptr_);
-  const std::string pp = ptr_ + "/pbrMetallicRoughness";
-  const Json& p = pbr ? *pbr : empty;
+  readAlpha(g);
+  readCore(g);
+  const Json* exts = object(m_, "extensions", ptr_);
+  const std::string ep = ptr_ + "/extensions";
+  if (exts) {
+    for (const auto& [name, ext] : exts->items()) {
+      const std::string xp = ep + "/" + pointerToken(name);
+      if (!ext.is_object()) {
+        error(xp, "expected an object");
+        continue;
+      }
+      const auto& readers = extensionReaders();
+      if (auto r = readers.find(name); r != readers.end()) (this->*(r->second))(ext, xp, name, g);
+      else warn(xp, fmt::format("extension {} is not imported; ignored", name));
+    }
+  }
+  if (isLiteral(g.emissive, 0)) g.emissive = Value();
+  if (g.unlit && exts && exts->size() > 1)
+    warn(ep, "KHR_materials_unlit: the material is its base colour, unlit; its other extensions are ignored");
+  return ok_;
+}
 
+void MaterialReader::readAlpha(GltfPbr& g) {
   std::string alphaMode = "OPAQUE";
   if (auto a = m_.find("alphaMode"); a != m_.end()) {
     if (!a->is_string() || (*a != "OPAQUE" && *a != "MASK" && *a != "BLEND"))
@@ -294,6 +338,13 @@ bool MaterialReader::read(GltfPbr& g) {
   g.alphaCutoff = number(m_, "alphaCutoff", ptr_, 0, kBig).value_or(0.5);
   if (g.alphaMode != AlphaMode::Mask && m_.contains("alphaCutoff"))
     warn(ptr_ + "/alphaCutoff", "alphaCutoff applies to alphaMode MASK only; ignored");
+}
+
+void MaterialReader::readCore(GltfPbr& g) {
+  const Json empty = Json::object();
+  const Json* pbr = object(m_, "pbrMetallicRoughness", ptr_);
+  const std::string pp = ptr_ + "/pbrMetallicRoughness";
+  const Json& p = pbr ? *pbr : empty;
 
   // Base colour and alpha.
   const auto bc = numbers(p, "baseColorFactor", pp, 4, 0, 1);
@@ -319,132 +370,157 @@ bool MaterialReader::read(GltfPbr& g) {
     warn(ptr_ + "/occlusionTexture", "occlusionTexture: ambient occlusion is the renderer's (a Substrate material "
                                      "has no occlusion pin); ignored");
 
-  Value emissive = color(m_, "emissiveFactor", ptr_, {0, 0, 0}, 0, Kind::Switch, "emissiveFactor", kBig);
+  g.emissive = color(m_, "emissiveFactor", ptr_, {0, 0, 0}, 0, Kind::Switch, "emissiveFactor", kBig);
   const Value emissiveTex = sample(m_, "emissiveTexture", ptr_, true);
-  if (!isLiteral(emissive, 0) && !emissiveTex.is_null()) {
-    emissive = times(emissive, outputOf(emissiveTex, "rgb"));
-  }
+  if (!isLiteral(g.emissive, 0) && !emissiveTex.is_null()) g.emissive = times(g.emissive, outputOf(emissiveTex, "rgb"));
+}
 
-  const Json* exts = object(m_, "extensions", ptr_);
-  const std::string ep = ptr_ + "/extensions";
-  if (exts) {
-    for (const auto& [name, ext] : exts->items()) {
-      const std::string xp = ep + "/" + pointerToken(name);
-      if (!ext.is_object()) {
-        error(xp, "expected an object");
-        continue;
-      }
-      if (name == "KHR_materials_emissive_strength") {
-        const Value strength = scalar(ext, "emissiveStrength", xp, 1, 0, kBig, Kind::Plain, name + ".emissiveStrength");
-        if (!isLiteral(emissive, 0)) emissive = mul(emissive, strength);
-      } else if (name == "KHR_materials_ior") {
-        g.ior = scalar(ext, "ior", xp, 1.5, 0, kBig, Kind::Plain, name + ".ior: index of refraction of the dielectric");
-        if (g.ior.is_number() && g.ior.get<double>() == 1.5 && !ext.contains("ior")) g.ior = Value();
-      } else if (name == "KHR_materials_specular") {
-        g.specular = scalar(ext, "specularFactor", xp, 1, 0, 1, Kind::Switch, name + ".specularFactor");
-        if (const Value t = sample(ext, "specularTexture", xp, false); !t.is_null()) g.specular = times(g.specular, outputOf(t, "a"));
-        g.specularColor = color(ext, "specularColorFactor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".specularColorFactor", kBig);
-        if (const Value t = sample(ext, "specularColorTexture", xp, true); !t.is_null())
-          g.specularColor = times(g.specularColor, outputOf(t, "rgb"));
-      } else if (name == "KHR_materials_clearcoat") {
-        g.clearcoat = scalar(ext, "clearcoatFactor", xp, 0, 0, 1, Kind::Switch, name + ".clearcoatFactor");
-        if (const Value t = sample(ext, "clearcoatTexture", xp, false); !t.is_null()) g.clearcoat = times(g.clearcoat, outputOf(t, "r"));
-        g.clearcoatRoughness = scalar(ext, "clearcoatRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".clearcoatRoughnessFactor");
-        if (const Value t = sample(ext, "clearcoatRoughnessTexture", xp, false); !t.is_null())
-          g.clearcoatRoughness = times(g.clearcoatRoughness, outputOf(t, "g"));
-        g.clearcoatNormal = normalFrom(ext, "clearcoatNormalTexture", xp);
-      } else if (name == "KHR_materials_sheen") {
-        g.sheenColor = color(ext, "sheenColorFactor", xp, {0, 0, 0}, 0, Kind::Switch, name + ".sheenColorFactor");
-        if (const Value t = sample(ext, "sheenColorTexture", xp, true); !t.is_null())
-          g.sheenColor = times(g.sheenColor, outputOf(t, "rgb"));
-        g.sheenRoughness = scalar(ext, "sheenRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".sheenRoughnessFactor");
-        if (const Value t = sample(ext, "sheenRoughnessTexture", xp, false); !t.is_null())
-          g.sheenRoughness = times(g.sheenRoughness, outputOf(t, "a"));
-      } else if (name == "KHR_materials_transmission") {
-        g.transmission = scalar(ext, "transmissionFactor", xp, 0, 0, 1, Kind::Switch, name + ".transmissionFactor");
-        if (const Value t = sample(ext, "transmissionTexture", xp, false); !t.is_null())
-          g.transmission = times(g.transmission, outputOf(t, "r"));
-        if (!isLiteral(g.transmission, 0))
-          warn(xp, name + ": " + kTransmissionNote);
-      } else if (name == "KHR_materials_volume") {
-        g.thickness = scalar(ext, "thicknessFactor", xp, 0, 0, kBig, Kind::Plain, name + ".thicknessFactor (metres)");
-        if (const Value t = sample(ext, "thicknessTexture", xp, false); !t.is_null()) g.thickness = times(g.thickness, outputOf(t, "g"));
-        g.attenuationDistance = number(ext, "attenuationDistance", xp, 0, kBig).value_or(0);
-        g.attenuationColor = color(ext, "attenuationColor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".attenuationColor");
-      } else if (name == "KHR_materials_iridescence") {
-        g.iridescence = scalar(ext, "iridescenceFactor", xp, 0, 0, 1, Kind::Switch, name + ".iridescenceFactor");
-        if (const Value t = sample(ext, "iridescenceTexture", xp, false); !t.is_null()) g.iridescence = times(g.iridescence, outputOf(t, "r"));
-        g.iridescenceIor = scalar(ext, "iridescenceIor", xp, 1.3, 1, 5, Kind::Plain, name + ".iridescenceIor");
-        const Value hi = scalar(ext, "iridescenceThicknessMaximum", xp, 400, 0, kBig, Kind::Plain,
-                                name + ".iridescenceThicknessMaximum (nanometres)");
-        if (const Value t = sample(ext, "iridescenceThicknessTexture", xp, false); !t.is_null()) {
-          const Value lo = scalar(ext, "iridescenceThicknessMinimum", xp, 100, 0, kBig, Kind::Plain,
-                                  name + ".iridescenceThicknessMinimum (nanometres)");
-          g.iridescenceThickness = vlerp(lo, hi, outputOf(t, "g"));
-        } else {
-          g.iridescenceThickness = hi;
-        }
-      } else if (name == "KHR_materials_anisotropy") {
-        g.anisotropyStrength = scalar(ext, "anisotropyStrength", xp, 0, 0, 1, Kind::Switch, name + ".anisotropyStrength");
-        g.anisotropyRotation = number(ext, "anisotropyRotation", xp, -kBig, kBig).value_or(0);
-        if (const Value t = sample(ext, "anisotropyTexture", xp, false); !t.is_null()) {
-          g.anisotropyStrength = times(g.anisotropyStrength, outputOf(t, "b"));
-          g.anisotropyDirection = sub(mul(swizzle(outputOf(t, "rgb"), "xy"), 2.0), 1.0);
-        }
-      } else if (name == "KHR_materials_dispersion") {
-        if (number(ext, "dispersion", xp, 0, kBig).value_or(0) > 0)
-          warn(xp, name + ": dispersion (an IOR per wavelength) is not represented; one IOR for every colour");
-      } else if (name == "KHR_materials_diffuse_transmission") {
-        g.diffuseTransmission = scalar(ext, "diffuseTransmissionFactor", xp, 0, 0, 1, Kind::Switch, name + ".diffuseTransmissionFactor");
-        if (const Value t = sample(ext, "diffuseTransmissionTexture", xp, false); !t.is_null())
-          g.diffuseTransmission = times(g.diffuseTransmission, outputOf(t, "a"));
-        g.diffuseTransmissionColor = color(ext, "diffuseTransmissionColorFactor", xp, {1, 1, 1}, 1, Kind::Switch,
-                                           name + ".diffuseTransmissionColorFactor");
-        if (const Value t = sample(ext, "diffuseTransmissionColorTexture", xp, true); !t.is_null())
-          g.diffuseTransmissionColor =
-              times(g.diffuseTransmissionColor, outputOf(t, "rgb"));
-        if (!isLiteral(g.diffuseTransmission, 0))
-          warn(xp, name + ": light diffusely transmitted through a thin surface is approximated by wrap lighting "
-                          "(sss_type wrap, light reaching past the horizon)");
-      } else if (name == "KHR_materials_unlit") {
-        g.unlit = true;
-      } else if (name == "KHR_materials_coat") {
-        g.coat = scalar(ext, "coatFactor", xp, 0, 0, 1, Kind::Switch, name + ".coatFactor");
-        if (const Value t = sample(ext, "coatTexture", xp, false); !t.is_null()) g.coat = times(g.coat, outputOf(t, "r"));
-        g.coatRoughness = scalar(ext, "coatRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".coatRoughnessFactor");
-        if (const Value t = sample(ext, "coatRoughnessTexture", xp, false); !t.is_null()) g.coatRoughness = times(g.coatRoughness, outputOf(t, "g"));
-        g.coatIor = scalar(ext, "coatIor", xp, 1.5, 0, kBig, Kind::Plain, name + ".coatIor");
-        g.coatColor = color(ext, "coatColorFactor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".coatColorFactor");
-        if (const Value t = sample(ext, "coatColorTexture", xp, true); !t.is_null())
-          g.coatColor = times(g.coatColor, outputOf(t, "rgb"));
-        g.coatNormal = normalFrom(ext, "coatNormalTexture", xp);
-        g.coatAnisotropyStrength = scalar(ext, "coatAnisotropyStrength", xp, 0, 0, 1, Kind::Switch, name + ".coatAnisotropyStrength");
-        g.coatAnisotropyRotation = number(ext, "coatAnisotropyRotation", xp, -kBig, kBig).value_or(0);
-        if (ext.contains("coatAnisotropyTexture"))
-          warn(xp + "/coatAnisotropyTexture", name + ": a textured coat anisotropy direction is not imported; the "
-                                                     "factors alone are used");
-        if (number(ext, "coatDarkeningFactor", xp, 0, 1).value_or(1) > 0 && !isLiteral(g.coat, 0))
-          warn(xp, name + ": coat darkening (light trapped under the coat by internal reflection) is not modelled; "
-                          "the base is seen through the coat's transmittance only");
-      } else if (name == "KHR_materials_fuzz") {
-        g.fuzz = scalar(ext, "fuzzFactor", xp, 0, 0, 1, Kind::Switch, name + ".fuzzFactor");
-        if (const Value t = sample(ext, "fuzzTexture", xp, false); !t.is_null()) g.fuzz = times(g.fuzz, outputOf(t, "r"));
-        g.fuzzColor = color(ext, "fuzzColorFactor", xp, {1, 1, 1}, 1, Kind::Plain, name + ".fuzzColorFactor");
-        if (const Value t = sample(ext, "fuzzColorTexture", xp, true); !t.is_null()) g.fuzzColor = times(g.fuzzColor, outputOf(t, "rgb"));
-        g.fuzzRoughness = scalar(ext, "fuzzRoughnessFactor", xp, 0.5, 0, 1, Kind::Plain, name + ".fuzzRoughnessFactor");
-        if (const Value t = sample(ext, "fuzzRoughnessTexture", xp, false); !t.is_null()) g.fuzzRoughness = times(g.fuzzRoughness, outputOf(t, "a"));
-      } else if (name == "KHR_materials_diffuse_roughness") {
-        if (number(ext, "diffuseRoughnessFactor", xp, 0, 1).value_or(0) > 0 || ext.contains("diffuseRoughnessTexture"))
-          warn(xp, name + ": a slab's diffuse roughness is its specular roughness; the diffuse roughness is ignored");
-      } else {
-        warn(xp, fmt::format("extension {} is not imported; ignored", name));
-      }
-    }
+Value MaterialReader::textured(const Value& factor, const Json& ext, const char* key, const std::string& xp, bool srgb,
+                               const char* channel) {
+  const Value t = sample(ext, key, xp, srgb);
+  return t.is_null() ? factor : times(factor, outputOf(t, channel));
+}
+
+const std::map<std::string, MaterialReader::ExtensionReader>& MaterialReader::extensionReaders() {
+  static const std::map<std::string, ExtensionReader> table = {
+      {"KHR_materials_emissive_strength", &MaterialReader::readEmissiveStrength},
+      {"KHR_materials_ior", &MaterialReader::readIor},
+      {"KHR_materials_specular", &MaterialReader::readSpecular},
+      {"KHR_materials_clearcoat", &MaterialReader::readClearcoat},
+      {"KHR_materials_sheen", &MaterialReader::readSheen},
+      {"KHR_materials_transmission", &MaterialReader::readTransmission},
+      {"KHR_materials_volume", &MaterialReader::readVolume},
+      {"KHR_materials_iridescence", &MaterialReader::readIridescence},
+      {"KHR_materials_anisotropy", &MaterialReader::readAnisotropy},
+      {"KHR_materials_dispersion", &MaterialReader::readDispersion},
+      {"KHR_materials_diffuse_transmission", &MaterialReader::readDiffuseTransmission},
+      {"KHR_materials_unlit", &MaterialReader::readUnlit},
+      {"KHR_materials_coat", &MaterialReader::readCoat},
+      {"KHR_materials_fuzz", &MaterialReader::readFuzz},
+      {"KHR_materials_diffuse_roughness", &MaterialReader::readDiffuseRoughness}};
+  return table;
+}
+
+void MaterialReader::readEmissiveStrength(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  const Value strength = scalar(ext, "emissiveStrength", xp, 1, 0, kBig, Kind::Plain, name + ".emissiveStrength");
+  if (!isLiteral(g.emissive, 0)) g.emissive = mul(g.emissive, strength);
+}
+
+void MaterialReader::readIor(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.ior = scalar(ext, "ior", xp, 1.5, 0, kBig, Kind::Plain, name + ".ior: index of refraction of the dielectric");
+  if (g.ior.is_number() && g.ior.get<double>() == 1.5 && !ext.contains("ior")) g.ior = Value();
+}
+
+void MaterialReader::readSpecular(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.specular = textured(scalar(ext, "specularFactor", xp, 1, 0, 1, Kind::Switch, name + ".specularFactor"), ext,
+                        "specularTexture", xp, false, "a");
+  g.specularColor = textured(color(ext, "specularColorFactor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".specularColorFactor", kBig),
+                             ext, "specularColorTexture", xp, true, "rgb");
+}
+
+void MaterialReader::readClearcoat(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.clearcoat = textured(scalar(ext, "clearcoatFactor", xp, 0, 0, 1, Kind::Switch, name + ".clearcoatFactor"), ext,
+                         "clearcoatTexture", xp, false, "r");
+  g.clearcoatRoughness =
+      textured(scalar(ext, "clearcoatRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".clearcoatRoughnessFactor"), ext,
+               "clearcoatRoughnessTexture", xp, false, "g");
+  g.clearcoatNormal = normalFrom(ext, "clearcoatNormalTexture", xp);
+}
+
+void MaterialReader::readSheen(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.sheenColor = textured(color(ext, "sheenColorFactor", xp, {0, 0, 0}, 0, Kind::Switch, name + ".sheenColorFactor"), ext,
+                          "sheenColorTexture", xp, true, "rgb");
+  g.sheenRoughness = textured(scalar(ext, "sheenRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".sheenRoughnessFactor"),
+                              ext, "sheenRoughnessTexture", xp, false, "a");
+}
+
+void MaterialReader::readTransmission(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.transmission = textured(scalar(ext, "transmissionFactor", xp, 0, 0, 1, Kind::Switch, name + ".transmissionFactor"),
+                            ext, "transmissionTexture", xp, false, "r");
+  if (!isLiteral(g.transmission, 0)) warn(xp, name + ": " + kTransmissionNote);
+}
+
+void MaterialReader::readVolume(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.thickness = textured(scalar(ext, "thicknessFactor", xp, 0, 0, kBig, Kind::Plain, name + ".thicknessFactor (metres)"),
+                         ext, "thicknessTexture", xp, false, "g");
+  g.attenuationDistance = number(ext, "attenuationDistance", xp, 0, kBig).value_or(0);
+  g.attenuationColor = color(ext, "attenuationColor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".attenuationColor");
+}
+
+void MaterialReader::readIridescence(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.iridescence = textured(scalar(ext, "iridescenceFactor", xp, 0, 0, 1, Kind::Switch, name + ".iridescenceFactor"), ext,
+                           "iridescenceTexture", xp, false, "r");
+  g.iridescenceIor = scalar(ext, "iridescenceIor", xp, 1.3, 1, 5, Kind::Plain, name + ".iridescenceIor");
+  const Value hi = scalar(ext, "iridescenceThicknessMaximum", xp, 400, 0, kBig, Kind::Plain,
+                          name + ".iridescenceThicknessMaximum (nanometres)");
+  if (const Value t = sample(ext, "iridescenceThicknessTexture", xp, false); !t.is_null()) {
+    const Value lo = scalar(ext, "iridescenceThicknessMinimum", xp, 100, 0, kBig, Kind::Plain,
+                            name + ".iridescenceThicknessMinimum (nanometres)");
+    g.iridescenceThickness = vlerp(lo, hi, outputOf(t, "g"));
+  } else {
+    g.iridescenceThickness = hi;
   }
-  g.emissive = isLiteral(emissive, 0) ? Value() : emissive;
-  if (g.unlit && exts && exts->size() > 1)
-    warn(ep, "KHR_materials_unlit: the material is its base colour, unlit; its other extensions are ignored");
-  return ok_;
+}
+
+void MaterialReader::readAnisotropy(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.anisotropyStrength = scalar(ext, "anisotropyStrength", xp, 0, 0, 1, Kind::Switch, name + ".anisotropyStrength");
+  g.anisotropyRotation = number(ext, "anisotropyRotation", xp, -kBig, kBig).value_or(0);
+  if (const Value t = sample(ext, "anisotropyTexture", xp, false); !t.is_null()) {
+    g.anisotropyStrength = times(g.anisotropyStrength, outputOf(t, "b"));
+    g.anisotropyDirection = sub(mul(swizzle(outputOf(t, "rgb"), "xy"), 2.0), 1.0);
+  }
+}
+
+void MaterialReader::readDispersion(const Json& ext, const std::string& xp, const std::string& name, GltfPbr&) {
+  if (number(ext, "dispersion", xp, 0, kBig).value_or(0) > 0)
+    warn(xp, name + ": dispersion (an IOR per wavelength) is not represented; one IOR for every colour");
+}
+
+void MaterialReader::readDiffuseTransmission(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.diffuseTransmission = textured(scalar(ext, "diffuseTransmissionFactor", xp, 0, 0, 1, Kind::Switch,
+                                          name + ".diffuseTransmissionFactor"),
+                                   ext, "diffuseTransmissionTexture", xp, false, "a");
+  g.diffuseTransmissionColor = textured(color(ext, "diffuseTransmissionColorFactor", xp, {1, 1, 1}, 1, Kind::Switch,
+                                              name + ".diffuseTransmissionColorFactor"),
+                                        ext, "diffuseTransmissionColorTexture", xp, true, "rgb");
+  if (!isLiteral(g.diffuseTransmission, 0))
+    warn(xp, name + ": light diffusely transmitted through a thin surface is approximated by wrap lighting "
+                    "(sss_type wrap, light reaching past the horizon)");
+}
+
+void MaterialReader::readUnlit(const Json&, const std::string&, const std::string&, GltfPbr& g) { g.unlit = true; }
+
+void MaterialReader::readCoat(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.coat = textured(scalar(ext, "coatFactor", xp, 0, 0, 1, Kind::Switch, name + ".coatFactor"), ext, "coatTexture", xp,
+                    false, "r");
+  g.coatRoughness = textured(scalar(ext, "coatRoughnessFactor", xp, 0, 0, 1, Kind::Plain, name + ".coatRoughnessFactor"),
+                             ext, "coatRoughnessTexture", xp, false, "g");
+  g.coatIor = scalar(ext, "coatIor", xp, 1.5, 0, kBig, Kind::Plain, name + ".coatIor");
+  g.coatColor = textured(color(ext, "coatColorFactor", xp, {1, 1, 1}, 1, Kind::Switch, name + ".coatColorFactor"), ext,
+                         "coatColorTexture", xp, true, "rgb");
+  g.coatNormal = normalFrom(ext, "coatNormalTexture", xp);
+  g.coatAnisotropyStrength = scalar(ext, "coatAnisotropyStrength", xp, 0, 0, 1, Kind::Switch, name + ".coatAnisotropyStrength");
+  g.coatAnisotropyRotation = number(ext, "coatAnisotropyRotation", xp, -kBig, kBig).value_or(0);
+  if (ext.contains("coatAnisotropyTexture"))
+    warn(xp + "/coatAnisotropyTexture", name + ": a textured coat anisotropy direction is not imported; the "
+                                               "factors alone are used");
+  if (number(ext, "coatDarkeningFactor", xp, 0, 1).value_or(1) > 0 && !isLiteral(g.coat, 0))
+    warn(xp, name + ": coat darkening (light trapped under the coat by internal reflection) is not modelled; "
+                    "the base is seen through the coat's transmittance only");
+}
+
+void MaterialReader::readFuzz(const Json& ext, const std::string& xp, const std::string& name, GltfPbr& g) {
+  g.fuzz = textured(scalar(ext, "fuzzFactor", xp, 0, 0, 1, Kind::Switch, name + ".fuzzFactor"), ext, "fuzzTexture", xp,
+                    false, "r");
+  g.fuzzColor = textured(color(ext, "fuzzColorFactor", xp, {1, 1, 1}, 1, Kind::Plain, name + ".fuzzColorFactor"), ext,
+                         "fuzzColorTexture", xp, true, "rgb");
+  g.fuzzRoughness = textured(scalar(ext, "fuzzRoughnessFactor", xp, 0.5, 0, 1, Kind::Plain, name + ".fuzzRoughnessFactor"),
+                             ext, "fuzzRoughnessTexture", xp, false, "a");
+}
+
+void MaterialReader::readDiffuseRoughness(const Json& ext, const std::string& xp, const std::string& name, GltfPbr&) {
+  if (number(ext, "diffuseRoughnessFactor", xp, 0, 1).value_or(0) > 0 || ext.contains("diffuseRoughnessTexture"))
+    warn(xp, name + ": a slab's diffuse roughness is its specular roughness; the diffuse roughness is ignored");
 }
 
 }  // namespace

@@ -21,31 +21,8 @@ RoughnessAnisotropy anisotropic(MaterialWriter& w, const std::string& prefix, co
   return ra;
 }
 
-}  // namespace
-
-LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
-  LayeredSurface s;
-  const Value baseColor = namedValue(w, "base_color", g.baseColor.is_null() ? literal3(1, 1, 1) : g.baseColor);
-  s.baseColor = baseColor;
-  s.metallic = g.metallic.is_null() ? Value(1.0) : g.metallic;
-  s.roughness = g.roughness.is_null() ? Value(1.0) : g.roughness;
-  s.normal = g.normal;
-
-  if (g.unlit) {
-    // KHR_materials_unlit: the base colour is the radiance; nothing reflects.
-    s.metallic = Value();
-    s.diffuseColor = 0.0;
-    s.specularF0 = 0.0;
-    s.specularF90 = 0.0;
-    s.roughness = 1.0;
-    s.normal = Value();
-    s.emissive = baseColor;
-    s.opacity = g.alpha;
-    s.alphaMode = g.alphaMode;
-    s.alphaCutoff = g.alphaCutoff;
-    return s;
-  }
-
+/// The dielectric Fresnel and the specular anisotropy.
+void gltfSpecular(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
   // Dielectric Fresnel (KHR_materials_ior, KHR_materials_specular):
   //   F0 = min(((ior − 1)/(ior + 1))² · specularColor, 1) · specular,  F90 = specular.
   if (!g.ior.is_null() || !off(g.specular, 1) || !off(g.specularColor, 1)) {
@@ -78,7 +55,10 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
       s.tangent = vnormalize(combine({tx, ty, 0.0}));
     }
   }
+}
 
+/// Sheen (KHR_materials_sheen) or fuzz (KHR_materials_fuzz) as the slab's fuzz.
+void gltfFuzz(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
   // Sheen: Charlie lobe over the base with albedo scaling
   //   fuzz_amount = max(sheenColor), fuzz_color = sheenColor / fuzz_amount.
   if (!off(g.sheenColor, 0)) {
@@ -99,6 +79,61 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
     s.fuzzColor = g.fuzzColor.is_null() ? Value(1.0) : g.fuzzColor;
     s.fuzzRoughness = g.fuzzRoughness.is_null() ? Value(0.5) : g.fuzzRoughness;
   }
+}
+
+/// KHR_materials_clearcoat, then KHR_materials_coat over it.
+void gltfCoat(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
+  // Clearcoat: a colourless dielectric (IOR 1.5) on top, its own roughness and normal.
+  if (!off(g.clearcoat, 0)) {
+    s.coatWeight = g.clearcoat;
+    s.coatF0 = 0.04;
+    s.coatRoughness = g.clearcoatRoughness.is_null() ? Value(0.0) : g.clearcoatRoughness;
+    s.coatNormal = g.clearcoatNormal;
+  }
+  // KHR_materials_coat: the same with its IOR, an absorbing colour (one pass
+  // each way: per-pass transmittance sqrt(coatColor)) and anisotropy.
+  if (!off(g.coat, 0)) {
+    s.coatWeight = g.coat;
+    s.coatF0 = iorToF0Value(g.coatIor.is_null() ? Value(1.5) : g.coatIor);
+    s.coatRoughness = g.coatRoughness.is_null() ? Value(0.0) : g.coatRoughness;
+    s.coatNormal = g.coatNormal;
+    if (!off(g.coatColor, 1)) s.coatTransmittance = vsqrt(g.coatColor);
+    if (!off(g.coatAnisotropyStrength, 0)) {
+      const RoughnessAnisotropy ra = anisotropic(w, "coat_", s.coatRoughness, g.coatAnisotropyStrength);
+      s.coatRoughness = ra.roughness;
+      s.coatAnisotropy = ra.anisotropy;
+      s.coatTangent = rotatedTangent(g.coatAnisotropyRotation);
+    }
+  }
+}
+
+}  // namespace
+
+LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
+  LayeredSurface s;
+  const Value baseColor = namedValue(w, "base_color", g.baseColor.is_null() ? literal3(1, 1, 1) : g.baseColor);
+  s.baseColor = baseColor;
+  s.metallic = g.metallic.is_null() ? Value(1.0) : g.metallic;
+  s.roughness = g.roughness.is_null() ? Value(1.0) : g.roughness;
+  s.normal = g.normal;
+
+  if (g.unlit) {
+    // KHR_materials_unlit: the base colour is the radiance; nothing reflects.
+    s.metallic = Value();
+    s.diffuseColor = 0.0;
+    s.specularF0 = 0.0;
+    s.specularF90 = 0.0;
+    s.roughness = 1.0;
+    s.normal = Value();
+    s.emissive = baseColor;
+    s.opacity = g.alpha;
+    s.alphaMode = g.alphaMode;
+    s.alphaCutoff = g.alphaCutoff;
+    return s;
+  }
+
+  gltfSpecular(g, w, s);
+  gltfFuzz(g, w, s);
 
   // Thin-film iridescence: F0 = vlerp(F0, thin_film(F0, F90, d, ior).f0, factor), d in metres.
   if (!off(g.iridescence, 0)) {
@@ -128,28 +163,7 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
     s.diffuseColor = vlerp(baseColor, color, mul(g.diffuseTransmission, 0.5));
   }
 
-  // Clearcoat: a colourless dielectric (IOR 1.5) on top, its own roughness and normal.
-  if (!off(g.clearcoat, 0)) {
-    s.coatWeight = g.clearcoat;
-    s.coatF0 = 0.04;
-    s.coatRoughness = g.clearcoatRoughness.is_null() ? Value(0.0) : g.clearcoatRoughness;
-    s.coatNormal = g.clearcoatNormal;
-  }
-  // KHR_materials_coat: the same with its IOR, an absorbing colour (one pass
-  // each way: per-pass transmittance sqrt(coatColor)) and anisotropy.
-  if (!off(g.coat, 0)) {
-    s.coatWeight = g.coat;
-    s.coatF0 = iorToF0Value(g.coatIor.is_null() ? Value(1.5) : g.coatIor);
-    s.coatRoughness = g.coatRoughness.is_null() ? Value(0.0) : g.coatRoughness;
-    s.coatNormal = g.coatNormal;
-    if (!off(g.coatColor, 1)) s.coatTransmittance = vsqrt(g.coatColor);
-    if (!off(g.coatAnisotropyStrength, 0)) {
-      const RoughnessAnisotropy ra = anisotropic(w, "coat_", s.coatRoughness, g.coatAnisotropyStrength);
-      s.coatRoughness = ra.roughness;
-      s.coatAnisotropy = ra.anisotropy;
-      s.coatTangent = rotatedTangent(g.coatAnisotropyRotation);
-    }
-  }
+  gltfCoat(g, w, s);
 
   s.emissive = g.emissive;
   s.opacity = g.alpha;

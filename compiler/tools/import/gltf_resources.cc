@@ -138,105 +138,129 @@ std::map<std::size_t, std::string> sampledImages(const Json& doc) {
 
 }  // namespace
 
-bool checkGltfResources(const Json& doc, const std::string& baseDir, std::optional<std::size_t> glbBinBytes,
-                        Diagnostics& diags) {
-  if (!doc.is_object()) return true;
-  bool ok = true;
-  int warnings = 0, unreported = 0;
-  std::set<std::string> warnedFiles;  // one warning per missing file
-  auto warn = [&](const std::string& pointer, const std::string& file, const std::string& message) {
-    if (!file.empty() && !warnedFiles.insert(file).second) return;
-    if (++warnings > kMaxResourceWarnings) {
-      ++unreported;
+namespace {
+
+/// checkGltfResources' state: the warnings given (one per missing file, at
+/// most kMaxResourceWarnings listed) and what each buffer holds.
+class ResourceCheck {
+ public:
+  ResourceCheck(const std::string& baseDir, Diagnostics& d) : baseDir_(baseDir), d_(d) {}
+  /// buffers[i]: geometry, never needed by a material; what it holds, for the images.
+  void buffer(const Json& b, std::size_t i, std::optional<std::size_t> glbBinBytes);
+  /// images[i]: an error when a material samples it and it cannot be read.
+  void image(const Json& img, std::size_t i, const Json* views, const Json* bufferArray,
+             const std::map<std::size_t, std::string>& sampled);
+  bool finish() {
+    if (unreported_ > 0) d_.warning("", fmt::format("{} more resources cannot be read (not listed)", unreported_));
+    return ok_;
+  }
+
+ private:
+  void warn(const std::string& pointer, const std::string& file, const std::string& message) {
+    if (!file.empty() && !warnedFiles_.insert(file).second) return;
+    if (++warnings_ > kMaxResourceWarnings) {
+      ++unreported_;
       return;
     }
-    diags.warning(pointer, message);
-  };
-  auto resolve = [&](const std::string& uri) -> std::pair<std::string, Readable> {
+    d_.warning(pointer, message);
+  }
+  std::pair<std::string, Readable> resolve(const std::string& uri) const {
     if (uri.rfind("data:", 0) == 0) return {"", dataUri(uri)};
     auto path = uriPath(uri);
     if (!path) return {"", {false, 0, "not a relative file path (only files next to the document are read)"}};
-    const std::string full = (std::filesystem::path(baseDir) / *path).string();
+    const std::string full = (std::filesystem::path(baseDir_) / *path).string();
     return {full, file(full)};
-  };
+  }
 
+  const std::string& baseDir_;
+  Diagnostics& d_;
+  bool ok_ = true;
+  int warnings_ = 0, unreported_ = 0;
+  std::set<std::string> warnedFiles_;  // one warning per missing file
+  std::vector<Readable> buffers_;
+};
+
+void ResourceCheck::buffer(const Json& b, std::size_t i, std::optional<std::size_t> glbBinBytes) {
+  const std::string ptr = fmt::format("/buffers/{}", i);
+  const std::uintmax_t need = b.is_object() ? countOf(b, "byteLength") : 0;
+  Readable r;
+  std::string file;
+  if (b.is_object() && b.contains("uri") && b["uri"].is_string()) {
+    std::tie(file, r) = resolve(b["uri"].get<std::string>());
+    if (!r.ok)
+      warn(ptr + "/uri", file, fmt::format("buffers[{}] {} cannot be read ({}); materials do not need geometry",
+                                           i, quoteForDiagnostic(file.empty() ? b["uri"].get<std::string>() : file, 200),
+                                           r.why));
+  } else if (i == 0 && glbBinBytes) {
+    r = {true, *glbBinBytes, ""};
+  } else {
+    r = {false, 0, "no uri and no .glb binary chunk"};
+    warn(ptr, "", fmt::format("buffers[{}] has no uri and the document has no .glb binary chunk; materials do not "
+                              "need geometry", i));
+  }
+  if (r.ok && r.bytes < need) {
+    warn(ptr + "/byteLength", file, fmt::format("buffers[{}] holds {} bytes, fewer than its byteLength {}; "
+                                                "materials do not need geometry", i, r.bytes, need));
+    r.ok = false;
+    r.why = fmt::format("its buffer holds {} of {} bytes", r.bytes, need);
+  }
+  buffers_.push_back(r);
+}
+
+void ResourceCheck::image(const Json& img, std::size_t i, const Json* views, const Json* bufferArray,
+                          const std::map<std::size_t, std::string>& sampled) {
+  if (!img.is_object()) return;  // the material reader reports it when a texture uses it
+  std::string ptr = fmt::format("/images/{}", i), file, what;
+  Readable r;
+  if (img.contains("uri") && img["uri"].is_string()) {
+    std::tie(file, r) = resolve(img["uri"].get<std::string>());
+    ptr += "/uri";
+    what = quoteForDiagnostic(file.empty() ? img["uri"].get<std::string>() : file, 200);
+  } else if (auto v = indexIn(img, "bufferView", views); v) {
+    ptr += "/bufferView";
+    what = fmt::format("in bufferViews[{}]", *v);
+    const Json& view = (*views)[*v];
+    auto b = view.is_object() ? indexIn(view, "buffer", bufferArray) : std::nullopt;
+    if (!b) r = {false, 0, "its bufferView names no buffer of the document"};
+    else if (!buffers_[*b].ok) r = {false, 0, fmt::format("buffers[{}] cannot be read", *b)};
+    else {
+      const std::uintmax_t offset = countOf(view, "byteOffset"), length = countOf(view, "byteLength");
+      r = offset <= buffers_[*b].bytes && length <= buffers_[*b].bytes - offset
+              ? Readable{true, length, ""}
+              : Readable{false, 0, fmt::format("bytes {}..{} are past the end of buffers[{}] ({} bytes)", offset,
+                                               offset + length, *b, buffers_[*b].bytes)};
+    }
+  } else {
+    r = {false, 0, "neither a uri nor a bufferView of the document"};
+    what = "(no source)";
+  }
+  if (r.ok) return;
+  if (auto s = sampled.find(i); s != sampled.end()) {
+    d_.error(ptr, fmt::format("images[{}] {} cannot be read ({}): material {} samples it", i, what, r.why, s->second));
+    ok_ = false;
+  } else {
+    warn(ptr, file, fmt::format("images[{}] {} cannot be read ({}); no material samples it", i, what, r.why));
+  }
+}
+
+}  // namespace
+
+bool checkGltfResources(const Json& doc, const std::string& baseDir, std::optional<std::size_t> glbBinBytes,
+                        Diagnostics& diags) {
+  if (!doc.is_object()) return true;
+  ResourceCheck check(baseDir, diags);
   // Buffers: geometry, never needed by a material; what each holds, for the images.
   const Json* buffers = arrayOf(doc, "buffers");
-  std::vector<Readable> bufferState;
   if (buffers)
-    for (std::size_t i = 0; i < buffers->size(); ++i) {
-      const Json& b = (*buffers)[i];
-      const std::string ptr = fmt::format("/buffers/{}", i);
-      const std::uintmax_t need = b.is_object() ? countOf(b, "byteLength") : 0;
-      Readable r;
-      std::string file;
-      if (b.is_object() && b.contains("uri") && b["uri"].is_string()) {
-        std::tie(file, r) = resolve(b["uri"].get<std::string>());
-        if (!r.ok)
-          warn(ptr + "/uri", file, fmt::format("buffers[{}] {} cannot be read ({}); materials do not need geometry",
-                                               i, quoteForDiagnostic(file.empty() ? b["uri"].get<std::string>() : file, 200),
-                                               r.why));
-      } else if (i == 0 && glbBinBytes) {
-        r = {true, *glbBinBytes, ""};
-      } else {
-        r = {false, 0, "no uri and no .glb binary chunk"};
-        warn(ptr, "", fmt::format("buffers[{}] has no uri and the document has no .glb binary chunk; materials do not "
-                                  "need geometry", i));
-      }
-      if (r.ok && r.bytes < need) {
-        warn(ptr + "/byteLength", file, fmt::format("buffers[{}] holds {} bytes, fewer than its byteLength {}; "
-                                                    "materials do not need geometry", i, r.bytes, need));
-        r.ok = false;
-        r.why = fmt::format("its buffer holds {} of {} bytes", r.bytes, need);
-      }
-      bufferState.push_back(r);
-    }
-
+    for (std::size_t i = 0; i < buffers->size(); ++i) check.buffer((*buffers)[i], i, glbBinBytes);
   // Images: needed when a material samples them.
   const Json* images = arrayOf(doc, "images");
   const Json* views = arrayOf(doc, "bufferViews");
   if (images) {
     const std::map<std::size_t, std::string> sampled = sampledImages(doc);
-    for (std::size_t i = 0; i < images->size(); ++i) {
-      const Json& img = (*images)[i];
-      if (!img.is_object()) continue;  // the material reader reports it when a texture uses it
-      std::string ptr = fmt::format("/images/{}", i), file, what;
-      Readable r;
-      if (img.contains("uri") && img["uri"].is_string()) {
-        std::tie(file, r) = resolve(img["uri"].get<std::string>());
-        ptr += "/uri";
-        what = quoteForDiagnostic(file.empty() ? img["uri"].get<std::string>() : file, 200);
-      } else if (auto v = indexIn(img, "bufferView", views); v) {
-        ptr += "/bufferView";
-        what = fmt::format("in bufferViews[{}]", *v);
-        const Json& view = (*views)[*v];
-        auto b = view.is_object() ? indexIn(view, "buffer", buffers) : std::nullopt;
-        if (!b) r = {false, 0, "its bufferView names no buffer of the document"};
-        else if (!bufferState[*b].ok) r = {false, 0, fmt::format("buffers[{}] cannot be read", *b)};
-        else {
-          const std::uintmax_t offset = countOf(view, "byteOffset"), length = countOf(view, "byteLength");
-          r = offset <= bufferState[*b].bytes && length <= bufferState[*b].bytes - offset
-                  ? Readable{true, length, ""}
-                  : Readable{false, 0, fmt::format("bytes {}..{} are past the end of buffers[{}] ({} bytes)", offset,
-                                                   offset + length, *b, bufferState[*b].bytes)};
-        }
-      } else {
-        r = {false, 0, "neither a uri nor a bufferView of the document"};
-        what = "(no source)";
-      }
-      if (r.ok) continue;
-      if (auto s = sampled.find(i); s != sampled.end()) {
-        diags.error(ptr, fmt::format("images[{}] {} cannot be read ({}): material {} samples it", i, what, r.why,
-                                     s->second));
-        ok = false;
-      } else {
-        warn(ptr, file, fmt::format("images[{}] {} cannot be read ({}); no material samples it", i, what, r.why));
-      }
-    }
+    for (std::size_t i = 0; i < images->size(); ++i) check.image((*images)[i], i, views, buffers, sampled);
   }
-  if (unreported > 0)
-    diags.warning("", fmt::format("{} more resources cannot be read (not listed)", unreported));
-  return ok;
+  return check.finish();
 }
 
 }  // namespace substratec::import

@@ -47,12 +47,13 @@ Value rotatedTangent(const Value& angle) {
   return Json{{"kind", "rotation_to_tangent"}, {"angle", angle}};
 }
 
-void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
-  const bool metal = !absent(s.metallic, 0);
+namespace {
+
+/// The base's diffuse albedo, F0 and F90 (null: 1) from the metallic
+/// workflow: the metalness helper node when the dielectric is a plain grey
+/// F0 <= 0.08 (specular = F0 / 0.08), otherwise the same formulas spelled out.
+void baseReflectance(const LayeredSurface& s, MaterialWriter& w, bool metal, Value& diffuse, Value& f0, Value& f90) {
   const bool f90Given = !s.specularF90.is_null() || !s.metalF90.is_null();
-  Value diffuse, f0, f90;
-  // The metalness helper when the dielectric is a plain grey F0 <= 0.08
-  // (specular = F0 / 0.08), otherwise the same formulas spelled out.
   const auto greyF0 = literalOf(s.specularF0);
   const bool helper = metal && s.diffuseColor.is_null() &&
                       (s.specularF0.is_null() || (greyF0 && greyF0->size() == 1 && (*greyF0)[0] <= 0.08));
@@ -73,6 +74,38 @@ void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
     const Value m90 = s.metalF90.is_null() ? Value(1.0) : s.metalF90;
     f90 = metal ? vlerp(d90, m90, s.metallic) : d90;
   }
+}
+
+/// `root` under the coat slab (its presence the coat weight).
+Value coatedRoot(const LayeredSurface& s, MaterialWriter& w, const Value& root) {
+  Json coat = {{"kind", "slab"}, {"diffuse_albedo", 0}};
+  coat["f0"] = s.coatF0.is_null() ? Value(0.04) : s.coatF0;
+  coat["roughness"] = s.coatRoughness.is_null() ? Value(0.0) : s.coatRoughness;
+  if (!absent(s.coatAnisotropy, 0)) {
+    coat["anisotropy"] = s.coatAnisotropy;
+    if (!s.coatTangent.is_null()) coat["tangent"] = s.coatTangent;
+  }
+  if (!s.coatNormal.is_null()) coat["normal"] = s.coatNormal;
+  if (absent(s.coatTransmittance, 1)) {
+    coat["sss_mfp"] = 10;  // clear: a mean free path far longer than the layer
+  } else {
+    const Value medium = w.node("coat_medium", Json{{"kind", "transmittance_to_mfp"},
+                                                    {"transmittance", s.coatTransmittance},
+                                                    {"thickness", 0.0001}});
+    coat["sss_mfp"] = outputOf(medium, "mfp");
+  }
+  Value top = w.node("coat_slab", coat);
+  if (!isLiteral(s.coatWeight, 1))
+    top = w.node("coat_presence", Json{{"kind", "coverage_weight"}, {"a", top}, {"weight", s.coatWeight}});
+  return w.node("coated", Json{{"kind", "vertical"}, {"top", top}, {"base", root}, {"thickness", 0.0001}});
+}
+
+}  // namespace
+
+void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
+  const bool metal = !absent(s.metallic, 0);
+  Value diffuse, f0, f90;
+  baseReflectance(s, w, metal, diffuse, f0, f90);
   if (!absent(s.filmWeight, 0) && !s.filmThickness.is_null()) {
     Json film = {{"kind", "thin_film"}, {"f0", f0}};
     if (!f90.is_null()) film["f90"] = f90;
@@ -112,28 +145,7 @@ void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
       root = w.node("transmission_mix", Json{{"kind", "horizontal"}, {"background", root}, {"foreground", glassSlab}, {"mix", mix}});
     }
   }
-  if (!absent(s.coatWeight, 0)) {
-    Json coat = {{"kind", "slab"}, {"diffuse_albedo", 0}};
-    coat["f0"] = s.coatF0.is_null() ? Value(0.04) : s.coatF0;
-    coat["roughness"] = s.coatRoughness.is_null() ? Value(0.0) : s.coatRoughness;
-    if (!absent(s.coatAnisotropy, 0)) {
-      coat["anisotropy"] = s.coatAnisotropy;
-      if (!s.coatTangent.is_null()) coat["tangent"] = s.coatTangent;
-    }
-    if (!s.coatNormal.is_null()) coat["normal"] = s.coatNormal;
-    if (absent(s.coatTransmittance, 1)) {
-      coat["sss_mfp"] = 10;  // clear: a mean free path far longer than the layer
-    } else {
-      const Value medium = w.node("coat_medium", Json{{"kind", "transmittance_to_mfp"},
-                                                      {"transmittance", s.coatTransmittance},
-                                                      {"thickness", 0.0001}});
-      coat["sss_mfp"] = outputOf(medium, "mfp");
-    }
-    Value top = w.node("coat_slab", coat);
-    if (!isLiteral(s.coatWeight, 1))
-      top = w.node("coat_presence", Json{{"kind", "coverage_weight"}, {"a", top}, {"weight", s.coatWeight}});
-    root = w.node("coated", Json{{"kind", "vertical"}, {"top", top}, {"base", root}, {"thickness", 0.0001}});
-  }
+  if (!absent(s.coatWeight, 0)) root = coatedRoot(s, w, root);
   std::string blend = transmits ? "translucent_colored" : "opaque";
   const bool present = s.alphaMode != AlphaMode::Opaque || !absent(s.opacity, 1);
   if (present && !s.opacity.is_null()) {

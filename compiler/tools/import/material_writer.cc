@@ -120,37 +120,37 @@ Value MaterialWriter::addInput(std::string_view name, Json body) {
   return "$" + id;
 }
 
+Value MaterialWriter::describedInput(std::string_view name, Json body, const std::string& description) {
+  if (!description.empty()) body["description"] = description;
+  return addInput(name, std::move(body));
+}
+
 Value MaterialWriter::floatInput(std::string_view name, double value, std::optional<double> lo,
                                  std::optional<double> hi, const std::string& description) {
   Json b = {{"type", "float"}, {"default", value}};
   if (lo) b["min"] = *lo;
   if (hi) b["max"] = *hi;
-  if (!description.empty()) b["description"] = description;
-  return addInput(name, std::move(b));
+  return describedInput(name, std::move(b), description);
 }
 
 Value MaterialWriter::colorInput(std::string_view name, const std::vector<double>& rgb, const std::string& description) {
   Json b = {{"type", "color"}, {"default", literal(rgb)}};
-  if (!description.empty()) b["description"] = description;
-  return addInput(name, std::move(b));
+  return describedInput(name, std::move(b), description);
 }
 
 Value MaterialWriter::vec2Input(std::string_view name, double x, double y, const std::string& description) {
   Json b = {{"type", "vec2"}, {"default", Json::array({x, y})}};
-  if (!description.empty()) b["description"] = description;
-  return addInput(name, std::move(b));
+  return describedInput(name, std::move(b), description);
 }
 
 Value MaterialWriter::vec3Input(std::string_view name, const std::vector<double>& xyz, const std::string& description) {
   Json b = {{"type", "vec3"}, {"default", literal(xyz)}};
-  if (!description.empty()) b["description"] = description;
-  return addInput(name, std::move(b));
+  return describedInput(name, std::move(b), description);
 }
 
 Value MaterialWriter::textureInput(std::string_view name, bool srgb, const std::string& description) {
   Json b = {{"type", "texture2d"}, {"colorspace", srgb ? "srgb" : "linear"}};
-  if (!description.empty()) b["description"] = description;
-  return addInput(name, std::move(b));
+  return describedInput(name, std::move(b), description);
 }
 
 Value MaterialWriter::node(std::string_view wantedId, Json body) {

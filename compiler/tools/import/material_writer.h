@@ -119,6 +119,8 @@ class MaterialWriter {
 
  private:
   Value addInput(std::string_view name, Json body);
+  /// addInput with the body's "description" when `description` is not empty.
+  Value describedInput(std::string_view name, Json body, const std::string& description);
   std::string name_, description_, output_;
   Json settings_ = Json::object(), inputs_ = Json::object(), nodes_ = Json::object();
   NameSet used_;

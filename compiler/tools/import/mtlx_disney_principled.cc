@@ -12,9 +12,7 @@
 namespace substratec::import {
 
 LayeredSurface disneyPrincipled(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  auto P = [&](const char* name, const char* type, std::vector<double> def, ParamKind k = ParamKind::Plain) {
-    return v.param(n, name, type, def, k);
-  };
+  const MtlxParam P{n, v};
   LayeredSurface s;
   const Value baseColor = namedValue(w, "base_color_value", P("baseColor", "color3", {0.16, 0.16, 0.16}));
   s.baseColor = baseColor;
@@ -25,13 +23,9 @@ LayeredSurface disneyPrincipled(pugi::xml_node n, MtlxValues& v, MaterialWriter&
     s.specularF0 = mul(mul(specular, 0.08), vlerp(literal3(1, 1, 1), baseColor, specularTint));
   const Value roughness = P("roughness", "float", {0.5});
   const Value anisotropic = P("anisotropic", "float", {0}, ParamKind::Switch);
-  if (!isLiteral(anisotropic, 0)) {
-    const RoughnessAnisotropy ra = mtlxRoughnessAnisotropy(roughness, anisotropic, w, "specular_");
-    s.roughness = namedValue(w, "anisotropic_roughness", ra.roughness);
-    s.anisotropy = ra.anisotropy;
-  } else {
-    s.roughness = roughness;
-  }
+  const RoughnessAnisotropy ra = roughnessPins(roughness, anisotropic, w, "specular_");
+  s.roughness = ra.roughness;
+  s.anisotropy = ra.anisotropy;
   const Value sheen = P("sheen", "float", {0}, ParamKind::Switch);
   if (!isLiteral(sheen, 0)) {
     s.fuzzAmount = sheen;

@@ -8,12 +8,8 @@
 namespace substratec::import {
 
 LayeredSurface mtlxGltfPbr(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  auto P = [&](const char* name, const char* type, std::vector<double> def, ParamKind k = ParamKind::Plain) {
-    return v.param(n, name, type, def, k);
-  };
-  auto C = [&](const char* name, const char* type, std::vector<double> def) {
-    return v.constant(n, name, type, def).value_or(def);
-  };
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
   GltfPbr g;
   g.baseColor = P("base_color", "color3", {1, 1, 1});
   g.metallic = P("metallic", "float", {1}, ParamKind::Switch);

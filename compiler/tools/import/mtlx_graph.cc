@@ -22,22 +22,20 @@ std::string str(pugi::xml_node n, const char* attr) { return n.attribute(attr).a
 bool isColor(const std::string& type) { return type == "color3" || type == "color4"; }
 
 /// Procedural nodes: no value node and no constant to fold; baked into a texture.
-bool isProcedural(const std::string& kind) {
-  static const char* const kinds[] = {"noise2d", "noise3d", "fractal2d", "fractal3d", "cellnoise2d", "cellnoise3d",
+const char* const kProceduralKinds[] = {"noise2d", "noise3d", "fractal2d", "fractal3d", "cellnoise2d", "cellnoise3d",
                                       "worleynoise2d", "worleynoise3d", "unifiednoise2d", "unifiednoise3d",
                                       "checkerboard", "randomfloat", "randomcolor", "circle", "cloverleaf",
                                       "hexagon", "grid", "crosshatch", "tiledcircles", "tiledcloverleafs",
                                       "tiledhexagons", "ramp4", "splitlr", "splittb", "ramplr", "ramptb"};
-  return std::find(std::begin(kinds), std::end(kinds), kind) != std::end(kinds);
+
+bool isProcedural(const std::string& kind) {
+  return std::find(std::begin(kProceduralKinds), std::end(kProceduralKinds), kind) != std::end(kProceduralKinds);
 }
 
 /// Nodes without a value node that are evaluated at import when constant.
-bool isFoldable(const std::string& kind) {
-  static const char* const kinds[] = {"rgbtohsv", "hsvtorgb", "sin", "cos", "tan", "asin", "acos", "atan2", "floor",
+const char* const kFoldableKinds[] = {"rgbtohsv", "hsvtorgb", "sin", "cos", "tan", "asin", "acos", "atan2", "floor",
                                       "ceil", "round", "modulo", "fract", "exp", "ln", "sign", "smoothstep",
                                       "ifgreater", "ifgreatereq", "ifequal", "rotate2d"};
-  return std::find(std::begin(kinds), std::end(kinds), kind) != std::end(kinds);
-}
 
 std::array<double, 3> rgbToHsv(double r, double g, double b) {
   const double mx = std::max({r, g, b}), mn = std::min({r, g, b}), delta = mx - mn;
@@ -403,39 +401,174 @@ Value MtlxValues::sampleOf(const Value& texture, const Value& uv) {
   return n;
 }
 
-MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind, const std::string& type,
-                                    const std::string& output, bool frozen, int depth) {
-  if (frozen) return {Value(), type};
-  auto in = [&](const char* name, const std::string& t, std::vector<double> def) {
-    return inputOf(node, name, t, def, false, depth + 1).v;
-  };
+/// One node being computed (MtlxValues::compute): the element, its kind, the
+/// type and output wanted, and the mode (frozen: constants only, where a
+/// varying input gives no value). Each node rule is a member, found by kind
+/// in rules(); it reads the node's inputs with in().
+struct MtlxValues::Call {
+  MtlxValues& self;
+  pugi::xml_node node;
+  const std::string& kind;
+  const std::string& type;
+  const std::string& output;
+  bool frozen;
+  int depth;
+
+  using Rule = Typed (Call::*)() const;
+  /// Node kind -> its rule; a kind not in it is unsupported().
+  static const std::map<std::string, Rule>& rules();
+
+  Value in(const char* name, const std::string& t, std::vector<double> def) const {
+    return self.inputOf(node, name, t, def, frozen, depth + 1).v;
+  }
+  /// The input at its constant value (interface inputs at their defaults); a
+  /// single number broadcasts to the type's components (the folds index them).
+  std::optional<std::vector<double>> constantIn(const char* name, const std::string& t, std::vector<double> def) const;
+  /// The type the document declares on input `name`, else `fallback`.
+  std::string declared(const char* name, const std::string& fallback) const {
+    pugi::xml_node i = node.find_child_by_attribute("input", "name", name);
+    return i ? str(i, "type") : fallback;
+  }
+  /// In a frozen evaluation, whether any of the values is not a constant.
+  bool varies(std::initializer_list<Value> vs) const {
+    if (!frozen) return false;
+    for (const auto& v : vs)
+      if (!literalOf(v)) return true;
+    return false;
+  }
+  Typed none(const std::string& t) const { return {Value(), t}; }
+
+  // Images (texture inputs sampled at uv arithmetic).
+  Typed image() const;
+  std::optional<Value> imageTexture() const;
+  Value imageUv() const;
+  Typed imageOutput(const Value& sample) const;
+  // Nodes without a value node: folded at import, else baked (or written out).
+  Typed procedural() const;
+  Typed fold() const;
+  std::optional<std::vector<double>> folded() const;
+  Typed hsvToRgbNode() const;
+  // Nodes with value nodes.
+  Typed constant() const;
+  Typed convert() const;
+  Typed binary() const;
+  Typed mix() const;
+  Typed clamp() const;
+  Typed invert() const;
+  Typed unaryMath() const;
+  Typed dotproduct() const;
+  Typed remap() const;
+  Typed luminance() const;
+  Typed combineN() const;
+  Typed extract() const;
+  Typed swizzleNode() const;
+  Typed normalmap() const;
+  Typed texcoord() const;
+  Typed place2d() const;
+  Typed geometric() const;
+  Typed unsupported() const;
+};
+
+namespace {
+
+/// p rotated counter-clockwise by `degrees` about the origin.
+Value rotated2(const Value& p, double degrees) {
+  const double a = degrees * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
+  return combine({sub(mul(swizzle(p, "x"), c), mul(swizzle(p, "y"), s)), add(mul(swizzle(p, "x"), s), mul(swizzle(p, "y"), c))});
+}
+
+/// A texture sample as a value of `type` (1 to 4 components).
+Value sampleAs(const Value& sample, const std::string& type) {
+  const int n = mtlxComponents(type);
+  if (n == 1) return outputOf(sample, "r");
+  if (n == 2) return swizzle(outputOf(sample, "rgb"), "xy");
+  if (n == 3) return outputOf(sample, "rgb");
+  return combine({outputOf(sample, "r"), outputOf(sample, "g"), outputOf(sample, "b"), outputOf(sample, "a")});
+}
+
+/// A tangent-space normal from a normal map's colour, its xy scaled by `scale`.
+Value unpackNormal(const Value& rgb, const Value& scale) {
+  Value n = sub(mul(rgb, 2.0), 1.0);
+  if (!isLiteral(scale, 1)) n = mul(n, combine({scale, scale, 1.0}));
+  return vnormalize(n);
+}
+
+}  // namespace
+
+const std::map<std::string, MtlxValues::Call::Rule>& MtlxValues::Call::rules() {
+  static const std::map<std::string, Rule> table = [] {
+    std::map<std::string, Rule> t = {
+        {"image", &Call::image}, {"tiledimage", &Call::image}, {"hextiledimage", &Call::image},
+        {"gltf_image", &Call::image}, {"gltf_colorimage", &Call::image}, {"gltf_normalmap", &Call::image},
+        {"constant", &Call::constant}, {"dot", &Call::constant}, {"convert", &Call::convert},
+        {"add", &Call::binary}, {"subtract", &Call::binary}, {"multiply", &Call::binary},
+        {"divide", &Call::binary}, {"min", &Call::binary}, {"max", &Call::binary}, {"power", &Call::binary},
+        {"mix", &Call::mix}, {"clamp", &Call::clamp}, {"invert", &Call::invert},
+        {"absval", &Call::unaryMath}, {"sqrt", &Call::unaryMath}, {"normalize", &Call::unaryMath},
+        {"magnitude", &Call::unaryMath}, {"dotproduct", &Call::dotproduct}, {"remap", &Call::remap},
+        {"luminance", &Call::luminance}, {"combine2", &Call::combineN}, {"combine3", &Call::combineN},
+        {"combine4", &Call::combineN}, {"extract", &Call::extract}, {"separate2", &Call::extract},
+        {"separate3", &Call::extract}, {"separate4", &Call::extract}, {"swizzle", &Call::swizzleNode},
+        {"normalmap", &Call::normalmap}, {"texcoord", &Call::texcoord}, {"place2d", &Call::place2d},
+        {"position", &Call::geometric}, {"normal", &Call::geometric}, {"tangent", &Call::geometric},
+        {"bitangent", &Call::geometric}, {"geomcolor", &Call::geometric}};
+    for (const char* k : kProceduralKinds) t.emplace(k, &Call::procedural);
+    for (const char* k : kFoldableKinds) t.emplace(k, &Call::fold);
+    return t;
+  }();
+  return table;
+}
+
+MtlxValues::Typed MtlxValues::compute(pugi::xml_node node, const std::string& kind, const std::string& type,
+                                      const std::string& output, bool frozen, int depth) {
+  const Call call{*this, node, kind, type, output, frozen, depth};
+  const auto& rules = Call::rules();
+  const auto rule = rules.find(kind);
+  return rule == rules.end() ? call.unsupported() : (call.*(rule->second))();
+}
+
+// ---- images ----
+
+MtlxValues::Typed MtlxValues::Call::image() const {
+  if (frozen) return none(type);
+  const std::optional<Value> tex = imageTexture();
+  if (!tex) return none(type);
+  return imageOutput(self.sampleOf(*tex, imageUv()));
+}
+
+/// The texture input for the node's file (followed through interface names),
+/// in its colour space; nullopt (an error) without a file.
+std::optional<Value> MtlxValues::Call::imageTexture() const {
   pugi::xml_node fileIn = node.find_child_by_attribute("input", "name", "file");
   // The file may come through an interface name.
   for (int guard = 0; fileIn && fileIn.attribute("interfacename") && guard < 8; ++guard) {
     pugi::xml_node graph = fileIn.parent().parent();
     pugi::xml_node next = graph.find_child_by_attribute("input", "name", str(fileIn, "interfacename").c_str());
-    if (!bindings_.empty() && bindings_.back().graph == graph)
-      next = bindings_.back().instance.find_child_by_attribute("input", "name", str(fileIn, "interfacename").c_str());
+    if (!self.bindings_.empty() && self.bindings_.back().graph == graph)
+      next = self.bindings_.back().instance.find_child_by_attribute("input", "name", str(fileIn, "interfacename").c_str());
     fileIn = next;
   }
   const std::string file = fileIn ? str(fileIn, "value") : "";
   if (file.empty()) {
-    error(node, "an image node without a file");
-    return {Value(), type};
+    self.error(node, "an image node without a file");
+    return std::nullopt;
   }
   const std::string cs = fileIn.attribute("colorspace") ? str(fileIn, "colorspace") : "";
   const bool srgb = cs == "srgb_texture" || cs == "srgb_displayp3";
   if (!cs.empty() && !srgb && cs != "lin_rec709" && cs != "raw" && cs != "none")
-    warn(node, fmt::format("colour space '{}' of the file is read as linear Rec.709", cs));
+    self.warn(node, fmt::format("colour space '{}' of the file is read as linear Rec.709", cs));
   for (const char* mode : {"uaddressmode", "vaddressmode"})
     if (auto a = node.find_child_by_attribute("input", "name", mode)) {
       const std::string m = str(a, "value");
       if (!m.empty() && m != "periodic")
-        warn(node, fmt::format("{} '{}': a material does not choose its sampler (the renderer binds one)", mode, m));
+        self.warn(node, fmt::format("{} '{}': a material does not choose its sampler (the renderer binds one)", mode, m));
     }
-  const Value tex = textureOf(node, file, srgb && (type != "float"));
+  return self.textureOf(node, file, srgb && (type != "float"));
+}
 
-  // Texture coordinates.
+/// The texture coordinates: the texcoord input (null: uv0) through the
+/// tiling or glTF texture transform.
+Value MtlxValues::Call::imageUv() const {
   Value uv = in("texcoord", "vector2", {});
   if (uv.is_null()) uv = Value();  // uv0
   auto uvOr0 = [&]() { return uv.is_null() ? geometry("uv0") : uv; };
@@ -450,8 +583,8 @@ MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind
       t = apply(t, in("realworldimagesize", "vector2", {1, 1}), 1, divide);
       t = apply(t, in("realworldtilesize", "vector2", {1, 1}), 1, mul);
     } else {
-      warn(node, "hexagonal tiling (random rotation, scale and offset per tile, blended) is not represented: "
-                 "sampled as a plain tiled image");
+      self.warn(node, "hexagonal tiling (random rotation, scale and offset per tile, blended) is not represented: "
+                      "sampled as a plain tiled image");
     }
     uv = t == geometry("uv0") ? Value() : t;
   } else if (kind == "gltf_image" || kind == "gltf_colorimage" || kind == "gltf_normalmap") {
@@ -461,21 +594,18 @@ MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind
       // KHR_texture_transform as MaterialX's gltf nodes apply it (about the pivot (0, 1)).
       const Value pivot = in("pivot", "vector2", {0, 1});
       Value p = mul(sub(uvOr0(), pivot), scale);
-      if (rotate != 0) {
-        const double a = rotate * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
-        p = combine({sub(mul(swizzle(p, "x"), c), mul(swizzle(p, "y"), s)), add(mul(swizzle(p, "x"), s), mul(swizzle(p, "y"), c))});
-      }
+      if (rotate != 0) p = rotated2(p, rotate);
       uv = add(add(p, pivot), offset);
     }
   }
-  const Value sample = sampleOf(tex, uv);
+  return uv;
+}
+
+/// What the image node gives from its sample: a normal, a glTF colour (times
+/// its factors) or alpha, or the sample as the node's type.
+MtlxValues::Typed MtlxValues::Call::imageOutput(const Value& sample) const {
   const Value rgb = outputOf(sample, "rgb");
-  if (kind == "gltf_normalmap") {
-    const Value s = in("scale", "float", {1});
-    Value n = sub(mul(rgb, 2.0), 1.0);
-    if (!isLiteral(s, 1)) n = mul(n, combine({s, s, 1.0}));
-    return {vnormalize(n), "vector3"};
-  }
+  if (kind == "gltf_normalmap") return {unpackNormal(rgb, in("scale", "float", {1})), "vector3"};
   if (kind == "gltf_colorimage") {
     const Value factor = in("color", "color4", {1, 1, 1, 1});
     const Value geom = in("geomcolor", "color4", {1, 1, 1, 1});
@@ -489,12 +619,7 @@ MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind
     if (!isLiteral(geom, 1)) c = mul(c, swizzle(geom, "xyz"));
     return {c, "color3"};
   }
-  Value v;
-  const int n = mtlxComponents(type);
-  if (n == 1) v = outputOf(sample, "r");
-  else if (n == 2) v = swizzle(rgb, "xy");
-  else if (n == 3) v = rgb;
-  else v = combine({outputOf(sample, "r"), outputOf(sample, "g"), outputOf(sample, "b"), outputOf(sample, "a")});
+  Value v = sampleAs(sample, type);
   if (kind == "gltf_image") {
     const Value factor = in("factor", type, {1, 1, 1, 1});
     if (!isLiteral(factor, 1)) v = mul(v, factor);
@@ -502,311 +627,315 @@ MtlxValues::Typed MtlxValues::image(pugi::xml_node node, const std::string& kind
   return {v, type};
 }
 
+// ---- nodes without a value node ----
+
 MtlxValues::Typed MtlxValues::bake(pugi::xml_node node, const std::string& kind, const std::string& type,
                                    const std::string& why) {
   const Value tex = w_.textureInput(std::string(str(node, "name")) + "_baked", false,
                                     fmt::format("bake of {} ({})", doc_.describe(node), kind));
   warn(node, fmt::format("{}: replaced by the texture input '{}' sampled at uv0 (bake the node into it)", why,
                          tex.get<std::string>().substr(1)));
-  const Value sample = sampleOf(tex, Value());
-  const int n = mtlxComponents(type);
-  if (n == 1) return {outputOf(sample, "r"), type};
-  if (n == 2) return {swizzle(outputOf(sample, "rgb"), "xy"), type};
-  if (n == 3) return {outputOf(sample, "rgb"), type};
-  return {combine({outputOf(sample, "r"), outputOf(sample, "g"), outputOf(sample, "b"), outputOf(sample, "a")}), type};
+  return {sampleAs(sampleOf(tex, Value()), type), type};
 }
 
-MtlxValues::Typed MtlxValues::bakeOrFold(pugi::xml_node node, const std::string& kind, const std::string& type,
-                                         bool frozen, int depth) {
-  // Every input at its constant value (interface inputs at their defaults).
-  // A single number broadcasts to the type's components (the folds below index them).
-  auto c = [&](const char* name, const std::string& t, std::vector<double> def) {
-    auto lit = literalOf(inputOf(node, name, t, def, true, depth + 1).v);
-    const std::size_t want = static_cast<std::size_t>(std::max(1, mtlxComponents(t)));
-    if (lit && lit->size() == 1 && want > 1) lit = std::vector<double>(want, (*lit)[0]);
-    return lit;
-  };
-  const int readsBefore = frozenReads_;
-  const int n = std::max(1, mtlxComponents(type));
-  std::optional<std::vector<double>> r;
-  auto unary = [&](const char* name, auto f) {
-    if (auto x = c(name, type, {0})) {
-      r = *x;
-      for (double& v : *r) v = f(v);
-    }
-  };
-  if (kind == "sin") unary("in", [](double x) { return std::sin(x); });
-  else if (kind == "cos") unary("in", [](double x) { return std::cos(x); });
-  else if (kind == "tan") unary("in", [](double x) { return std::tan(x); });
-  else if (kind == "asin") unary("in", [](double x) { return std::asin(std::clamp(x, -1.0, 1.0)); });
-  else if (kind == "acos") unary("in", [](double x) { return std::acos(std::clamp(x, -1.0, 1.0)); });
-  else if (kind == "floor") unary("in", [](double x) { return std::floor(x); });
-  else if (kind == "ceil") unary("in", [](double x) { return std::ceil(x); });
-  else if (kind == "round") unary("in", [](double x) { return std::round(x); });
-  else if (kind == "fract") unary("in", [](double x) { return x - std::floor(x); });
-  else if (kind == "exp") unary("in", [](double x) { return std::exp(x); });
-  else if (kind == "ln") unary("in", [](double x) { return x > 0 ? std::log(x) : 0.0; });
-  else if (kind == "sign") unary("in", [](double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; });
-  else if (kind == "rgbtohsv" || kind == "hsvtorgb") {
-    if (auto x = c("in", type, {0, 0, 0}); x && x->size() >= 3) {  // a colour (a float node type has no hue)
-      const auto h = kind == "rgbtohsv" ? rgbToHsv((*x)[0], (*x)[1], (*x)[2]) : hsvToRgb((*x)[0], (*x)[1], (*x)[2]);
-      r = std::vector<double>(h.begin(), h.end());
-      if (n == 4) r->push_back(x->size() > 3 ? (*x)[3] : 1);
-    }
-  } else if (kind == "modulo" || kind == "atan2") {
-    auto a = c("in1", type, {0}), b = c("in2", type, {kind == "modulo" ? 1.0 : 1.0});
-    if (a && b) {
-      r = std::vector<double>(n);
-      for (int i = 0; i < n; ++i) {
-        const double x = (*a)[std::min<std::size_t>(i, a->size() - 1)], y = (*b)[std::min<std::size_t>(i, b->size() - 1)];
-        (*r)[i] = kind == "atan2" ? std::atan2(x, y) : (y == 0 ? 0.0 : x - y * std::floor(x / y));
-      }
-    }
-  } else if (kind == "smoothstep") {
-    auto x = c("in", type, {0}), lo = c("low", type, {0}), hi = c("high", type, {1});
-    if (x && lo && hi) {
-      r = std::vector<double>(n);
-      for (int i = 0; i < n; ++i) {
-        const double a = (*lo)[std::min<std::size_t>(i, lo->size() - 1)], b = (*hi)[std::min<std::size_t>(i, hi->size() - 1)];
-        const double t = b == a ? ((*x)[i] >= b ? 1.0 : 0.0) : std::clamp(((*x)[i] - a) / (b - a), 0.0, 1.0);
-        (*r)[i] = t * t * (3 - 2 * t);
-      }
-    }
-  } else if (kind == "ifgreater" || kind == "ifgreatereq" || kind == "ifequal") {
-    auto a = c("value1", "float", {1}), b = c("value2", "float", {0});
-    auto x = c("in1", type, {0}), y = c("in2", type, {0});
-    if (a && b && x && y) {
-      const bool take = kind == "ifgreater" ? (*a)[0] > (*b)[0] : kind == "ifgreatereq" ? (*a)[0] >= (*b)[0] : (*a)[0] == (*b)[0];
-      r = take ? *x : *y;
-    }
-  } else if (kind == "rotate2d") {
-    auto x = c("in", "vector2", {0, 0}), a = c("amount", "float", {0});
-    if (x && a) {
-      const double t = (*a)[0] * std::numbers::pi / 180, cs = std::cos(t), sn = std::sin(t);
-      r = std::vector<double>{(*x)[0] * cs - (*x)[1] * sn, (*x)[0] * sn + (*x)[1] * cs};
-    }
-  }
+MtlxValues::Typed MtlxValues::Call::procedural() const {
+  if (frozen) return none(type);
+  return self.bake(node, kind, type, fmt::format("the procedural {} has no value node", kind));
+}
+
+std::optional<std::vector<double>> MtlxValues::Call::constantIn(const char* name, const std::string& t,
+                                                                std::vector<double> def) const {
+  auto lit = literalOf(self.inputOf(node, name, t, def, true, depth + 1).v);
+  const std::size_t want = static_cast<std::size_t>(std::max(1, mtlxComponents(t)));
+  if (lit && lit->size() == 1 && want > 1) lit = std::vector<double>(want, (*lit)[0]);
+  return lit;
+}
+
+/// A foldable node: its value at import when its inputs are constants (a
+/// warning when that freezes a material input); else hsvtorgb written out,
+/// anything else baked.
+MtlxValues::Typed MtlxValues::Call::fold() const {
+  const int readsBefore = self.frozenReads_;
+  const std::optional<std::vector<double>> r = folded();
   if (r && std::all_of(r->begin(), r->end(), [](double v) { return std::isfinite(v); })) {
-    if (!frozen && frozenReads_ > readsBefore)
-      warn(node, fmt::format("{} has no value node: evaluated at import with the material inputs it reads at "
-                             "their values (changing them at run time does not change this)", kind));
+    if (!frozen && self.frozenReads_ > readsBefore)
+      self.warn(node, fmt::format("{} has no value node: evaluated at import with the material inputs it reads at "
+                                  "their values (changing them at run time does not change this)", kind));
     return {mtlxLiteral(*r, type, ""), type};
   }
-  if (frozen) return {Value(), type};
-  if (kind == "hsvtorgb") {
-    // rgb = v · vlerp(1, saturate(|x − 6| − 3| − 1), s) with x = 6h + (6, 4, 2): the triangle wave
-    // |fract(h + k)·6 − 3| folded with abs, exact for h in [−1/3, 1] (h is clamped there).
-    const Value hsv = namedValue(w_, std::string(str(node, "name")) + "_hsv", inputOf(node, "in", "color3", {0, 0, 0}, false, depth + 1).v);
-    const Value h = vclamp(swizzle(hsv, "x"), -1.0 / 3.0, 1.0);
-    const Value x = add(mul(swizzle(h, "xxx"), 6.0), literal3(6, 4, 2));
-    const Value tri = vabs(sub(vabs(sub(x, 6.0)), 3.0));
-    const Value rgb = mul(vlerp(literal3(1, 1, 1), saturate(sub(tri, 1.0)), swizzle(hsv, "y")), swizzle(hsv, "z"));
-    warn(node, "hsvtorgb: written with abs and clamp (exact for hue in [-1/3, 1]; hue is clamped to it)");
-    return {rgb, "color3"};
-  }
-  return bake(node, kind, type, fmt::format("{} has no value node and its inputs vary", kind));
+  if (frozen) return none(type);
+  if (kind == "hsvtorgb") return hsvToRgbNode();
+  return self.bake(node, kind, type, fmt::format("{} has no value node and its inputs vary", kind));
 }
 
-MtlxValues::Typed MtlxValues::compute(pugi::xml_node node, const std::string& kind, const std::string& type,
-                                      const std::string& output, bool frozen, int depth) {
-  auto in = [&](const char* name, const std::string& t, std::vector<double> def) {
-    return inputOf(node, name, t, def, frozen, depth + 1).v;
-  };
-  auto varies = [&](std::initializer_list<Value> vs) {
-    if (!frozen) return false;
-    for (const auto& v : vs)
-      if (!literalOf(v)) return true;
-    return false;
-  };
-  const std::string T = type;
-  if (kind == "image" || kind == "tiledimage" || kind == "hextiledimage" || kind == "gltf_image" ||
-      kind == "gltf_colorimage" || kind == "gltf_normalmap")
-    return image(node, kind, type, output, frozen, depth);
-  if (isProcedural(kind)) {
-    if (frozen) return {Value(), type};
-    return bake(node, kind, type, fmt::format("the procedural {} has no value node", kind));
+/// The foldable node's value from its inputs' constants (nullopt when one varies).
+std::optional<std::vector<double>> MtlxValues::Call::folded() const {
+  static const std::map<std::string, double (*)(double)> kUnary = {
+      {"sin", [](double x) { return std::sin(x); }},
+      {"cos", [](double x) { return std::cos(x); }},
+      {"tan", [](double x) { return std::tan(x); }},
+      {"asin", [](double x) { return std::asin(std::clamp(x, -1.0, 1.0)); }},
+      {"acos", [](double x) { return std::acos(std::clamp(x, -1.0, 1.0)); }},
+      {"floor", [](double x) { return std::floor(x); }},
+      {"ceil", [](double x) { return std::ceil(x); }},
+      {"round", [](double x) { return std::round(x); }},
+      {"fract", [](double x) { return x - std::floor(x); }},
+      {"exp", [](double x) { return std::exp(x); }},
+      {"ln", [](double x) { return x > 0 ? std::log(x) : 0.0; }},
+      {"sign", [](double x) { return x > 0 ? 1.0 : x < 0 ? -1.0 : 0.0; }}};
+  const int n = std::max(1, mtlxComponents(type));
+  // Component i of a (the last one repeats).
+  auto at = [](const std::vector<double>& a, int i) { return a[std::min<std::size_t>(i, a.size() - 1)]; };
+  if (auto f = kUnary.find(kind); f != kUnary.end()) {
+    auto x = constantIn("in", type, {0});
+    if (x)
+      for (double& v : *x) v = f->second(v);
+    return x;
   }
-  if (isFoldable(kind)) return bakeOrFold(node, kind, type, frozen, depth);
-  if (kind == "constant" || kind == "dot") {
-    const Value v = in(kind == "constant" ? "value" : "in", T, std::vector<double>(std::max(1, mtlxComponents(T)), 0.0));
-    return {v, T};
+  if (kind == "rgbtohsv" || kind == "hsvtorgb") {
+    auto x = constantIn("in", type, {0, 0, 0});
+    if (!x || x->size() < 3) return std::nullopt;  // a colour (a float node type has no hue)
+    const auto h = kind == "rgbtohsv" ? rgbToHsv((*x)[0], (*x)[1], (*x)[2]) : hsvToRgb((*x)[0], (*x)[1], (*x)[2]);
+    std::vector<double> r(h.begin(), h.end());
+    if (n == 4) r.push_back(x->size() > 3 ? (*x)[3] : 1);
+    return r;
   }
-  if (kind == "convert") {
-    pugi::xml_node i = node.find_child_by_attribute("input", "name", "in");
-    const std::string from = i ? str(i, "type") : T;
-    return {convertValue(in("in", from, {0}), from, T), T};
-  }
-  static const std::map<std::string, std::pair<std::string, double>> kBinary = {
-      {"add", {"add", 0}}, {"subtract", {"subtract", 0}}, {"multiply", {"multiply", 1}}, {"divide", {"divide", 1}},
-      {"min", {"min", 0}}, {"max", {"max", 0}}, {"power", {"pow", 1}}};
-  if (auto b = kBinary.find(kind); b != kBinary.end()) {
-    const Value a = in("in1", T, {0}), c = in("in2", T, {b->second.second});
-    if (varies({a, c})) return {Value(), T};
-    const std::string& op = b->second.first;
-    Value v = op == "add" ? add(a, c) : op == "subtract" ? sub(a, c) : op == "multiply" ? mul(a, c)
-              : op == "divide" ? divide(a, c) : op == "min" ? vmin(a, c) : op == "max" ? vmax(a, c) : vpow(a, c);
-    return {v, T};
-  }
-  if (kind == "mix") {
-    const Value fg = in("fg", T, {0}), bg = in("bg", T, {0}), m = in("mix", "float", {0});
-    if (varies({fg, bg, m})) return {Value(), T};
-    return {vlerp(bg, fg, m), T};
-  }
-  if (kind == "clamp") {
-    const Value x = in("in", T, {0}), lo = in("low", T, {0}), hi = in("high", T, {1});
-    if (varies({x, lo, hi})) return {Value(), T};
-    return {vclamp(x, lo, hi), T};
-  }
-  if (kind == "invert") {
-    const Value x = in("in", T, {0}), amount = in("amount", T, {1});
-    if (varies({x, amount})) return {Value(), T};
-    return {sub(amount, x), T};
-  }
-  if (kind == "absval" || kind == "sqrt" || kind == "normalize" || kind == "magnitude") {
-    pugi::xml_node i = node.find_child_by_attribute("input", "name", "in");
-    const Value x = in("in", i ? str(i, "type") : T, {0});
-    if (varies({x})) return {Value(), T};
-    if (kind == "absval") return {vabs(x), T};
-    if (kind == "sqrt") return {vsqrt(x), T};
-    if (kind == "normalize") return {vnormalize(x), T};
-    return {vlength(x), "float"};
-  }
-  if (kind == "dotproduct") {
-    pugi::xml_node i = node.find_child_by_attribute("input", "name", "in1");
-    const std::string it = i ? str(i, "type") : "vector3";
-    const Value a = in("in1", it, {0}), b = in("in2", it, {0});
-    if (varies({a, b})) return {Value(), "float"};
-    return {vdot(a, b), "float"};
-  }
-  if (kind == "remap") {
-    const Value x = in("in", T, {0}), il = in("inlow", T, {0}), ih = in("inhigh", T, {1}), ol = in("outlow", T, {0}),
-                oh = in("outhigh", T, {1});
-    if (varies({x, il, ih, ol, oh})) return {Value(), T};
-    return {add(ol, mul(divide(sub(x, il), sub(ih, il)), sub(oh, ol))), T};
-  }
-  if (kind == "luminance") {
-    const Value x = in("in", T, {0}), k = in("lumacoeffs", "color3", {0.2126, 0.7152, 0.0722});
-    if (varies({x, k})) return {Value(), T};
-    const Value y = vdot(mtlxComponents(T) == 4 ? swizzle(x, "xyz") : x, k);
-    return {mtlxComponents(T) == 4 ? combine({y, y, y, swizzle(x, "w")}) : swizzle(y, "xxx"), T};
-  }
-  if (kind == "combine2" || kind == "combine3" || kind == "combine4") {
-    const int n = kind.back() - '0';
-    std::vector<Value> parts;
+  if (kind == "modulo" || kind == "atan2") {
+    auto a = constantIn("in1", type, {0}), b = constantIn("in2", type, {1.0});
+    if (!a || !b) return std::nullopt;
+    std::vector<double> r(n);
     for (int i = 0; i < n; ++i) {
-      const std::string name = "in" + std::to_string(i + 1);
-      pugi::xml_node ie = node.find_child_by_attribute("input", "name", name.c_str());
-      const std::string it = ie ? str(ie, "type") : "float";
-      const Value v = in(name.c_str(), it, {0});
-      if (mtlxComponents(it) == 1) {
-        parts.push_back(v);
-      } else {
-        for (int k = 0; k < mtlxComponents(it); ++k) parts.push_back(swizzle(v, std::string(1, "xyzw"[k])));
-      }
+      const double x = at(*a, i), y = at(*b, i);
+      r[i] = kind == "atan2" ? std::atan2(x, y) : (y == 0 ? 0.0 : x - y * std::floor(x / y));
     }
-    for (const auto& v : parts)
-      if (varies({v})) return {Value(), T};
-    if (static_cast<int>(parts.size()) != mtlxComponents(T)) {
-      error(node, fmt::format("{} builds {} components for a {}", kind, parts.size(), T));
-      return {Value(), T};
-    }
-    return {combine(parts), T};
+    return r;
   }
-  if (kind == "extract" || kind == "separate2" || kind == "separate3" || kind == "separate4") {
-    pugi::xml_node ie = node.find_child_by_attribute("input", "name", "in");
-    const std::string it = ie ? str(ie, "type") : "vector3";
-    const Value x = in("in", it, {0});
-    if (varies({x})) return {Value(), "float"};
-    int index = 0;
-    if (kind == "extract") {
-      const auto k = literalOf(in("index", "integer", {0}));
-      index = k ? static_cast<int>((*k)[0]) : -1;
+  if (kind == "smoothstep") {
+    auto x = constantIn("in", type, {0}), lo = constantIn("low", type, {0}), hi = constantIn("high", type, {1});
+    if (!x || !lo || !hi) return std::nullopt;
+    std::vector<double> r(n);
+    for (int i = 0; i < n; ++i) {
+      const double a = at(*lo, i), b = at(*hi, i);
+      const double t = b == a ? ((*x)[i] >= b ? 1.0 : 0.0) : std::clamp(((*x)[i] - a) / (b - a), 0.0, 1.0);
+      r[i] = t * t * (3 - 2 * t);
+    }
+    return r;
+  }
+  if (kind == "ifgreater" || kind == "ifgreatereq" || kind == "ifequal") {
+    auto a = constantIn("value1", "float", {1}), b = constantIn("value2", "float", {0});
+    auto x = constantIn("in1", type, {0}), y = constantIn("in2", type, {0});
+    if (!a || !b || !x || !y) return std::nullopt;
+    const bool take = kind == "ifgreater" ? (*a)[0] > (*b)[0] : kind == "ifgreatereq" ? (*a)[0] >= (*b)[0] : (*a)[0] == (*b)[0];
+    return take ? *x : *y;
+  }
+  if (kind == "rotate2d") {
+    auto x = constantIn("in", "vector2", {0, 0}), a = constantIn("amount", "float", {0});
+    if (!x || !a) return std::nullopt;
+    const double t = (*a)[0] * std::numbers::pi / 180, cs = std::cos(t), sn = std::sin(t);
+    return std::vector<double>{(*x)[0] * cs - (*x)[1] * sn, (*x)[0] * sn + (*x)[1] * cs};
+  }
+  return std::nullopt;
+}
+
+/// hsvtorgb on varying inputs: rgb = v · vlerp(1, saturate(|x − 6| − 3| − 1), s)
+/// with x = 6h + (6, 4, 2): the triangle wave |fract(h + k)·6 − 3| folded with
+/// abs, exact for h in [−1/3, 1] (h is clamped there).
+MtlxValues::Typed MtlxValues::Call::hsvToRgbNode() const {
+  const Value hsv = namedValue(self.w_, std::string(str(node, "name")) + "_hsv",
+                               self.inputOf(node, "in", "color3", {0, 0, 0}, false, depth + 1).v);
+  const Value h = vclamp(swizzle(hsv, "x"), -1.0 / 3.0, 1.0);
+  const Value x = add(mul(swizzle(h, "xxx"), 6.0), literal3(6, 4, 2));
+  const Value tri = vabs(sub(vabs(sub(x, 6.0)), 3.0));
+  const Value rgb = mul(vlerp(literal3(1, 1, 1), saturate(sub(tri, 1.0)), swizzle(hsv, "y")), swizzle(hsv, "z"));
+  self.warn(node, "hsvtorgb: written with abs and clamp (exact for hue in [-1/3, 1]; hue is clamped to it)");
+  return {rgb, "color3"};
+}
+
+// ---- nodes with value nodes ----
+
+MtlxValues::Typed MtlxValues::Call::constant() const {
+  return {in(kind == "constant" ? "value" : "in", type, std::vector<double>(std::max(1, mtlxComponents(type)), 0.0)), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::convert() const {
+  const std::string from = declared("in", type);
+  return {convertValue(in("in", from, {0}), from, type), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::binary() const {
+  // kind -> (value node op, identity of in2)
+  static const std::map<std::string, std::pair<Value (*)(const Value&, const Value&), double>> kBinary = {
+      {"add", {add, 0}}, {"subtract", {sub, 0}}, {"multiply", {mul, 1}}, {"divide", {divide, 1}},
+      {"min", {vmin, 0}}, {"max", {vmax, 0}}, {"power", {vpow, 1}}};
+  const auto& [op, identity] = kBinary.at(kind);
+  const Value a = in("in1", type, {0}), c = in("in2", type, {identity});
+  if (varies({a, c})) return none(type);
+  return {op(a, c), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::mix() const {
+  const Value fg = in("fg", type, {0}), bg = in("bg", type, {0}), m = in("mix", "float", {0});
+  if (varies({fg, bg, m})) return none(type);
+  return {vlerp(bg, fg, m), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::clamp() const {
+  const Value x = in("in", type, {0}), lo = in("low", type, {0}), hi = in("high", type, {1});
+  if (varies({x, lo, hi})) return none(type);
+  return {vclamp(x, lo, hi), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::invert() const {
+  const Value x = in("in", type, {0}), amount = in("amount", type, {1});
+  if (varies({x, amount})) return none(type);
+  return {sub(amount, x), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::unaryMath() const {
+  const Value x = in("in", declared("in", type), {0});
+  if (varies({x})) return none(type);
+  if (kind == "absval") return {vabs(x), type};
+  if (kind == "sqrt") return {vsqrt(x), type};
+  if (kind == "normalize") return {vnormalize(x), type};
+  return {vlength(x), "float"};
+}
+
+MtlxValues::Typed MtlxValues::Call::dotproduct() const {
+  const std::string it = declared("in1", "vector3");
+  const Value a = in("in1", it, {0}), b = in("in2", it, {0});
+  if (varies({a, b})) return none("float");
+  return {vdot(a, b), "float"};
+}
+
+MtlxValues::Typed MtlxValues::Call::remap() const {
+  const Value x = in("in", type, {0}), il = in("inlow", type, {0}), ih = in("inhigh", type, {1}),
+              ol = in("outlow", type, {0}), oh = in("outhigh", type, {1});
+  if (varies({x, il, ih, ol, oh})) return none(type);
+  return {add(ol, mul(divide(sub(x, il), sub(ih, il)), sub(oh, ol))), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::luminance() const {
+  const Value x = in("in", type, {0}), k = in("lumacoeffs", "color3", {0.2126, 0.7152, 0.0722});
+  if (varies({x, k})) return none(type);
+  const Value y = vdot(mtlxComponents(type) == 4 ? swizzle(x, "xyz") : x, k);
+  return {mtlxComponents(type) == 4 ? combine({y, y, y, swizzle(x, "w")}) : swizzle(y, "xxx"), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::combineN() const {
+  const int n = kind.back() - '0';
+  std::vector<Value> parts;
+  for (int i = 0; i < n; ++i) {
+    const std::string name = "in" + std::to_string(i + 1);
+    const std::string it = declared(name.c_str(), "float");
+    const Value v = in(name.c_str(), it, {0});
+    if (mtlxComponents(it) == 1) {
+      parts.push_back(v);
     } else {
-      static const std::string names = "xyzwrgba";
-      const std::size_t at = output.size() == 4 ? names.find(output[3]) : std::string::npos;
-      index = at == std::string::npos ? -1 : static_cast<int>(at % 4);
+      for (int k = 0; k < mtlxComponents(it); ++k) parts.push_back(swizzle(v, std::string(1, "xyzw"[k])));
     }
-    if (index < 0 || index >= mtlxComponents(it)) {
-      error(node, fmt::format("{}: no channel {} of a {}", kind, kind == "extract" ? std::to_string(index) : output, it));
-      return {Value(), "float"};
-    }
-    return {swizzle(x, std::string(1, "xyzw"[index])), "float"};
   }
-  if (kind == "swizzle") {  // MaterialX 1.38
-    pugi::xml_node ie = node.find_child_by_attribute("input", "name", "in");
-    const std::string it = ie ? str(ie, "type") : "color3";
-    const Value x = in("in", it, {0});
-    pugi::xml_node ch = node.find_child_by_attribute("input", "name", "channels");
-    std::string channels = ch ? str(ch, "value") : "";
-    if (channels.empty() || channels.find_first_not_of("xyzwrgba") != std::string::npos) {
-      error(node, fmt::format("swizzle channels '{}' (constant channels are not supported)", channels));
-      return {Value(), T};
-    }
-    if (varies({x})) return {Value(), T};
-    return {swizzle(x, channels), T};
+  for (const auto& v : parts)
+    if (varies({v})) return none(type);
+  if (static_cast<int>(parts.size()) != mtlxComponents(type)) {
+    self.error(node, fmt::format("{} builds {} components for a {}", kind, parts.size(), type));
+    return none(type);
   }
-  if (kind == "normalmap") {
-    const Value x = in("in", "vector3", {0.5, 0.5, 1});
-    const Value s = in("scale", "float", {1});
-    if (varies({x, s})) return {Value(), "vector3"};
-    if (auto space = node.find_child_by_attribute("input", "name", "space"); space && str(space, "value") == "object")
-      warn(node, "an object-space normal map is read as a tangent-space one");
-    Value n = sub(mul(x, 2.0), 1.0);
-    if (!isLiteral(s, 1)) n = mul(n, combine({s, s, 1.0}));
-    return {vnormalize(n), "vector3"};
-  }
-  if (kind == "texcoord") {
-    if (frozen) return {Value(), T};
+  return {combine(parts), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::extract() const {
+  const std::string it = declared("in", "vector3");
+  const Value x = in("in", it, {0});
+  if (varies({x})) return none("float");
+  int index = 0;
+  if (kind == "extract") {
     const auto k = literalOf(in("index", "integer", {0}));
-    int index = k ? static_cast<int>((*k)[0]) : 0;
-    if (index > 1) {
-      warn(node, fmt::format("texcoord index {}: a material reads uv0 and uv1 only; uv1 is used", index));
-      index = 1;
-    }
-    return {convertValue(geometry(index == 0 ? "uv0" : "uv1"), "vector2", T), T};
+    index = k ? static_cast<int>((*k)[0]) : -1;
+  } else {
+    static const std::string names = "xyzwrgba";
+    const std::size_t at = output.size() == 4 ? names.find(output[3]) : std::string::npos;
+    index = at == std::string::npos ? -1 : static_cast<int>(at % 4);
   }
-  if (kind == "place2d") {
-    const Value uv = in("texcoord", "vector2", {});
-    const Value pivot = in("pivot", "vector2", {0, 0}), scale = in("scale", "vector2", {1, 1}),
-                offset = in("offset", "vector2", {0, 0});
-    const auto rotate = literalOf(in("rotate", "float", {0}));
-    if (frozen) return {Value(), T};
-    if (!rotate) {
-      error(node, "place2d: a varying rotation is not supported (the rotation must be a constant)");
-      return {Value(), T};
-    }
-    if (auto order = literalOf(in("operationorder", "integer", {0})); order && (*order)[0] != 0)
-      warn(node, "place2d operationorder TRS is applied as SRT");
-    // uv' = R(rotate) · ((uv − pivot) / scale) + pivot − offset, R counter-clockwise in degrees.
-    Value p = divide(sub(uv.is_null() ? geometry("uv0") : uv, pivot), scale);
-    if ((*rotate)[0] != 0) {
-      const double a = (*rotate)[0] * std::numbers::pi / 180, c = std::cos(a), s = std::sin(a);
-      const Value pn = namedValue(w_, std::string(str(node, "name")) + "_scaled", p);
-      p = combine({sub(mul(swizzle(pn, "x"), c), mul(swizzle(pn, "y"), s)), add(mul(swizzle(pn, "x"), s), mul(swizzle(pn, "y"), c))});
-    }
-    return {sub(add(p, pivot), offset), T};
+  if (index < 0 || index >= mtlxComponents(it)) {
+    self.error(node, fmt::format("{}: no channel {} of a {}", kind, kind == "extract" ? std::to_string(index) : output, it));
+    return none("float");
   }
-  if (kind == "position" || kind == "normal" || kind == "tangent" || kind == "bitangent" || kind == "geomcolor") {
-    if (frozen) return {Value(), T};
-    const std::string space = str(node.find_child_by_attribute("input", "name", "space"), "value");
-    if (kind == "position") {
-      if (space != "world") warn(node, fmt::format("position in {} space: the world-space position is used", space.empty() ? "object" : space));
-      return {geometry("position"), T};
-    }
-    if (kind == "geomcolor") return {convertValue(geometry("vertex_color"), "vector4", T), T};
-    if (kind == "bitangent") return {Json::array({0.0, 1.0, 0.0}), T};
-    warn(node, fmt::format("the geometric {} is read in tangent space", kind));
-    return {geometry(kind), T};
+  return {swizzle(x, std::string(1, "xyzw"[index])), "float"};
+}
+
+MtlxValues::Typed MtlxValues::Call::swizzleNode() const {  // MaterialX 1.38
+  const Value x = in("in", declared("in", "color3"), {0});
+  pugi::xml_node ch = node.find_child_by_attribute("input", "name", "channels");
+  std::string channels = ch ? str(ch, "value") : "";
+  if (channels.empty() || channels.find_first_not_of("xyzwrgba") != std::string::npos) {
+    self.error(node, fmt::format("swizzle channels '{}' (constant channels are not supported)", channels));
+    return none(type);
   }
+  if (varies({x})) return none(type);
+  return {swizzle(x, channels), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::normalmap() const {
+  const Value x = in("in", "vector3", {0.5, 0.5, 1});
+  const Value s = in("scale", "float", {1});
+  if (varies({x, s})) return none("vector3");
+  if (auto space = node.find_child_by_attribute("input", "name", "space"); space && str(space, "value") == "object")
+    self.warn(node, "an object-space normal map is read as a tangent-space one");
+  return {unpackNormal(x, s), "vector3"};
+}
+
+MtlxValues::Typed MtlxValues::Call::texcoord() const {
+  if (frozen) return none(type);
+  const auto k = literalOf(in("index", "integer", {0}));
+  int index = k ? static_cast<int>((*k)[0]) : 0;
+  if (index > 1) {
+    self.warn(node, fmt::format("texcoord index {}: a material reads uv0 and uv1 only; uv1 is used", index));
+    index = 1;
+  }
+  return {convertValue(geometry(index == 0 ? "uv0" : "uv1"), "vector2", type), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::place2d() const {
+  const Value uv = in("texcoord", "vector2", {});
+  const Value pivot = in("pivot", "vector2", {0, 0}), scale = in("scale", "vector2", {1, 1}),
+              offset = in("offset", "vector2", {0, 0});
+  const auto rotate = literalOf(in("rotate", "float", {0}));
+  if (frozen) return none(type);
+  if (!rotate) {
+    self.error(node, "place2d: a varying rotation is not supported (the rotation must be a constant)");
+    return none(type);
+  }
+  if (auto order = literalOf(in("operationorder", "integer", {0})); order && (*order)[0] != 0)
+    self.warn(node, "place2d operationorder TRS is applied as SRT");
+  // uv' = R(rotate) · ((uv − pivot) / scale) + pivot − offset, R counter-clockwise in degrees.
+  Value p = divide(sub(uv.is_null() ? geometry("uv0") : uv, pivot), scale);
+  if ((*rotate)[0] != 0) p = rotated2(namedValue(self.w_, std::string(str(node, "name")) + "_scaled", p), (*rotate)[0]);
+  return {sub(add(p, pivot), offset), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::geometric() const {
+  if (frozen) return none(type);
+  const std::string space = str(node.find_child_by_attribute("input", "name", "space"), "value");
+  if (kind == "position") {
+    if (space != "world") self.warn(node, fmt::format("position in {} space: the world-space position is used", space.empty() ? "object" : space));
+    return {geometry("position"), type};
+  }
+  if (kind == "geomcolor") return {convertValue(geometry("vertex_color"), "vector4", type), type};
+  if (kind == "bitangent") return {Json::array({0.0, 1.0, 0.0}), type};
+  self.warn(node, fmt::format("the geometric {} is read in tangent space", kind));
+  return {geometry(kind), type};
+}
+
+MtlxValues::Typed MtlxValues::Call::unsupported() const {
   static const char* const kShading[] = {"surface", "surfacematerial", "standard_surface", "open_pbr_surface",
                                          "gltf_pbr", "UsdPreviewSurface", "disney_principled"};
   if (std::find(std::begin(kShading), std::end(kShading), kind) != std::end(kShading) || type == "BSDF" ||
       type == "EDF" || type == "VDF" || type == "surfaceshader") {
-    error(node, fmt::format("unsupported node '{}': a shader where a value is expected", kind));
-    return {Value(), T};
+    self.error(node, fmt::format("unsupported node '{}': a shader where a value is expected", kind));
+    return none(type);
   }
-  error(node, fmt::format("unsupported node '{}' (no Substrate value node or import rule for it)", kind));
-  return {Value(), T};
+  self.error(node, fmt::format("unsupported node '{}' (no Substrate value node or import rule for it)", kind));
+  return none(type);
 }
 
 }  // namespace substratec::import

@@ -82,9 +82,8 @@ class MtlxValues {
   Typed nodeValue(pugi::xml_node node, const std::string& output, bool frozen, int depth);
   Typed compute(pugi::xml_node node, const std::string& kind, const std::string& type, const std::string& output,
                 bool frozen, int depth);
-  Typed image(pugi::xml_node node, const std::string& kind, const std::string& type, const std::string& output,
-              bool frozen, int depth);
-  Typed bakeOrFold(pugi::xml_node node, const std::string& kind, const std::string& type, bool frozen, int depth);
+  /// One node's computation; its rules (per node kind) are members (mtlx_graph.cc).
+  struct Call;
   Typed bake(pugi::xml_node node, const std::string& kind, const std::string& type, const std::string& why);
   Value textureOf(pugi::xml_node node, const std::string& file, bool srgb);
   Value sampleOf(const Value& texture, const Value& uv);

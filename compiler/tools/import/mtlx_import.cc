@@ -19,6 +19,13 @@ RoughnessAnisotropy mtlxRoughnessAnisotropy(const Value& roughness, const Value&
   return fromAlphas(at, ab);
 }
 
+RoughnessAnisotropy roughnessPins(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
+                                  const std::string& prefix, AnisotropyModel model) {
+  if (anisotropy.is_null() || isLiteral(anisotropy, 0)) return {roughness, Value()};
+  const RoughnessAnisotropy ra = model(roughness, anisotropy, w, prefix);
+  return {namedValue(w, (prefix == "specular_" ? "" : prefix) + "anisotropic_roughness", ra.roughness), ra.anisotropy};
+}
+
 void mtlxTransmission(pugi::xml_node n, MtlxValues& v, const Value& weight, const char* dispersion,
                       LayeredSurface& s) {
   auto C = [&](const char* name, const char* type, std::vector<double> def) {

@@ -28,15 +28,31 @@ RoughnessAnisotropy openPbrAnisotropy(const Value& roughness, const Value& aniso
   return fromAlphas(at, mul(inv, at));
 }
 
+/// The coat (coat_weight not 0): F0(coat_ior), its roughness and anisotropy,
+/// normal, per-pass transmittance sqrt(coat_color).
+void openPbrCoat(pugi::xml_node n, MtlxValues& v, MaterialWriter& w, const Value& coat, const Value& coatRoughness,
+                 LayeredSurface& s) {
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
+  s.coatWeight = coat;
+  s.coatF0 = iorToF0Value(P("coat_ior", "float", {1.6}));
+  const Value coatAnisotropy = P("coat_roughness_anisotropy", "float", {0}, ParamKind::Switch);
+  const RoughnessAnisotropy ra = roughnessPins(coatRoughness, coatAnisotropy, w, "coat_", openPbrAnisotropy);
+  s.coatRoughness = ra.roughness;
+  s.coatAnisotropy = ra.anisotropy;
+  if (v.given(n, "geometry_coat_normal")) s.coatNormal = P("geometry_coat_normal", "vector3", {0, 0, 1});
+  const Value coatColor = P("coat_color", "color3", {1, 1, 1});
+  if (!isLiteral(coatColor, 1)) s.coatTransmittance = vsqrt(coatColor);
+  if (C("coat_darkening", "float", {1})[0] > 0)
+    v.warn(n, "coat_darkening: light trapped under the coat by internal reflection is not modelled; the base is "
+              "seen through the coat's transmittance only");
+}
+
 }  // namespace
 
 LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  auto P = [&](const char* name, const char* type, std::vector<double> def, ParamKind k = ParamKind::Plain) {
-    return v.param(n, name, type, def, k);
-  };
-  auto C = [&](const char* name, const char* type, std::vector<double> def) {
-    return v.constant(n, name, type, def).value_or(def);
-  };
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
   auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
   LayeredSurface s;
   const Value weight = P("base_weight", "float", {1}, ParamKind::Switch);
@@ -77,13 +93,9 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
     roughness = vlerp(r, vpow(vmin(add(mul(c4, 2.0), r4), 1.0), 0.25), coat);
   }
   const Value anisotropy = P("specular_roughness_anisotropy", "float", {0}, ParamKind::Switch);
-  if (!off(anisotropy, 0)) {
-    const RoughnessAnisotropy ra = openPbrAnisotropy(roughness, anisotropy, w, "specular_");
-    s.roughness = namedValue(w, "anisotropic_roughness", ra.roughness);
-    s.anisotropy = ra.anisotropy;
-  } else {
-    s.roughness = roughness;
-  }
+  const RoughnessAnisotropy ra = roughnessPins(roughness, anisotropy, w, "specular_", openPbrAnisotropy);
+  s.roughness = ra.roughness;
+  s.anisotropy = ra.anisotropy;
   if (v.given(n, "geometry_normal")) s.normal = P("geometry_normal", "vector3", {0, 0, 1});
   for (const char* t : {"geometry_tangent", "geometry_coat_tangent"})
     if (v.given(n, t)) v.warn(n, std::string(t) + ": a connected tangent is not imported; the geometric tangent is used");
@@ -106,24 +118,7 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   const Value transmission = P("transmission_weight", "float", {0}, ParamKind::Switch);
   if (!off(transmission, 0)) mtlxTransmission(n, v, transmission, "transmission_dispersion_scale", s);
 
-  if (!off(coat, 0)) {
-    s.coatWeight = coat;
-    s.coatF0 = iorToF0Value(P("coat_ior", "float", {1.6}));
-    const Value coatAnisotropy = P("coat_roughness_anisotropy", "float", {0}, ParamKind::Switch);
-    if (!off(coatAnisotropy, 0)) {
-      const RoughnessAnisotropy ra = openPbrAnisotropy(coatRoughness, coatAnisotropy, w, "coat_");
-      s.coatRoughness = namedValue(w, "coat_anisotropic_roughness", ra.roughness);
-      s.coatAnisotropy = ra.anisotropy;
-    } else {
-      s.coatRoughness = coatRoughness;
-    }
-    if (v.given(n, "geometry_coat_normal")) s.coatNormal = P("geometry_coat_normal", "vector3", {0, 0, 1});
-    const Value coatColor = P("coat_color", "color3", {1, 1, 1});
-    if (!isLiteral(coatColor, 1)) s.coatTransmittance = vsqrt(coatColor);
-    if (C("coat_darkening", "float", {1})[0] > 0)
-      v.warn(n, "coat_darkening: light trapped under the coat by internal reflection is not modelled; the base is "
-                "seen through the coat's transmittance only");
-  }
+  if (!off(coat, 0)) openPbrCoat(n, v, w, coat, coatRoughness, s);
 
   const Value opacity = P("geometry_opacity", "float", {1}, ParamKind::Switch);
   if (!isLiteral(opacity, 1)) {

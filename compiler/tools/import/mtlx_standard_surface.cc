@@ -21,15 +21,54 @@ namespace substratec::import {
 
 namespace {
 constexpr double kTwoPi = 6.28318530717958647692;
+
+/// The coat (coat not 0): F0(coat_IOR), its roughness, anisotropy and rotation,
+/// normal, and per-pass transmittance sqrt(coat_color).
+void standardCoat(pugi::xml_node n, MtlxValues& v, MaterialWriter& w, const Value& coat, LayeredSurface& s) {
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
+  auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
+  s.coatWeight = coat;
+  s.coatF0 = iorToF0Value(P("coat_IOR", "float", {1.5}));
+  const Value coatRoughness = P("coat_roughness", "float", {0.1});
+  const Value coatAnisotropy = P("coat_anisotropy", "float", {0}, ParamKind::Switch);
+  const RoughnessAnisotropy ra = roughnessPins(coatRoughness, coatAnisotropy, w, "coat_");
+  s.coatRoughness = ra.roughness;
+  s.coatAnisotropy = ra.anisotropy;
+  if (!off(coatAnisotropy, 0)) s.coatTangent = rotatedTangent(C("coat_rotation", "float", {0})[0] * kTwoPi);
+  if (v.given(n, "coat_normal")) s.coatNormal = P("coat_normal", "vector3", {0, 0, 1});
+  const Value coatColor = P("coat_color", "color3", {1, 1, 1});
+  if (!isLiteral(coatColor, 1)) s.coatTransmittance = vsqrt(coatColor);
 }
 
+/// Thin film (thickness in nm), emission and transmission.
+void standardFilmEmissionTransmission(pugi::xml_node n, MtlxValues& v, LayeredSurface& s) {
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
+  auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
+  const double film = C("thin_film_thickness", "float", {0})[0];
+  if (film > 0 || (v.given(n, "thin_film_thickness") && !v.constant(n, "thin_film_thickness", "float", {0}))) {
+    s.filmWeight = 1.0;
+    s.filmThickness = mul(P("thin_film_thickness", "float", {0}), 1e-9);
+    s.filmIor = P("thin_film_IOR", "float", {1.5});
+  }
+
+  const Value emission = P("emission", "float", {0}, ParamKind::Switch);
+  if (!off(emission, 0)) s.emissive = mul(emission, P("emission_color", "color3", {1, 1, 1}));
+
+  const Value transmission = P("transmission", "float", {0}, ParamKind::Switch);
+  if (!off(transmission, 0)) {
+    mtlxTransmission(n, v, transmission, "transmission_dispersion", s);
+    if (C("transmission_extra_roughness", "float", {0})[0] != 0)
+      v.warn(n, "transmission_extra_roughness: the transmitted light is not blurred; ignored");
+  }
+}
+
+}  // namespace
+
 LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  auto P = [&](const char* name, const char* type, std::vector<double> def, ParamKind k = ParamKind::Plain) {
-    return v.param(n, name, type, def, k);
-  };
-  auto C = [&](const char* name, const char* type, std::vector<double> def) {
-    return v.constant(n, name, type, def).value_or(def);
-  };
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
   auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
   LayeredSurface s;
   const Value base = P("base", "float", {1}, ParamKind::Switch);
@@ -74,14 +113,10 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
   if (!off(coat, 0) && v.given(n, "coat_affect_roughness"))
     roughness = vlerp(roughness, 1.0, mul(mul(coat, P("coat_affect_roughness", "float", {0})), P("coat_roughness", "float", {0.1})));
   const Value anisotropy = P("specular_anisotropy", "float", {0}, ParamKind::Switch);
-  if (!off(anisotropy, 0)) {
-    const RoughnessAnisotropy ra = mtlxRoughnessAnisotropy(roughness, anisotropy, w, "specular_");
-    s.roughness = namedValue(w, "anisotropic_roughness", ra.roughness);
-    s.anisotropy = ra.anisotropy;
-    s.tangent = rotatedTangent(C("specular_rotation", "float", {0})[0] * kTwoPi);
-  } else {
-    s.roughness = roughness;
-  }
+  const RoughnessAnisotropy ra = roughnessPins(roughness, anisotropy, w, "specular_");
+  s.roughness = ra.roughness;
+  s.anisotropy = ra.anisotropy;
+  if (!off(anisotropy, 0)) s.tangent = rotatedTangent(C("specular_rotation", "float", {0})[0] * kTwoPi);
   s.normal = v.given(n, "normal") ? P("normal", "vector3", {0, 0, 1}) : Value();
   if (v.given(n, "tangent")) v.warn(n, "tangent: a connected tangent is not imported; the geometric tangent is used");
 
@@ -92,40 +127,9 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
     s.fuzzRoughness = P("sheen_roughness", "float", {0.3});
   }
 
-  const double film = C("thin_film_thickness", "float", {0})[0];
-  if (film > 0 || (v.given(n, "thin_film_thickness") && !v.constant(n, "thin_film_thickness", "float", {0}))) {
-    s.filmWeight = 1.0;
-    s.filmThickness = mul(P("thin_film_thickness", "float", {0}), 1e-9);
-    s.filmIor = P("thin_film_IOR", "float", {1.5});
-  }
+  standardFilmEmissionTransmission(n, v, s);
 
-  const Value emission = P("emission", "float", {0}, ParamKind::Switch);
-  if (!off(emission, 0)) s.emissive = mul(emission, P("emission_color", "color3", {1, 1, 1}));
-
-  const Value transmission = P("transmission", "float", {0}, ParamKind::Switch);
-  if (!off(transmission, 0)) {
-    mtlxTransmission(n, v, transmission, "transmission_dispersion", s);
-    if (C("transmission_extra_roughness", "float", {0})[0] != 0)
-      v.warn(n, "transmission_extra_roughness: the transmitted light is not blurred; ignored");
-  }
-
-  if (!off(coat, 0)) {
-    s.coatWeight = coat;
-    s.coatF0 = iorToF0Value(P("coat_IOR", "float", {1.5}));
-    const Value coatRoughness = P("coat_roughness", "float", {0.1});
-    const Value coatAnisotropy = P("coat_anisotropy", "float", {0}, ParamKind::Switch);
-    if (!off(coatAnisotropy, 0)) {
-      const RoughnessAnisotropy ra = mtlxRoughnessAnisotropy(coatRoughness, coatAnisotropy, w, "coat_");
-      s.coatRoughness = namedValue(w, "coat_anisotropic_roughness", ra.roughness);
-      s.coatAnisotropy = ra.anisotropy;
-      s.coatTangent = rotatedTangent(C("coat_rotation", "float", {0})[0] * kTwoPi);
-    } else {
-      s.coatRoughness = coatRoughness;
-    }
-    if (v.given(n, "coat_normal")) s.coatNormal = P("coat_normal", "vector3", {0, 0, 1});
-    const Value coatColor = P("coat_color", "color3", {1, 1, 1});
-    if (!isLiteral(coatColor, 1)) s.coatTransmittance = vsqrt(coatColor);
-  }
+  if (!off(coat, 0)) standardCoat(n, v, w, coat, s);
 
   if (v.given(n, "opacity")) {
     const Value opacity = P("opacity", "color3", {1, 1, 1});

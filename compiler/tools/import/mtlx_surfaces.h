@@ -33,4 +33,32 @@ void mtlxTransmission(pugi::xml_node shader, MtlxValues& v, const Value& weight,
 RoughnessAnisotropy mtlxRoughnessAnisotropy(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
                                             const std::string& prefix);
 
+/// An anisotropic roughness model (values named with `prefix`).
+using AnisotropyModel = RoughnessAnisotropy (*)(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
+                                                const std::string& prefix);
+/// The slab's (roughness, anisotropy): `roughness` alone (no anisotropy) when
+/// `anisotropy` is null or 0, else through `model`, its roughness named
+/// "<prefix>anisotropic_roughness" (the specular's without the prefix).
+RoughnessAnisotropy roughnessPins(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
+                                  const std::string& prefix, AnisotropyModel model = mtlxRoughnessAnisotropy);
+
+/// A shading node's inputs as the units read them: P(name, type, default
+/// [, kind]) its value (MtlxValues::param); C(name, type, default) its
+/// constant at import, the default when it varies (MtlxValues::constant).
+struct MtlxParam {
+  pugi::xml_node n;
+  MtlxValues& v;
+  Value operator()(const char* name, const char* type, const std::vector<double>& def,
+                   ParamKind k = ParamKind::Plain) const {
+    return v.param(n, name, type, def, k);
+  }
+};
+struct MtlxConstant {
+  pugi::xml_node n;
+  MtlxValues& v;
+  std::vector<double> operator()(const char* name, const char* type, const std::vector<double>& def) const {
+    return v.constant(n, name, type, def).value_or(def);
+  }
+};
+
 }  // namespace substratec::import

@@ -12,12 +12,8 @@
 namespace substratec::import {
 
 LayeredSurface usdPreviewSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  auto P = [&](const char* name, const char* type, std::vector<double> def, ParamKind k = ParamKind::Plain) {
-    return v.param(n, name, type, def, k);
-  };
-  auto C = [&](const char* name, const char* type, std::vector<double> def) {
-    return v.constant(n, name, type, def).value_or(def);
-  };
+  const MtlxParam P{n, v};
+  const MtlxConstant C{n, v};
   (void)w;
   LayeredSurface s;
   s.baseColor = P("diffuseColor", "color3", {0.18, 0.18, 0.18});

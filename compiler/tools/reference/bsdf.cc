@@ -330,6 +330,8 @@ T glintFactor(const Closure<T>& c, T d, T ToH, T BoH, T NoH) {
 // ---------------------------------------------------------------------------
 // substrate_eval_closure.
 
+// long: it mirrors substrate_eval_closure statement for statement, so the two
+// are compared side by side (the float instantiation must round as the shader).
 template <class T>
 V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffuseModel) {
   const V3<T> zero = splat3(T(0));
@@ -395,26 +397,23 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
       ToH = dot(Tn, H);
       BoH = dot(Bn, H);
     }
-    V2<T> alpha1 = ggxAlpha(roughness, anisotropy);
+    // GGX D and visibility at a roughness (anisotropic along the frame when anisotropy is not 0).
+    auto ggxTerms = [&](T rough, T& d, T& vis) {
+      const V2<T> alpha = ggxAlpha(rough, anisotropy);
+      if (anisotropy != T(0)) {
+        d = ggxDAniso(alpha, ToH, BoH, NoH);
+        vis = ggxVisAniso(alpha, ToV, BoV, NoV, ToL, BoL, NoLc);
+      } else {
+        d = ggxD(alpha[0], NoH);
+        vis = ggxVis(alpha[0], NoV, NoLc);
+      }
+    };
     T d1, vis1;
-    if (anisotropy != T(0)) {
-      d1 = ggxDAniso(alpha1, ToH, BoH, NoH);
-      vis1 = ggxVisAniso(alpha1, ToV, BoV, NoV, ToL, BoL, NoLc);
-    } else {
-      d1 = ggxD(alpha1[0], NoH);
-      vis1 = ggxVis(alpha1[0], NoV, NoLc);
-    }
+    ggxTerms(roughness, d1, vis1);
     V3<T> lobe = w1 * (d1 * vis1 * NoLc);
     if (hazeWeight > T(0)) {
-      V2<T> alpha2 = ggxAlpha(hazeRoughness, anisotropy);
       T d2, vis2;
-      if (anisotropy != T(0)) {
-        d2 = ggxDAniso(alpha2, ToH, BoH, NoH);
-        vis2 = ggxVisAniso(alpha2, ToV, BoV, NoV, ToL, BoL, NoLc);
-      } else {
-        d2 = ggxD(alpha2[0], NoH);
-        vis2 = ggxVis(alpha2[0], NoV, NoLc);
-      }
+      ggxTerms(hazeRoughness, d2, vis2);
       lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
     }
     spec = fresnel(f0, f90, VoH) * lobe;

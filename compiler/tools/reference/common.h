@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "ir/value_eval.h"
 #include "reference/reference.h"
 
 namespace substratec::reference::detail {
@@ -250,6 +251,27 @@ inline std::array<std::uint32_t, 3> pcg3d(std::array<std::uint32_t, 3> v) {
 template <class T>
 T hashToUnit(std::uint32_t h) {
   return (static_cast<T>(h >> 8u) + T(1)) * (T(1) / T(16777216));
+}
+
+// ---------------------------------------------------------------------------
+// The value DAG's evaluation point.
+
+/// The point evaluateDag sees at `g`, as the generated code does: tangent
+/// space (normal (0,0,1), tangent (1,0,0), view = ts_view = (V.T, V.(N x T),
+/// V.N), not renormalized), g's position, uvs and vertex colour; `tex` (when
+/// set) samples the textures. Inputs at their defaults.
+inline EvalPoint tangentSpacePoint(const Geometry& g, const TextureFn& tex) {
+  EvalPoint p;
+  p.normal = {0, 0, 1};
+  p.tangent = {1, 0, 0};
+  const V3<double> B = cross(g.N, g.T);
+  p.view = {dot(g.V, g.T), dot(g.V, B), dot(g.V, g.N)};
+  p.position = g.position;
+  p.uv0 = g.uv0;
+  p.uv1 = g.uv1;
+  p.vertexColor = g.vertexColor;
+  if (tex) p.sampler = tex;
+  return p;
 }
 
 }  // namespace substratec::reference::detail

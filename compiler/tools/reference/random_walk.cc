@@ -473,6 +473,190 @@ bool propagate(const Medium& M, const V& w, double& t, V& beta, SplitMix64& rng,
   return false;
 }
 
+/// An importance-sampled bounce off I from `from` (flags: which lobes):
+/// beta *= f |cos| / pdf and w = the sampled direction; false: no sample.
+bool bounce(const Interface& I, const V& from, int flags, Rng& rng, V& beta, V& w, BsdfSample& bs) {
+  if (!bsdfSample(I, from, rng, Mode::Importance, flags, bs)) return false;
+  beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
+  w = bs.wi;
+  return true;
+}
+
+/// The light chain of one evalGroup sample: from wi down through every
+/// interface (transmission only). dir[k] the direction below I_k, weight[k]
+/// the chain's throughput to there; returns the chain's length, and pB0 the
+/// light-side density of dir[0] (infinite: a delta through a pass-through).
+int traceLightChain(const Resolved& s, int last, const V& wi, Rng& rng, std::vector<V>& dir, std::vector<V>& weight,
+                    double& pB0) {
+  int chainLen = 0;
+  pB0 = kInf;
+  V from = wi;
+  V wgt{1, 1, 1};
+  for (int k = 0; k <= last; ++k) {
+    const Interface& I = s.ifc[k];
+    V c;
+    if (I.kind == Interface::Kind::Pass) {
+      // A delta transmission: f / pdf = 1 / |cos|, and f |cos| / pdf = 1 (k >= 1).
+      c = neg(from);
+      if (k == 0) wgt = wgt / std::fabs(c[2]);
+    } else {
+      BsdfSample bs;
+      if (!bsdfSample(I, from, rng, Mode::Radiance, kTransmission, bs)) break;
+      c = bs.wi;
+      // The cosine of the segment above I_k (towards the exit) for k >= 1;
+      // at I_0 that segment is wi's, which the caller's |cos wi| carries.
+      wgt = wgt * bs.f * ((k == 0 ? 1.0 : std::fabs(from[2])) / bs.pdf);
+      if (k == 0) pB0 = bs.pdf;
+    }
+    if (!(c[2] < 0)) break;
+    dir[k] = c;
+    weight[k] = wgt;
+    chainLen = k + 1;
+    if (k < last) {
+      wgt = wgt * std::exp(-s.med[k].tau / std::fabs(c[2]));
+      from = neg(c);
+    }
+  }
+  return chainLen;
+}
+
+/// One walk of evalGroup from wo into the stack: its state (layer k, optical
+/// depth t, direction w, weight beta) and the two strategies by which its
+/// vertices add to `sum` (exitA: leaving through I_0 towards wi; connectB:
+/// joining the light chain).
+struct EvalWalk {
+  const Resolved& s;
+  const V& wi;
+  bool exitDelta;
+  const std::vector<V>& chainDir;
+  const std::vector<V>& chainW;
+  int chainLen;
+  double pB0;
+  Rng& rng;
+  V& sum;
+  V beta{1, 1, 1}, w{0, 0, 0};
+  int k = 0;
+  double t = 0;
+
+  /// The exit through the top interface after a vertex of layer 0 sampled w1
+  /// (strategy A): beta already includes that sample; pA its density; tr the
+  /// transmittance to I_0.
+  void exitA(const V& w1, double pA, double tr) {
+    if (exitDelta || !(w1[2] > 0)) return;
+    V fe = bsdfF(s.ifc[0], neg(w1), wi, Mode::Importance);
+    if (isZero(fe)) return;
+    double pB = bsdfPdf(s.ifc[0], wi, neg(w1), kTransmission);
+    sum = sum + beta * fe * (tr * powerHeuristic(pA, pB));
+  }
+  /// The connection of a vertex of layer k to the light chain (strategy B):
+  /// fv the vertex's f (times |cos| for a surface) towards -c_k, pA the density
+  /// of the walk's own sampling of -c_k, tr the transmittance to I_k.
+  void connectB(const V& fv, double pA, double tr) {
+    double wB = (k == 0 && !exitDelta) ? powerHeuristic(pB0, pA) : 1.0;
+    sum = sum + beta * fv * chainW[k] * (tr * wB);
+  }
+  /// Enters through the top interface (its reflection is counted apart); false: no entry.
+  bool enter(const V& wo) {
+    if (exitDelta) {
+      w = neg(wo);
+    } else {
+      BsdfSample bs;
+      if (!bsdfSample(s.ifc[0], wo, rng, Mode::Importance, kTransmission, bs)) return false;
+      w = bs.wi;
+      beta = bs.f * (std::fabs(w[2]) / bs.pdf);
+    }
+    return w[2] < 0;
+  }
+  /// Walks up to maxDepth events.
+  void run(int maxDepth, const std::array<bool, 3>& mask) {
+    for (int depth = 0; depth < maxDepth; ++depth) {
+      if (!roulette(beta, depth, mask, rng)) break;
+      const Medium& M = s.med[k];
+      bool alive;
+      if (propagate(M, w, t, beta, rng, alive)) {
+        scatter(M);
+        continue;
+      }
+      if (!alive) break;
+      if (!(w[2] > 0 ? up() : down(M))) break;
+    }
+  }
+  /// A scattering vertex at depth t of layer k.
+  void scatter(const Medium& M) {
+    if (k < chainLen) {
+      V lw = neg(chainDir[k]);
+      double p = hg(dot(w, lw), M.g);
+      connectB(M.omega * p, p, std::exp(-t / std::fabs(lw[2])));
+    }
+    V w1 = sampleHg(w, M.g, rng.uniform(), rng.uniform());
+    double p1 = hg(dot(w, w1), M.g);
+    beta = beta * M.omega;
+    if (k == 0) exitA(w1, p1, std::exp(-t / std::fabs(w1[2])));
+    w = w1;
+  }
+  /// At I_k from below; false: the walk ends.
+  bool up() {
+    const Interface& I = s.ifc[k];
+    if (k == 0) {
+      // Leaving is counted at the last vertex: only reflection continues.
+      if (exitDelta) return false;
+      BsdfSample bs;
+      return bounce(I, neg(w), kReflection, rng, beta, w, bs);
+    }
+    if (I.kind == Interface::Kind::Pass) {
+      --k;
+      t = s.med[k].tau;
+      return true;
+    }
+    BsdfSample bs;
+    if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
+    if (!bs.reflect) {
+      --k;
+      t = s.med[k].tau;
+    }
+    return true;
+  }
+  /// At the bottom of layer k (medium M), going down: a surface vertex (or a
+  /// pass-through); false: the walk ends.
+  bool down(const Medium& M) {
+    const double trUp = M.tau;  // optical depth from the vertex to I_k
+    if (k == static_cast<int>(s.ifc.size()) - 1) {
+      // The Lambertian base (Bottom::Lambert; tau 0).
+      if (s.bottom != Bottom::Lambert) return false;
+      if (k < chainLen) {
+        V lw = neg(chainDir[k]);
+        connectB(s.lambert * (kInvPi * lw[2]), lw[2] * kInvPi, std::exp(-trUp / lw[2]));
+      }
+      V w1 = sampleCosine(rng.uniform(), rng.uniform());
+      if (!(w1[2] > 0)) return false;
+      beta = beta * s.lambert;
+      if (k == 0) exitA(w1, w1[2] * kInvPi, std::exp(-trUp / w1[2]));
+      w = w1;
+      return true;
+    }
+    const Interface& I = s.ifc[k + 1];
+    if (I.kind == Interface::Kind::Pass) {
+      ++k;
+      t = 0;
+      return true;
+    }
+    if (k < chainLen) {
+      V lw = neg(chainDir[k]);
+      V fv = bsdfF(I, neg(w), lw, Mode::Importance);
+      if (!isZero(fv)) connectB(fv * std::fabs(lw[2]), bsdfPdf(I, neg(w), lw, kAll), std::exp(-trUp / std::fabs(lw[2])));
+    }
+    BsdfSample bs;
+    if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
+    if (bs.reflect) {
+      if (k == 0) exitA(w, bs.pdf, std::exp(-trUp / std::fabs(w[2])));
+    } else {
+      ++k;
+      t = 0;
+    }
+    return true;
+  }
+};
+
 /// layeredEval for one group: sum over the walks of f(wo, wi) (no cosine), divided by the count.
 V evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, SplitMix64& rng) {
   const Resolved& s = grp.stack;
@@ -481,162 +665,15 @@ V evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, Sp
   const int last = s.lastLayer();
   if (last < 0 || o.samples <= 0) return topReflection;  // a conductor alone
   const bool exitDelta = top.kind == Interface::Kind::Pass;
-  const int n = static_cast<int>(s.ifc.size());
 
   std::vector<V> chainDir(static_cast<std::size_t>(last) + 1), chainW(static_cast<std::size_t>(last) + 1);
   V sum{0, 0, 0};
   for (int sample = 0; sample < o.samples; ++sample) {
-    // The light chain: from wi down through every interface (transmission only).
-    int chainLen = 0;
-    double pB0 = kInf;  // light-side density of c_0 (a delta through a pass-through)
-    {
-      V from = wi;
-      V weight{1, 1, 1};
-      for (int k = 0; k <= last; ++k) {
-        const Interface& I = s.ifc[k];
-        V c;
-        if (I.kind == Interface::Kind::Pass) {
-          // A delta transmission: f / pdf = 1 / |cos|, and f |cos| / pdf = 1 (k >= 1).
-          c = neg(from);
-          if (k == 0) weight = weight / std::fabs(c[2]);
-        } else {
-          BsdfSample bs;
-          if (!bsdfSample(I, from, rng, Mode::Radiance, kTransmission, bs)) break;
-          c = bs.wi;
-          // The cosine of the segment above I_k (towards the exit) for k >= 1;
-          // at I_0 that segment is wi's, which the caller's |cos wi| carries.
-          weight = weight * bs.f * ((k == 0 ? 1.0 : std::fabs(from[2])) / bs.pdf);
-          if (k == 0) pB0 = bs.pdf;
-        }
-        if (!(c[2] < 0)) break;
-        chainDir[k] = c;
-        chainW[k] = weight;
-        chainLen = k + 1;
-        if (k < last) {
-          weight = weight * std::exp(-s.med[k].tau / std::fabs(c[2]));
-          from = neg(c);
-        }
-      }
-    }
-
-    // Enter through the top interface (its reflection is topReflection).
-    V beta{1, 1, 1}, w;
-    if (exitDelta) {
-      w = neg(wo);
-    } else {
-      BsdfSample bs;
-      if (!bsdfSample(top, wo, rng, Mode::Importance, kTransmission, bs)) continue;
-      w = bs.wi;
-      beta = bs.f * (std::fabs(w[2]) / bs.pdf);
-    }
-    if (!(w[2] < 0)) continue;
-
-    // The exit through the top interface after a vertex of layer 0 sampled w1
-    // (strategy A): beta already includes that sample; pA its density; tr the
-    // transmittance to I_0.
-    auto exitA = [&](const V& w1, double pA, double tr) {
-      if (exitDelta || !(w1[2] > 0)) return;
-      V fe = bsdfF(top, neg(w1), wi, Mode::Importance);
-      if (isZero(fe)) return;
-      double pB = bsdfPdf(top, wi, neg(w1), kTransmission);
-      sum = sum + beta * fe * (tr * powerHeuristic(pA, pB));
-    };
-    // The connection of a vertex of layer k to the light chain (strategy B):
-    // fv the vertex's f (times |cos| for a surface) towards -c_k, pA the density
-    // of the walk's own sampling of -c_k, tr the transmittance to I_k.
-    auto connectB = [&](int k, const V& fv, double pA, double tr) {
-      double wB = (k == 0 && !exitDelta) ? powerHeuristic(pB0, pA) : 1.0;
-      sum = sum + beta * fv * chainW[k] * (tr * wB);
-    };
-
-    int k = 0;
-    double t = 0;
-    for (int depth = 0; depth < o.maxDepth; ++depth) {
-      if (!roulette(beta, depth, grp.mask, rng)) break;
-      const Medium& M = s.med[k];
-      bool alive;
-      if (propagate(M, w, t, beta, rng, alive)) {
-        // A scattering vertex at depth t of layer k.
-        if (k < chainLen) {
-          V lw = neg(chainDir[k]);
-          double p = hg(dot(w, lw), M.g);
-          connectB(k, M.omega * p, p, std::exp(-t / std::fabs(lw[2])));
-        }
-        V w1 = sampleHg(w, M.g, rng.uniform(), rng.uniform());
-        double p1 = hg(dot(w, w1), M.g);
-        beta = beta * M.omega;
-        if (k == 0) exitA(w1, p1, std::exp(-t / std::fabs(w1[2])));
-        w = w1;
-        continue;
-      }
-      if (!alive) break;
-
-      if (w[2] > 0) {
-        // At I_k from below.
-        const Interface& I = s.ifc[k];
-        if (k == 0) {
-          // Leaving is counted at the last vertex: only reflection continues.
-          if (exitDelta) break;
-          BsdfSample bs;
-          if (!bsdfSample(I, neg(w), rng, Mode::Importance, kReflection, bs)) break;
-          beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
-          w = bs.wi;
-          continue;
-        }
-        if (I.kind == Interface::Kind::Pass) {
-          --k;
-          t = s.med[k].tau;
-          continue;
-        }
-        BsdfSample bs;
-        if (!bsdfSample(I, neg(w), rng, Mode::Importance, kAll, bs)) break;
-        beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
-        w = bs.wi;
-        if (!bs.reflect) {
-          --k;
-          t = s.med[k].tau;
-        }
-        continue;
-      }
-
-      // At the bottom of layer k, going down: a surface vertex (or a pass-through).
-      const double trUp = M.tau;  // optical depth from the vertex to I_k
-      if (k == n - 1) {
-        // The Lambertian base (Bottom::Lambert; tau 0).
-        if (s.bottom != Bottom::Lambert) break;
-        if (k < chainLen) {
-          V lw = neg(chainDir[k]);
-          connectB(k, s.lambert * (kInvPi * lw[2]), lw[2] * kInvPi, std::exp(-trUp / lw[2]));
-        }
-        V w1 = sampleCosine(rng.uniform(), rng.uniform());
-        if (!(w1[2] > 0)) break;
-        beta = beta * s.lambert;
-        if (k == 0) exitA(w1, w1[2] * kInvPi, std::exp(-trUp / w1[2]));
-        w = w1;
-        continue;
-      }
-      const Interface& I = s.ifc[k + 1];
-      if (I.kind == Interface::Kind::Pass) {
-        ++k;
-        t = 0;
-        continue;
-      }
-      if (k < chainLen) {
-        V lw = neg(chainDir[k]);
-        V fv = bsdfF(I, neg(w), lw, Mode::Importance);
-        if (!isZero(fv)) connectB(k, fv * std::fabs(lw[2]), bsdfPdf(I, neg(w), lw, kAll), std::exp(-trUp / std::fabs(lw[2])));
-      }
-      BsdfSample bs;
-      if (!bsdfSample(I, neg(w), rng, Mode::Importance, kAll, bs)) break;
-      beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
-      w = bs.wi;
-      if (bs.reflect) {
-        if (k == 0) exitA(w, bs.pdf, std::exp(-trUp / std::fabs(w[2])));
-      } else {
-        ++k;
-        t = 0;
-      }
-    }
+    double pB0 = kInf;
+    const int chainLen = traceLightChain(s, last, wi, rng, chainDir, chainW, pB0);
+    EvalWalk walk{s, wi, exitDelta, chainDir, chainW, chainLen, pB0, rng, sum};
+    if (!walk.enter(wo)) continue;
+    walk.run(o.maxDepth, grp.mask);
   }
   return topReflection + sum / static_cast<double>(o.samples);
 }
@@ -659,9 +696,7 @@ V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& r
         const Interface& I = s.ifc[0];
         if (I.kind != Interface::Kind::Pass) {
           BsdfSample bs;
-          if (!bsdfSample(I, wo, rng, Mode::Importance, kAll, bs)) break;
-          beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
-          w = bs.wi;
+          if (!bounce(I, wo, kAll, rng, beta, w, bs)) break;
           if (w[2] > 0) {
             sum = sum + beta;
             break;
@@ -682,9 +717,7 @@ V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& r
         bool up = true;
         if (I.kind != Interface::Kind::Pass) {
           BsdfSample bs;
-          if (!bsdfSample(I, neg(w), rng, Mode::Importance, kAll, bs)) break;
-          beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
-          w = bs.wi;
+          if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) break;
           up = !bs.reflect;
         }
         if (up) {
@@ -707,9 +740,7 @@ V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& r
       bool down = true;
       if (I.kind != Interface::Kind::Pass) {
         BsdfSample bs;
-        if (!bsdfSample(I, neg(w), rng, Mode::Importance, kAll, bs)) break;
-        beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
-        w = bs.wi;
+        if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) break;
         down = !bs.reflect;
       }
       if (down) {
@@ -901,16 +932,7 @@ std::vector<WalkTerm> groundTruthTerms(const CompileResult& r, const Geometry& g
   const Material& m = r.material;
   if (m.root < 0) return {};
   // The value DAG as evaluateMaterial evaluates it (tangent space; inputs at their defaults).
-  EvalPoint p;
-  p.normal = {0, 0, 1};
-  p.tangent = {1, 0, 0};
-  const V B = cross(g.N, g.T);
-  p.view = {dot(g.V, g.T), dot(g.V, B), dot(g.V, g.N)};
-  p.position = g.position;
-  p.uv0 = g.uv0;
-  p.uv1 = g.uv1;
-  p.vertexColor = g.vertexColor;
-  if (tex) p.sampler = tex;
+  const EvalPoint p = tangentSpacePoint(g, tex);
   std::vector<std::array<double, 4>> vals;
   if (m.values.size() > 0) vals = evaluateDag(m, p, static_cast<ValueId>(m.values.size() - 1));
   TreeExpansion tree(m, vals);

@@ -267,50 +267,11 @@ class Walk {
   Closure<T> closure(const ClosureLayout& cl) const {
     const Slab& s = m_.slabs[cl.slab];
     const int node = t_.slabNode[cl.slab];
-    // The walk up to the root: the weight is C (when the slab has a coverage) times
-    // each mix/coverage/select factor, multiplied in walk order.
-    T weight = s.coverage == kNoValue ? T(1) : C_[node];
-    struct Layer {
-      int top;  // node index of the vertical's top layer
-    };
-    std::vector<Layer> layers;
-    for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
-      const TreeNode& op = m_.nodes[p];
-      switch (op.op) {
-        case TreeOp::Horizontal: weight = weight * (op.right == x ? scalar(op.a) : T(1) - scalar(op.a)); break;
-        case TreeOp::CoverageWeight: weight = weight * scalar(op.a); break;
-        case TreeOp::Select: weight = weight * (op.right == x ? T(1) - step(op) : step(op)); break;
-        case TreeOp::Vertical:
-          if (op.right == x) layers.push_back({op.left});
-          break;
-        default: break;
-      }
-    }
-    // The layers above, from the root down (substrate_layer_above); a slab on
-    // top of a vertical transmits T (1 - F0) and widens the roughness below by
-    // C * variance(its roughness). An operator on top: its TI (its slabs'
-    // T (1 - F0) through the operators), no widening. The lighting applies
-    // 1 + cl.extraInterfaces interfaces (the first ones from the root down);
-    // every further one (TreeInfo::interfaces of the tops) times
-    // extraInterfaces.
+    std::vector<int> tops;
+    const T weight = weightAndTops(s, node, tops);
     T ca = T(0), va = T(0);
     V3<T> ta = splat3(T(1));
-    if (!cl.isTop) {
-      int lit = 1 + cl.extraInterfaces;
-      for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
-        const TreeNode& top = m_.nodes[it->top];
-        V3<T> tTop = TI_[it->top];
-        if (top.op == TreeOp::Slab) {
-          tTop = Tr_[it->top];
-          const Slab& ts = m_.slabs[top.slab];
-          va = va + C_[it->top] * roughnessToVariance(scalar(ts.pin(SlabPin::Roughness)));
-          tTop = tTop * (splat3(T(1)) - vec3(ts.pin(SlabPin::F0)));
-        }
-        const int extra = foldedInterfaces(t_.interfaces[it->top], lit);
-        if (extra > 0) tTop = tTop * extraInterfaces<T>(extra);
-        layerAbove(ca, ta, C_[it->top], tTop);
-      }
-    }
+    if (!cl.isTop) layersAbove(cl, tops, ca, va, ta);
 
     Closure<T> c;  // substrate_closure_init
     c.diffuseAlbedo = vec3(s.pin(SlabPin::DiffuseAlbedo));
@@ -325,6 +286,66 @@ class Walk {
     if (!cl.isTop) rough = varianceToRoughness(roughnessToVariance(rough) + va);
     c.roughness = rough;
     c.N = tangentToWorld(vec3(s.pin(SlabPin::Normal)), gN_, gT_);
+    std::uint32_t bits = featurePins(s, c);
+    if (cl.storesWeight) bits |= kFeatureWeight;
+    if (cl.storesCoverageAbove) bits |= kFeatureCoverageAbove;
+    c.weight = weight;
+    if (!cl.isTop) {
+      c.topTransmittance = ta;
+      c.coverageAbove = ca;
+      c.extraInterfaces = static_cast<std::uint32_t>(cl.extraInterfaces);
+      c.isTop = false;
+    }
+    c.features = bits;
+    return c;
+  }
+
+  /// The walk up to the root: the weight is C (when the slab has a coverage)
+  /// times each mix/coverage/select factor, multiplied in walk order; `tops`
+  /// gets the top layer of each vertical the slab is under (root last).
+  T weightAndTops(const Slab& s, int node, std::vector<int>& tops) const {
+    T weight = s.coverage == kNoValue ? T(1) : C_[node];
+    for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
+      const TreeNode& op = m_.nodes[p];
+      switch (op.op) {
+        case TreeOp::Horizontal: weight = weight * (op.right == x ? scalar(op.a) : T(1) - scalar(op.a)); break;
+        case TreeOp::CoverageWeight: weight = weight * scalar(op.a); break;
+        case TreeOp::Select: weight = weight * (op.right == x ? T(1) - step(op) : step(op)); break;
+        case TreeOp::Vertical:
+          if (op.right == x) tops.push_back(op.left);
+          break;
+        default: break;
+      }
+    }
+    return weight;
+  }
+
+  /// The layers above, from the root down (substrate_layer_above); a slab on
+  /// top of a vertical transmits T (1 - F0) and widens the roughness below by
+  /// C * variance(its roughness). An operator on top: its TI (its slabs'
+  /// T (1 - F0) through the operators), no widening. The lighting applies
+  /// 1 + cl.extraInterfaces interfaces (the first ones from the root down);
+  /// every further one (TreeInfo::interfaces of the tops) times
+  /// extraInterfaces.
+  void layersAbove(const ClosureLayout& cl, const std::vector<int>& tops, T& ca, T& va, V3<T>& ta) const {
+    int lit = 1 + cl.extraInterfaces;
+    for (auto it = tops.rbegin(); it != tops.rend(); ++it) {
+      const TreeNode& top = m_.nodes[*it];
+      V3<T> tTop = TI_[*it];
+      if (top.op == TreeOp::Slab) {
+        tTop = Tr_[*it];
+        const Slab& ts = m_.slabs[top.slab];
+        va = va + C_[*it] * roughnessToVariance(scalar(ts.pin(SlabPin::Roughness)));
+        tTop = tTop * (splat3(T(1)) - vec3(ts.pin(SlabPin::F0)));
+      }
+      const int extra = foldedInterfaces(t_.interfaces[*it], lit);
+      if (extra > 0) tTop = tTop * extraInterfaces<T>(extra);
+      layerAbove(ca, ta, C_[*it], tTop);
+    }
+  }
+
+  /// The pins of the slab's features into c; returns their feature bits.
+  std::uint32_t featurePins(const Slab& s, Closure<T>& c) const {
     std::uint32_t bits = 0;
     const std::uint16_t f = s.features;
     if (has(f, kFeatF90)) {
@@ -363,17 +384,7 @@ class Walk {
       c.specularProfile = static_cast<std::uint32_t>(profileIndex_.at(s.specularProfileInput) + 1);
     }
     if (has(f, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
-    if (cl.storesWeight) bits |= kFeatureWeight;
-    if (cl.storesCoverageAbove) bits |= kFeatureCoverageAbove;
-    c.weight = weight;
-    if (!cl.isTop) {
-      c.topTransmittance = ta;
-      c.coverageAbove = ca;
-      c.extraInterfaces = static_cast<std::uint32_t>(cl.extraInterfaces);
-      c.isTop = false;
-    }
-    c.features = bits;
-    return c;
+    return bits;
   }
 
   const Material& m_;
@@ -394,19 +405,9 @@ template <class T>
 MaterialResult<T> evaluateMaterial(const CompileResult& r, const Geometry& g, const InputValues& in,
                                    const TextureFn& tex) {
   const Material& m = r.material;
-  // The value DAG in double. Tangent space as the generated code: normal (0,0,1),
-  // tangent (1,0,0), view = ts_view = (V.T, V.(N x T), V.N) (not renormalized).
-  EvalPoint p;
-  p.normal = {0, 0, 1};
-  p.tangent = {1, 0, 0};
-  const V3<double> B = cross(g.N, g.T);
-  p.view = {dot(g.V, g.T), dot(g.V, B), dot(g.V, g.N)};
-  p.position = g.position;
-  p.uv0 = g.uv0;
-  p.uv1 = g.uv1;
-  p.vertexColor = g.vertexColor;
+  // The value DAG in double, at the generated code's tangent-space point.
+  EvalPoint p = tangentSpacePoint(g, tex);
   p.inputs = in.values;
-  if (tex) p.sampler = tex;
   std::vector<std::array<double, 4>> values;
   if (m.values.size() > 0) values = evaluateDag(m, p, static_cast<ValueId>(m.values.size() - 1));
   return Walk<T>(r, values, g).run();
