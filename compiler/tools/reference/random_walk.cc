@@ -475,7 +475,7 @@ bool propagate(const Medium& M, const V& w, double& t, V& beta, SplitMix64& rng,
 
 /// An importance-sampled bounce off I from `from` (flags: which lobes):
 /// beta *= f |cos| / pdf and w = the sampled direction; false: no sample.
-bool bounce(const Interface& I, const V& from, int flags, Rng& rng, V& beta, V& w, BsdfSample& bs) {
+bool bounce(const Interface& I, const V& from, int flags, SplitMix64& rng, V& beta, V& w, BsdfSample& bs) {
   if (!bsdfSample(I, from, rng, Mode::Importance, flags, bs)) return false;
   beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
   w = bs.wi;
@@ -486,7 +486,7 @@ bool bounce(const Interface& I, const V& from, int flags, Rng& rng, V& beta, V& 
 /// interface (transmission only). dir[k] the direction below I_k, weight[k]
 /// the chain's throughput to there; returns the chain's length, and pB0 the
 /// light-side density of dir[0] (infinite: a delta through a pass-through).
-int traceLightChain(const Resolved& s, int last, const V& wi, Rng& rng, std::vector<V>& dir, std::vector<V>& weight,
+int traceLightChain(const Resolved& s, int last, const V& wi, SplitMix64& rng, std::vector<V>& dir, std::vector<V>& weight,
                     double& pB0) {
   int chainLen = 0;
   pB0 = kInf;
@@ -532,7 +532,7 @@ struct EvalWalk {
   const std::vector<V>& chainW;
   int chainLen;
   double pB0;
-  Rng& rng;
+  SplitMix64& rng;
   V& sum;
   V beta{1, 1, 1}, w{0, 0, 0};
   int k = 0;
