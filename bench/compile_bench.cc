@@ -26,7 +26,7 @@
 
 #include "diag/diagnostics.h"
 #include "format/json_document.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "pipeline/pipeline.h"
 
 namespace fs = std::filesystem;

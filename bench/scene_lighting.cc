@@ -127,7 +127,7 @@ BuiltScene builtScene(const std::string& source, const std::string& manifest) {
   o.manifest = source + "/examples/scenes/" + manifest;
   o.batch.generate.hlsl = false;
   SceneBuild b = substratec::buildScene(o);
-  if (b.status != 0) die("scene " + manifest + ":\n" + b.messages);
+  if (b.status != SceneStatus::Ok) die("scene " + manifest + ":\n" + b.messages);
   BuiltScene s;
   for (const OutputFile& f : b.files) s.files[f.name] = f.contents;
   // The materials again (their CompileResult, for the reference), in manifest order.

@@ -74,7 +74,7 @@
 #define SHADER_COST_HAVE_CALLGRIND 0
 #endif
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "emit/kernel_emitter.h"
 #include "gpu/harness.h"
 #include "gpu/sample_run.h"
@@ -159,7 +159,7 @@ ShaderValidation compileSource(const ShaderSource& src) {
   return v;
 }
 
-/// The material's Throughput kernel, compiled as compileKernel (emit/generate.h)
+/// The material's Throughput kernel, compiled as compileKernel (pipeline/generate.h)
 /// compiles it — the same material file, kernel text and embedded runtime — and
 /// also optimized, for its instruction count.
 std::unique_ptr<Kernel> generatedKernel(const CompileResult& r, const EmitOptions& emit, const std::string& label) {

@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "diag/diagnostics.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "pipeline/pipeline.h"
 #include "report/report.h"
 

@@ -15,7 +15,7 @@
 #include <gtest/gtest.h>
 
 #include "pipeline/pipeline.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "report/report.h"
 #include "import/import.h"
 

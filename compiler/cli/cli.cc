@@ -8,7 +8,7 @@
 #include "pipeline/pipeline.h"
 #include "report/report.h"
 #include "validate/toolchain.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "output/atomic_write.h"
 #include "output/depfile.h"
 #include "cli/cli_options.h"
@@ -698,6 +698,17 @@ struct SceneArgs {
 
 /// Every material of a scene for its platform, and the lighting the scene
 /// needs (scene/scene.h), written atomically into the output directory.
+/// The exit code of a scene build's status (the scene floor knows no exit codes).
+int exitCode(SceneStatus s) {
+  switch (s) {
+    case SceneStatus::Ok: return kExitOk;
+    case SceneStatus::BadInput: return kExitBadInput;
+    case SceneStatus::BadUsage: return kExitUsage;
+    case SceneStatus::InternalError: return kExitInternal;
+  }
+  return kExitInternal;
+}
+
 int runScene(const SceneArgs& a, std::ostream& out, std::ostream& err) {
   SceneOptions o;
   o.manifest = a.manifest;
@@ -713,7 +724,7 @@ int runScene(const SceneArgs& a, std::ostream& out, std::ostream& err) {
   if (int status = outputs.check(err); status != kExitOk) return status;
   SceneBuild b = buildScene(o);
   err << b.messages;
-  if (b.status != kExitOk) return b.status;
+  if (b.status != SceneStatus::Ok) return exitCode(b.status);
   // The scene's depfile has one target, scene.json: which lighting files a
   // scene has depends on its materials, so a build system cannot list them
   // beforehand; it depends on scene.json (written with them, atomically).

@@ -34,7 +34,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "material_fixture.h"
 
 namespace substratec::gputest {

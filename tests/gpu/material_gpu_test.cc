@@ -26,7 +26,7 @@
 
 #include <fmt/format.h>
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "material_fixture.h"
 
 namespace substratec::gputest {

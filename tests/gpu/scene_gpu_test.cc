@@ -30,7 +30,7 @@
 #include <fmt/format.h>
 
 #include "batch/batch.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "emit/scene_emitter.h"
 #include "gpu/gbuffer.h"
 #include "material_fixture.h"

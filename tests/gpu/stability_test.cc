@@ -15,7 +15,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "gpu/sample_run.h"
 #include "../stack_furnace.h"
 #include "material_fixture.h"

@@ -13,7 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "corpus.h"
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "pipeline/pipeline.h"
 
 namespace fs = std::filesystem;

@@ -16,7 +16,7 @@
 
 #include <gtest/gtest.h>
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "import/glb_container.h"
 #include "import/gltf_resources.h"
 #include "import/import.h"

@@ -9,7 +9,7 @@
 
 #include "pipeline/pipeline.h"
 #include "scene/manifest.h"
-#include "scene/platform.h"
+#include "pipeline/platform.h"
 
 namespace substratec {
 namespace {

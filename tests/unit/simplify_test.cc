@@ -12,7 +12,7 @@
 #include "passes/blend.h"
 #include "passes/simplify.h"
 #include "pipeline/pipeline.h"
-#include "report/dump.h"
+#include "ir/dump.h"
 #include "test_util.h"
 
 namespace substratec {

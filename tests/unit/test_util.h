@@ -15,7 +15,7 @@
 #include "passes/features.h"
 #include "passes/resolve.h"
 #include "passes/shared_bases.h"
-#include "report/dump.h"
+#include "ir/dump.h"
 
 namespace substratec::test {
 

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "report/dump.h"
+#include "ir/dump.h"
 #include "substrate_constants.h"  // runtime_shaders/: SUBSTRATE_FEATURE_* bits
 
 namespace substratec {

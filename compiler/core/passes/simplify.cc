@@ -6,7 +6,7 @@
 #include "passes/blend.h"
 #include "passes/features.h"
 #include "passes/shared_bases.h"
-#include "report/dump.h"
+#include "ir/dump.h"
 
 namespace substratec {
 

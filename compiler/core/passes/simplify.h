@@ -40,7 +40,7 @@ struct SimplifyBudget {
   int maxClosures = 8;
   bool full = false;
   BlendRule rule = BlendRule::ProjectRules;  // blending rules of the collapses
-  std::uint16_t disallowed = 0;              // kFeat* bits the platform does not allow (scene/platform.h)
+  std::uint16_t disallowed = 0;              // kFeat* bits the platform does not allow (pipeline/platform.h)
   std::string platform;                      // its name, for the diagnostic ("" without a platform)
 };
 

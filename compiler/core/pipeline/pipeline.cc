@@ -9,7 +9,7 @@
 #include "passes/cull.h"
 #include "passes/features.h"
 #include "passes/shared_bases.h"
-#include "report/dump.h"
+#include "ir/dump.h"
 
 namespace substratec {
 

@@ -12,7 +12,7 @@
 #include "passes/build_tree.h"
 #include "passes/resolve.h"
 #include "passes/simplify.h"
-#include "scene/platform.h"
+#include "pipeline/platform.h"
 #include "storage/layout.h"
 
 namespace substratec {

@@ -2,7 +2,7 @@
 
 #include <fmt/format.h>
 
-#include "report/dump.h"
+#include "ir/dump.h"
 
 namespace substratec {
 

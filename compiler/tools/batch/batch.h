@@ -13,7 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "emit/scene_emitter.h"
 #include "pipeline/pipeline.h"
 

@@ -7,7 +7,7 @@
 #include <mutex>
 #include <random>
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "gpu/block_layout.h"
 #include "validate/runtime_files.h"
 

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "emit/kernel_emitter.h"
 #include "gpu/block_layout.h"
 #include "gpu/sample_run.h"

@@ -5,7 +5,6 @@
 
 #include <fmt/format.h>
 
-#include "cli/cli.h"
 #include "scene/manifest.h"
 
 namespace substratec {
@@ -30,14 +29,14 @@ std::optional<Platform> choosePlatform(const SceneOptions& o, const SceneManifes
   if (!name) return std::nullopt;
   if (const Platform* p = table.find(*name)) return *p;
   if (o.platform) {
-    b.status = kExitUsage;
+    b.status = SceneStatus::BadUsage;
     b.messages += fmt::format("substratec: error: unknown platform {} (known: {})\n", quoteForDiagnostic(*name),
                               table.names());
   } else {
     Diagnostics d(o.manifest);
     d.error(scene.platformPointer,
             fmt::format("unknown platform {} (known: {})", quoteForDiagnostic(*name), table.names()));
-    b.status = kExitBadInput;
+    b.status = SceneStatus::BadInput;
     b.messages += d.formatAll();
   }
   return std::nullopt;
@@ -58,7 +57,7 @@ SceneBuild buildScene(const SceneOptions& o) {
     Diagnostics d(o.manifest);
     if (auto text = readSourceFile(o.manifest, limits, d)) scene = readSceneManifest(o.manifest, *text, limits, d);
     b.messages += d.formatAll();
-    if (!scene) return b.status = kExitBadInput, b;
+    if (!scene) return b.status = SceneStatus::BadInput, b;
     bad = d.hasErrors();
   }
   if (!o.platformsFile.empty()) b.inputs.push_back(o.platformsFile);
@@ -68,9 +67,9 @@ SceneBuild buildScene(const SceneOptions& o) {
     bad = true;
   } else {
     batch.compile.platform = choosePlatform(o, *scene, *table, b);
-    if (b.status == kExitUsage) return b;  // an unknown --platform: bad usage, before anything is built
-    if (b.status != 0) bad = true;
-    b.status = 0;
+    if (b.status == SceneStatus::BadUsage) return b;  // an unknown --platform: bad usage, before anything is built
+    if (b.status != SceneStatus::Ok) bad = true;
+    b.status = SceneStatus::Ok;
   }
 
   std::vector<std::string> paths;
@@ -105,8 +104,8 @@ SceneBuild buildScene(const SceneOptions& o) {
     b.messages += d.formatAll();
     bad = bad || d.hasErrors();
   }
-  if (internal) return b.status = kExitInternal, b;
-  if (bad) return b.status = kExitBadInput, b;
+  if (internal) return b.status = SceneStatus::InternalError, b;
+  if (bad) return b.status = SceneStatus::BadInput, b;
 
   // The lighting: what the materials store after simplification, and no more.
   std::vector<SceneMaterialShape> shapes;
@@ -124,7 +123,7 @@ SceneBuild buildScene(const SceneOptions& o) {
     validateGenerated(lighting, {.optimize = true}, static_cast<std::size_t>(std::max(0, o.batch.jobs)));
     if (!lighting.valid) {
       b.messages += "substratec: internal compiler error: the scene's lighting does not validate\n" + lighting.failure + "\n";
-      return b.status = kExitInternal, b;
+      return b.status = SceneStatus::InternalError, b;
     }
   }
   std::map<std::string, const EntryReport*> counts;

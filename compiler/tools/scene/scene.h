@@ -23,8 +23,11 @@ struct SceneOptions {
   BatchOptions batch;                   // read limits, budget overrides, targets, diffuse model, -j, --cache
 };
 
+/// How a scene build ended (the CLI maps it to its exit code).
+enum class SceneStatus { Ok, BadInput, BadUsage, InternalError };
+
 struct SceneBuild {
-  int status = 0;                   // ExitCode (cli/cli.h)
+  SceneStatus status = SceneStatus::Ok;
   std::string messages;             // everything for stderr, in a fixed order
   std::vector<OutputFile> files;    // every output (materials, lighting, scene.json); empty unless status is 0
   std::vector<std::string> inputs;  // every file read (manifest, platforms file, materials): the depfile's

@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 #include "gpu/sample_run.h"
 #include "reference/reference.h"
 #include "storage/pack.h"

@@ -1,4 +1,4 @@
-#include "emit/generate.h"
+#include "pipeline/generate.h"
 
 #include <algorithm>
 #include <map>

@@ -1,4 +1,4 @@
-#include "scene/platform.h"
+#include "pipeline/platform.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "report/dump.h"
+#include "ir/dump.h"
 
 #include <fmt/format.h>
 
