@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "cli/cli.h"
+#include "cli/messages.h"
 
 namespace substratec {
 
@@ -39,8 +40,7 @@ int CommandOutputs::refuseInputs(const std::vector<std::string>& outputs, std::o
   std::error_code ec;
   for (const std::string& f : namedFiles_)
     if (std::filesystem::is_directory(f, ec)) {
-      err << "substratec: error: output '" << f << "' is a directory; expected the name of a file\n";
-      return kExitUsage;
+      return cli::printError(err, kExitUsage, fmt::format("output '{}' is a directory; expected the name of a file", f));
     }
   std::vector<std::string> all = directories_;
   all.insert(all.end(), outputs.begin(), outputs.end());
@@ -51,8 +51,7 @@ int CommandOutputs::refuseInputs(const std::vector<std::string>& outputs, std::o
   if (error.rfind(named, 0) == 0)  // `>> input`: say it as the user wrote it
     error = "standard output" + error.substr(named.size(), error.find(';') - named.size()) +
             "; refusing to write to it";
-  err << "substratec: error: " << error << "\n";
-  return kExitUsage;
+  return cli::printError(err, kExitUsage, error);
 }
 
 std::vector<std::string> CommandOutputs::prerequisites(const std::vector<std::string>& named) const {
@@ -72,18 +71,14 @@ int CommandOutputs::check(std::ostream& err) const {
   std::string error = checkWritable(namedFiles_);
   for (std::size_t i = 0; error.empty() && i < directories_.size(); ++i) error = checkWritableDirectory(directories_[i]);
   if (error.empty()) return kExitOk;
-  err << "substratec: error: " << error << "\n";
-  return kExitBadInput;
+  return cli::printError(err, kExitBadInput, error);
 }
 
 int CommandOutputs::commit(const std::vector<OutputPath>& files, std::ostream& err) const {
   std::vector<std::string> paths;
   for (const OutputPath& f : files) paths.push_back(f.path);
   if (int status = refuseInputs(paths, err); status != kExitOk) return status;
-  if (std::string error = writePathsAtomically(files); !error.empty()) {
-    err << "substratec: error: " << error << "\n";
-    return kExitBadInput;
-  }
+  if (std::string error = writePathsAtomically(files); !error.empty()) return cli::printError(err, kExitBadInput, error);
   return kExitOk;
 }
 

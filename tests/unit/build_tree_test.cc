@@ -16,12 +16,11 @@
 namespace substratec {
 namespace {
 
-using test::buildMaterial;
 using test::diagnosticsOf;
 using test::material;
-using test::Stage;
+using test::runUntil;
 
-Material tree(const std::string& json) { return buildMaterial(json, Stage::Tree); }
+Material tree(const std::string& json) { return runUntil(json, "build-tree"); }
 
 /// Instance ids in pre-order, space separated.
 std::string ids(const Material& m) {

@@ -12,10 +12,9 @@
 namespace substratec {
 namespace {
 
-using test::buildMaterial;
 using test::diagnosticsOf;
 using test::material;
-using test::Stage;
+using test::runUntil;
 
 constexpr const char* kInputs = R"({
   "m": {"type": "float", "default": 0.5, "min": 0, "max": 1},
@@ -28,7 +27,7 @@ class CullTest : public ::testing::Test {
   /// Builds the tree of `nodes` (output "root"), checks its dump is `before`,
   /// culls it and returns the dump after.
   std::string cull(const std::string& nodes, const std::string& before) {
-    m = buildMaterial(material(nodes, kInputs), Stage::Tree);
+    m = runUntil(material(nodes, kInputs), "build-tree");
     EXPECT_EQ(dumpMaterial(m), before) << "(input dump)";
     Diagnostics d("test.json");
     ok = cullStaticMatter(m, d);
@@ -592,7 +591,7 @@ TEST_F(CullTest, OpaqueTopsOverOpaqueTopsCollapseToTheVisibleOne) {
   for (int k = 0; k < 12; ++k)
     nodes += fmt::format(R"("{}": {{"kind": "vertical", "top": "s{}", "base": "{}"}}{})", k == 0 ? "root" : fmt::format("v{}", k),
                          k, k == 11 ? "s12" : fmt::format("v{}", k + 1), k == 11 ? "" : ", ");
-  m = buildMaterial(material(nodes, kInputs), Stage::Tree);
+  m = runUntil(material(nodes, kInputs), "build-tree");
   Diagnostics d("test.json");
   ASSERT_TRUE(cullStaticMatter(m, d));
   EXPECT_EQ(dumpMaterial(m).substr(0, dumpMaterial(m).find("culled")), "SLAB s0\n    roughness = 0\n");

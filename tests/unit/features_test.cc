@@ -11,8 +11,7 @@
 namespace substratec {
 namespace {
 
-using test::buildMaterial;
-using test::Stage;
+using test::runUntil;
 
 std::string document(const std::string& nodes, const std::string& inputs = "{}",
                      const std::string& settings = "{}") {
@@ -25,14 +24,14 @@ class FeaturesTest : public ::testing::Test {
   /// Builds up to culling, checks the dump is `before`, runs the pass and
   /// returns the dump after it.
   std::string run(const std::string& json, const std::string& before) {
-    m = buildMaterial(json, Stage::Cull);
+    m = runUntil(json, "cull");
     EXPECT_EQ(dumpMaterial(m), before) << "(input dump)";
     analyzeFeatures(m);
     return dumpMaterial(m);
   }
   /// Features of the single slab "root" with `pins`.
   std::string featuresOf(const std::string& pins, const std::string& inputs = "{}") {
-    Material s = buildMaterial(document(R"("root": {"kind": "slab", )" + pins + "}", inputs), Stage::Cull);
+    Material s = runUntil(document(R"("root": {"kind": "slab", )" + pins + "}", inputs), "cull");
     analyzeFeatures(s);
     if (s.slabs.size() != 1) return "?";
     return featureList(s.slabs[0].features);
@@ -322,10 +321,10 @@ TEST_F(FeaturesTest, NoSssMeansSssTypeNone) {
 }
 
 TEST_F(FeaturesTest, RunningThePassTwiceGivesTheSameResult) {
-  m = buildMaterial(document(R"(
+  m = runUntil(document(R"(
     "coat": {"kind": "slab", "sss_mfp": 10},
     "root": {"kind": "vertical", "top": "coat", "base": {"kind": "slab", "sss_mfp": 0.01}})"),
-                    Stage::Cull);
+               "cull");
   analyzeFeatures(m);
   const std::string once = dumpMaterial(m);
   analyzeFeatures(m);

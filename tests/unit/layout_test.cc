@@ -19,7 +19,6 @@ namespace {
 
 using test::buildMaterial;
 using test::material;
-using test::Stage;
 
 constexpr const char* kInputs = R"({
   "m": {"type": "float", "default": 0.5},
@@ -42,7 +41,7 @@ struct Priced {
 
 Priced price(const std::string& json) {
   Priced p;
-  p.m = buildMaterial(json, Stage::Bases);
+  p.m = buildMaterial(json);
   if (p.m.root >= 0) p.layout = computeLayout(p.m, analyzeTree(p.m));
   return p;
 }

@@ -12,9 +12,8 @@
 namespace substratec {
 namespace {
 
-using test::buildMaterial;
 using test::material;
-using test::Stage;
+using test::runUntil;
 
 constexpr const char* kInputs = R"({
   "m": {"type": "float", "default": 0.5},
@@ -28,7 +27,7 @@ constexpr const char* kInputs = R"({
 class SharedBasesTest : public ::testing::Test {
  protected:
   std::string run(const std::string& nodes, const std::string& before) {
-    m = buildMaterial(material(nodes, kInputs), Stage::Features);
+    m = runUntil(material(nodes, kInputs), "features");
     EXPECT_EQ(dumpMaterial(m), before) << "(input dump)";
     shareLocalBases(m);
     return dumpMaterial(m);

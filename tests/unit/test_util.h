@@ -1,58 +1,47 @@
 // Helpers for pass tests: build a material from inline JSON up to (and
-// including) a named stage, so a test can dump the IR, run one pass, and
-// compare dumps — the Tint style of "input dump -> pass -> output dump".
+// including) a named pass of the registry (pipeline/pass_registry.h), so a
+// test can dump the IR, run one pass, and compare dumps — the Tint style of
+// "input dump -> pass -> output dump".
 #pragma once
 #include <string>
+#include <string_view>
 
 #include <gtest/gtest.h>
 
 #include "diag/diagnostics.h"
-#include "format/json_document.h"
 #include "ir/material.h"
-#include "passes/build_tree.h"
-#include "passes/build_values.h"
-#include "passes/cull.h"
-#include "passes/features.h"
-#include "passes/resolve.h"
-#include "passes/shared_bases.h"
+#include "pipeline/pass_registry.h"
 #include "ir/dump.h"
 
 namespace substratec::test {
 
-enum class Stage { Tree, Cull, Features, Bases };
+/// Runs the pipeline's passes in order up to and including `last` (a
+/// registry name: "build-tree", "cull", "features", "shared-bases", ...) on
+/// `json` with the default options, diagnostics into `d`; the material.
+inline Material runPassesUntil(const std::string& json, std::string_view last, Diagnostics& d) {
+  CompileOptions options;
+  CompileResult result;
+  PassContext context(json, options, d, result);
+  if (!findPass(last)) ADD_FAILURE() << "no pass named " << last << " (the passes: " << passNames() << ")";
+  else runPasses(context, last);
+  return std::move(result.material);
+}
 
-/// Runs parse, resolve, build-values, build-tree and then the passes up to
-/// and including `last`. Fails the test (and returns an empty material) on
-/// any diagnostic.
-inline Material buildMaterial(const std::string& json, Stage last = Stage::Bases) {
-  Material m;
+/// runPassesUntil, failing the test (and returning an empty material) on any diagnostic.
+inline Material runUntil(const std::string& json, std::string_view last) {
   Diagnostics d("test.json");
-  auto doc = parseJsonDocument(json, ReadLimits{}, d);
-  std::optional<ResolvedDoc> r;
-  if (doc) r = resolveDocument(*doc, d);
-  if (r) {
-    ValueTable t = buildValueDag(*r, m);
-    if (buildSubstrateTree(*r, t, m, d)) {
-      if (last >= Stage::Cull) cullStaticMatter(m, d);
-      if (last >= Stage::Features) analyzeFeatures(m);
-      if (last >= Stage::Bases) shareLocalBases(m);
-    }
-  }
+  Material m = runPassesUntil(json, last, d);
   EXPECT_FALSE(d.hasErrors()) << d.formatAll();
   return m;
 }
 
-/// The diagnostics a document produces (formatted, one per line).
+/// The material as the pass tests mostly want it: analysed, not yet priced.
+inline Material buildMaterial(const std::string& json) { return runUntil(json, "shared-bases"); }
+
+/// The diagnostics a document produces through cull (formatted, one per line).
 inline std::string diagnosticsOf(const std::string& json) {
-  Material m;
   Diagnostics d("test.json");
-  auto doc = parseJsonDocument(json, ReadLimits{}, d);
-  std::optional<ResolvedDoc> r;
-  if (doc) r = resolveDocument(*doc, d);
-  if (r) {
-    ValueTable t = buildValueDag(*r, m);
-    if (buildSubstrateTree(*r, t, m, d)) cullStaticMatter(m, d);
-  }
+  runPassesUntil(json, "cull", d);
   return d.formatAll();
 }
 

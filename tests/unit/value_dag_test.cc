@@ -143,14 +143,14 @@ TEST_F(ValueDagTest, OutputIndexAndTypeArePartOfTheKey) {
 TEST(ValueDagFromDocument, RepeatedAndCommutedExpressionsAreOneNode) {
   // The value DAG is built once per material: the same inline expression in
   // two pins, or with its operands swapped, is one node.
-  Material m = test::buildMaterial(test::material(R"("root": {"kind": "slab",
+  Material m = test::runUntil(test::material(R"("root": {"kind": "slab",
       "roughness": {"kind": "multiply", "a": "$m", "b": 0.5},
       "second_roughness": {"kind": "multiply", "a": "$m", "b": 0.5},
       "fuzz_amount": {"kind": "add", "a": "$m", "b": "$n"},
       "fuzz_roughness": {"kind": "add", "a": "$n", "b": "$m"}})",
                                                   R"({"m": {"type": "float", "default": 0.5},
                                                       "n": {"type": "float", "default": 0.25}})"),
-                                   test::Stage::Tree);
+                              "build-tree");
   ASSERT_EQ(m.slabs.size(), 1u);
   const Slab& s = m.slabs[0];
   EXPECT_EQ(s.pin(SlabPin::Roughness), s.pin(SlabPin::SecondRoughness));
@@ -159,10 +159,10 @@ TEST(ValueDagFromDocument, RepeatedAndCommutedExpressionsAreOneNode) {
 }
 
 TEST(ValueDagFromDocument, ConstantExpressionsAreFoldedWhenTheDocumentIsBuilt) {
-  Material m = test::buildMaterial(test::material(R"("root": {"kind": "slab",
+  Material m = test::runUntil(test::material(R"("root": {"kind": "slab",
       "roughness": {"kind": "multiply", "a": {"kind": "sqrt", "x": 0.25}, "b": {"kind": "one_minus", "x": 0.2}},
       "f0": {"kind": "ior_to_f0", "ior": 1.5}})"),
-                                   test::Stage::Tree);
+                              "build-tree");
   const Slab& s = m.slabs[0];
   ASSERT_TRUE(m.values.isConst(s.pin(SlabPin::Roughness)));
   EXPECT_DOUBLE_EQ(m.values.node(s.pin(SlabPin::Roughness)).c[0], 0.4);

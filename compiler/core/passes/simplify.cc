@@ -4,8 +4,6 @@
 
 #include "ir/tree_info.h"
 #include "passes/blend.h"
-#include "passes/features.h"
-#include "passes/shared_bases.h"
 #include "ir/dump.h"
 
 namespace substratec {
@@ -55,13 +53,6 @@ void disableFeature(Material& m, std::uint16_t feature) {
 
 namespace {
 
-/// Re-runs the analyses after a rewrite and prices the result.
-StorageLayout reprice(Material& m) {
-  analyzeFeatures(m);
-  shareLocalBases(m);
-  return computeLayout(m, analyzeTree(m));
-}
-
 /// The next operator to collapse: deepest first; at equal depth horizontal,
 /// add, select and coverage weight before vertical; then the smallest tree id.
 int pickOperator(const Material& m, const TreeInfo& t) {
@@ -110,7 +101,7 @@ bool present(const Material& m, std::uint16_t f) {
 
 /// Disables every feature of `mask` the material uses, in the documented
 /// order (emissive last), recording each as `action`.
-void disableAll(Material& m, std::uint16_t mask, const char* action, StorageLayout& layout,
+void disableAll(Material& m, std::uint16_t mask, const char* action, Reprice reprice, StorageLayout& layout,
                 std::vector<SimplifyStep>& steps) {
   std::vector<std::uint16_t> order = featureDisableOrder();
   order.push_back(kFeatEmissive);
@@ -133,10 +124,10 @@ bool over(const StorageLayout& L, const SimplifyBudget& b) {
 
 }  // namespace
 
-bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& layout,
+bool simplifyToBudget(Material& m, const SimplifyBudget& budget, Reprice reprice, StorageLayout& layout,
                       std::vector<SimplifyStep>& steps, Diagnostics& diags) {
   // What the platform's lighting does not evaluate goes first.
-  disableAll(m, budget.disallowed, "disallow", layout, steps);
+  disableAll(m, budget.disallowed, "disallow", reprice, layout, steps);
   while (over(layout, budget)) {
     TreeInfo t = analyzeTree(m);
     int n = pickOperator(m, t);
@@ -151,11 +142,11 @@ bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& 
   }
   for (std::uint16_t f : featureDisableOrder()) {
     if (!over(layout, budget)) break;
-    disableAll(m, f, "disable", layout, steps);
+    disableAll(m, f, "disable", reprice, layout, steps);
   }
   // A collapse blends a disallowed feature's neutral value with another
   // slab's: the blend may use it again.
-  disableAll(m, budget.disallowed, "disallow", layout, steps);
+  disableAll(m, budget.disallowed, "disallow", reprice, layout, steps);
   if (over(layout, budget)) {
     if (budget.full)
       diags.error("", fmt::format("full simplification cannot fit a {}-byte payload: the smallest reachable size is {} "

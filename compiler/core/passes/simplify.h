@@ -14,7 +14,8 @@
 //
 // Rewrite: Material (priced)  ->  Material (fits), plus the list of steps.
 // Must run after shared-bases and pricing; it re-runs features, bases and
-// pricing after every step, so the IR stays analysed.
+// pricing after every step (the registry's analyses, handed in as `reprice`),
+// so the IR stays analysed.
 #pragma once
 #include <string>
 #include <vector>
@@ -50,9 +51,15 @@ inline constexpr int kFullSimplificationBytes = 32;
 /// Order in which features are disabled (docs/simplification.md).
 const std::vector<std::uint16_t>& featureDisableOrder();
 
+/// Re-analyses a rewritten material and prices it: the pipeline's analyses
+/// and pricing, in the pipeline's order (pipeline/pass_registry.h:
+/// repriceMaterial). Passed in, so that the order is written once.
+using Reprice = StorageLayout (*)(Material& m);
+
 /// Returns false (with an error) when the budget cannot be met. `layout` is
-/// the current price on entry and the final one on return.
-bool simplifyToBudget(Material& m, const SimplifyBudget& budget, StorageLayout& layout,
+/// the current price on entry and the final one on return; `reprice` runs
+/// after every step.
+bool simplifyToBudget(Material& m, const SimplifyBudget& budget, Reprice reprice, StorageLayout& layout,
                       std::vector<SimplifyStep>& steps, Diagnostics& diags);
 
 /// Disables one feature on every slab (used by simplification; exposed for tests).

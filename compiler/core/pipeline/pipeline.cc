@@ -5,87 +5,141 @@
 
 #include <fmt/format.h>
 
-#include "passes/build_values.h"
+#include "passes/build_tree.h"
 #include "passes/cull.h"
 #include "passes/features.h"
 #include "passes/shared_bases.h"
+#include "pipeline/pass_registry.h"
 #include "ir/dump.h"
 
 namespace substratec {
 
 namespace {
 
-/// Runs one pass, timing it and dumping the IR after it when asked.
-class PassRunner {
- public:
-  PassRunner(const CompileOptions& o, CompileResult& r) : options_(o), result_(r) {}
-
-  template <typename F>
-  auto run(const char* name, F&& pass) {
-    auto t0 = std::chrono::steady_clock::now();
-    auto out = pass();
-    if (options_.timePasses) {
-      double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      result_.timings.push_back({name, ms});
-    }
-    if (options_.printAfterAll)
-      result_.debugLog += fmt::format("; IR after {}\n{}\n", name, dumpMaterial(result_.material));
-    return out;
+/// The budget the material is simplified to: its settings, overridden by
+/// --budget / --max-closures, capped by the platform.
+void chooseBudget(PassContext& c) {
+  const Material& m = c.result.material;
+  c.result.budgetBytes = c.options.budgetOverride.value_or(m.settings.bytesPerPixel);
+  c.result.maxClosures = c.options.maxClosuresOverride.value_or(m.settings.maxClosures);
+  if (c.options.platform) {  // the platform caps what the material asks for
+    c.result.budgetBytes = std::min(c.result.budgetBytes, c.options.platform->bytesPerPixel);
+    c.result.maxClosures = std::min(c.result.maxClosures, c.options.platform->maxClosures);
   }
+}
 
- private:
-  const CompileOptions& options_;
-  CompileResult& result_;
-};
+bool simplifyPass(PassContext& c) {
+  const CompileOptions& o = c.options;
+  c.result.after = c.result.before;
+  SimplifyBudget budget{c.result.budgetBytes, c.result.maxClosures, o.fullSimplification, o.blendRule,
+                        o.platform ? o.platform->disallowedFeatures() : std::uint16_t{0},
+                        o.platform ? o.platform->name : std::string()};
+  return simplifyToBudget(c.result.material, budget, repriceMaterial, c.result.after, c.result.steps, c.diags);
+}
+
+/// The pipeline: every pass in order, with the reason for its place.
+const std::vector<Pass>& passList() {
+  static const std::vector<Pass> passes = {
+      // 1. parse: text -> JSON document (syntax errors carry line:col).
+      {"parse", "text -> JSON document (syntax errors at file:line:col)",
+       [](PassContext& c) { return bool(c.doc = parseJsonDocument(c.text, c.options.read, c.diags)); }},
+      // 2. resolve: keys, kinds, types, ranges, references, cycles (JSON pointers).
+      {"resolve", "JSON -> resolved document: keys, kinds, types, ranges, references, cycles",
+       [](PassContext& c) { return bool(c.resolved = resolveDocument(*c.doc, c.diags, c.options.resolve)); }},
+      // 3. value DAG: structural hashing + constant folding. Culling (5) and
+      //    feature analysis (6) rely on folded constants, so this comes first.
+      {"build-values", "value nodes -> the hash-consed value DAG, constants folded",
+       [](PassContext& c) {
+         c.values = buildValueDag(*c.resolved, c.result.material);
+         return true;
+       }},
+      // 4. Substrate tree: instance the Substrate graph from the output.
+      {"build-tree", "Substrate graph -> tree (a node referenced twice is instanced twice)",
+       [](PassContext& c) {
+         return buildSubstrateTree(*c.resolved, c.values, c.result.material, c.diags, c.options.tree);
+       }},
+      // 5. static culling (constant weights, bases under opaque tops): before any
+      //    analysis, so culled matter costs nothing.
+      {"cull", "removes matter that can never show",
+       [](PassContext& c) { return cullStaticMatter(c.result.material, c.diags); }},
+      // 6. features per slab (needs the culled tree: top/bottom positions).
+      {"features", "per-slab opt-in features",
+       [](PassContext& c) {
+         analyzeFeatures(c.result.material);
+         return true;
+       },
+       analyzeFeatures},
+      // 7. shared local bases (needs the anisotropy flags from 6).
+      {"shared-bases", "slabs with equal normals (and tangents) share a basis",
+       [](PassContext& c) {
+         shareLocalBases(c.result.material);
+         return true;
+       },
+       shareLocalBases},
+      // 8. layout and pricing, against the budget the material asks for.
+      {"price", "the storage layout and its bytes per pixel",
+       [](PassContext& c) {
+         chooseBudget(c);
+         c.result.before = computeLayout(c.result.material, analyzeTree(c.result.material));
+         return true;
+       }},
+      // 9. simplify to the budget (re-runs 6-8 after each step, so it comes last).
+      {"simplify", "collapses operators and disables features until the material fits its budget", simplifyPass},
+  };
+  return passes;
+}
+
+/// Runs one pass, timing it and dumping the IR after it when asked.
+bool runPass(const Pass& pass, PassContext& c) {
+  auto t0 = std::chrono::steady_clock::now();
+  const bool ok = pass.run(c);
+  if (c.options.timePasses) {
+    double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    c.result.timings.push_back({std::string(pass.name), ms});
+  }
+  if (c.options.printAfterAll || pass.name == c.options.printAfter)
+    c.result.debugLog += fmt::format("; IR after {}\n{}\n", pass.name, dumpMaterial(c.result.material));
+  return ok;
+}
 
 }  // namespace
+
+std::span<const Pass> passRegistry() { return passList(); }
+
+const Pass* findPass(std::string_view name) {
+  for (const Pass& p : passList())
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+std::string passNames() {
+  std::string names;
+  for (const Pass& p : passList()) names += (names.empty() ? "" : ", ") + std::string(p.name);
+  return names;
+}
+
+bool runPasses(PassContext& c, std::string_view last) {
+  for (const Pass& pass : passList()) {
+    if (!runPass(pass, c)) return false;
+    if (pass.name == last) break;
+  }
+  return true;
+}
+
+StorageLayout repriceMaterial(Material& m) {
+  for (const Pass& pass : passList())
+    if (pass.reanalyze) pass.reanalyze(m);
+  return computeLayout(m, analyzeTree(m));
+}
 
 std::optional<CompileResult> compileText(const std::string& displayName, const std::string& text,
                                          const CompileOptions& options, Diagnostics& diags) {
   (void)displayName;  // diagnostics already carry the file name
   CompileResult result;
-  Material& m = result.material;
-  m.file = diags.file();
-  PassRunner pass(options, result);
-
-  // 1. parse: text -> JSON document (syntax errors carry line:col).
-  auto doc = pass.run("parse", [&] { return parseJsonDocument(text, options.read, diags); });
-  if (!doc) return std::nullopt;
-  // 2. resolve: keys, kinds, types, ranges, references, cycles (JSON pointers).
-  auto resolved = pass.run("resolve", [&] { return resolveDocument(*doc, diags, options.resolve); });
-  if (!resolved) return std::nullopt;
-  // 3. value DAG: structural hashing + constant folding. Culling (5) and
-  //    feature analysis (6) rely on folded constants, so this comes first.
-  auto table = pass.run("build-values", [&] { return buildValueDag(*resolved, m); });
-  // 4. Substrate tree: instance the Substrate graph from the output.
-  if (!pass.run("build-tree", [&] { return buildSubstrateTree(*resolved, table, m, diags, options.tree); }))
-    return std::nullopt;
-  // 5. static culling (constant weights, bases under opaque tops): before any
-  //    analysis, so culled matter costs nothing.
-  if (!pass.run("cull", [&] { return cullStaticMatter(m, diags); })) return std::nullopt;
-  // 6. features per slab (needs the culled tree: top/bottom positions).
-  pass.run("features", [&] { analyzeFeatures(m); return true; });
-  // 7. shared local bases (needs the anisotropy flags from 6).
-  pass.run("shared-bases", [&] { shareLocalBases(m); return true; });
-  // 8. layout and pricing.
-  result.budgetBytes = options.budgetOverride.value_or(m.settings.bytesPerPixel);
-  result.maxClosures = options.maxClosuresOverride.value_or(m.settings.maxClosures);
-  if (options.platform) {  // the platform caps what the material asks for
-    result.budgetBytes = std::min(result.budgetBytes, options.platform->bytesPerPixel);
-    result.maxClosures = std::min(result.maxClosures, options.platform->maxClosures);
-  }
-  pass.run("price", [&] {
-    result.before = computeLayout(m, analyzeTree(m));
-    return true;
-  });
-  // 9. simplify to the budget (re-runs 6-8 after each step, so it comes last).
-  result.after = result.before;
-  SimplifyBudget budget{result.budgetBytes, result.maxClosures, options.fullSimplification, options.blendRule,
-                        options.platform ? options.platform->disallowedFeatures() : std::uint16_t{0},
-                        options.platform ? options.platform->name : std::string()};
-  if (!pass.run("simplify", [&] { return simplifyToBudget(m, budget, result.after, result.steps, diags); }))
-    return std::nullopt;
-  result.tree = analyzeTree(m);
+  result.material.file = diags.file();
+  PassContext context(text, options, diags, result);
+  if (!runPasses(context, options.stopAfter)) return std::nullopt;
+  if (options.stopAfter.empty()) result.tree = analyzeTree(result.material);
   return result;
 }
 

@@ -1,5 +1,6 @@
-// The compiler pipeline: one straight-line function from JSON text to a
-// priced material. Each step is a pass with one job (see passes/*.h).
+// The compiler pipeline: JSON text to a priced material, through the passes
+// of the pass registry (pipeline/pass_registry.h) in order. Each step is a
+// pass with one job (see passes/*.h).
 #pragma once
 #include <optional>
 #include <string>
@@ -27,6 +28,8 @@ struct CompileOptions {
   std::optional<Platform> platform;        // --platform: caps budget and closures, disallows features
   BlendRule blendRule = BlendRule::ProjectRules;  // collapse rules (PlainLerp: the accuracy baseline)
   bool printAfterAll = false;              // dump the IR after every pass into debugLog
+  std::string printAfter;                  // --print-after: dump the IR after this pass into debugLog
+  std::string stopAfter;                   // --stop-after: run the passes through this one only
   bool timePasses = false;                 // record per-pass wall time
 };
 
@@ -44,10 +47,12 @@ struct CompileResult {
   int maxClosures = 8;
   std::vector<SimplifyStep> steps;
   std::vector<PassTiming> timings;
-  std::string debugLog;     // --print-after-all output
+  std::string debugLog;     // --print-after(-all) output
 };
 
-/// Compiles JSON text. `displayName` is what diagnostics call the file.
+/// Compiles JSON text. `displayName` is what diagnostics call the file. With
+/// options.stopAfter (a pass name) the result is partial: only the passes
+/// through that one ran (it is for their dumps, not for emitting).
 std::optional<CompileResult> compileText(const std::string& displayName, const std::string& text,
                                          const CompileOptions& options, Diagnostics& diags);
 

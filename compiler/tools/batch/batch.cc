@@ -99,6 +99,7 @@ MaterialBuild buildOne(const std::string& path, const BatchOptions& o, std::size
     Diagnostics compileDiags(source->displayName);
     r = compileText(source->displayName, source->text, o.compile, compileDiags);
     b.messages += compileDiags.formatAll();
+    if (r) b.messages += r->debugLog;  // --print-after
   }
   if (!r) {
     if (source && source->imported) {
@@ -106,6 +107,10 @@ MaterialBuild buildOne(const std::string& path, const BatchOptions& o, std::size
       b.messages += fmt::format("substratec: internal compiler error: the material imported from {} does not compile\n",
                                 source->displayName);
     }
+    return b;
+  }
+  if (!o.compile.stopAfter.empty()) {  // --stop-after: the passes' dumps only, nothing generated
+    b.ok = true;
     return b;
   }
   GenerateOptions go = o.generate;
