@@ -40,6 +40,18 @@
 // A constant array: SUBSTRATE_CONST float NAME[4] = SUBSTRATE_ARRAY_BEGIN(float, 4) a, b, c, d SUBSTRATE_ARRAY_END;
 #define SUBSTRATE_ARRAY_BEGIN(T, N) T[N](
 #define SUBSTRATE_ARRAY_END )
+// Textures (the sampler argument is for HLSL: a GLSL texture carries its own)
+// and storage images: words in layers of an array, or a colour at a pixel.
+#define SUBSTRATE_TEXTURE_SAMPLE(t, s, uv) texture(t, uv)
+#define SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, lod) textureLod(t, uv, lod)
+#define SUBSTRATE_IMAGE_LOAD_LAYER(img, p, layer) imageLoad(img, ivec3(int((p).x), int((p).y), int(layer))).x
+#define SUBSTRATE_IMAGE_STORE_LAYER(img, p, layer, v) imageStore(img, ivec3(int((p).x), int((p).y), int(layer)), uvec4((v), 0u, 0u, 0u))
+#define SUBSTRATE_IMAGE_STORE(img, p, v) imageStore(img, ivec2(int((p).x), int((p).y)), v)
+// Compute: group-shared memory, its barrier and atomics (HLSL spellings).
+#define groupshared shared
+#define GroupMemoryBarrierWithGroupSync() memoryBarrierShared(); barrier()
+#define InterlockedMax(dest, value) atomicMax(dest, value)
+#define InterlockedAdd(dest, value, original) (original) = atomicAdd(dest, value)
 
 // Medium precision (docs/stability.md, "Half precision"): the runtime keeps
 // colours, albedos, Fresnel, energy weights and throughputs in mfloat types,

@@ -13,6 +13,12 @@
 #define substrate_f16tof32(x) f16tof32(uint(x))
 #define SUBSTRATE_ARRAY_BEGIN(T, N) {
 #define SUBSTRATE_ARRAY_END }
+// Textures and storage images (see substrate_prelude.glsl).
+#define SUBSTRATE_TEXTURE_SAMPLE(t, s, uv) t.Sample(s, uv)
+#define SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, lod) t.SampleLevel(s, uv, lod)
+#define SUBSTRATE_IMAGE_LOAD_LAYER(img, p, layer) img[uint3((p).x, (p).y, layer)]
+#define SUBSTRATE_IMAGE_STORE_LAYER(img, p, layer, v) img[uint3((p).x, (p).y, layer)] = (v)
+#define SUBSTRATE_IMAGE_STORE(img, p, v) img[(p)] = (v)
 
 // Medium precision: see substrate_prelude.glsl. With SUBSTRATE_PRECISION_HALF
 // the shader must be compiled with native 16-bit types (DXC

@@ -24,7 +24,7 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform car_paint_Inputs {
-  vec3 i_paint_color;
+  float3 i_paint_color;
   float i_metallic;
   float i_specular;
   float i_base_roughness;
@@ -36,43 +36,43 @@ layout(set = 1, binding = 0, std140) uniform car_paint_Inputs {
 } car_paint_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_PAINT_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_PAINT_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec3 n_paint_diffuse_albedo = substrate_metalness_to_diffuse(car_paint_inputs.i_paint_color, car_paint_inputs.i_metallic, car_paint_inputs.i_specular);
-  vec3 n_paint_f0 = substrate_metalness_to_f0(car_paint_inputs.i_paint_color, car_paint_inputs.i_metallic, car_paint_inputs.i_specular);
+  float3 n_paint_diffuse_albedo = substrate_metalness_to_diffuse(car_paint_inputs.i_paint_color, car_paint_inputs.i_metallic, car_paint_inputs.i_specular);
+  float3 n_paint_f0 = substrate_metalness_to_f0(car_paint_inputs.i_paint_color, car_paint_inputs.i_metallic, car_paint_inputs.i_specular);
   float n_haze_second_roughness = substrate_haziness_second_roughness(car_paint_inputs.i_base_roughness, car_paint_inputs.i_haziness);
   float n_haze_second_roughness_weight = substrate_haziness_weight(car_paint_inputs.i_base_roughness, car_paint_inputs.i_haziness);
-  vec2 v11 = car_paint_inputs.i_flake_scale.xx;
-  vec2 v12 = (g.uv0 * v11);
+  float2 v11 = car_paint_inputs.i_flake_scale.xx;
+  float2 v12 = (g.uv0 * v11);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'clearcoat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_clearcoat = 1.0;
-  vec3 T_clearcoat = substrate_transmittance(vec3(10.0, 10.0, 10.0), car_paint_inputs.i_clearcoat_thickness);
+  float3 T_clearcoat = substrate_transmittance(float3(10.0, 10.0, 10.0), car_paint_inputs.i_clearcoat_thickness);
   // slab 'base' (Id=2, BSDF 1)
   float C_base = 1.0;
-  vec3 T_base = vec3(0.0, 0.0, 0.0);
+  float3 T_base = float3(0.0, 0.0, 0.0);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=1)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_clearcoat, T_clearcoat, C_base, T_base, C_root, T_root);
 
   // Closure 0: slab 'clearcoat' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = car_paint_inputs.i_clearcoat_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   // Closure 1: slab 'base' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_base = 0.0; vec3 ta_base = vec3(1.0, 1.0, 1.0); float va_base = 0.0;
+  float ca_base = 0.0; float3 ta_base = float3(1.0, 1.0, 1.0); float va_base = 0.0;
   va_base += C_clearcoat * substrate_roughness_to_variance(car_paint_inputs.i_clearcoat_roughness);
-  substrate_layer_above(ca_base, ta_base, C_clearcoat, T_clearcoat * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'clearcoat' (vertical 'root')
+  substrate_layer_above(ca_base, ta_base, C_clearcoat, T_clearcoat * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'clearcoat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = n_paint_diffuse_albedo;
   closures[1].f0 = n_paint_f0;
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(car_paint_inputs.i_base_roughness) + va_base);
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].secondRoughness = n_haze_second_roughness;
   closures[1].secondRoughnessWeight = n_haze_second_roughness_weight;
   closures[1].glintValue = car_paint_inputs.i_flake_density;
@@ -101,7 +101,7 @@ void car_paint_pack(SubstrateClosure closures[CAR_PAINT_CLOSURE_COUNT], float di
   words[7] = 0u;
   words[8] = 0u;
   words[9] = 0u;
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

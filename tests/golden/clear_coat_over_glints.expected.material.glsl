@@ -24,7 +24,7 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform clear_coat_over_glints_Inputs {
-  vec3 i_paint_color;
+  float3 i_paint_color;
   float i_paint_roughness;
   float i_glint_density;
   float i_glint_tiling;
@@ -33,39 +33,39 @@ layout(set = 1, binding = 0, std140) uniform clear_coat_over_glints_Inputs {
 } clear_coat_over_glints_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void clear_coat_over_glints_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CLEAR_COAT_OVER_GLINTS_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void clear_coat_over_glints_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CLEAR_COAT_OVER_GLINTS_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec2 v2 = clear_coat_over_glints_inputs.i_glint_tiling.xx;
-  vec2 v3 = (g.uv0 * v2);
+  float2 v2 = clear_coat_over_glints_inputs.i_glint_tiling.xx;
+  float2 v3 = (g.uv0 * v2);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
-  vec3 T_coat = substrate_transmittance(vec3(1000000.0, 1000000.0, 1000000.0), clear_coat_over_glints_inputs.i_coat_thickness);
+  float3 T_coat = substrate_transmittance(float3(1000000.0, 1000000.0, 1000000.0), clear_coat_over_glints_inputs.i_coat_thickness);
   // slab 'paint' (Id=2, BSDF 1)
   float C_paint = 1.0;
-  vec3 T_paint = vec3(0.0, 0.0, 0.0);
+  float3 T_paint = float3(0.0, 0.0, 0.0);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=1)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_coat, T_coat, C_paint, T_paint, C_root, T_root);
 
   // Closure 0: slab 'coat' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = clear_coat_over_glints_inputs.i_coat_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   // Closure 1: slab 'paint' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_paint = 0.0; vec3 ta_paint = vec3(1.0, 1.0, 1.0); float va_paint = 0.0;
+  float ca_paint = 0.0; float3 ta_paint = float3(1.0, 1.0, 1.0); float va_paint = 0.0;
   va_paint += C_coat * substrate_roughness_to_variance(clear_coat_over_glints_inputs.i_coat_roughness);
-  substrate_layer_above(ca_paint, ta_paint, C_coat, T_coat * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
+  substrate_layer_above(ca_paint, ta_paint, C_coat, T_coat * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = clear_coat_over_glints_inputs.i_paint_color;
-  closures[1].f0 = vec3(0.04, 0.04, 0.04);
+  closures[1].f0 = float3(0.04, 0.04, 0.04);
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(clear_coat_over_glints_inputs.i_paint_roughness) + va_paint);
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].glintValue = clear_coat_over_glints_inputs.i_glint_density;
   closures[1].glintUv = v3;
   closures[1].glintUvDerivatives = g.uvDerivatives;
@@ -92,7 +92,7 @@ void clear_coat_over_glints_pack(SubstrateClosure closures[CLEAR_COAT_OVER_GLINT
   words[7] = 0u;
   words[8] = 0u;
   words[9] = 0u;
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

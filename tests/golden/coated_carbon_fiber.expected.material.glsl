@@ -26,12 +26,12 @@
 layout(set = 1, binding = 0, std140) uniform coated_carbon_fiber_Inputs {
   float i_weave_tiling;
   float i_mask;
-  vec3 i_fiber_color;
+  float3 i_fiber_color;
   float i_fiber_roughness;
   float i_fiber_anisotropy;
-  vec3 i_metal_f0;
+  float3 i_metal_f0;
   float i_metal_roughness;
-  vec3 i_tint;
+  float3 i_tint;
   float i_coat_thickness;
   float i_coat_roughness;
 } coated_carbon_fiber_inputs;
@@ -39,63 +39,63 @@ layout(set = 1, binding = 1) uniform sampler2D t_weave;
 layout(set = 1, binding = 2) uniform sampler2D t_metal_mask;
 #ifndef SUBSTRATE_SAMPLE
 #ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives
-#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)
 #else
-#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)
 #endif
 #endif
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure closures[COATED_CARBON_FIBER_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure closures[COATED_CARBON_FIBER_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec2 v2 = coated_carbon_fiber_inputs.i_weave_tiling.xx;
-  vec2 v3 = (g.uv0 * v2);
-  vec4 v4 = SUBSTRATE_SAMPLE(t_weave, s_weave, v3);
-  vec3 n_weave_tex_rgb = v4.xyz;
+  float2 v2 = coated_carbon_fiber_inputs.i_weave_tiling.xx;
+  float2 v3 = (g.uv0 * v2);
+  float4 v4 = SUBSTRATE_SAMPLE(t_weave, s_weave, v3);
+  float3 n_weave_tex_rgb = v4.xyz;
   float n_weave_tex_a = v4.w;
-  vec3 v12 = (n_weave_tex_rgb * vec3(2.0, 2.0, 2.0));
-  vec3 v15 = (v12 - vec3(1.0, 1.0, 1.0));
-  vec3 n_weave_normal = substrate_value_normalize(v15);
+  float3 v12 = (n_weave_tex_rgb * float3(2.0, 2.0, 2.0));
+  float3 v15 = (v12 - float3(1.0, 1.0, 1.0));
+  float3 n_weave_normal = substrate_value_normalize(v15);
   float v18 = (n_weave_tex_a * 1.5707963);
-  vec3 n_fiber_tangent = substrate_rotation_to_tangent(v18, n_weave_normal);
-  vec4 v20 = SUBSTRATE_SAMPLE(t_metal_mask, s_metal_mask, g.uv0);
+  float3 n_fiber_tangent = substrate_rotation_to_tangent(v18, n_weave_normal);
+  float4 v20 = SUBSTRATE_SAMPLE(t_metal_mask, s_metal_mask, g.uv0);
   float n_metal_mask_tex_r = v20.x;
-  vec3 n_coat_absorption_mfp = substrate_transmittance_to_mfp(coated_carbon_fiber_inputs.i_tint, coated_carbon_fiber_inputs.i_coat_thickness);
+  float3 n_coat_absorption_mfp = substrate_transmittance_to_mfp(coated_carbon_fiber_inputs.i_tint, coated_carbon_fiber_inputs.i_coat_thickness);
   float n_coat_absorption_thickness = substrate_transmittance_to_mfp_thickness(coated_carbon_fiber_inputs.i_tint, coated_carbon_fiber_inputs.i_coat_thickness);
   float v31 = (n_metal_mask_tex_r * coated_carbon_fiber_inputs.i_mask);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'root_top' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_root_top = 1.0;
-  vec3 T_root_top = substrate_transmittance(n_coat_absorption_mfp, n_coat_absorption_thickness);
+  float3 T_root_top = substrate_transmittance(n_coat_absorption_mfp, n_coat_absorption_thickness);
   // slab 'carbon' (Id=3, BSDF 1)
   float C_carbon = 1.0;
-  vec3 T_carbon = vec3(0.0, 0.0, 0.0);
+  float3 T_carbon = float3(0.0, 0.0, 0.0);
   // slab 'metal' (Id=4, BSDF 2)
   float C_metal = 1.0;
-  vec3 T_metal = vec3(0.0, 0.0, 0.0);
+  float3 T_metal = float3(0.0, 0.0, 0.0);
   // HORIZONTAL 'substrate' (Id=2, DistanceFromLeaves=1)
-  float C_substrate; vec3 T_substrate;
+  float C_substrate; float3 T_substrate;
   substrate_op_horizontal(C_carbon, T_carbon, C_metal, T_metal, v31, C_substrate, T_substrate);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=2)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_root_top, T_root_top, C_substrate, T_substrate, C_root, T_root);
 
   // Closure 0: slab 'root_top' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = coated_carbon_fiber_inputs.i_coat_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   // Closure 1: slab 'carbon' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_carbon = 0.0; vec3 ta_carbon = vec3(1.0, 1.0, 1.0); float va_carbon = 0.0;
+  float ca_carbon = 0.0; float3 ta_carbon = float3(1.0, 1.0, 1.0); float va_carbon = 0.0;
   va_carbon += C_root_top * substrate_roughness_to_variance(coated_carbon_fiber_inputs.i_coat_roughness);
-  substrate_layer_above(ca_carbon, ta_carbon, C_root_top, T_root_top * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
+  substrate_layer_above(ca_carbon, ta_carbon, C_root_top, T_root_top * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = coated_carbon_fiber_inputs.i_fiber_color;
-  closures[1].f0 = vec3(0.05, 0.05, 0.05);
+  closures[1].f0 = float3(0.05, 0.05, 0.05);
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(coated_carbon_fiber_inputs.i_fiber_roughness) + va_carbon);
   closures[1].N = substrate_tangent_to_world(n_weave_normal, g.N, g.T);
   closures[1].anisotropy = coated_carbon_fiber_inputs.i_fiber_anisotropy;
@@ -107,14 +107,14 @@ void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure clos
   closures[1].features = 66u;
 
   // Closure 2: slab 'metal' (BSDF 2, LayerDepth 1, under a layer)
-  float ca_metal = 0.0; vec3 ta_metal = vec3(1.0, 1.0, 1.0); float va_metal = 0.0;
+  float ca_metal = 0.0; float3 ta_metal = float3(1.0, 1.0, 1.0); float va_metal = 0.0;
   va_metal += C_root_top * substrate_roughness_to_variance(coated_carbon_fiber_inputs.i_coat_roughness);
-  substrate_layer_above(ca_metal, ta_metal, C_root_top, T_root_top * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
+  substrate_layer_above(ca_metal, ta_metal, C_root_top, T_root_top * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
   substrate_closure_init(closures[2]);
-  closures[2].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
+  closures[2].diffuseAlbedo = float3(0.0, 0.0, 0.0);
   closures[2].f0 = coated_carbon_fiber_inputs.i_metal_f0;
   closures[2].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(coated_carbon_fiber_inputs.i_metal_roughness) + va_metal);
-  closures[2].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[2].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[2].weight = v31;
   closures[2].topTransmittance = ta_metal;
   closures[2].coverageAbove = ca_metal;
@@ -157,7 +157,7 @@ void coated_carbon_fiber_pack(SubstrateClosure closures[COATED_CARBON_FIBER_CLOS
       words[1] |= q << 24u; }
     return;
   }
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

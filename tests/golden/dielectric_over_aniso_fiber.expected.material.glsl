@@ -24,48 +24,48 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform dielectric_over_aniso_fiber_Inputs {
-  vec3 i_absorption_mfp;
+  float3 i_absorption_mfp;
   float i_layer_thickness;
   float i_dielectric_roughness;
-  vec3 i_fiber_f0;
+  float3 i_fiber_f0;
   float i_fiber_roughness;
   float i_fiber_anisotropy;
   float i_fiber_angle;
 } dielectric_over_aniso_fiber_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure closures[DIELECTRIC_OVER_ANISO_FIBER_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure closures[DIELECTRIC_OVER_ANISO_FIBER_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec3 v2 = substrate_rotation_to_tangent(dielectric_over_aniso_fiber_inputs.i_fiber_angle, vec3(0.0, 0.0, 1.0));
+  float3 v2 = substrate_rotation_to_tangent(dielectric_over_aniso_fiber_inputs.i_fiber_angle, float3(0.0, 0.0, 1.0));
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'dielectric' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_dielectric = 1.0;
-  vec3 T_dielectric = substrate_transmittance(dielectric_over_aniso_fiber_inputs.i_absorption_mfp, dielectric_over_aniso_fiber_inputs.i_layer_thickness);
+  float3 T_dielectric = substrate_transmittance(dielectric_over_aniso_fiber_inputs.i_absorption_mfp, dielectric_over_aniso_fiber_inputs.i_layer_thickness);
   // slab 'fiber' (Id=2, BSDF 1)
   float C_fiber = 1.0;
-  vec3 T_fiber = vec3(0.0, 0.0, 0.0);
+  float3 T_fiber = float3(0.0, 0.0, 0.0);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=1)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_dielectric, T_dielectric, C_fiber, T_fiber, C_root, T_root);
 
   // Closure 0: slab 'dielectric' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = dielectric_over_aniso_fiber_inputs.i_dielectric_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   // Closure 1: slab 'fiber' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_fiber = 0.0; vec3 ta_fiber = vec3(1.0, 1.0, 1.0); float va_fiber = 0.0;
+  float ca_fiber = 0.0; float3 ta_fiber = float3(1.0, 1.0, 1.0); float va_fiber = 0.0;
   va_fiber += C_dielectric * substrate_roughness_to_variance(dielectric_over_aniso_fiber_inputs.i_dielectric_roughness);
-  substrate_layer_above(ca_fiber, ta_fiber, C_dielectric, T_dielectric * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'dielectric' (vertical 'root')
+  substrate_layer_above(ca_fiber, ta_fiber, C_dielectric, T_dielectric * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'dielectric' (vertical 'root')
   substrate_closure_init(closures[1]);
-  closures[1].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
+  closures[1].diffuseAlbedo = float3(0.0, 0.0, 0.0);
   closures[1].f0 = dielectric_over_aniso_fiber_inputs.i_fiber_f0;
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(dielectric_over_aniso_fiber_inputs.i_fiber_roughness) + va_fiber);
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].anisotropy = dielectric_over_aniso_fiber_inputs.i_fiber_anisotropy;
   closures[1].T = substrate_orthogonal_tangent(closures[1].N, substrate_tangent_to_world(v2, g.N, g.T));
   closures[1].topTransmittance = ta_fiber;
@@ -87,7 +87,7 @@ void dielectric_over_aniso_fiber_pack(SubstrateClosure closures[DIELECTRIC_OVER_
   words[3] = 0u;
   words[4] = 0u;
   words[5] = 0u;
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

@@ -25,45 +25,45 @@
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform gold_sss_mix_Inputs {
   float i_gold_amount;
-  vec3 i_gold_f0;
+  float3 i_gold_f0;
   float i_gold_roughness;
-  vec3 i_skin_albedo;
-  vec3 i_skin_mfp;
+  float3 i_skin_albedo;
+  float3 i_skin_mfp;
   float i_skin_roughness;
 } gold_sss_mix_inputs;
 layout(set = 1, binding = 1) uniform sampler2D t_gold_mask;
 #ifndef SUBSTRATE_SAMPLE
 #ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives
-#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)
 #else
-#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)
 #endif
 #endif
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void gold_sss_mix_evaluate(SubstrateGeometry g, out SubstrateClosure closures[GOLD_SSS_MIX_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void gold_sss_mix_evaluate(SubstrateGeometry g, out SubstrateClosure closures[GOLD_SSS_MIX_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec4 v1 = SUBSTRATE_SAMPLE(t_gold_mask, s_gold_mask, g.uv0);
+  float4 v1 = SUBSTRATE_SAMPLE(t_gold_mask, s_gold_mask, g.uv0);
   float n_gold_mask_tex_r = v1.x;
   float v8 = (n_gold_mask_tex_r * gold_sss_mix_inputs.i_gold_amount);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'skin' (Id=1, BSDF 0)
   float C_skin = 1.0;
-  vec3 T_skin = substrate_transmittance(gold_sss_mix_inputs.i_skin_mfp, 0.0001);
+  float3 T_skin = substrate_transmittance(gold_sss_mix_inputs.i_skin_mfp, 0.0001);
   // slab 'gold' (Id=2, BSDF 1)
   float C_gold = 1.0;
-  vec3 T_gold = vec3(0.0, 0.0, 0.0);
+  float3 T_gold = float3(0.0, 0.0, 0.0);
   // HORIZONTAL 'root' (Id=0, DistanceFromLeaves=1)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_horizontal(C_skin, T_skin, C_gold, T_gold, v8, C_root, T_root);
 
   // Closure 0: slab 'skin' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
   closures[0].diffuseAlbedo = gold_sss_mix_inputs.i_skin_albedo;
-  closures[0].f0 = vec3(0.028, 0.028, 0.028);
+  closures[0].f0 = float3(0.028, 0.028, 0.028);
   closures[0].roughness = gold_sss_mix_inputs.i_skin_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].sssMfp = gold_sss_mix_inputs.i_skin_mfp;
   closures[0].sssPhaseAnisotropy = 0.0;
   closures[0].sssType = 2u;
@@ -72,10 +72,10 @@ void gold_sss_mix_evaluate(SubstrateGeometry g, out SubstrateClosure closures[GO
 
   // Closure 1: slab 'gold' (BSDF 1, LayerDepth 0, top layer)
   substrate_closure_init(closures[1]);
-  closures[1].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
+  closures[1].diffuseAlbedo = float3(0.0, 0.0, 0.0);
   closures[1].f0 = gold_sss_mix_inputs.i_gold_f0;
   closures[1].roughness = gold_sss_mix_inputs.i_gold_roughness;
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].weight = v8;
   closures[1].features = 64u;
 
@@ -129,7 +129,7 @@ void gold_sss_mix_pack(SubstrateClosure closures[GOLD_SSS_MIX_CLOSURE_COUNT], fl
       words[1] |= q << 24u; }
     return;
   }
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N + closures[1].weight * closures[1].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N + closures[1].weight * closures[1].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness + closures[1].weight * closures[1].roughness) / max(closures[0].weight + closures[1].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

@@ -24,25 +24,25 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row12_simple_Inputs {
-  vec3 i_albedo;
-  vec3 i_specular;
+  float3 i_albedo;
+  float3 i_specular;
   float i_roughness;
 } row12_simple_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void row12_simple_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW12_SIMPLE_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void row12_simple_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW12_SIMPLE_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'root' (Id=0, BSDF 0)
   float C_root = 1.0;
-  vec3 T_root = vec3(0.0, 0.0, 0.0);
+  float3 T_root = float3(0.0, 0.0, 0.0);
 
   // Closure 0: slab 'root' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
   closures[0].diffuseAlbedo = row12_simple_inputs.i_albedo;
   closures[0].f0 = row12_simple_inputs.i_specular;
   closures[0].roughness = row12_simple_inputs.i_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   coverage = C_root;
@@ -55,7 +55,7 @@ void row12_simple_evaluate(SubstrateGeometry g, out SubstrateClosure closures[RO
 void row12_simple_pack(SubstrateClosure closures[ROW12_SIMPLE_CLOSURE_COUNT], float dither, out uint words[ROW12_SIMPLE_WORD_COUNT], out uint topLayer) {
   words[0] = 0u;
   words[1] = 0u;
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

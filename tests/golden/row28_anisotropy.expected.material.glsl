@@ -24,36 +24,36 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row28_anisotropy_Inputs {
-  vec3 i_albedo;
-  vec3 i_specular;
+  float3 i_albedo;
+  float3 i_specular;
   float i_roughness;
-  vec3 i_sss_mfp;
+  float3 i_sss_mfp;
   float i_haze_roughness;
   float i_haze;
-  vec3 i_edge_tint;
+  float3 i_edge_tint;
   float i_fuzz;
-  vec3 i_fuzz_color;
+  float3 i_fuzz_color;
   float i_fuzz_roughness;
   float i_anisotropy;
 } row28_anisotropy_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void row28_anisotropy_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW28_ANISOTROPY_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void row28_anisotropy_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW28_ANISOTROPY_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'root' (Id=0, BSDF 0)
   float C_root = 1.0;
-  vec3 T_root = substrate_transmittance(row28_anisotropy_inputs.i_sss_mfp, 0.0001);
+  float3 T_root = substrate_transmittance(row28_anisotropy_inputs.i_sss_mfp, 0.0001);
 
   // Closure 0: slab 'root' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
   closures[0].diffuseAlbedo = row28_anisotropy_inputs.i_albedo;
   closures[0].f0 = row28_anisotropy_inputs.i_specular;
   closures[0].roughness = row28_anisotropy_inputs.i_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].f90 = row28_anisotropy_inputs.i_edge_tint;
   closures[0].anisotropy = row28_anisotropy_inputs.i_anisotropy;
-  closures[0].T = substrate_orthogonal_tangent(closures[0].N, substrate_tangent_to_world(vec3(1.0, 0.0, 0.0), g.N, g.T));
+  closures[0].T = substrate_orthogonal_tangent(closures[0].N, substrate_tangent_to_world(float3(1.0, 0.0, 0.0), g.N, g.T));
   closures[0].sssMfp = row28_anisotropy_inputs.i_sss_mfp;
   closures[0].sssPhaseAnisotropy = 0.0;
   closures[0].sssType = 1u;
@@ -78,7 +78,7 @@ void row28_anisotropy_pack(SubstrateClosure closures[ROW28_ANISOTROPY_CLOSURE_CO
   words[3] = 0u;
   words[4] = 0u;
   words[5] = 0u;
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

@@ -24,15 +24,15 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform row60_glint_Inputs {
-  vec3 i_albedo;
-  vec3 i_specular;
+  float3 i_albedo;
+  float3 i_specular;
   float i_roughness;
-  vec3 i_sss_mfp;
+  float3 i_sss_mfp;
   float i_haze_roughness;
   float i_haze;
-  vec3 i_edge_tint;
+  float3 i_edge_tint;
   float i_fuzz;
-  vec3 i_fuzz_color;
+  float3 i_fuzz_color;
   float i_fuzz_roughness;
   float i_anisotropy;
   float i_coat_roughness;
@@ -42,42 +42,42 @@ layout(set = 1, binding = 0, std140) uniform row60_glint_Inputs {
 } row60_glint_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void row60_glint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void row60_glint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec2 v2 = row60_glint_inputs.i_glint_tiling.xx;
-  vec2 v3 = (g.uv0 * v2);
+  float2 v2 = row60_glint_inputs.i_glint_tiling.xx;
+  float2 v3 = (g.uv0 * v2);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
-  vec3 T_coat = substrate_transmittance(vec3(10.0, 10.0, 10.0), row60_glint_inputs.i_coat_thickness);
+  float3 T_coat = substrate_transmittance(float3(10.0, 10.0, 10.0), row60_glint_inputs.i_coat_thickness);
   // slab 'base' (Id=2, BSDF 1)
   float C_base = 1.0;
-  vec3 T_base = substrate_transmittance(row60_glint_inputs.i_sss_mfp, 0.0001);
+  float3 T_base = substrate_transmittance(row60_glint_inputs.i_sss_mfp, 0.0001);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=1)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_coat, T_coat, C_base, T_base, C_root, T_root);
 
   // Closure 0: slab 'coat' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = row60_glint_inputs.i_coat_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   // Closure 1: slab 'base' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_base = 0.0; vec3 ta_base = vec3(1.0, 1.0, 1.0); float va_base = 0.0;
+  float ca_base = 0.0; float3 ta_base = float3(1.0, 1.0, 1.0); float va_base = 0.0;
   va_base += C_coat * substrate_roughness_to_variance(row60_glint_inputs.i_coat_roughness);
-  substrate_layer_above(ca_base, ta_base, C_coat, T_coat * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
+  substrate_layer_above(ca_base, ta_base, C_coat, T_coat * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = row60_glint_inputs.i_albedo;
   closures[1].f0 = row60_glint_inputs.i_specular;
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(row60_glint_inputs.i_roughness) + va_base);
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].f90 = row60_glint_inputs.i_edge_tint;
   closures[1].anisotropy = row60_glint_inputs.i_anisotropy;
-  closures[1].T = substrate_orthogonal_tangent(closures[1].N, substrate_tangent_to_world(vec3(1.0, 0.0, 0.0), g.N, g.T));
+  closures[1].T = substrate_orthogonal_tangent(closures[1].N, substrate_tangent_to_world(float3(1.0, 0.0, 0.0), g.N, g.T));
   closures[1].sssMfp = row60_glint_inputs.i_sss_mfp;
   closures[1].sssPhaseAnisotropy = 0.0;
   closures[1].sssType = 1u;
@@ -117,7 +117,7 @@ void row60_glint_pack(SubstrateClosure closures[ROW60_GLINT_CLOSURE_COUNT], floa
   words[11] = 0u;
   words[12] = 0u;
   words[13] = 0u;
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

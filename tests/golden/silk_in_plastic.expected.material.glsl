@@ -25,8 +25,8 @@
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform silk_in_plastic_Inputs {
   float i_weave_tiling;
-  vec3 i_warp_color;
-  vec3 i_weft_color;
+  float3 i_warp_color;
+  float3 i_weft_color;
   float i_silk_roughness;
   float i_silk_anisotropy;
   float i_fuzz_amount;
@@ -37,56 +37,56 @@ layout(set = 1, binding = 0, std140) uniform silk_in_plastic_Inputs {
 layout(set = 1, binding = 1) uniform sampler2D t_weave;
 #ifndef SUBSTRATE_SAMPLE
 #ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives
-#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)
 #else
-#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)
 #endif
 #endif
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec2 v2 = silk_in_plastic_inputs.i_weave_tiling.xx;
-  vec2 n_weave_uv = (g.uv0 * v2);
-  vec4 v4 = SUBSTRATE_SAMPLE(t_weave, s_weave, n_weave_uv);
+  float2 v2 = silk_in_plastic_inputs.i_weave_tiling.xx;
+  float2 n_weave_uv = (g.uv0 * v2);
+  float4 v4 = SUBSTRATE_SAMPLE(t_weave, s_weave, n_weave_uv);
   float n_weave_tex_r = v4.x;
-  vec3 v12 = substrate_rotation_to_tangent(0.0, vec3(0.0, 0.0, 1.0));
-  vec3 v14 = substrate_rotation_to_tangent(1.5707963, vec3(0.0, 0.0, 1.0));
+  float3 v12 = substrate_rotation_to_tangent(0.0, float3(0.0, 0.0, 1.0));
+  float3 v14 = substrate_rotation_to_tangent(1.5707963, float3(0.0, 0.0, 1.0));
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'root_top' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_root_top = 1.0;
-  vec3 T_root_top = substrate_transmittance(vec3(10.0, 10.0, 10.0), silk_in_plastic_inputs.i_plastic_thickness);
+  float3 T_root_top = substrate_transmittance(float3(10.0, 10.0, 10.0), silk_in_plastic_inputs.i_plastic_thickness);
   // slab 'warp' (Id=3, BSDF 1)
   float C_warp = 1.0;
-  vec3 T_warp = vec3(0.0, 0.0, 0.0);
+  float3 T_warp = float3(0.0, 0.0, 0.0);
   // slab 'weft' (Id=4, BSDF 2)
   float C_weft = 1.0;
-  vec3 T_weft = vec3(0.0, 0.0, 0.0);
+  float3 T_weft = float3(0.0, 0.0, 0.0);
   // HORIZONTAL 'silk' (Id=2, DistanceFromLeaves=1)
-  float C_silk; vec3 T_silk;
+  float C_silk; float3 T_silk;
   substrate_op_horizontal(C_warp, T_warp, C_weft, T_weft, n_weave_tex_r, C_silk, T_silk);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=2)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_root_top, T_root_top, C_silk, T_silk, C_root, T_root);
 
   // Closure 0: slab 'root_top' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = silk_in_plastic_inputs.i_plastic_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].features = 0u;
 
   // Closure 1: slab 'warp' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_warp = 0.0; vec3 ta_warp = vec3(1.0, 1.0, 1.0); float va_warp = 0.0;
+  float ca_warp = 0.0; float3 ta_warp = float3(1.0, 1.0, 1.0); float va_warp = 0.0;
   va_warp += C_root_top * substrate_roughness_to_variance(silk_in_plastic_inputs.i_plastic_roughness);
-  substrate_layer_above(ca_warp, ta_warp, C_root_top, T_root_top * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
+  substrate_layer_above(ca_warp, ta_warp, C_root_top, T_root_top * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = silk_in_plastic_inputs.i_warp_color;
-  closures[1].f0 = vec3(0.04, 0.04, 0.04);
+  closures[1].f0 = float3(0.04, 0.04, 0.04);
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(silk_in_plastic_inputs.i_silk_roughness) + va_warp);
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].anisotropy = silk_in_plastic_inputs.i_silk_anisotropy;
   closures[1].T = substrate_orthogonal_tangent(closures[1].N, substrate_tangent_to_world(v12, g.N, g.T));
   closures[1].fuzzAmount = silk_in_plastic_inputs.i_fuzz_amount;
@@ -99,14 +99,14 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   closures[1].features = 74u;
 
   // Closure 2: slab 'weft' (BSDF 2, LayerDepth 1, under a layer)
-  float ca_weft = 0.0; vec3 ta_weft = vec3(1.0, 1.0, 1.0); float va_weft = 0.0;
+  float ca_weft = 0.0; float3 ta_weft = float3(1.0, 1.0, 1.0); float va_weft = 0.0;
   va_weft += C_root_top * substrate_roughness_to_variance(silk_in_plastic_inputs.i_plastic_roughness);
-  substrate_layer_above(ca_weft, ta_weft, C_root_top, T_root_top * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
+  substrate_layer_above(ca_weft, ta_weft, C_root_top, T_root_top * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'root_top' (vertical 'root')
   substrate_closure_init(closures[2]);
   closures[2].diffuseAlbedo = silk_in_plastic_inputs.i_weft_color;
-  closures[2].f0 = vec3(0.04, 0.04, 0.04);
+  closures[2].f0 = float3(0.04, 0.04, 0.04);
   closures[2].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(silk_in_plastic_inputs.i_silk_roughness) + va_weft);
-  closures[2].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[2].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[2].anisotropy = silk_in_plastic_inputs.i_silk_anisotropy;
   closures[2].T = substrate_orthogonal_tangent(closures[2].N, substrate_tangent_to_world(v14, g.N, g.T));
   closures[2].fuzzAmount = silk_in_plastic_inputs.i_fuzz_amount;
@@ -157,7 +157,7 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
       words[1] |= q << 24u; }
     return;
   }
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

@@ -24,8 +24,8 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform skin_coated_Inputs {
-  vec3 i_skin_albedo;
-  vec3 i_skin_mfp;
+  float3 i_skin_albedo;
+  float3 i_skin_mfp;
   float i_skin_roughness;
   float i_coat_roughness;
   float i_coat_thickness;
@@ -34,53 +34,53 @@ layout(set = 1, binding = 0, std140) uniform skin_coated_Inputs {
 layout(set = 1, binding = 1) uniform sampler2D t_sweat_mask;
 #ifndef SUBSTRATE_SAMPLE
 #ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives
-#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)
 #else
-#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)
 #endif
 #endif
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKIN_COATED_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKIN_COATED_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec4 v1 = SUBSTRATE_SAMPLE(t_sweat_mask, s_sweat_mask, g.uv0);
+  float4 v1 = SUBSTRATE_SAMPLE(t_sweat_mask, s_sweat_mask, g.uv0);
   float n_sweat_mask_tex_r = v1.x;
   float v10 = (n_sweat_mask_tex_r * skin_coated_inputs.i_sweat_amount);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'sweat_a' (Id=2, BSDF 0), in the top layer of vertical 'root'
   float C_sweat_a = 1.0;
-  vec3 T_sweat_a = substrate_transmittance(vec3(10.0, 10.0, 10.0), skin_coated_inputs.i_coat_thickness);
-  vec3 TI_sweat_a = T_sweat_a * (1.0 - vec3(0.0200593122, 0.0200593122, 0.0200593122));
+  float3 T_sweat_a = substrate_transmittance(float3(10.0, 10.0, 10.0), skin_coated_inputs.i_coat_thickness);
+  float3 TI_sweat_a = T_sweat_a * (1.0 - float3(0.0200593122, 0.0200593122, 0.0200593122));
   // slab 'skin' (Id=3, BSDF 1)
   float C_skin = 1.0;
-  vec3 T_skin = substrate_transmittance(skin_coated_inputs.i_skin_mfp, 0.0001);
+  float3 T_skin = substrate_transmittance(skin_coated_inputs.i_skin_mfp, 0.0001);
   // WEIGHT 'sweat' (Id=1, DistanceFromLeaves=1)
-  float C_sweat; vec3 T_sweat;
+  float C_sweat; float3 T_sweat;
   C_sweat = v10 * C_sweat_a; T_sweat = T_sweat_a;
-  vec3 TI_sweat;
+  float3 TI_sweat;
   TI_sweat = TI_sweat_a;
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=2)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_sweat, T_sweat, C_skin, T_skin, C_root, T_root);
 
   // Closure 0: slab 'sweat_a' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.0200593122, 0.0200593122, 0.0200593122);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.0200593122, 0.0200593122, 0.0200593122);
   closures[0].roughness = skin_coated_inputs.i_coat_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].weight = v10;
   closures[0].features = 64u;
 
   // Closure 1: slab 'skin' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_skin = 0.0; vec3 ta_skin = vec3(1.0, 1.0, 1.0); float va_skin = 0.0;
+  float ca_skin = 0.0; float3 ta_skin = float3(1.0, 1.0, 1.0); float va_skin = 0.0;
   substrate_layer_above(ca_skin, ta_skin, C_sweat, TI_sweat);  // under 'sweat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = skin_coated_inputs.i_skin_albedo;
-  closures[1].f0 = vec3(0.028, 0.028, 0.028);
+  closures[1].f0 = float3(0.028, 0.028, 0.028);
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(skin_coated_inputs.i_skin_roughness) + va_skin);
-  closures[1].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].sssMfp = skin_coated_inputs.i_skin_mfp;
   closures[1].sssPhaseAnisotropy = 0.0;
   closures[1].sssType = 2u;
@@ -122,7 +122,7 @@ void skin_coated_pack(SubstrateClosure closures[SKIN_COATED_CLOSURE_COUNT], floa
       words[1] |= q << 24u; }
     return;
   }
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

@@ -24,30 +24,30 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform translucent_absorbing_Inputs {
-  vec3 i_transmittance;
+  float3 i_transmittance;
   float i_roughness;
   float i_coverage;
 } translucent_absorbing_inputs;
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void translucent_absorbing_evaluate(SubstrateGeometry g, out SubstrateClosure closures[TRANSLUCENT_ABSORBING_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void translucent_absorbing_evaluate(SubstrateGeometry g, out SubstrateClosure closures[TRANSLUCENT_ABSORBING_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec3 n_absorption_mfp = substrate_transmittance_to_mfp(translucent_absorbing_inputs.i_transmittance, 0.0001);
+  float3 n_absorption_mfp = substrate_transmittance_to_mfp(translucent_absorbing_inputs.i_transmittance, 0.0001);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'glass' (Id=1, BSDF 0)
   float C_glass = 1.0;
-  vec3 T_glass = substrate_transmittance(n_absorption_mfp, 0.0001);
+  float3 T_glass = substrate_transmittance(n_absorption_mfp, 0.0001);
   // WEIGHT 'root' (Id=0, DistanceFromLeaves=1)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   C_root = translucent_absorbing_inputs.i_coverage * C_glass; T_root = T_glass;
 
   // Closure 0: slab 'glass' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = translucent_absorbing_inputs.i_roughness;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].weight = translucent_absorbing_inputs.i_coverage;
   closures[0].features = 64u;
 
@@ -80,7 +80,7 @@ void translucent_absorbing_pack(SubstrateClosure closures[TRANSLUCENT_ABSORBING_
       words[1] |= q << 24u; }
     return;
   }
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

@@ -24,10 +24,10 @@
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform worked_example_72_Inputs {
-  vec3 i_coat_tint;
+  float3 i_coat_tint;
   float i_coat_thickness;
-  vec3 i_color_a;
-  vec3 i_color_b;
+  float3 i_color_a;
+  float3 i_color_b;
   float i_fuzz;
   float i_haze;
   float i_dust;
@@ -38,70 +38,70 @@ layout(set = 1, binding = 2) uniform sampler2D t_normals_a;
 layout(set = 1, binding = 3) uniform sampler2D t_normals_b;
 #ifndef SUBSTRATE_SAMPLE
 #ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives
-#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)
 #else
-#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)
 #endif
 #endif
 
 // Evaluates the material at one shading point into its closures (fully unrolled).
-void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_COUNT], out float coverage, out vec3 transmittance) {
-  vec3 ts_view = vec3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
+void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_COUNT], out float coverage, out float3 transmittance) {
+  float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
   // Values (the value DAG, in dependency order)
-  vec3 n_coat_medium_mfp = substrate_transmittance_to_mfp(worked_example_72_inputs.i_coat_tint, worked_example_72_inputs.i_coat_thickness);
-  vec4 v5 = SUBSTRATE_SAMPLE(t_mask, s_mask, g.uv0);
+  float3 n_coat_medium_mfp = substrate_transmittance_to_mfp(worked_example_72_inputs.i_coat_tint, worked_example_72_inputs.i_coat_thickness);
+  float4 v5 = SUBSTRATE_SAMPLE(t_mask, s_mask, g.uv0);
   float n_mask_r_r = v5.x;
-  vec4 v11 = SUBSTRATE_SAMPLE(t_normals_a, s_normals_a, g.uv0);
-  vec3 v12 = v11.xyz;
-  vec3 v19 = (v12 * vec3(2.0, 2.0, 2.0));
-  vec3 v22 = (v19 - vec3(1.0, 1.0, 1.0));
-  vec3 v23 = substrate_value_normalize(v22);
-  vec3 v25 = substrate_rotation_to_tangent(0.0, v23);
-  vec4 v26 = SUBSTRATE_SAMPLE(t_normals_b, s_normals_b, g.uv0);
-  vec3 v27 = v26.xyz;
-  vec3 v32 = (vec3(2.0, 2.0, 2.0) * v27);
-  vec3 v33 = (v32 - vec3(1.0, 1.0, 1.0));
-  vec3 v34 = substrate_value_normalize(v33);
-  vec3 v36 = substrate_rotation_to_tangent(1.5707963, v34);
+  float4 v11 = SUBSTRATE_SAMPLE(t_normals_a, s_normals_a, g.uv0);
+  float3 v12 = v11.xyz;
+  float3 v19 = (v12 * float3(2.0, 2.0, 2.0));
+  float3 v22 = (v19 - float3(1.0, 1.0, 1.0));
+  float3 v23 = substrate_value_normalize(v22);
+  float3 v25 = substrate_rotation_to_tangent(0.0, v23);
+  float4 v26 = SUBSTRATE_SAMPLE(t_normals_b, s_normals_b, g.uv0);
+  float3 v27 = v26.xyz;
+  float3 v32 = (float3(2.0, 2.0, 2.0) * v27);
+  float3 v33 = (v32 - float3(1.0, 1.0, 1.0));
+  float3 v34 = substrate_value_normalize(v33);
+  float3 v36 = substrate_rotation_to_tangent(1.5707963, v34);
   // Tree: coverage C and transmittance T (along the normal) of every node.
   // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
-  vec3 T_coat = substrate_transmittance(n_coat_medium_mfp, worked_example_72_inputs.i_coat_thickness);
+  float3 T_coat = substrate_transmittance(n_coat_medium_mfp, worked_example_72_inputs.i_coat_thickness);
   // slab 'fabric_a' (Id=3, BSDF 1)
   float C_fabric_a = 1.0;
-  vec3 T_fabric_a = vec3(0.0, 0.0, 0.0);
+  float3 T_fabric_a = float3(0.0, 0.0, 0.0);
   // slab 'fabric_b' (Id=4, BSDF 2)
   float C_fabric_b = 1.0;
-  vec3 T_fabric_b = vec3(0.0, 0.0, 0.0);
+  float3 T_fabric_b = float3(0.0, 0.0, 0.0);
   // HORIZONTAL 'fabrics' (Id=2, DistanceFromLeaves=1)
-  float C_fabrics; vec3 T_fabrics;
+  float C_fabrics; float3 T_fabrics;
   substrate_op_horizontal(C_fabric_a, T_fabric_a, C_fabric_b, T_fabric_b, n_mask_r_r, C_fabrics, T_fabrics);
   // VERTICAL 'root' (Id=0, DistanceFromLeaves=2)
-  float C_root; vec3 T_root;
+  float C_root; float3 T_root;
   substrate_op_vertical(C_coat, T_coat, C_fabrics, T_fabrics, C_root, T_root);
 
   // Closure 0: slab 'coat' (BSDF 0, LayerDepth 0, top layer)
   substrate_closure_init(closures[0]);
-  closures[0].diffuseAlbedo = vec3(0.0, 0.0, 0.0);
-  closures[0].f0 = vec3(0.04, 0.04, 0.04);
+  closures[0].diffuseAlbedo = float3(0.0, 0.0, 0.0);
+  closures[0].f0 = float3(0.04, 0.04, 0.04);
   closures[0].roughness = 0.1;
-  closures[0].N = substrate_tangent_to_world(vec3(0.0, 0.0, 1.0), g.N, g.T);
+  closures[0].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[0].anisotropy = worked_example_72_inputs.i_coat_anisotropy;
-  closures[0].T = substrate_orthogonal_tangent(closures[0].N, substrate_tangent_to_world(vec3(1.0, 0.0, 0.0), g.N, g.T));
+  closures[0].T = substrate_orthogonal_tangent(closures[0].N, substrate_tangent_to_world(float3(1.0, 0.0, 0.0), g.N, g.T));
   closures[0].secondRoughness = 0.6;
   closures[0].secondRoughnessWeight = worked_example_72_inputs.i_haze;
   closures[0].fuzzAmount = worked_example_72_inputs.i_dust;
-  closures[0].fuzzColor = vec3(0.8, 0.8, 0.8);
+  closures[0].fuzzColor = float3(0.8, 0.8, 0.8);
   closures[0].fuzzRoughness = 0.7;
   closures[0].features = 14u;
 
   // Closure 1: slab 'fabric_a' (BSDF 1, LayerDepth 1, under a layer)
-  float ca_fabric_a = 0.0; vec3 ta_fabric_a = vec3(1.0, 1.0, 1.0); float va_fabric_a = 0.0;
+  float ca_fabric_a = 0.0; float3 ta_fabric_a = float3(1.0, 1.0, 1.0); float va_fabric_a = 0.0;
   va_fabric_a += C_coat * substrate_roughness_to_variance(0.1);
-  substrate_layer_above(ca_fabric_a, ta_fabric_a, C_coat, T_coat * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
+  substrate_layer_above(ca_fabric_a, ta_fabric_a, C_coat, T_coat * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = worked_example_72_inputs.i_color_a;
-  closures[1].f0 = vec3(0.04, 0.04, 0.04);
+  closures[1].f0 = float3(0.04, 0.04, 0.04);
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(0.5) + va_fabric_a);
   closures[1].N = substrate_tangent_to_world(v23, g.N, g.T);
   closures[1].anisotropy = 0.7;
@@ -118,12 +118,12 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   closures[1].features = 78u;
 
   // Closure 2: slab 'fabric_b' (BSDF 2, LayerDepth 1, under a layer)
-  float ca_fabric_b = 0.0; vec3 ta_fabric_b = vec3(1.0, 1.0, 1.0); float va_fabric_b = 0.0;
+  float ca_fabric_b = 0.0; float3 ta_fabric_b = float3(1.0, 1.0, 1.0); float va_fabric_b = 0.0;
   va_fabric_b += C_coat * substrate_roughness_to_variance(0.1);
-  substrate_layer_above(ca_fabric_b, ta_fabric_b, C_coat, T_coat * (1.0 - vec3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
+  substrate_layer_above(ca_fabric_b, ta_fabric_b, C_coat, T_coat * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
   substrate_closure_init(closures[2]);
   closures[2].diffuseAlbedo = worked_example_72_inputs.i_color_b;
-  closures[2].f0 = vec3(0.04, 0.04, 0.04);
+  closures[2].f0 = float3(0.04, 0.04, 0.04);
   closures[2].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(0.5) + va_fabric_b);
   closures[2].N = substrate_tangent_to_world(v34, g.N, g.T);
   closures[2].anisotropy = 0.7;
@@ -182,7 +182,7 @@ void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_
       words[1] |= q << 24u; }
     return;
   }
-  vec3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
+  float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
   float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)

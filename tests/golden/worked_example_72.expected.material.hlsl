@@ -41,9 +41,9 @@
 [[vk::binding(19, 1)]] SamplerState s_normals_b;
 #ifndef SUBSTRATE_SAMPLE
 #ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives
-#define SUBSTRATE_SAMPLE(t, s, uv) t.SampleLevel(s, uv, 0.0)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)
 #else
-#define SUBSTRATE_SAMPLE(t, s, uv) t.Sample(s, uv)
+#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)
 #endif
 #endif
 

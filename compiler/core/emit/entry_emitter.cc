@@ -6,23 +6,11 @@ namespace substratec {
 
 namespace {
 
-bool translucent(const Material& m) {
-  return m.settings.blendMode == BlendMode::TranslucentGrey || m.settings.blendMode == BlendMode::TranslucentColored ||
-         m.settings.blendMode == BlendMode::ColoredTransmittanceOnly;
-}
-
-bool usesEmissive(const Material& m, const StorageLayout& L) {
-  for (const auto& c : L.closures)
-    if (m.slabs[c.slab].features & kFeatEmissive) return true;
-  return false;
-}
-
 /// Shared prologue: includes. The material file includes the runtime it needs;
 /// the base pass includes substrate_pack.h before it, which compiles the
 /// material's pack function in (the forward pass does not pack).
 std::string includes(const Material& m, const Syntax& syn, bool lighting, Precision precision = Precision::Float) {
-  std::string s;
-  if (syn.target == Target::Glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  std::string s(syn.header);
   // The forward pass lights the closures <name>_evaluate returns: their normals are unit.
   if (lighting) s += "#define SUBSTRATE_UNIT_CLOSURE_NORMALS 1  // lit as evaluated: unit normals\n";
   s += precisionDefine(precision);
@@ -33,219 +21,127 @@ std::string includes(const Material& m, const Syntax& syn, bool lighting, Precis
   return s;
 }
 
-/// Fills SubstrateGeometry `g` from the interpolants (both entry kinds).
-std::string geometryCode(const Syntax& syn) {
-  if (syn.target == Target::Glsl)
-    return R"(  SubstrateGeometry g;
-  g.N = normalize(inNormal);
-  g.T = substrate_orthogonal_tangent(g.N, inTangent.xyz);
-  g.V = normalize(frame.cameraPosition.xyz - inPosition);
-  g.position = inPosition;
-  g.uv0 = inUv0;
-  g.uv1 = inUv1;
-  g.vertexColor = inColor;
-  g.uvDerivatives = vec4(dFdx(inUv0), dFdy(inUv0));
-  // Interleaved gradient noise (Jimenez 2014): the per-pixel dither.
-  g.dither = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));
-)";
-  return R"(  SubstrateGeometry g;
-  g.N = normalize(i.normal);
-  g.T = substrate_orthogonal_tangent(g.N, i.tangent.xyz);
-  g.V = normalize(frame.cameraPosition.xyz - i.worldPosition);
-  g.position = i.worldPosition;
-  g.uv0 = i.uv0;
-  g.uv1 = i.uv1;
-  g.vertexColor = i.color;
-  g.uvDerivatives = float4(ddx(i.uv0), ddy(i.uv0));
-  // Interleaved gradient noise (Jimenez 2014): the per-pixel dither.
-  g.dither = frac(52.9829189 * frac(dot(i.position.xy, float2(0.06711056, 0.00583715))));
-)";
+/// The interpolants of the stock vertex stage (both entry kinds).
+const std::vector<StageVar>& interpolants() {
+  static const std::vector<StageVar> v = {{0, "float3", "worldPosition", "POSITION0"}, {1, "float3", "normal", "NORMAL0"},
+                                          {2, "float4", "tangent", "TANGENT0"},        {3, "float2", "uv0", "TEXCOORD0"},
+                                          {4, "float2", "uv1", "TEXCOORD1"},           {5, "float4", "color", "COLOR0"}};
+  return v;
 }
 
-std::string frameResources(const Syntax& syn, bool environment) {
-  if (syn.target == Target::Glsl) {
-    std::string s = R"(layout(set = 0, binding = 0, std140) uniform SubstrateFrame {
-  vec4 cameraPosition;  // xyz: world position of the eye
-  vec4 lightDirection;  // xyz: unit vector toward the light
-  vec4 lightRadiance;   // rgb
-  vec4 envParams;       // x: mip count of the prefiltered environment
-} frame;
-)";
-    if (environment)
-      s += "layout(set = 0, binding = 1) uniform samplerCube envPrefiltered;\n"
-           "layout(set = 0, binding = 2) uniform samplerCube envIrradiance;\n"
-           "// set 0, binding 5: the energy tables (a uniform buffer, declared by substrate_energy_lut.h).\n";
-    s += R"(
-layout(location = 0) in vec3 inPosition;
-layout(location = 1) in vec3 inNormal;
-layout(location = 2) in vec4 inTangent;
-layout(location = 3) in vec2 inUv0;
-layout(location = 4) in vec2 inUv1;
-layout(location = 5) in vec4 inColor;
-)";
-    return s;
-  }
-  std::string s = R"(struct SubstrateFrameData {
-  float4 cameraPosition;  // xyz: world position of the eye
-  float4 lightDirection;  // xyz: unit vector toward the light
-  float4 lightRadiance;   // rgb
-  float4 envParams;       // x: mip count of the prefiltered environment
-};
-[[vk::binding(0, 0)]] ConstantBuffer<SubstrateFrameData> frame;
-)";
-  if (environment)
-    s += "[[vk::binding(1, 0)]] TextureCube<float4> envPrefiltered;\n"
-         "[[vk::binding(2, 0)]] TextureCube<float4> envIrradiance;\n"
-         "[[vk::binding(3, 0)]] SamplerState envSampler;\n"
-         "// set 0, binding 5: the energy tables (a uniform buffer, declared by substrate_energy_lut.h).\n";
-  s += R"(
-struct PSInput {
-  float4 position : SV_Position;
-  [[vk::location(0)]] float3 worldPosition : POSITION0;
-  [[vk::location(1)]] float3 normal : NORMAL0;
-  [[vk::location(2)]] float4 tangent : TANGENT0;
-  [[vk::location(3)]] float2 uv0 : TEXCOORD0;
-  [[vk::location(4)]] float2 uv1 : TEXCOORD1;
-  [[vk::location(5)]] float4 color : COLOR0;
-};
-)";
+/// The frame block (set 0, binding 0), with `environment` the split-sum
+/// environment, then the stage interface with `outputs`, up to main's brace.
+std::string resourcesAndMain(const Syntax& syn, bool environment, const std::vector<StageVar>& outputs,
+                             const std::string& more = "") {
+  std::string s = syn.uniformBlock(0, 0, "SubstrateFrame", "frame",
+                                   "  float4 cameraPosition;  // xyz: world position of the eye\n"
+                                   "  float4 lightDirection;  // xyz: unit vector toward the light\n"
+                                   "  float4 lightRadiance;   // rgb\n"
+                                   "  float4 envParams;       // x: mip count of the prefiltered environment\n");
+  if (environment) s += environmentResources(syn);
+  s += more + "\n" + syn.fragmentInterface(interpolants(), outputs) + "\n" + syn.fragmentMain();
   return s;
 }
 
-}  // namespace
-
-std::string forwardFileName(const Material& m, const Syntax& syn) {
-  return m.name + (syn.target == Target::Glsl ? ".forward.frag" : ".forward.ps.hlsl");
+/// Fills SubstrateGeometry `g` from the interpolants, evaluates the material
+/// into `closures`, `coverage` and `transmittance` (both entry kinds).
+std::string geometryAndEvaluate(const Material& m, const Syntax& syn) {
+  auto in = [&](const char* n) { return syn.input(n); };
+  std::string s = "  SubstrateGeometry g;\n";
+  s += fmt::format("  g.N = normalize({});\n", in("normal"));
+  s += fmt::format("  g.T = substrate_orthogonal_tangent(g.N, {}.xyz);\n", in("tangent"));
+  s += fmt::format("  g.V = normalize(frame.cameraPosition.xyz - {});\n", in("worldPosition"));
+  s += fmt::format("  g.position = {};\n", in("worldPosition"));
+  s += fmt::format("  g.uv0 = {};\n  g.uv1 = {};\n", in("uv0"), in("uv1"));
+  s += fmt::format("  g.vertexColor = {};\n", in("color"));
+  s += fmt::format("  g.uvDerivatives = float4(ddx({0}), ddy({0}));\n", in("uv0"));
+  s += "  // Interleaved gradient noise (Jimenez 2014): the per-pixel dither.\n";
+  s += fmt::format("  g.dither = frac(52.9829189 * frac(dot({}.xy, float2(0.06711056, 0.00583715))));\n", syn.fragCoord());
+  return s + evaluateCall(m);
 }
-std::string basePassFileName(const Material& m, const Syntax& syn) {
-  return m.name + (syn.target == Target::Glsl ? ".basepass.frag" : ".basepass.ps.hlsl");
-}
 
-std::string emitForwardEntry(const Material& m, const StorageLayout& L, const Syntax& syn, Precision precision) {
-  const bool glsl = syn.target == Target::Glsl;
-  const std::string upper = materialUpper(m);
-  const std::string v3 = syn.type(VType::Vec3);
-  const int n = static_cast<int>(L.closures.size());
-  const bool dual = translucent(m);
-  std::string s = fmt::format("// Generated by substratec: the forward pass of '{}' ({} closure(s), lit inline, no packing).\n",
-                              m.name, n);
-  s += includes(m, syn, true, precision) + "\n" + frameResources(syn, true);
-  if (glsl) {
-    s += dual ? "layout(location = 0, index = 0) out vec4 outColor;\n"
-                "layout(location = 0, index = 1) out vec4 outTransmittance;  // dual-source: background multiplier\n"
-              : "layout(location = 0) out vec4 outColor;\n";
-    s += "\nvoid main() {\n";
-  } else {
-    s += "\nstruct PSOutput {\n  [[vk::location(0)]] float4 color : SV_Target0;\n";
-    // Dual-source blending wants [[vk::location(0), vk::index(1)]] (DXC); glslang's HLSL
-    // front end does not know vk::index, so the transmittance goes to target 1.
-    if (dual) s += "  [[vk::location(1)]] float4 transmittance : SV_Target1;  // the background multiplier\n";
-    s += "};\n\nPSOutput main(PSInput i) {\n";
-  }
-  s += geometryCode(syn);
-  s += fmt::format("  SubstrateClosure closures[{}_CLOSURE_COUNT];\n  float coverage;\n  {} transmittance;\n", upper, v3);
-  s += fmt::format("  {}_evaluate(g, closures, coverage, transmittance);\n", m.name);
-  s += fmt::format("  {} L = frame.lightDirection.xyz;\n  {} color = SUBSTRATE_SPLAT3(0.0);\n", v3, v3);
-  // One closure: lit inline (no loop). Several: one loop over them, so the
-  // lighting code exists once in the shader instead of once per closure.
-  const bool loop = n > 1;
+/// The forward pass's lighting of the closures into `color`: one closure
+/// inline, several in one loop (the lighting code exists once in the shader).
+std::string forwardLighting(const Material& m, const StorageLayout& L) {
+  const bool loop = L.closures.size() > 1;
   const std::string cl = loop ? "closures[k]" : "closures[0]";
   // A closure whose weight is 0 at this pixel is skipped (dynamic culling);
   // a lone closure of static weight 1 needs no test.
   const bool test = loop || L.closures[0].storesWeight;
+  std::string s = "  float3 L = frame.lightDirection.xyz;\n  float3 color = SUBSTRATE_SPLAT3(0.0);\n";
   if (loop) {
-    s += fmt::format("  for (uint k = 0u; k < uint({}_CLOSURE_COUNT); ++k) {{\n", upper);
+    s += fmt::format("  for (uint k = 0u; k < uint({}_CLOSURE_COUNT); ++k) {{\n", materialUpper(m));
     s += "    if (!substrate_closure_visible(closures[k])) continue;  // weight 0 here: nothing to light\n";
   } else {
     s += fmt::format("  // closure 0 ('{}')\n", m.slabs[L.closures[0].slab].id);
     if (test) s += "  if (substrate_closure_visible(closures[0])) {  // weight 0 here: nothing to light\n";
   }
   const std::string in = test ? "    " : "  ";
-  s += fmt::format("{}color += substrate_light_closure({}, g.V, L, frame.lightRadiance.rgb);\n", in, cl);
-  std::string pre = glsl ? fmt::format("textureLod(envPrefiltered, substrate_reflection_dir({0}, g.V), "
-                                       "substrate_env_mip(substrate_env_roughness({0}), frame.envParams.x)).rgb", cl)
-                         : fmt::format("envPrefiltered.SampleLevel(envSampler, substrate_reflection_dir({0}, g.V), "
-                                       "substrate_env_mip(substrate_env_roughness({0}), frame.envParams.x)).rgb", cl);
-  std::string irr = glsl ? fmt::format("textureLod(envIrradiance, {}.N, 0.0).rgb", cl)
-                         : fmt::format("envIrradiance.SampleLevel(envSampler, {}.N, 0.0).rgb", cl);
-  s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * "
-                   "substrate_env_split_sum({1}, g.V, {2}, {3});\n", in, cl, pre, irr);
-  if (usesEmissive(m, L))
+  s += lightClosureCode(cl, "g.V", in);
+  if (anyEmissive(m, L))
     s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * {1}.emissive;\n", in, cl);
   if (test) s += "  }\n";
-  std::string color = "color", alpha = "coverage";
-  if (m.settings.blendMode == BlendMode::AlphaHoldout) color = "SUBSTRATE_SPLAT3(0.0)";
-  if (m.settings.blendMode == BlendMode::Masked)
-    s += glsl ? "  if (coverage < 0.5) discard;\n" : "  clip(coverage - 0.5);\n";
-  if (m.settings.blendMode == BlendMode::ColoredTransmittanceOnly) color = "SUBSTRATE_SPLAT3(0.0)";
-  std::string through = fmt::format("SUBSTRATE_SPLAT3(1.0 - coverage) + coverage * transmittance");
-  if (m.settings.blendMode == BlendMode::TranslucentGrey)
-    through = "SUBSTRATE_SPLAT3(1.0 - coverage + coverage * dot(transmittance, SUBSTRATE_SPLAT3(1.0 / 3.0)))";
-  if (glsl) {
-    s += fmt::format("  outColor = vec4({}, {});\n", color, alpha);
-    if (dual) s += fmt::format("  outTransmittance = vec4({}, 1.0);\n", through);
-    s += "}\n";
-  } else {
-    s += fmt::format("  PSOutput o;\n  o.color = float4({}, {});\n", color, alpha);
-    if (dual) s += fmt::format("  o.transmittance = float4({}, 1.0);\n", through);
-    s += "  return o;\n}\n";
-  }
   return s;
 }
 
+}  // namespace
+
+std::string forwardFileName(const Material& m, const Syntax& syn) {
+  return m.name + ".forward" + std::string(syn.fragmentExtension);
+}
+std::string basePassFileName(const Material& m, const Syntax& syn) {
+  return m.name + ".basepass" + std::string(syn.fragmentExtension);
+}
+
+std::string emitForwardEntry(const Material& m, const StorageLayout& L, const Syntax& syn, Precision precision) {
+  const bool dual = translucentBlend(m);
+  std::string s = fmt::format("// Generated by substratec: the forward pass of '{}' ({} closure(s), lit inline, no packing).\n",
+                              m.name, L.closures.size());
+  std::vector<StageVar> outputs = {{0, "float4", "color"}};
+  if (dual) outputs.push_back({0, "float4", "transmittance", "", "dual-source: the background multiplier", 1});
+  s += includes(m, syn, true, precision) + "\n" + resourcesAndMain(syn, true, outputs);
+  s += geometryAndEvaluate(m, syn);
+  s += forwardLighting(m, L);
+  std::string color = "color";
+  if (m.settings.blendMode == BlendMode::AlphaHoldout) color = "SUBSTRATE_SPLAT3(0.0)";
+  if (m.settings.blendMode == BlendMode::Masked) s += "  if (coverage < 0.5) discard;\n";
+  if (m.settings.blendMode == BlendMode::ColoredTransmittanceOnly) color = "SUBSTRATE_SPLAT3(0.0)";
+  s += fmt::format("  {} = float4({}, coverage);\n", syn.output("color"), color);
+  if (dual) s += fmt::format("  {} = float4({}, 1.0);\n", syn.output("transmittance"), backgroundThroughput(m));
+  return s + syn.fragmentEnd();
+}
+
 std::string emitBasePassEntry(const Material& m, const StorageLayout& L, const Syntax& syn) {
-  const bool glsl = syn.target == Target::Glsl;
   const std::string upper = materialUpper(m);
-  const std::string v3 = syn.type(VType::Vec3);
   const int words = L.words();
   const int rts = std::min(words, 3);
-  const bool emissive = usesEmissive(m, L);
+  const bool emissive = anyEmissive(m, L);
   std::string s = fmt::format(
       "// Generated by substratec: the base pass of '{}' — {} packed words ({} to render targets, {} to the "
       "material buffer) and the top-layer word.\n",
       m.name, words, rts, words - rts);
-  s += includes(m, syn, false) + "\n" + frameResources(syn, false);
-  if (glsl) {
-    for (int k = 0; k < rts; ++k) s += fmt::format("layout(location = {0}) out uint outWord{0};\n", k);
-    s += "layout(location = 3) out uint outTopLayer;\n";
-    if (emissive) s += "layout(location = 4) out vec4 outEmissive;\n";
-    if (words > 3) s += "layout(set = 0, binding = 4, r32ui) uniform writeonly uimage2DArray materialBuffer;\n";
-    s += "\nvoid main() {\n";
-  } else {
-    if (words > 3) s += "[[vk::binding(4, 0)]] RWTexture2DArray<uint> materialBuffer;\n";
-    s += "\nstruct PSOutput {\n";
-    for (int k = 0; k < rts; ++k) s += fmt::format("  [[vk::location({0})]] uint word{0} : SV_Target{0};\n", k);
-    s += "  [[vk::location(3)]] uint topLayer : SV_Target3;\n";
-    if (emissive) s += "  [[vk::location(4)]] float4 emissive : SV_Target4;\n";
-    s += "};\n\nPSOutput main(PSInput i) {\n";
-  }
-  s += geometryCode(syn);
-  s += fmt::format("  SubstrateClosure closures[{}_CLOSURE_COUNT];\n  float coverage;\n  {} transmittance;\n", upper, v3);
-  s += fmt::format("  {}_evaluate(g, closures, coverage, transmittance);\n", m.name);
+  std::vector<StageVar> outputs;
+  for (int k = 0; k < rts; ++k) outputs.push_back({k, "uint", fmt::format("word{}", k)});
+  outputs.push_back({3, "uint", "topLayer"});
+  if (emissive) outputs.push_back({4, "float4", "emissive"});
+  const std::string buffer = words > 3 ? syn.storageImage(0, 4, Access::Write, ImageKind::UintArray, "materialBuffer") : "";
+  s += includes(m, syn, false) + "\n" + resourcesAndMain(syn, false, outputs, buffer);
+  s += geometryAndEvaluate(m, syn);
   s += fmt::format("  uint words[{}_WORD_COUNT];\n  uint topLayer;\n", upper);
   s += fmt::format("  {}_pack(closures, g.dither, words, topLayer);\n", m.name);
-  if (glsl) {
-    for (int k = 0; k < rts; ++k) s += fmt::format("  outWord{0} = words[{0}];\n", k);
-    s += "  outTopLayer = topLayer;\n";
-    for (int k = 3; k < words; ++k)
-      s += fmt::format("  imageStore(materialBuffer, ivec3(ivec2(gl_FragCoord.xy), {}), uvec4(words[{}], 0u, 0u, 0u));\n",
-                       k - 3, k);
-  } else {
-    s += "  PSOutput o;\n";
-    for (int k = 0; k < rts; ++k) s += fmt::format("  o.word{0} = words[{0}];\n", k);
-    s += "  o.topLayer = topLayer;\n";
-    for (int k = 3; k < words; ++k)
-      s += fmt::format("  materialBuffer[uint3(uint2(i.position.xy), {}u)] = words[{}];\n", k - 3, k);
-  }
+  for (int k = 0; k < rts; ++k) s += fmt::format("  {} = words[{}];\n", syn.output(fmt::format("word{}", k)), k);
+  s += fmt::format("  {} = topLayer;\n", syn.output("topLayer"));
+  for (int k = 3; k < words; ++k)
+    s += fmt::format("  SUBSTRATE_IMAGE_STORE_LAYER(materialBuffer, uint2({}.xy), {}u, words[{}]);\n", syn.fragCoord(),
+                     k - 3, k);
   if (emissive) {
     std::string sum = "SUBSTRATE_SPLAT3(0.0)";
     for (std::size_t c = 0; c < L.closures.size(); ++c)
       if (m.slabs[L.closures[c].slab].features & kFeatEmissive)
         sum += fmt::format(" + closures[{0}].weight * closures[{0}].emissive", c);  // the light-independent part
-    s += glsl ? fmt::format("  outEmissive = vec4({}, 1.0);\n", sum) : fmt::format("  o.emissive = float4({}, 1.0);\n", sum);
+    s += fmt::format("  {} = float4({}, 1.0);\n", syn.output("emissive"), sum);
   }
-  s += glsl ? "}\n" : "  return o;\n}\n";
-  return s;
+  return s + syn.fragmentEnd();
 }
 
 }  // namespace substratec
@@ -378,9 +274,8 @@ std::string aloneAndPlain(const Material& m, const StorageLayout& L, int k) {
 
 }  // namespace
 
-std::string emitPackFunction(const Material& m, const StorageLayout& L, const Syntax& syn, bool dynamicSimplification) {
+std::string emitPackFunction(const Material& m, const StorageLayout& L, const Syntax&, bool dynamicSimplification) {
   const std::string upper = materialUpper(m);
-  const std::string v3 = syn.type(VType::Vec3);
   std::string s;
   s += "// Packs the closures into the uint stream of docs/storage.md (static bit offsets, centred dither).\n";
   s += "// Compiled when substrate_pack.h is included before this file (the base pass does).\n";
@@ -408,7 +303,7 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
     rsum += (rsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.roughness", c);
     wsum += (wsum.empty() ? "" : " + ") + fmt::format("{}.weight", c);
   }
-  s += fmt::format("  {} topN = substrate_safe_normalize({}, closures[0].N);\n", v3, nsum);
+  s += fmt::format("  float3 topN = substrate_safe_normalize({}, closures[0].N);\n", nsum);
   s += fmt::format("  float topRoughness = saturate(({}) / max({}, 1e-6));\n", rsum, wsum);
   s += "  topLayer = substrate_q_top_layer(topN, topRoughness, dither);\n";
   std::vector<int> identity(L.closures.size());

@@ -10,24 +10,11 @@ namespace {
 
 using namespace kernel;
 
-bool anyEmissive(const Material& m, const StorageLayout& L) {
-  for (const auto& c : L.closures)
-    if (m.slabs[c.slab].features & kFeatEmissive) return true;
-  return false;
-}
-
-bool translucentBlend(const Material& m) {
-  return m.settings.blendMode == BlendMode::TranslucentGrey || m.settings.blendMode == BlendMode::TranslucentColored ||
-         m.settings.blendMode == BlendMode::ColoredTransmittanceOnly;
-}
-
 /// Includes, in the order the entries use: the storage code before the
 /// material (compiles its pack function in), the unpacker and lighting after.
 std::string includes(const Material& m, const StorageLayout& L, const Syntax& syn, KernelMode mode,
                      Precision precision) {
-  const bool glsl = syn.target == Target::Glsl;
-  std::string s;
-  if (glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  std::string s(syn.header);
   s += "#define SUBSTRATE_TEXTURE_LOD0 1  // no implicit derivatives in a compute shader\n";
   s += precisionDefine(precision);
   // The closures lit come straight from <name>_evaluate (unit normals), except
@@ -87,7 +74,6 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
 /// (material order) per sample; the material's private input globals
 /// (EmitOptions::inputsPerInvocation) are set from it.
 std::string assignSampleInputs(const Material& m, const Syntax& syn) {
-  const bool glsl = syn.target == Target::Glsl;
   int count = 0;
   for (const Input& in : m.inputs) count += in.type != VType::Texture;
   std::string s;
@@ -95,8 +81,7 @@ std::string assignSampleInputs(const Material& m, const Syntax& syn) {
   for (const Input& in : m.inputs) {
     if (in.type == VType::Texture) continue;
     static const char* swizzle[] = {"", ".x", ".xy", ".xyz", ""};
-    const std::string target = glsl ? fmt::format("{}_inputs.i_{}", m.name, in.name) : fmt::format("{}_i_{}", m.name, in.name);
-    s += fmt::format("  {} = sampleInputs[i * {}u + {}u]{};\n", target, count, j++,
+    s += fmt::format("  {} = sampleInputs[i * {}u + {}u]{};\n", syn.inputAccess(m.name, in.name), count, j++,
                      swizzle[componentCount(in.type)]);
   }
   return s;
@@ -105,7 +90,6 @@ std::string assignSampleInputs(const Material& m, const Syntax& syn) {
 std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax& syn, KernelMode mode,
                          const EmitOptions& emit) {
   const bool perSampleInputs = emit.inputsPerInvocation;
-  const bool glsl = syn.target == Target::Glsl;
   const std::string upper = materialUpper(m);
   const int n = static_cast<int>(L.closures.size());
   std::string s = fmt::format(
@@ -113,19 +97,10 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
       "// Layouts: compiler/core/emit/kernel_emitter.h.\n",
       m.name, mode == KernelMode::Forward ? "closures lit inline" : "closures packed, unpacked generically, then lit");
   s += includes(m, L, syn, mode, emit.precision);
-  if (glsl) {
-    s += fmt::format("layout(local_size_x = {}) in;\n", kLocalSize);
-    s += "layout(set = 0, binding = 6, std430) readonly buffer SubstrateSamples { vec4 samples[]; };\n";
-    s += "layout(set = 0, binding = 7, std430) writeonly buffer SubstrateResults { float results[]; };\n";
-    if (perSampleInputs)
-      s += "layout(set = 0, binding = 8, std430) readonly buffer SubstrateSampleInputs { vec4 sampleInputs[]; };\n";
-    s += "\nvoid main() {\n  uint i = gl_GlobalInvocationID.x;\n";
-  } else {
-    s += "[[vk::binding(6, 0)]] StructuredBuffer<float4> samples;\n";
-    s += "[[vk::binding(7, 0)]] RWStructuredBuffer<float> results;\n";
-    if (perSampleInputs) s += "[[vk::binding(8, 0)]] StructuredBuffer<float4> sampleInputs;\n";
-    s += fmt::format("\n[numthreads({}, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID) {{\n  uint i = id.x;\n", kLocalSize);
-  }
+  s += syn.storageBuffer(0, 6, Access::Read, "SubstrateSamples", "float4", "samples");
+  s += syn.storageBuffer(0, 7, Access::Write, "SubstrateResults", "float", "results");
+  if (perSampleInputs) s += syn.storageBuffer(0, 8, Access::Read, "SubstrateSampleInputs", "float4", "sampleInputs");
+  s += "\n" + syn.computeMain(kLocalSize, 1) + fmt::format("  uint i = {}.x;\n", syn.computeId(ComputeId::Dispatch));
   if (perSampleInputs) s += assignSampleInputs(m, syn);
   auto sample = [&](int k) { return fmt::format("samples[i * {}u + {}u]", kSampleVec4s, k); };
   s += "  SubstrateGeometry g;\n";
@@ -141,8 +116,7 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   s += fmt::format("  float3 radiance = {}.xyz;\n", sample(kSampleRadiance));
   s += fmt::format("  float3 prefiltered = {}.xyz;\n", sample(kSamplePrefiltered));
   s += fmt::format("  float3 irradiance = {}.xyz;\n", sample(kSampleIrradiance));
-  s += fmt::format("  SubstrateClosure closures[{}_CLOSURE_COUNT];\n  float coverage;\n  float3 transmittance;\n", upper);
-  s += fmt::format("  {}_evaluate(g, closures, coverage, transmittance);\n", m.name);
+  s += evaluateCall(m);
   std::string count = fmt::format("uint({}_CLOSURE_COUNT)", upper);
   if (mode == KernelMode::Deferred) {
     // The base pass packs; a deferred pass sees only the words.
@@ -187,50 +161,8 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   return s;
 }
 
-std::string previewKernel(const Material& m, const StorageLayout& L, const Syntax& syn, Precision precision) {
-  const bool glsl = syn.target == Target::Glsl;
-  const std::string upper = materialUpper(m);
-  std::string s = fmt::format(
-      "// Generated by substratec: '{}' on a unit sphere, {} lights and a split-sum environment (substratec preview).\n"
-      "// Layouts: compiler/core/emit/kernel_emitter.h.\n",
-      m.name, kPreviewLights);
-  s += includes(m, L, syn, KernelMode::Preview, precision);
-  if (glsl) {
-    s += fmt::format(R"(layout(local_size_x = 8, local_size_y = 8) in;
-layout(set = 0, binding = 0, std140) uniform SubstratePreview {{
-  vec4 camera;
-  vec4 viewport;
-  vec4 lightDirection[{0}];
-  vec4 lightRadiance[{0}];
-}} preview;
-layout(set = 0, binding = 1) uniform samplerCube envPrefiltered;
-layout(set = 0, binding = 2) uniform samplerCube envIrradiance;
-layout(set = 0, binding = 7, std430) writeonly buffer SubstrateResults {{ vec4 results[]; }};
-#define SUBSTRATE_ENV_PREFILTERED(dir, lod) textureLod(envPrefiltered, dir, lod).rgb
-#define SUBSTRATE_ENV_IRRADIANCE(dir) textureLod(envIrradiance, dir, 0.0).rgb
-
-)",
-                     kPreviewLights);
-  } else {
-    s += fmt::format(R"(struct SubstratePreviewData {{
-  float4 camera;
-  float4 viewport;
-  float4 lightDirection[{0}];
-  float4 lightRadiance[{0}];
-}};
-[[vk::binding(0, 0)]] ConstantBuffer<SubstratePreviewData> preview;
-[[vk::binding(1, 0)]] TextureCube<float4> envPrefiltered;
-[[vk::binding(2, 0)]] TextureCube<float4> envIrradiance;
-[[vk::binding(3, 0)]] SamplerState envSampler;
-[[vk::binding(7, 0)]] RWStructuredBuffer<float4> results;
-#define SUBSTRATE_ENV_PREFILTERED(dir, lod) envPrefiltered.SampleLevel(envSampler, dir, lod).rgb
-#define SUBSTRATE_ENV_IRRADIANCE(dir) envIrradiance.SampleLevel(envSampler, dir, 0.0).rgb
-
-)",
-                     kPreviewLights);
-  }
-  // The ray through pixel (x, y) and its hit on the unit sphere.
-  s += R"(// The view ray through pixel p (centre of the pixel) from the camera, looking at the origin.
+/// The preview's ray through pixel p and its hit on the unit sphere.
+constexpr const char* kPreviewHelpers = R"(// The view ray through pixel p (centre of the pixel) from the camera, looking at the origin.
 float3 substrate_preview_ray(float2 p) {
   float2 ndc = (p / preview.viewport.xy) * 2.0 - SUBSTRATE_SPLAT2(1.0);
   float3 forward = normalize(-preview.camera.xyz);
@@ -255,21 +187,20 @@ float2 substrate_preview_uv(float3 n) {
 }
 
 )";
-  if (glsl) {
-    s += "void main() {\n  uint2 pixel = gl_GlobalInvocationID.xy;\n";
-  } else {
-    s += "[numthreads(8, 8, 1)]\nvoid main(uint3 id : SV_DispatchThreadID) {\n  uint2 pixel = id.xy;\n";
-  }
-  s += fmt::format(R"(  if (float(pixel.x) >= preview.viewport.x || float(pixel.y) >= preview.viewport.y) return;
+
+/// The preview's shading point: the pixel's ray, its hit on the sphere (or
+/// the background) and the geometry `g` there.
+std::string previewShadingPoint() {
+  return R"(  if (float(pixel.x) >= preview.viewport.x || float(pixel.y) >= preview.viewport.y) return;
   uint index = pixel.y * uint(preview.viewport.x) + pixel.x;
   float3 eye = preview.camera.xyz;
   float3 dir = substrate_preview_ray(float2(pixel) + SUBSTRATE_SPLAT2(0.5));
   float3 background = SUBSTRATE_ENV_PREFILTERED(dir, 0.0);
   float t = substrate_preview_hit(eye, dir);
-  if (t < 0.0) {{
+  if (t < 0.0) {
     results[index] = float4(background, 0.0);
     return;
-  }}
+  }
   float3 P = eye + t * dir;
   SubstrateGeometry g;
   g.N = normalize(P);
@@ -293,14 +224,17 @@ float2 substrate_preview_uv(float3 n) {
   g.uvDerivatives = float4(du, dv);
   // Interleaved gradient noise (Jimenez 2014): the per-pixel dither.
   g.dither = frac(52.9829189 * frac(dot(float2(pixel) + SUBSTRATE_SPLAT2(0.5), float2(0.06711056, 0.00583715))));
-  SubstrateClosure closures[{0}_CLOSURE_COUNT];
-  float coverage;
-  float3 transmittance;
-  {1}_evaluate(g, closures, coverage, transmittance);
-  float3 color = SUBSTRATE_SPLAT3(0.0);
+)";
+}
+
+/// The preview's lighting of the closures into `color`, composited over the
+/// environment seen through the sphere as the blend mode says.
+std::string previewLighting(const Material& m, const StorageLayout& L) {
+  std::string s = evaluateCall(m);
+  s += fmt::format(R"(  float3 color = SUBSTRATE_SPLAT3(0.0);
   for (int k = 0; k < {0}_CLOSURE_COUNT; ++k) {{
     if (!substrate_closure_visible(closures[k])) continue;  // dynamic culling: weight 0
-    for (int l = 0; l < {2}; ++l) {{
+    for (int l = 0; l < {1}; ++l) {{
       color += substrate_light_closure(closures[k], g.V, preview.lightDirection[l].xyz, preview.lightRadiance[l].rgb);
     }}
     float3 viewT = substrate_closure_view_throughput(closures[k], dot(closures[k].N, g.V));
@@ -308,10 +242,9 @@ float2 substrate_preview_uv(float3 n) {
                                            substrate_env_mip(substrate_env_roughness(closures[k]), preview.viewport.z));
     color += viewT * substrate_env_split_sum(closures[k], g.V, pre, SUBSTRATE_ENV_IRRADIANCE(closures[k].N));
 )",
-                   upper, m.name, kPreviewLights);
+                   materialUpper(m), kPreviewLights);
   if (anyEmissive(m, L)) s += "    color += viewT * closures[k].emissive;\n";
   s += "  }\n";
-  // Composite over the environment seen through the sphere as the blend mode says.
   switch (m.settings.blendMode) {
     case BlendMode::Masked:
       s += "  if (coverage < 0.5) color = background;\n";
@@ -321,37 +254,41 @@ float2 substrate_preview_uv(float3 n) {
       break;
     default:
       if (translucentBlend(m)) {
-        std::string through = "SUBSTRATE_SPLAT3(1.0 - coverage) + coverage * transmittance";
-        if (m.settings.blendMode == BlendMode::TranslucentGrey)
-          through = "SUBSTRATE_SPLAT3(1.0 - coverage + coverage * dot(transmittance, SUBSTRATE_SPLAT3(1.0 / 3.0)))";
         if (m.settings.blendMode == BlendMode::ColoredTransmittanceOnly) s += "  color = SUBSTRATE_SPLAT3(0.0);\n";
-        s += fmt::format("  color += background * ({});\n", through);
+        s += fmt::format("  color += background * ({});\n", backgroundThroughput(m));
       } else {
         s += "  color = lerp(background, color, coverage);\n";
       }
   }
-  s += "  results[index] = float4(color, 1.0);\n}\n";
-  (void)glsl;
-  return s;
+  return s + "  results[index] = float4(color, 1.0);\n}\n";
+}
+
+std::string previewKernel(const Material& m, const StorageLayout& L, const Syntax& syn, Precision precision) {
+  std::string s = fmt::format(
+      "// Generated by substratec: '{}' on a unit sphere, {} lights and a split-sum environment (substratec preview).\n"
+      "// Layouts: compiler/core/emit/kernel_emitter.h.\n",
+      m.name, kPreviewLights);
+  s += includes(m, L, syn, KernelMode::Preview, precision);
+  std::string lights;
+  for (const char* l : {"lightDirection", "lightRadiance"}) lights += fmt::format("  float4 {}[{}];\n", l, kPreviewLights);
+  s += syn.uniformBlock(0, 0, "SubstratePreview", "preview", "  float4 camera;\n  float4 viewport;\n" + lights);
+  s += environmentResources(syn);
+  s += syn.storageBuffer(0, 7, Access::Write, "SubstrateResults", "float4", "results") + "\n";
+  s += kPreviewHelpers;
+  s += syn.computeMain(8, 8) + fmt::format("  uint2 pixel = {}.xy;\n", syn.computeId(ComputeId::Dispatch));
+  return s + previewShadingPoint() + previewLighting(m, L);
 }
 
 /// The cost kernel: one shading point per invocation, made up from its index
 /// (a hash), so that nothing but the material and the lighting is measured.
 std::string throughputKernel(const Material& m, const StorageLayout& L, const Syntax& syn, Precision precision) {
-  const bool glsl = syn.target == Target::Glsl;
   const std::string upper = materialUpper(m);
   std::string s = fmt::format(
       "// Generated by substratec: the cost of '{}' per shading point (one light and a split-sum environment).\n",
       m.name);
   s += includes(m, L, syn, KernelMode::Throughput, precision);
-  if (glsl) {
-    s += fmt::format("layout(local_size_x = {}) in;\n", kLocalSize);
-    s += "layout(set = 0, binding = 7, std430) writeonly buffer SubstrateResults { vec4 results[]; };\n\n";
-    s += "void main() {\n  uint i = gl_GlobalInvocationID.x;\n";
-  } else {
-    s += "[[vk::binding(7, 0)]] RWStructuredBuffer<float4> results;\n\n";
-    s += fmt::format("[numthreads({}, 1, 1)]\nvoid main(uint3 id : SV_DispatchThreadID) {{\n  uint i = id.x;\n", kLocalSize);
-  }
+  s += syn.storageBuffer(0, 7, Access::Write, "SubstrateResults", "float4", "results") + "\n";
+  s += syn.computeMain(kLocalSize, 1) + fmt::format("  uint i = {}.x;\n", syn.computeId(ComputeId::Dispatch));
   s += fmt::format(R"(  uint3 h = substrate_pcg3d(uint3(i, i * 7919u + 17u, 0x5eedu));
   uint3 k = substrate_pcg3d(h);
   float z = substrate_hash_to_unit(h.x) * 2.0 - 1.0;
@@ -373,11 +310,7 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
   g.vertexColor = SUBSTRATE_SPLAT4(1.0);
   g.uvDerivatives = float4(1e-3, 0.0, 0.0, 1e-3);
   g.dither = substrate_hash_to_unit(k.x ^ h.z);
-  SubstrateClosure closures[{0}_CLOSURE_COUNT];
-  float coverage;
-  float3 transmittance;
-  {1}_evaluate(g, closures, coverage, transmittance);
-  float3 color = SUBSTRATE_SPLAT3(0.0);
+{1}  float3 color = SUBSTRATE_SPLAT3(0.0);
   for (int c = 0; c < {0}_CLOSURE_COUNT; ++c) {{
     if (!substrate_closure_visible(closures[c])) continue;  // dynamic culling: weight 0
     color += substrate_light_closure(closures[c], g.V, L, SUBSTRATE_SPLAT3(1.0));
@@ -387,7 +320,7 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
   results[i] = float4(color, coverage);
 }}
 )",
-                   upper, m.name);
+                   upper, evaluateCall(m));
   return s;
 }
 
@@ -405,7 +338,7 @@ std::string kernelFileName(const Material& m, const Syntax& syn, KernelMode mode
                      : mode == KernelMode::Deferred ? "deferred_samples"
                      : mode == KernelMode::Preview  ? "preview"
                                                     : "throughput";
-  return fmt::format("{}.{}{}", m.name, what, syn.target == Target::Glsl ? ".comp" : ".cs.hlsl");
+  return fmt::format("{}.{}{}", m.name, what, syn.computeExtension);
 }
 
 }  // namespace substratec

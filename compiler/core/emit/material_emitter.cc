@@ -47,6 +47,42 @@ std::string extraInterfacesDefine(const StorageLayout& layout) {
   return fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", any ? 1 : 0);
 }
 
+bool translucentBlend(const Material& m) {
+  return m.settings.blendMode == BlendMode::TranslucentGrey || m.settings.blendMode == BlendMode::TranslucentColored ||
+         m.settings.blendMode == BlendMode::ColoredTransmittanceOnly;
+}
+
+bool anyEmissive(const Material& m, const StorageLayout& L) {
+  for (const auto& c : L.closures)
+    if (m.slabs[c.slab].features & kFeatEmissive) return true;
+  return false;
+}
+
+std::string backgroundThroughput(const Material& m) {
+  if (m.settings.blendMode == BlendMode::TranslucentGrey)
+    return "SUBSTRATE_SPLAT3(1.0 - coverage + coverage * dot(transmittance, SUBSTRATE_SPLAT3(1.0 / 3.0)))";
+  return "SUBSTRATE_SPLAT3(1.0 - coverage) + coverage * transmittance";
+}
+
+std::string lightClosureCode(const std::string& c, const std::string& view, const std::string& indent) {
+  return fmt::format(
+      "{0}color += substrate_light_closure({1}, {2}, L, frame.lightRadiance.rgb);\n"
+      "{0}color += substrate_closure_view_throughput({1}, dot({1}.N, {2})) *\n"
+      "{0}         substrate_env_split_sum({1}, {2},\n"
+      "{0}                                 SUBSTRATE_ENV_PREFILTERED(substrate_reflection_dir({1}, {2}),\n"
+      "{0}                                                           substrate_env_mip(substrate_env_roughness({1}), "
+      "frame.envParams.x)),\n"
+      "{0}                                 SUBSTRATE_ENV_IRRADIANCE({1}.N));\n",
+      indent, c, view);
+}
+
+std::string evaluateCall(const Material& m) {
+  return fmt::format(
+      "  SubstrateClosure closures[{}_CLOSURE_COUNT];\n  float coverage;\n  float3 transmittance;\n"
+      "  {}_evaluate(g, closures, coverage, transmittance);\n",
+      materialUpper(m), m.name);
+}
+
 namespace {
 
 class Emitter {
@@ -65,7 +101,7 @@ class Emitter {
   void emitValues();
   bool nonZero(ValueId v) const;  // a constant without a 0, or max(c, x) with a positive constant c
   std::string vec3(double x, double y, double z) const {
-    return syn_.construct(VType::Vec3, fmt::format("{}, {}, {}", Syntax::literal(x), Syntax::literal(y), Syntax::literal(z)));
+    return fmt::format("float3({}, {}, {})", dialectLiteral(x), dialectLiteral(y), dialectLiteral(z));
   }
 
   // --- tree
@@ -73,6 +109,7 @@ class Emitter {
   void emitResources();
   void emitTree();
   void emitClosures();
+  std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
   bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
@@ -120,10 +157,10 @@ std::string Emitter::expr(ValueId v) {
   switch (n.op) {
     case Op::Const: {
       int k = componentCount(n.type);
-      if (k == 1) return Syntax::literal(n.c[0]);
+      if (k == 1) return dialectLiteral(n.c[0]);
       std::string args;
-      for (int i = 0; i < k; ++i) args += (i ? ", " : "") + Syntax::literal(n.c[i]);
-      return syn_.construct(n.type, args);
+      for (int i = 0; i < k; ++i) args += (i ? ", " : "") + dialectLiteral(n.c[i]);
+      return dialectType(n.type) + "(" + args + ")";
     }
     case Op::Input: return syn_.inputAccess(m_.name, m_.inputs[n.attr].name);
     case Op::Geometry:
@@ -180,9 +217,9 @@ std::string Emitter::opExpr(const ValueNode& n) {
       return call("substrate_safe_div");
     case Op::Min: return call("min");
     case Op::Max: return call("max");
-    case Op::Lerp: return syn_.lerp(a(0), a(1), a(2));
+    case Op::Lerp: return call("lerp");
     case Op::Clamp: return call("clamp");
-    case Op::Saturate: return syn_.saturate(a(0));
+    case Op::Saturate: return call("saturate");
     case Op::OneMinus: return fmt::format("(1.0 - {})", a(0));
     case Op::Abs: return call("abs");
     case Op::Sqrt: return call("substrate_value_sqrt");
@@ -200,9 +237,9 @@ std::string Emitter::opExpr(const ValueNode& n) {
     case Op::Combine: {
       std::string args;
       for (int i = 0; i < n.argCount; ++i) args += (i ? ", " : "") + a(i);
-      return syn_.construct(n.type, args);
+      return dialectType(n.type) + "(" + args + ")";
     }
-    case Op::Sample: return syn_.sample(m_.inputs[n.attr].name, a(0));
+    case Op::Sample: return fmt::format("SUBSTRATE_SAMPLE(t_{0}, s_{0}, {1})", m_.inputs[n.attr].name, a(0));
     case Op::MetalnessToDiffuseF0:
       return n.attr == 0 ? call("substrate_metalness_to_diffuse") : call("substrate_metalness_to_f0");
     case Op::IorToF0: return call("substrate_ior_to_f0");
@@ -285,53 +322,27 @@ void Emitter::collectNeeded() {
 }
 
 void Emitter::emitResources() {
-  const bool glsl = syn_.target == Target::Glsl;
-  std::vector<const Input*> uniforms;
+  std::vector<std::pair<VType, std::string>> uniforms;
   for (const auto& in : m_.inputs)
-    if (in.type != VType::Texture) uniforms.push_back(&in);
-  if (opt_.inputsPerInvocation && !uniforms.empty()) {
+    if (in.type != VType::Texture) uniforms.emplace_back(in.type, in.name);
+  if (opt_.inputsPerInvocation && !uniforms.empty())
     line("// Material inputs: private globals, set by the kernel for each shading point; textures from binding 1.");
-    if (glsl) {
-      line(fmt::format("struct {}_Inputs {{", m_.name));
-      for (const Input* in : uniforms) line(fmt::format("  {} i_{};", syn_.type(in->type), in->name));
-      line("};");
-      line(fmt::format("{0}_Inputs {0}_inputs;", m_.name));
-    } else {
-      for (const Input* in : uniforms) line(fmt::format("static {} {}_i_{};", syn_.type(in->type), m_.name, in->name));
-    }
-  } else {
+  else
     line("// Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.");
-  }
-  if (!uniforms.empty() && !opt_.inputsPerInvocation) {
-    if (glsl) {
-      line(fmt::format("layout(set = 1, binding = 0, std140) uniform {}_Inputs {{", m_.name));
-      for (const Input* in : uniforms) line(fmt::format("  {} i_{};", syn_.type(in->type), in->name));
-      line(fmt::format("}} {}_inputs;", m_.name));
-    } else {
-      line(fmt::format("[[vk::binding(0, 1)]] cbuffer {}_Inputs {{", m_.name));
-      for (const Input* in : uniforms) line(fmt::format("  {} {}_i_{};", syn_.type(in->type), m_.name, in->name));
-      line("};");
-    }
-  }
+  if (!uniforms.empty()) out_ += syn_.materialInputs(m_.name, uniforms, opt_.inputsPerInvocation);
   int binding = 1;
   for (std::size_t i = 0; i < m_.inputs.size(); ++i) {
     if (m_.inputs[i].type != VType::Texture || !textures_.count(static_cast<int>(i))) continue;
     const std::string& n = m_.inputs[i].name;
-    if (glsl) {
-      line(fmt::format("layout(set = 1, binding = {}) uniform sampler2D t_{};", binding, n));
-    } else {
-      line(fmt::format("[[vk::binding({}, 1)]] Texture2D<float4> t_{};", binding, n));
-      line(fmt::format("[[vk::binding({}, 1)]] SamplerState s_{};", binding + 16, n));
-    }
+    out_ += syn_.texture(1, binding, false, "t_" + n) + syn_.sampler(1, binding + 16, "s_" + n);
     ++binding;
   }
   if (!textures_.empty()) {
     line("#ifndef SUBSTRATE_SAMPLE");
     line("#ifdef SUBSTRATE_TEXTURE_LOD0  // compute shaders have no implicit derivatives");
-    line(glsl ? "#define SUBSTRATE_SAMPLE(t, s, uv) textureLod(t, uv, 0.0)"
-              : "#define SUBSTRATE_SAMPLE(t, s, uv) t.SampleLevel(s, uv, 0.0)");
+    line("#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, 0.0)");
     line("#else");
-    line(glsl ? "#define SUBSTRATE_SAMPLE(t, s, uv) texture(t, uv)" : "#define SUBSTRATE_SAMPLE(t, s, uv) t.Sample(s, uv)");
+    line("#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE(t, s, uv)");
     line("#endif");
     line("#endif");
   }
@@ -345,12 +356,11 @@ void Emitter::emitValues() {
     if (n.op == Op::Const || n.op == Op::Input || n.op == Op::Geometry) continue;
     if (!any) line("// Values (the value DAG, in dependency order)");
     any = true;
-    line(fmt::format("{} {} = {};", syn_.type(n.type), varName(v), opExpr(n)));
+    line(fmt::format("{} {} = {};", dialectType(n.type), varName(v), opExpr(n)));
   }
 }
 
 void Emitter::emitTree() {
-  const std::string v3 = syn_.type(VType::Vec3);
   line("// Tree: coverage C and transmittance T (along the normal) of every node.");
   for (int n : t_.preorder) {
     const TreeNode& node = m_.nodes[n];
@@ -363,13 +373,13 @@ void Emitter::emitTree() {
     if (knownOpaque(n))
       t = vec3(0, 0, 0);  // no medium: opaque matter
     else
-      t = fmt::format("substrate_transmittance({}, {})", mfpOf(s), v >= 0 ? expr(m_.nodes[v].a) : Syntax::literal(d));
+      t = fmt::format("substrate_transmittance({}, {})", mfpOf(s), v >= 0 ? expr(m_.nodes[v].a) : dialectLiteral(d));
     line(fmt::format("// slab '{}' (Id={}, BSDF {}){}", node.id, t_.reportId[n], t_.bsdfId[node.slab],
                      v >= 0 ? fmt::format(", in the top layer of vertical '{}'", m_.nodes[v].id) : ""));
     line(fmt::format("float C_{} = {};", node.id, c));
-    line(fmt::format("{} T_{} = {};", v3, node.id, t));
+    line(fmt::format("float3 T_{} = {};", node.id, t));
     if (underOperatorTop(n))  // what it lets through, its interface included (TI: see emitClosures)
-      line(fmt::format("{} TI_{} = T_{} * (1.0 - {});", v3, node.id, node.id, expr(s.pin(SlabPin::F0))));
+      line(fmt::format("float3 TI_{0} = T_{0} * (1.0 - {1});", node.id, expr(s.pin(SlabPin::F0))));
   }
   // Operators bottom-up: by distance from leaves, then tree id.
   for (int n : t_.bottomUpOperators) {
@@ -377,7 +387,7 @@ void Emitter::emitTree() {
     const std::string id = node.id, l = nodeName(node.left), r = node.right >= 0 ? nodeName(node.right) : "";
     line(fmt::format("// {} '{}' (Id={}, DistanceFromLeaves={})", treeOpName(node.op), id, t_.reportId[n],
                      t_.distanceFromLeaves[n]));
-    line(fmt::format("float C_{}; {} T_{};", id, v3, id));
+    line(fmt::format("float C_{0}; float3 T_{0};", id));
     switch (node.op) {
       case TreeOp::Horizontal:
         line(fmt::format("substrate_op_horizontal(C_{0}, T_{0}, C_{1}, T_{1}, {2}, C_{3}, T_{3});", l, r, expr(node.a), id));
@@ -397,7 +407,7 @@ void Emitter::emitTree() {
     }
     if (!underOperatorTop(n)) continue;
     // The same operator on what the children let through with their interfaces.
-    line(fmt::format("{} TI_{};", v3, id));
+    line(fmt::format("float3 TI_{};", id));
     switch (node.op) {
       case TreeOp::Horizontal:
         line(fmt::format("{{ float c; substrate_op_horizontal(C_{0}, TI_{0}, C_{1}, TI_{1}, {2}, c, TI_{3}); }}", l, r,
@@ -420,8 +430,58 @@ void Emitter::emitTree() {
   }
 }
 
+/// The walk from closure `cl`'s slab (tree node `node`, id `id`) up to the
+/// root: returns its mix/coverage weight (an expression, "" for 1) and, for a
+/// closure under layers, emits what the layers above do to it (ca_, ta_, va_).
+std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string& id) {
+  const Slab& s = m_.slabs[cl.slab];
+  // The walk up to the root: mix/coverage weights, and the layers above.
+  std::string weight = s.coverage == kNoValue ? "" : fmt::format("C_{}", id);
+  std::vector<std::pair<int, int>> layers;  // (vertical, its top) for each vertical above, bottom-up
+  for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
+    const TreeNode& op = m_.nodes[p];
+    std::string f;
+    switch (op.op) {
+      case TreeOp::Horizontal: f = op.right == x ? expr(op.a) : fmt::format("(1.0 - {})", expr(op.a)); break;
+      case TreeOp::CoverageWeight: f = expr(op.a); break;
+      case TreeOp::Select:
+        f = op.right == x ? fmt::format("(1.0 - step({}, {}))", expr(op.a), expr(op.b))
+                          : fmt::format("step({}, {})", expr(op.a), expr(op.b));
+        break;
+      case TreeOp::Vertical:
+        if (op.right == x) layers.emplace_back(p, op.left);
+        break;
+      default: break;
+    }
+    if (!f.empty()) weight += (weight.empty() ? "" : " * ") + f;
+  }
+  if (!cl.isTop) {
+    line(fmt::format("float ca_{0} = 0.0; float3 ta_{0} = {1}; float va_{0} = 0.0;", id, vec3(1, 1, 1)));
+    // From the root down. The top's interfaces transmit 1 - F0 at normal
+    // incidence: a slab's inline, an operator's (a partial coat, a mix of
+    // coats) through TI. The lighting applies the angular part of the first
+    // 1 + extraInterfaces interfaces on the way down (at most 4); every
+    // further one is folded in here as substrate_extra_interfaces
+    // (substrate_tree.h).
+    int lit = 1 + cl.extraInterfaces;
+    for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
+      const TreeNode& top = m_.nodes[it->second];
+      std::string tTop = fmt::format("TI_{}", top.id);
+      if (top.op == TreeOp::Slab)
+        tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
+      const int extra = foldedInterfaces(t_.interfaces[it->second], lit);
+      if (extra > 0) tTop = fmt::format("{} * substrate_extra_interfaces({})", tTop, dialectLiteral(extra));
+      if (top.op == TreeOp::Slab)
+        line(fmt::format("va_{0} += C_{1} * substrate_roughness_to_variance({2});", id, top.id,
+                         expr(m_.slabs[top.slab].pin(SlabPin::Roughness))));
+      line(fmt::format("substrate_layer_above(ca_{0}, ta_{0}, C_{1}, {2});  // under '{1}' (vertical '{3}')", id,
+                       top.id, tTop, m_.nodes[it->first].id));
+    }
+  }
+  return weight;
+}
+
 void Emitter::emitClosures() {
-  const std::string v3 = syn_.type(VType::Vec3);
   for (std::size_t i = 0; i < L_.closures.size(); ++i) {
     const ClosureLayout& cl = L_.closures[i];
     const Slab& s = m_.slabs[cl.slab];
@@ -431,49 +491,7 @@ void Emitter::emitClosures() {
     line(fmt::format("// Closure {}: slab '{}' (BSDF {}, LayerDepth {}, {}){}", i, id, i, t_.layerDepth[node],
                      cl.isTop ? "top layer" : "under a layer",
                      s.collapsedFrom.empty() ? "" : fmt::format(" (a blended {})", s.collapsedFrom)));
-    // The walk up to the root: mix/coverage weights, and the layers above.
-    std::string weight = s.coverage == kNoValue ? "" : fmt::format("C_{}", id);
-    std::vector<std::pair<int, int>> layers;  // (vertical, its top) for each vertical above, bottom-up
-    for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
-      const TreeNode& op = m_.nodes[p];
-      std::string f;
-      switch (op.op) {
-        case TreeOp::Horizontal: f = op.right == x ? expr(op.a) : fmt::format("(1.0 - {})", expr(op.a)); break;
-        case TreeOp::CoverageWeight: f = expr(op.a); break;
-        case TreeOp::Select:
-          f = op.right == x ? fmt::format("(1.0 - step({}, {}))", expr(op.a), expr(op.b))
-                            : fmt::format("step({}, {})", expr(op.a), expr(op.b));
-          break;
-        case TreeOp::Vertical:
-          if (op.right == x) layers.emplace_back(p, op.left);
-          break;
-        default: break;
-      }
-      if (!f.empty()) weight += (weight.empty() ? "" : " * ") + f;
-    }
-    if (!cl.isTop) {
-      line(fmt::format("float ca_{0} = 0.0; {1} ta_{0} = {2}; float va_{0} = 0.0;", id, v3, vec3(1, 1, 1)));
-      // From the root down. The top's interfaces transmit 1 - F0 at normal
-      // incidence: a slab's inline, an operator's (a partial coat, a mix of
-      // coats) through TI. The lighting applies the angular part of the first
-      // 1 + extraInterfaces interfaces on the way down (at most 4); every
-      // further one is folded in here as substrate_extra_interfaces
-      // (substrate_tree.h).
-      int lit = 1 + cl.extraInterfaces;
-      for (auto it = layers.rbegin(); it != layers.rend(); ++it) {
-        const TreeNode& top = m_.nodes[it->second];
-        std::string tTop = fmt::format("TI_{}", top.id);
-        if (top.op == TreeOp::Slab)
-          tTop = fmt::format("T_{} * (1.0 - {})", top.id, expr(m_.slabs[top.slab].pin(SlabPin::F0)));
-        const int extra = foldedInterfaces(t_.interfaces[it->second], lit);
-        if (extra > 0) tTop = fmt::format("{} * substrate_extra_interfaces({})", tTop, Syntax::literal(extra));
-        if (top.op == TreeOp::Slab)
-          line(fmt::format("va_{0} += C_{1} * substrate_roughness_to_variance({2});", id, top.id,
-                           expr(m_.slabs[top.slab].pin(SlabPin::Roughness))));
-        line(fmt::format("substrate_layer_above(ca_{0}, ta_{0}, C_{1}, {2});  // under '{1}' (vertical '{3}')", id,
-                         top.id, tTop, m_.nodes[it->first].id));
-      }
-    }
+    const std::string weight = walkUp(cl, node, id);
     line(fmt::format("substrate_closure_init({});", c));
     const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);
     if (verticalOfTop(node) >= 0 && !knownOpaque(node) && !m_.values.isConstEqual(albedo, 0.0))
@@ -566,11 +584,11 @@ std::string Emitter::run() {
   line("");
   line(fmt::format("// Evaluates the material at one shading point into its closures (fully unrolled)."));
   line(fmt::format("void {0}_evaluate(SubstrateGeometry g, out SubstrateClosure closures[{1}_CLOSURE_COUNT], "
-                   "out float coverage, out {2} transmittance) {{",
-                   m_.name, upper, syn_.type(VType::Vec3)));
+                   "out float coverage, out float3 transmittance) {{",
+                   m_.name, upper));
   indent_ = "  ";
-  line(fmt::format("{} ts_view = {};  // the view direction in tangent space", syn_.type(VType::Vec3),
-                   syn_.construct(VType::Vec3, "dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N)")));
+  line("float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in "
+       "tangent space");
   emitValues();
   emitTree();
   emitClosures();

@@ -1,5 +1,6 @@
 // Code generation: the flattened material function. One language-neutral
-// emitter; everything lexical goes through the target's Syntax table.
+// emitter writing the runtime's dialect; the target's Syntax table supplies
+// only the resource declarations and input access (emit/syntax.h).
 //
 // Output (docs/codegen.md): resources (the inputs' uniform block / constant
 // buffer and the textures), then `<name>_evaluate(g, closures, coverage,
@@ -51,6 +52,23 @@ std::string useDefines(std::uint16_t features);
 /// lies under more than one interface (ClosureLayout::extraInterfaces > 0),
 /// so the lighting compiles the interface term's power only for stacks.
 std::string extraInterfacesDefine(const StorageLayout& layout);
+
+/// Shared by the entry, kernel and scene emitters.
+/// A material blended over the background through its transmittance (dual-source).
+bool translucentBlend(const Material& m);
+/// A closure of `layout` is emissive.
+bool anyEmissive(const Material& m, const StorageLayout& layout);
+/// What the background is multiplied by behind a translucent material (float3,
+/// from `coverage` and `transmittance`).
+std::string backgroundThroughput(const Material& m);
+/// Lights closure `c` (an expression) seen from `view` into `color`: the light
+/// `L` of radiance frame.lightRadiance and the split-sum environment
+/// (SUBSTRATE_ENV_PREFILTERED / _IRRADIANCE, mip count frame.envParams.x).
+std::string lightClosureCode(const std::string& c, const std::string& view, const std::string& indent);
+
+/// Declares `closures`, `coverage` and `transmittance` and evaluates the
+/// material into them at the SubstrateGeometry `g` (an entry's or kernel's body).
+std::string evaluateCall(const Material& m);
 
 /// Names used across emitted files.
 std::string materialUpper(const Material& m);  // NAME in macros

@@ -35,72 +35,25 @@ std::string featureNames(std::uint16_t mask) {
 /// material buffer, tile lists (read) and the colour target; without it the
 /// tile lists and arguments (written).
 std::string resources(const Syntax& syn, bool lighting, bool materialBuffer) {
-  const bool glsl = syn.target == Target::Glsl;
-  std::string s;
-  if (glsl) {
-    s += fmt::format("layout(local_size_x = {0}, local_size_y = {0}) in;\n", kSceneTileSize);
-    s += R"(layout(set = 0, binding = 0, std140) uniform SubstrateSceneFrame {
-  vec4 cameraForward;   // xyz: unit view direction; w: tan(half the vertical field of view)
-  vec4 cameraRight;     // xyz: unit
-  vec4 cameraUp;        // xyz: unit
-  vec4 lightDirection;  // xyz: unit vector toward the light
-  vec4 lightRadiance;   // rgb
-  vec4 envParams;       // x: mip count of envPrefiltered
-  uvec4 viewport;       // x, y: size in pixels; z: capacity of each tile list
-} frame;
-layout(set = 0, binding = 6, r32ui) uniform readonly uimage2DArray gbuffer;  // words 0-2, top-layer word
-#define SUBSTRATE_SCENE_GBUFFER(p, layer) imageLoad(gbuffer, ivec3(int((p).x), int((p).y), int(layer))).x
-)";
-    if (lighting) {
-      s += R"(layout(set = 0, binding = 1) uniform samplerCube envPrefiltered;
-layout(set = 0, binding = 2) uniform samplerCube envIrradiance;
-// set 0, binding 5: the energy tables (a uniform buffer, declared by substrate_energy_lut.h).
-layout(set = 0, binding = 7, std430) readonly buffer SubstrateTileLists { uint tiles[]; };
-layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D sceneColor;
-#define SUBSTRATE_ENV_PREFILTERED(dir, lod) textureLod(envPrefiltered, dir, lod).rgb
-#define SUBSTRATE_ENV_IRRADIANCE(dir) textureLod(envIrradiance, dir, 0.0).rgb
-#define SUBSTRATE_SCENE_STORE(p, value) imageStore(sceneColor, ivec2(int((p).x), int((p).y)), value)
-)";
-      if (materialBuffer)
-        s += "layout(set = 0, binding = 4, r32ui) uniform readonly uimage2DArray materialBuffer;  // words 3..\n"
-             "#define SUBSTRATE_SCENE_MATERIAL_BUFFER(p, slice) imageLoad(materialBuffer, ivec3(int((p).x), "
-             "int((p).y), int(slice))).x\n";
-    } else {
-      s += "layout(set = 0, binding = 7, std430) writeonly buffer SubstrateTileLists { uint tiles[]; };\n";
-      s += "layout(set = 0, binding = 9, std430) buffer SubstrateTileArguments { uint tileArgs[]; };\n";
-    }
-    return s;
-  }
-  s += R"(struct SubstrateSceneFrameData {
-  float4 cameraForward;   // xyz: unit view direction; w: tan(half the vertical field of view)
-  float4 cameraRight;     // xyz: unit
-  float4 cameraUp;        // xyz: unit
-  float4 lightDirection;  // xyz: unit vector toward the light
-  float4 lightRadiance;   // rgb
-  float4 envParams;       // x: mip count of envPrefiltered
-  uint4 viewport;         // x, y: size in pixels; z: capacity of each tile list
-};
-[[vk::binding(0, 0)]] ConstantBuffer<SubstrateSceneFrameData> frame;
-[[vk::binding(6, 0)]] RWTexture2DArray<uint> gbuffer;  // words 0-2, top-layer word (read only)
-#define SUBSTRATE_SCENE_GBUFFER(p, layer) gbuffer[uint3((p).x, (p).y, layer)]
-)";
-  if (lighting) {
-    s += R"([[vk::binding(1, 0)]] TextureCube<float4> envPrefiltered;
-[[vk::binding(2, 0)]] TextureCube<float4> envIrradiance;
-[[vk::binding(3, 0)]] SamplerState envSampler;
-// set 0, binding 5: the energy tables (a uniform buffer, declared by substrate_energy_lut.h).
-[[vk::binding(7, 0)]] StructuredBuffer<uint> tiles;
-[[vk::binding(8, 0)]] RWTexture2D<float4> sceneColor;
-#define SUBSTRATE_ENV_PREFILTERED(dir, lod) envPrefiltered.SampleLevel(envSampler, dir, lod).rgb
-#define SUBSTRATE_ENV_IRRADIANCE(dir) envIrradiance.SampleLevel(envSampler, dir, 0.0).rgb
-#define SUBSTRATE_SCENE_STORE(p, value) sceneColor[(p)] = (value)
-)";
-    if (materialBuffer)
-      s += "[[vk::binding(4, 0)]] RWTexture2DArray<uint> materialBuffer;  // words 3.. (read only)\n"
-           "#define SUBSTRATE_SCENE_MATERIAL_BUFFER(p, slice) materialBuffer[uint3((p).x, (p).y, slice)]\n";
-  } else {
-    s += "[[vk::binding(7, 0)]] RWStructuredBuffer<uint> tiles;\n";
-    s += "[[vk::binding(9, 0)]] RWStructuredBuffer<uint> tileArgs;\n";
+  std::string s = syn.uniformBlock(0, 0, "SubstrateSceneFrame", "frame",
+                                   "  float4 cameraForward;   // xyz: unit view direction; w: tan(half the vertical field of view)\n"
+                                   "  float4 cameraRight;     // xyz: unit\n"
+                                   "  float4 cameraUp;        // xyz: unit\n"
+                                   "  float4 lightDirection;  // xyz: unit vector toward the light\n"
+                                   "  float4 lightRadiance;   // rgb\n"
+                                   "  float4 envParams;       // x: mip count of envPrefiltered\n"
+                                   "  uint4 viewport;         // x, y: size in pixels; z: capacity of each tile list\n");
+  s += "// G-buffer: words 0-2 and the top-layer word in layers 0-3.\n";
+  s += syn.storageImage(0, 6, Access::Read, ImageKind::UintArray, "gbuffer");
+  if (!lighting)
+    return s + syn.storageBuffer(0, 7, Access::Write, "SubstrateTileLists", "uint", "tiles") +
+           syn.storageBuffer(0, 9, Access::ReadWrite, "SubstrateTileArguments", "uint", "tileArgs");
+  s += environmentResources(syn);
+  s += syn.storageBuffer(0, 7, Access::Read, "SubstrateTileLists", "uint", "tiles");
+  s += syn.storageImage(0, 8, Access::Write, ImageKind::Float4, "sceneColor");
+  if (materialBuffer) {
+    s += "// Material buffer: words 3.. in layers 0..\n";
+    s += syn.storageImage(0, 4, Access::Read, ImageKind::UintArray, "materialBuffer");
   }
   return s;
 }
@@ -108,24 +61,9 @@ layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D sceneColor;
 /// The entry point's first lines: `group` (the workgroup id) and `local` (the
 /// invocation in the tile) as uint2.
 std::string entry(const Syntax& syn) {
-  if (syn.target == Target::Glsl)
-    return "void main() {\n  uint2 group = gl_WorkGroupID.xy;\n  uint2 local = gl_LocalInvocationID.xy;\n";
-  return fmt::format("[numthreads({0}, {0}, 1)]\nvoid main(uint3 groupId : SV_GroupID, uint3 localId : SV_GroupThreadID) "
-                     "{{\n  uint2 group = groupId.xy;\n  uint2 local = localId.xy;\n",
-                     kSceneTileSize);
-}
-
-/// Lights closure `c` (an expression) into `color`.
-std::string lightClosure(const std::string& c, const std::string& indent) {
-  return fmt::format(
-      "{0}color += substrate_light_closure({1}, V, L, frame.lightRadiance.rgb);\n"
-      "{0}color += substrate_closure_view_throughput({1}, dot({1}.N, V)) *\n"
-      "{0}         substrate_env_split_sum({1}, V,\n"
-      "{0}                                 SUBSTRATE_ENV_PREFILTERED(substrate_reflection_dir({1}, V),\n"
-      "{0}                                                           substrate_env_mip(substrate_env_roughness({1}), "
-      "frame.envParams.x)),\n"
-      "{0}                                 SUBSTRATE_ENV_IRRADIANCE({1}.N));\n",
-      indent, c);
+  return syn.computeMain(kSceneTileSize, kSceneTileSize) +
+         fmt::format("  uint2 group = {}.xy;\n  uint2 local = {}.xy;\n", syn.computeId(ComputeId::Group),
+                     syn.computeId(ComputeId::Local));
 }
 
 std::string materialList(const std::vector<std::string>& names) {
@@ -175,19 +113,17 @@ SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialSh
 }
 
 std::string sceneLightingFileName(const SceneShape& scene, LayoutClass cls, const Syntax& syn) {
-  return fmt::format("{}.lighting_{}{}", scene.name, tileClassName(cls), syn.target == Target::Glsl ? ".comp" : ".cs.hlsl");
+  return fmt::format("{}.lighting_{}{}", scene.name, tileClassName(cls), syn.computeExtension);
 }
 
 std::string tileClassificationFileName(const SceneShape& scene, const Syntax& syn) {
-  return fmt::format("{}.classify_tiles{}", scene.name, syn.target == Target::Glsl ? ".comp" : ".cs.hlsl");
+  return fmt::format("{}.classify_tiles{}", scene.name, syn.computeExtension);
 }
 
 std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass& k, const Syntax& syn) {
-  const bool glsl = syn.target == Target::Glsl;
   const bool simple = k.cls == LayoutClass::Simple;
   const bool one = k.maxClosures == 1;  // every pixel has a single-closure header
-  std::string s;
-  if (glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  std::string s(syn.header);
   s += fmt::format(
       "// Generated by substratec: the deferred lighting of scene '{}' for {} tiles ({} pixels and below).\n"
       "// Materials it may light: {}.\n"
@@ -227,37 +163,35 @@ float3 substrate_scene_view(uint2 p) {
 )",
                    kSceneTileSize);
   for (int w = 0; w < k.maxWords; ++w)
-    s += w < 3 ? fmt::format("  words[{0}] = SUBSTRATE_SCENE_GBUFFER(pixel, {0}u);\n", w)
-               : fmt::format("  words[{}] = SUBSTRATE_SCENE_MATERIAL_BUFFER(pixel, {}u);\n", w, w - 3);
-  s += "  uint topLayer = SUBSTRATE_SCENE_GBUFFER(pixel, 3u);\n";
+    s += w < 3 ? fmt::format("  words[{0}] = SUBSTRATE_IMAGE_LOAD_LAYER(gbuffer, pixel, {0}u);\n", w)
+               : fmt::format("  words[{}] = SUBSTRATE_IMAGE_LOAD_LAYER(materialBuffer, pixel, {}u);\n", w, w - 3);
+  s += "  uint topLayer = SUBSTRATE_IMAGE_LOAD_LAYER(gbuffer, pixel, 3u);\n";
   s += "  float3 V = substrate_scene_view(pixel);\n  float3 L = frame.lightDirection.xyz;\n";
   s += "  float3 color = SUBSTRATE_SPLAT3(0.0);\n";
   if (simple) {
     s += "  // SIMPLE pixels only: three fields at fixed offsets, one closure of weight 1, no feature.\n";
     s += "  SubstrateClosure c;\n  substrate_unpack_simple(words, topLayer, c);\n";
-    s += lightClosure("c", "  ");
+    s += lightClosureCode("c", "V", "  ");
   } else if (one) {
     s += "  // One closure a pixel (single-closure headers): no loop.\n";
     s += "  SubstrateClosure c;\n  substrate_unpack_single_closure(words, topLayer, c);\n";
     s += "  if (substrate_closure_visible(c)) {  // dynamic culling: weight 0 here\n";
-    s += lightClosure("c", "    ");
+    s += lightClosureCode("c", "V", "    ");
     s += "  }\n";
   } else {
     s += "  SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES];\n";
     s += "  uint count = substrate_unpack_material(words, topLayer, closures);\n";
     s += "  for (uint k = 0u; k < uint(SUBSTRATE_MAX_CLOSURES); ++k) {\n";
     s += "    if (k >= count || !substrate_closure_visible(closures[k])) continue;  // dynamic culling: weight 0 here\n";
-    s += lightClosure("closures[k]", "    ");
+    s += lightClosureCode("closures[k]", "V", "    ");
     s += "  }\n";
   }
-  s += "  SUBSTRATE_SCENE_STORE(pixel, float4(color, 1.0));\n}\n";
+  s += "  SUBSTRATE_IMAGE_STORE(sceneColor, pixel, float4(color, 1.0));\n}\n";
   return s;
 }
 
 std::string emitTileClassification(const SceneShape& scene, const Syntax& syn) {
-  const bool glsl = syn.target == Target::Glsl;
-  std::string s;
-  if (glsl) s += "#version 450\n#extension GL_GOOGLE_include_directive : require\n";
+  std::string s(syn.header);
   std::string classes;
   for (const SceneLightingClass& k : scene.classes) classes += (classes.empty() ? "" : ", ") + tileClassName(k.cls);
   s += fmt::format(
@@ -272,21 +206,20 @@ std::string emitTileClassification(const SceneShape& scene, const Syntax& syn) {
   for (LayoutClass c : {LayoutClass::Simple, LayoutClass::Single, LayoutClass::Complex})
     s += fmt::format("  if (c <= {}u) {{\n    return {}u;\n  }}\n", rank(c), rank(targetOf(scene, c).cls));
   s += fmt::format("  return {}u;\n}}\n\n", rank(targetOf(scene, LayoutClass::Special).cls));
-  s += glsl ? "shared uint substrateTileClass;\n\n" : "groupshared uint substrateTileClass;\n\n";
+  s += "groupshared uint substrateTileClass;\n\n";
   s += entry(syn);
-  const std::string barrier = glsl ? "  memoryBarrierShared();\n  barrier();\n" : "  GroupMemoryBarrierWithGroupSync();\n";
+  const std::string barrier = "  GroupMemoryBarrierWithGroupSync();\n";
   s += fmt::format("  uint index = local.y * {}u + local.x;\n", kSceneTileSize);
   s += fmt::format("  if (index == 0u) {{\n    substrateTileClass = {}u;\n  }}\n", rank(scene.classes.front().cls));
   s += barrier;
   s += fmt::format("  uint2 pixel = group * {}u + local;\n", kSceneTileSize);
   s += "  if (pixel.x < frame.viewport.x && pixel.y < frame.viewport.y) {\n";
-  s += "    uint c = substrate_scene_tile_target(substrate_layout_class(SUBSTRATE_SCENE_GBUFFER(pixel, 0u)));\n";
-  s += glsl ? "    atomicMax(substrateTileClass, c);\n" : "    InterlockedMax(substrateTileClass, c);\n";
+  s += "    uint c = substrate_scene_tile_target(substrate_layout_class(SUBSTRATE_IMAGE_LOAD_LAYER(gbuffer, pixel, 0u)));\n";
+  s += "    InterlockedMax(substrateTileClass, c);\n";
   s += "  }\n";
   s += barrier;
   s += "  if (index == 0u) {\n    uint c = substrateTileClass;\n";
-  s += glsl ? "    uint slot = atomicAdd(tileArgs[c * 4u], 1u);\n"
-            : "    uint slot;\n    InterlockedAdd(tileArgs[c * 4u], 1u, slot);\n";
+  s += "    uint slot;\n    InterlockedAdd(tileArgs[c * 4u], 1u, slot);\n";
   s += "    tiles[c * frame.viewport.z + slot] = group.x | (group.y << 16u);\n  }\n}\n";
   return s;
 }
