@@ -65,11 +65,7 @@ void Diagnostics::errorAt(int line, int column, std::string message, std::string
 }
 
 void Diagnostics::errorIn(std::string file, int line, int column, std::string message) {
-  located(Severity::Error, file.empty() ? file_ : std::move(file), line, column, std::move(message));
-}
-
-void Diagnostics::warningIn(std::string file, int line, int column, std::string message) {
-  located(Severity::Warning, file.empty() ? file_ : std::move(file), line, column, std::move(message));
+  located(Severity::Error, std::move(file), line, column, std::move(message));
 }
 
 void Diagnostics::warningAt(int line, int column, std::string message) {

@@ -58,10 +58,8 @@ class Diagnostics {
   /// given, is printed after the message.
   void errorAt(int line, int column, std::string message);
   void errorAt(int line, int column, std::string message, std::string pointer);
-  /// An error or warning located in another file than this one's (an
-  /// included file; "" is this one).
+  /// An error located in another file than this one's (an included file).
   void errorIn(std::string file, int line, int column, std::string message);
-  void warningIn(std::string file, int line, int column, std::string message);
   /// An error or warning about the value at `pointer`, located through the
   /// locator when there is one.
   void error(std::string pointer, std::string message);
