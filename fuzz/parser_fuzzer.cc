@@ -2,7 +2,8 @@
 // reader (pre-scan, SAX DOM builder) and, when they parse, through resolve.
 // Every input must end either in a document or in at least one diagnostic;
 // anything else (a crash, a sanitizer report, an uncaught exception, a
-// failure without a diagnostic) is a bug.
+// failure without a diagnostic, a pointer diagnostic of a parsed document
+// without a line:col) is a bug.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
@@ -23,6 +24,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   } else {
     auto resolved = resolveDocument(*doc, diags);
     if (!resolved && !diags.hasErrors()) std::abort();
+    // Every pointer into a parsed document is located in it (diagnostics.h).
+    for (const Diagnostic& d : diags.all())
+      if (d.hasPointer && (d.line < 1 || d.column < 1 || static_cast<std::size_t>(d.column) > size + 1)) std::abort();
   }
   // Diagnostics stay bounded whatever the input (50 errors, quoted excerpts).
   const std::string all = diags.formatAll();

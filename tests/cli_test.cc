@@ -184,7 +184,7 @@ TEST(Cli, AClearCoatWithoutAMediumHidesItsBaseWhichIsCulled) {
   const std::string opaque = (kSource / "tests/warnings/001_opaque_clear_coat.json").string();
   CliRun r = cli({"report", "--json", opaque});
   ASSERT_EQ(r.status, 0) << r.err;
-  EXPECT_NE(r.err.find(opaque + ": /nodes/coat: warning: 'coat' hides the base 'paint' of vertical 'root'"),
+  EXPECT_NE(r.err.find(opaque + ":58:13: warning: 'coat' hides the base 'paint' of vertical 'root'"),
             std::string::npos)
       << r.err;
   EXPECT_NE(r.err.find("sss_mfp"), std::string::npos);

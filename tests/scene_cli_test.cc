@@ -203,10 +203,10 @@ TEST(Scene, EveryMistakeIsLocatedAndNothingIsWritten) {
   std::ofstream(work / "plaster_again.json") << slurp(plaster);
   const std::string m4 = write("m4.json", "{\"format\": \"substrate-scene/1\",\n \"name\": \"s\", \"materials\": [}");
   const Case cases[] = {
-      {m1, {}, 1, m1 + ": /platform: error: unknown platform \"ps2\" (known: mobile, console, pc-high)"},
+      {m1, {}, 1, m1 + ":1:58: error: unknown platform \"ps2\" (known: mobile, console, pc-high) [/platform]"},
       {scene("simple_only.json"), {"--platform", "ps2"}, 2, "unknown platform \"ps2\""},
-      {m2, {}, 1, (work / "broken.json").string() + ": /name: error: expected a C identifier string, got 3"},
-      {m3, {}, 1, m3 + ": /materials/1: error: material \"plaster\""},
+      {m2, {}, 1, (work / "broken.json").string() + ":3:11: error: expected a C identifier string, got 3 [/name]"},
+      {m3, {}, 1, m3 + ":1:119: error: material \"plaster\""},
       {m4, {}, 1, m4 + ":2:"},
       {scene("simple_only.json"), {"--platforms", m4}, 1, m4 + ":2:"},
       {(work / "missing.json").string(), {}, 1, "missing.json"},
@@ -243,10 +243,10 @@ TEST(Scene, EveryErrorOfOneRunIsReported) {
   EXPECT_EQ(r.status, 1) << r.err;
   int found = 0;
   for (const std::string& want :
-       {manifest.string() + ": /materials/1: error: \"./a.json\" is already listed at /materials/0",
-        manifest.string() + ": /platform: error: unknown platform \"ps2\"", std::string("missing.json"),
-        (work / "bad.json").string() + ": /nodes/base/roughness: error: expected a float in [0,1], got 2",
-        manifest.string() + ": /materials/4: error: material \"PLASTER\" (" + (work / "b.json").string() +
+       {manifest.string() + ":2:29: error: \"./a.json\" is already listed at /materials/0 [/materials/1]",
+        manifest.string() + ":1:58: error: unknown platform \"ps2\"", std::string("missing.json"),
+        (work / "bad.json").string() + ":14:20: error: expected a float in [0,1], got 2 [/nodes/base/roughness]",
+        manifest.string() + ":2:69: error: material \"PLASTER\" (" + (work / "b.json").string() +
             ") has the name of /materials/0 (" + (work / "a.json").string() + ") but for letter case"}) {
     EXPECT_NE(r.err.find(want), std::string::npos) << want << "\n" << r.err;
     found += r.err.find(want) != std::string::npos;

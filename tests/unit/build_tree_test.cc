@@ -313,8 +313,7 @@ TEST(BuildTree, TreeAtTheSizeLimitIsBuilt) {
 TEST(BuildTree, SmallDagThatInstancesIntoAHugeTreeIsAnError) {
   // 11 nodes in the file, 2047 after instancing.
   EXPECT_EQ(diagnosticsOf(doublingChain(10)),
-            "test.json: /nodes/a10: error: the Substrate tree would have more than 1024 nodes after instancing (a "
-            "node referenced twice is instanced twice); this is the tree-size limit\n");
+            "test.json:1:509: error: the Substrate tree would have more than 1024 nodes after instancing (a node referenced twice is instanced twice); this is the tree-size limit [/nodes/a10]\n");
 }
 
 TEST(BuildTree, ExponentialDagIsRejectedWithoutBuildingIt) {
@@ -349,8 +348,7 @@ TEST(BuildTree, TreeLimitIsConfigurable) {
     ValueTable t = buildValueDag(*r, m);
     EXPECT_FALSE(buildSubstrateTree(*r, t, m, d, TreeLimits{2}));
     EXPECT_EQ(d.formatAll(),
-              "test.json: /nodes/a1: error: the Substrate tree would have more than 2 nodes after instancing (a "
-              "node referenced twice is instanced twice); this is the tree-size limit\n");
+              "test.json:1:103: error: the Substrate tree would have more than 2 nodes after instancing (a node referenced twice is instanced twice); this is the tree-size limit [/nodes/a1]\n");
   }
 }
 

@@ -550,9 +550,7 @@ culled root: vertical 'root' replaced by its top: the top is opaque
 )");
   EXPECT_TRUE(ok);
   EXPECT_EQ(diags,
-            "test.json: /nodes/coat: warning: 'coat' hides the base 'paint' of vertical 'root': it has no medium "
-            "(sss_mfp is 0 or absent), so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. "
-            "1e6 for a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper\n");
+            "test.json: warning: 'coat' hides the base 'paint' of vertical 'root': it has no medium (sss_mfp is 0 or absent), so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. 1e6 for a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper [/nodes/coat]\n");
 }
 
 TEST_F(CullTest, AnOpaqueMixOfCoatsHidesTheBase) {
@@ -714,9 +712,7 @@ TEST_F(CullTest, NoModify_AnOpaqueTopThatWouldTurnTransparentOutsideItsVertical)
             dump);
   EXPECT_TRUE(m.culled.empty());
   EXPECT_EQ(diags,
-            "test.json: /nodes/coat: warning: 'coat' hides the base 'hidden' of vertical 'inner': it has no medium "
-            "(sss_mfp is 0 or absent), so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. "
-            "1e6 for a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper\n");
+            "test.json: warning: 'coat' hides the base 'hidden' of vertical 'inner': it has no medium (sss_mfp is 0 or absent), so no light crosses it; to make it a transparent coat give it an sss_mfp (e.g. 1e6 for a clear coat), or one from a transmittance with the `transmittance_to_mfp` helper [/nodes/coat]\n");
 }
 
 TEST_F(CullTest, AnOpaqueTopInsideAnOpaqueTopIsCulledInTheNextRound) {
@@ -760,8 +756,7 @@ TEST_F(CullTest, NothingLeftIsAnError) {
 )");
   EXPECT_FALSE(ok);
   EXPECT_EQ(diags,
-            "test.json: /output: error: no matter is left after static culling (every slab is under a constant zero "
-            "weight)\n");
+            "test.json: error: no matter is left after static culling (every slab is under a constant zero weight) [/output]\n");
 }
 
 TEST_F(CullTest, NothingLeftThroughOperatorsIsAnError) {
@@ -782,8 +777,7 @@ TEST_F(CullTest, NothingLeftThroughOperatorsIsAnError) {
              "foreground": {"kind": "select", "a": "b", "b": {"kind": "coverage_weight", "a": "a", "weight": 0},
                             "value": 0.25, "threshold": 0}})",
                                    kInputs)),
-            "test.json: /output: error: no matter is left after static culling (every slab is under a constant zero "
-            "weight)\n");
+            "test.json:11:73: error: no matter is left after static culling (every slab is under a constant zero weight) [/output]\n");
 }
 
 }  // namespace

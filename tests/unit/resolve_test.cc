@@ -148,57 +148,52 @@ TEST(Resolve, UnknownTopLevelKey) {
   std::string doc = slab("");
   doc.insert(1, R"("colour": 1, )");
   EXPECT_EQ(diagnosticsOf(doc),
-            "test.json: /colour: error: unknown key \"colour\" (expected one of: format, name, settings, inputs, "
-            "nodes, output)\n");
+            "test.json:1:12: error: unknown key \"colour\" (expected one of: format, name, settings, inputs, nodes, output) [/colour]\n");
 }
 
 TEST(Resolve, UnknownSetting) {
   std::string doc = slab("");
   doc.insert(1, R"("settings": {"max_bytes": 40}, )");
   EXPECT_EQ(diagnosticsOf(doc),
-            "test.json: /settings/max_bytes: error: unknown setting \"max_bytes\" (expected bytes_per_pixel, "
-            "max_closures, thin_surface, surface_thickness or blend_mode)\n");
+            "test.json:1:28: error: unknown setting \"max_bytes\" (expected bytes_per_pixel, max_closures, thin_surface, surface_thickness or blend_mode) [/settings/max_bytes]\n");
 }
 
 TEST(Resolve, UnknownInputKey) {
   EXPECT_EQ(diagnosticsOf(material(R"("root": {"kind": "slab", "roughness": "$r"})",
                                    R"({"r": {"type": "float", "default": 0.5, "maximum": 1}})")),
-            "test.json: /inputs/r/maximum: error: unknown input key \"maximum\" (expected type, default, min, max, "
-            "description)\n");
+            "test.json:1:110: error: unknown input key \"maximum\" (expected type, default, min, max, description) [/inputs/r/maximum]\n");
 }
 
 TEST(Resolve, UnknownSlabPin) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughnes": 0.5)")),
-            "test.json: /nodes/root/roughnes: error: unknown slab pin \"roughnes\"\n");
+            "test.json:6:51: error: unknown slab pin \"roughnes\" [/nodes/root/roughnes]\n");
 }
 
 TEST(Resolve, UnknownPinOnAMathNode) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": {"kind": "multiply", "a": "$mask", "b": 2, "c": 3})")),
-            "test.json: /nodes/root/roughness/c: error: unknown pin \"c\" for a multiply node (pins: a, b)\n");
+            "test.json:6:100: error: unknown pin \"c\" for a multiply node (pins: a, b) [/nodes/root/roughness/c]\n");
 }
 
 TEST(Resolve, UnknownPinOnASubstrateOperator) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s", "base": "s", "mix": 0.5})")),
-            "test.json: /nodes/root/mix: error: unknown pin \"mix\" for a vertical node (pins: top, base, "
-            "thickness)\n");
+            "test.json:3:66: error: unknown pin \"mix\" for a vertical node (pins: top, base, thickness) [/nodes/root/mix]\n");
 }
 
 TEST(Resolve, UnknownNodeKind) {
   EXPECT_EQ(diagnosticsOf(material(R"("root": {"kind": "slub"})")),
-            "test.json: /nodes/root/kind: error: unknown node kind \"slub\"\n");
+            "test.json:1:90: error: unknown node kind \"slub\" [/nodes/root/kind]\n");
 }
 
 TEST(Resolve, UnknownInlineNodeKind) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": {"kind": "mystery", "x": 1})")),
-            "test.json: /nodes/root/roughness/kind: error: unknown node kind \"mystery\"\n");
+            "test.json:6:61: error: unknown node kind \"mystery\" [/nodes/root/roughness/kind]\n");
 }
 
 TEST(Resolve, UnknownGeometryAttribute) {
   EXPECT_EQ(diagnosticsOf(slab(R"("normal": {"kind": "geometry", "attribute": "bitangent"})")),
-            "test.json: /nodes/root/normal/attribute: error: expected one of normal, tangent, uv0, uv1, "
-            "vertex_color, position, view; got \"bitangent\"\n");
+            "test.json:6:83: error: expected one of normal, tangent, uv0, uv1, vertex_color, position, view; got \"bitangent\" [/nodes/root/normal/attribute]\n");
 }
 
 // ---------------------------------------------------------------------------
@@ -206,46 +201,43 @@ TEST(Resolve, UnknownGeometryAttribute) {
 
 TEST(Resolve, WrongType_FloatPinGivenAVec3Literal) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": [0.1, 0.2, 0.3])")),
-            "test.json: /nodes/root/roughness: error: expected a float, got a vec3\n");
+            "test.json:6:52: error: expected a float, got a vec3 [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, WrongType_ColorPinGivenAVec2Literal) {
   EXPECT_EQ(diagnosticsOf(slab(R"("diffuse_albedo": [0.1, 0.2])")),
-            "test.json: /nodes/root/diffuse_albedo: error: expected a color, got a vec2\n");
+            "test.json:6:57: error: expected a color, got a vec2 [/nodes/root/diffuse_albedo]\n");
 }
 
 TEST(Resolve, WrongType_DirectionIsNeverGrey) {
   EXPECT_EQ(diagnosticsOf(slab(R"("normal": 1)")),
-            "test.json: /nodes/root/normal: error: expected a vec3, got a float\n");
+            "test.json:6:49: error: expected a vec3, got a float [/nodes/root/normal]\n");
 }
 
 TEST(Resolve, WrongType_FloatPinGivenAColorInput) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": "$tint")")),
-            "test.json: /nodes/root/roughness: error: expected a float, got a vec3\n");
+            "test.json:6:52: error: expected a float, got a vec3 [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, WrongType_TextureInputUsedAsAValue) {
   EXPECT_EQ(diagnosticsOf(slab(R"("diffuse_albedo": "$weave")")),
-            "test.json: /nodes/root/diffuse_albedo: error: \"$weave\" is a texture2d input; sample it with a "
-            "\"texture\" node\n");
+            "test.json:6:57: error: \"$weave\" is a texture2d input; sample it with a \"texture\" node [/nodes/root/diffuse_albedo]\n");
 }
 
 TEST(Resolve, WrongType_VectorsOfDifferentSizesDoNotCombine) {
   EXPECT_EQ(diagnosticsOf(slab(R"("diffuse_albedo": {"kind": "add", "a": "$uv", "b": "$tint"})")),
-            "test.json: /nodes/root/diffuse_albedo: error: cannot combine vec2 \"a\" with vec3 \"b\" (a float "
-            "broadcasts; vectors must match)\n");
+            "test.json:6:57: error: cannot combine vec2 \"a\" with vec3 \"b\" (a float broadcasts; vectors must match) [/nodes/root/diffuse_albedo]\n");
 }
 
 TEST(Resolve, WrongType_SettingNotABoolean) {
   std::string doc = slab("");
   doc.insert(1, R"("settings": {"thin_surface": "yes"}, )");
-  EXPECT_EQ(diagnosticsOf(doc), "test.json: /settings/thin_surface: error: expected true or false, got \"yes\"\n");
+  EXPECT_EQ(diagnosticsOf(doc), "test.json:1:31: error: expected true or false, got \"yes\" [/settings/thin_surface]\n");
 }
 
 TEST(Resolve, WrongType_NumberWrittenAsAString) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": "0.5")")),
-            "test.json: /nodes/root/roughness: error: expected a number, got the string \"0.5\" (remove the "
-            "quotes)\n");
+            "test.json:6:52: error: expected a number, got the string \"0.5\" (remove the quotes) [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, WrongType_ValueNodeRules) {
@@ -258,16 +250,12 @@ TEST(Resolve, WrongType_ValueNodeRules) {
     "tex": {"kind": "texture", "texture": "$mask"},
     "root": {"kind": "slab"})",
                                    kInputs)),
-            "test.json: /nodes/tex/texture: error: input \"$mask\" is a float, expected a texture2d input\n"
-            "test.json: /nodes/sw/channels: error: channel out of range for a vec2\n"
-            "test.json: /nodes/d: error: dot needs two values of one type, got vec2 and vec3\n"
-            "test.json: /nodes/cb/w: error: \"w\" given without \"z\"\n"
-            "test.json: /nodes/l/t: error: expected a float or a vec3, got a vec2\n");
+            "test.json:11:43: error: input \"$mask\" is a float, expected a texture2d input [/nodes/tex/texture]\ntest.json:7:55: error: channel out of range for a vec2 [/nodes/sw/channels]\ntest.json:8:10: error: dot needs two values of one type, got vec2 and vec3 [/nodes/d]\ntest.json:9:52: error: \"w\" given without \"z\" [/nodes/cb/w]\ntest.json:10:54: error: expected a float or a vec3, got a vec2 [/nodes/l/t]\n");
 }
 
 TEST(Resolve, MissingOutput) {
   EXPECT_EQ(diagnosticsOf(R"({"format": "substrate-material/1", "name": "m", "nodes": {"root": {"kind": "slab"}}})"),
-            "test.json: /: error: missing required key \"output\" (the id of the root Substrate node)\n");
+            "test.json:1:1: error: missing required key \"output\" (the id of the root Substrate node) [/]\n");
 }
 
 // A named (or inline) value node plugged into a slab pin must have the pin's
@@ -279,14 +267,14 @@ TEST(Resolve, WrongType_FloatPinGivenAVec3ValueNode) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "v": {"kind": "multiply", "a": [1, 1, 1], "b": 0.5},
     "root": {"kind": "slab", "roughness": "v"})")),
-            "test.json: /nodes/root/roughness: error: expected a float, got a vec3\n");
+            "test.json:3:43: error: expected a float, got a vec3 [/nodes/root/roughness]\n");
   EXPECT_EQ(diagnosticsOf(slab(R"("anisotropy": {"kind": "add", "a": [0.1, 0.2], "b": 0.1})")),
-            "test.json: /nodes/root/anisotropy: error: expected a float, got a vec2\n");
+            "test.json:6:53: error: expected a float, got a vec2 [/nodes/root/anisotropy]\n");
   EXPECT_EQ(diagnosticsOf(material(R"(
     "v": {"kind": "multiply", "a": [1, 1, 1], "b": 0.5},
     "s": {"kind": "slab"},
     "root": {"kind": "horizontal", "background": "s", "foreground": "s", "mix": "v"})")),
-            "test.json: /nodes/root/mix: error: expected a float, got a vec3\n");
+            "test.json:4:81: error: expected a float, got a vec3 [/nodes/root/mix]\n");
 }
 
 // ---------------------------------------------------------------------------
@@ -294,44 +282,44 @@ TEST(Resolve, WrongType_FloatPinGivenAVec3ValueNode) {
 
 TEST(Resolve, OutOfRange_RoughnessAboveOne) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": 1.5)")),
-            "test.json: /nodes/root/roughness: error: expected a float in [0,1], got 1.5\n");
+            "test.json:6:52: error: expected a float in [0,1], got 1.5 [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, OutOfRange_AnisotropyBelowMinusOne) {
   EXPECT_EQ(diagnosticsOf(slab(R"("anisotropy": -1.5)")),
-            "test.json: /nodes/root/anisotropy: error: expected a float in [-1,1], got -1.5\n");
+            "test.json:6:53: error: expected a float in [-1,1], got -1.5 [/nodes/root/anisotropy]\n");
 }
 
 TEST(Resolve, OutOfRange_OneColorComponentAboveOne) {
   EXPECT_EQ(diagnosticsOf(slab(R"("f0": [0.5, 1.2, 0.1])")),
-            "test.json: /nodes/root/f0: error: expected a color with components in [0,1], got an array of 3\n");
+            "test.json:6:45: error: expected a color with components in [0,1], got an array of 3 [/nodes/root/f0]\n");
 }
 
 TEST(Resolve, OutOfRange_NegativeMeanFreePath) {
   EXPECT_EQ(diagnosticsOf(slab(R"("sss_mfp": -0.001)")),
-            "test.json: /nodes/root/sss_mfp: error: expected a color with components >= 0, got -0.001\n");
+            "test.json:6:50: error: expected a color with components >= 0, got -0.001 [/nodes/root/sss_mfp]\n");
 }
 
 TEST(Resolve, OutOfRange_OperatorValues) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "horizontal", "background": "s", "foreground": "s", "mix": 2})")),
-            "test.json: /nodes/root/mix: error: expected a float in [0,1], got 2\n");
+            "test.json:3:81: error: expected a float in [0,1], got 2 [/nodes/root/mix]\n");
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s", "base": "s", "thickness": -1})")),
-            "test.json: /nodes/root/thickness: error: expected a float >= 0, got -1\n");
+            "test.json:3:72: error: expected a float >= 0, got -1 [/nodes/root/thickness]\n");
 }
 
 TEST(Resolve, OutOfRange_ZeroDirection) {
   EXPECT_EQ(diagnosticsOf(slab(R"("normal": [0, 0, 0])")),
-            "test.json: /nodes/root/normal: error: expected a non-zero direction, got an array of 3\n");
+            "test.json:6:49: error: expected a non-zero direction, got an array of 3 [/nodes/root/normal]\n");
 }
 
 TEST(Resolve, OutOfRange_InputDefaultOutsideItsBounds) {
   EXPECT_EQ(diagnosticsOf(material(R"("root": {"kind": "slab", "roughness": "$r"})",
                                    R"({"r": {"type": "float", "default": 2, "min": 0, "max": 1}})")),
-            "test.json: /inputs/r/default: error: default 2 is outside [0, 1]\n");
+            "test.json:1:94: error: default 2 is outside [0, 1] [/inputs/r/default]\n");
 }
 
 TEST(Resolve, NoModify_RangeLimitsAreInclusive) {
@@ -343,37 +331,36 @@ TEST(Resolve, NoModify_RangeLimitsAreInclusive) {
 
 TEST(Resolve, Dangling_UnknownInput) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": "$nope")")),
-            "test.json: /nodes/root/roughness: error: unknown input \"$nope\"\n");
+            "test.json:6:52: error: unknown input \"$nope\" [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, Dangling_UnknownValueNode) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": "nope")")),
-            "test.json: /nodes/root/roughness: error: unknown node \"nope\"\n");
+            "test.json:6:52: error: unknown node \"nope\" [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, Dangling_InputNameWithoutDollar) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": "mask")")),
-            "test.json: /nodes/root/roughness: error: unknown node \"mask\"; to use the input write \"$mask\"\n");
+            "test.json:6:52: error: unknown node \"mask\"; to use the input write \"$mask\" [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, Dangling_UnknownSubstrateNode) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s", "base": "nope"})")),
-            "test.json: /nodes/root/base: error: unknown node \"nope\"\n");
+            "test.json:3:54: error: unknown node \"nope\" [/nodes/root/base]\n");
 }
 
 TEST(Resolve, Dangling_UnknownOutput) {
   EXPECT_EQ(diagnosticsOf(material(R"("s": {"kind": "slab"})", "{}", "root")),
-            "test.json: /output: error: unknown node \"root\"\n");
+            "test.json:1:107: error: unknown node \"root\" [/output]\n");
 }
 
 TEST(Resolve, Dangling_UnknownOutputSuffix) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "metal": {"kind": "metalness_to_diffuse_f0", "metallic": 1},
     "root": {"kind": "slab", "f0": "metal.specular"})")),
-            "test.json: /nodes/root/f0: error: node \"metal\" has no output \".specular\" (outputs: "
-            ".diffuse_albedo, .f0)\n");
+            "test.json:3:36: error: node \"metal\" has no output \".specular\" (outputs: .diffuse_albedo, .f0) [/nodes/root/f0]\n");
 }
 
 TEST(Resolve, Dangling_SuffixOnASingleOutputNode) {
@@ -381,8 +368,7 @@ TEST(Resolve, Dangling_SuffixOnASingleOutputNode) {
     "half": {"kind": "multiply", "a": "$mask", "b": 0.5},
     "root": {"kind": "slab", "roughness": "half.x"})",
                                    kInputs)),
-            "test.json: /nodes/root/roughness: error: node \"half\" has a single output; write \"half\" without a "
-            "suffix\n");
+            "test.json:8:43: error: node \"half\" has a single output; write \"half\" without a suffix [/nodes/root/roughness]\n");
 }
 
 // ---------------------------------------------------------------------------
@@ -392,20 +378,19 @@ TEST(Resolve, MixUp_ValuePinGivenASubstrateNode) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "coat": {"kind": "slab"},
     "root": {"kind": "slab", "roughness": "coat"})")),
-            "test.json: /nodes/root/roughness: error: expected a value, got Substrate node \"coat\"\n");
+            "test.json:3:43: error: expected a value, got Substrate node \"coat\" [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, MixUp_ValuePinGivenAnInlineSubstrateNode) {
   EXPECT_EQ(diagnosticsOf(slab(R"("roughness": {"kind": "slab"})")),
-            "test.json: /nodes/root/roughness: error: expected a value, got an inline Substrate node (slab)\n");
+            "test.json:6:52: error: expected a value, got an inline Substrate node (slab) [/nodes/root/roughness]\n");
 }
 
 TEST(Resolve, MixUp_SubstratePinGivenANumber) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s", "base": 0.5})")),
-            "test.json: /nodes/root/base: error: expected a Substrate node (an id or an inline slab/operator), "
-            "got 0.5\n");
+            "test.json:3:54: error: expected a Substrate node (an id or an inline slab/operator), got 0.5 [/nodes/root/base]\n");
 }
 
 TEST(Resolve, MixUp_SubstratePinGivenAnInput) {
@@ -413,7 +398,7 @@ TEST(Resolve, MixUp_SubstratePinGivenAnInput) {
     "s": {"kind": "slab"},
     "root": {"kind": "coverage_weight", "a": "$mask", "weight": 0.5})",
                                    kInputs)),
-            "test.json: /nodes/root/a: error: expected a Substrate node, got input \"$mask\"\n");
+            "test.json:8:46: error: expected a Substrate node, got input \"$mask\" [/nodes/root/a]\n");
 }
 
 TEST(Resolve, MixUp_SubstratePinGivenAValueNode) {
@@ -421,14 +406,14 @@ TEST(Resolve, MixUp_SubstratePinGivenAValueNode) {
     "v": {"kind": "multiply", "a": 0.5, "b": 0.5},
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "v", "base": "s"})")),
-            "test.json: /nodes/root/top: error: expected a Substrate node, got value node \"v\"\n");
+            "test.json:4:41: error: expected a Substrate node, got value node \"v\" [/nodes/root/top]\n");
 }
 
 TEST(Resolve, MixUp_SubstratePinGivenAnInlineValueNode) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s", "base": {"kind": "multiply", "a": 1, "b": 2}})")),
-            "test.json: /nodes/root/base: error: expected a Substrate node, got an inline multiply value node\n");
+            "test.json:3:54: error: expected a Substrate node, got an inline multiply value node [/nodes/root/base]\n");
 }
 
 TEST(Resolve, MixUp_OutputNamesAValueNode) {
@@ -436,13 +421,12 @@ TEST(Resolve, MixUp_OutputNamesAValueNode) {
     "v": {"kind": "multiply", "a": 0.5, "b": 0.5},
     "s": {"kind": "slab"})",
                                    "{}", "v")),
-            "test.json: /output: error: \"v\" is a value node; the output must be a Substrate node (slab, "
-            "horizontal, vertical, add, coverage_weight, select)\n");
+            "test.json:3:39: error: \"v\" is a value node; the output must be a Substrate node (slab, horizontal, vertical, add, coverage_weight, select) [/output]\n");
 }
 
 TEST(Resolve, MixUp_OutputNamesAnInput) {
   EXPECT_EQ(diagnosticsOf(material(R"("s": {"kind": "slab"})", kInputs, "mask")),
-            "test.json: /output: error: \"mask\" is an input, not a Substrate node\n");
+            "test.json:6:48: error: \"mask\" is an input, not a Substrate node [/output]\n");
 }
 
 // ---------------------------------------------------------------------------
@@ -453,28 +437,28 @@ TEST(Resolve, Cycle_TwoValueNodes) {
     "a": {"kind": "multiply", "a": "b", "b": 2},
     "b": {"kind": "add", "a": "a", "b": 1},
     "root": {"kind": "slab", "roughness": "a"})")),
-            "test.json: /nodes/b: error: cycle in values: a -> b -> a\n");
+            "test.json:3:10: error: cycle in values: a -> b -> a [/nodes/b]\n");
 }
 
 TEST(Resolve, Cycle_ValueNodeReferencesItself) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "a": {"kind": "saturate", "x": "a"},
     "root": {"kind": "slab", "roughness": "a"})")),
-            "test.json: /nodes/a: error: cycle in values: a -> a\n");
+            "test.json:2:10: error: cycle in values: a -> a [/nodes/a]\n");
 }
 
 TEST(Resolve, Cycle_ThroughAnInlineValueNodeIsNamedByItsPointer) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "a": {"kind": "one_minus", "x": {"kind": "abs", "x": "a"}},
     "root": {"kind": "slab", "roughness": "a"})")),
-            "test.json: /nodes/a/x: error: cycle in values: a -> /nodes/a/x -> a\n");
+            "test.json:2:37: error: cycle in values: a -> /nodes/a/x -> a [/nodes/a/x]\n");
 }
 
 TEST(Resolve, Cycle_SubstrateSelfReference) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s", "base": "root"})")),
-            "test.json: /nodes/root: error: cycle in the Substrate graph: root -> root\n");
+            "test.json:3:13: error: cycle in the Substrate graph: root -> root [/nodes/root]\n");
 }
 
 TEST(Resolve, Cycle_ThreeSubstrateNodes) {
@@ -483,7 +467,7 @@ TEST(Resolve, Cycle_ThreeSubstrateNodes) {
     "root": {"kind": "vertical", "top": "s", "base": "h"},
     "h": {"kind": "horizontal", "background": "s", "foreground": "w", "mix": 0.5},
     "w": {"kind": "coverage_weight", "a": "root", "weight": 0.5})")),
-            "test.json: /nodes/w: error: cycle in the Substrate graph: root -> h -> w -> root\n");
+            "test.json:5:10: error: cycle in the Substrate graph: root -> h -> w -> root [/nodes/w]\n");
 }
 
 TEST(Resolve, Cycle_SubstrateThroughAnInlineNode) {
@@ -491,7 +475,7 @@ TEST(Resolve, Cycle_SubstrateThroughAnInlineNode) {
     "s": {"kind": "slab"},
     "root": {"kind": "vertical", "top": "s",
              "base": {"kind": "horizontal", "background": "root", "foreground": "s", "mix": 0.5}})")),
-            "test.json: /nodes/root/base: error: cycle in the Substrate graph: root -> root_base -> root\n");
+            "test.json:4:22: error: cycle in the Substrate graph: root -> root_base -> root [/nodes/root/base]\n");
 }
 
 TEST(Resolve, NoModify_ADiamondIsNotACycle) {
@@ -560,8 +544,7 @@ TEST(Resolve, Add_MixingMatterAndAValueIsAnError) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "s": {"kind": "slab"},
     "root": {"kind": "add", "a": "s", "b": 0.5})")),
-            "test.json: /nodes/root/b: error: expected a Substrate node (an id or an inline slab/operator), got "
-            "0.5\n");
+            "test.json:3:44: error: expected a Substrate node (an id or an inline slab/operator), got 0.5 [/nodes/root/b]\n");
 }
 
 // ---------------------------------------------------------------------------
@@ -624,8 +607,7 @@ TEST(Resolve, MultiOutput_NoOutputNamedLikeThePinIsAnError) {
   EXPECT_EQ(diagnosticsOf(material(R"(
     "metal": {"kind": "metalness_to_diffuse_f0", "metallic": 1},
     "root": {"kind": "slab", "fuzz_color": "metal", "fuzz_amount": 0.5})")),
-            "test.json: /nodes/root/fuzz_color: error: node \"metal\" has several outputs; name one "
-            "(.diffuse_albedo, .f0)\n");
+            "test.json:3:44: error: node \"metal\" has several outputs; name one (.diffuse_albedo, .f0) [/nodes/root/fuzz_color]\n");
 }
 
 TEST(Resolve, MultiOutput_TextureWithoutSuffixIsRgb) {
@@ -657,13 +639,7 @@ TEST(Resolve, AllErrorsAreReportedInOneRun) {
                              kInputs);
   doc.insert(1, R"("settings": {"max_closures": 9}, )");
   EXPECT_EQ(diagnosticsOf(doc),
-            "test.json: /settings/max_closures: error: expected an integer in [1,8], got 9\n"
-            "test.json: /nodes/a/roughness: error: expected a float in [0,1], got 2\n"
-            "test.json: /nodes/b/diffuse_albedo: error: unknown input \"$nope\"\n"
-            "test.json: /nodes/c/rougness: error: unknown slab pin \"rougness\"\n"
-            "test.json: /nodes/d/f0: error: expected a color, got a vec2\n"
-            "test.json: /nodes/e/roughness/channels: error: expected 1 to 4 channels from xyzw or rgba, got "
-            "\"q\"\n");
+            "test.json:1:31: error: expected an integer in [1,8], got 9 [/settings/max_closures]\ntest.json:7:40: error: expected a float in [0,1], got 2 [/nodes/a/roughness]\ntest.json:8:45: error: unknown input \"$nope\" [/nodes/b/diffuse_albedo]\ntest.json:9:39: error: unknown slab pin \"rougness\" [/nodes/c/rougness]\ntest.json:10:33: error: expected a color, got a vec2 [/nodes/d/f0]\ntest.json:11:86: error: expected 1 to 4 channels from xyzw or rgba, got \"q\" [/nodes/e/roughness/channels]\n");
 }
 
 TEST(Resolve, ErrorsStopAtTheLimit) {

@@ -74,15 +74,15 @@ TEST(Platforms, EveryMistakeIsLocatedAndNothingIsApplied) {
 })";
   EXPECT_FALSE(t.applyText(text, ReadLimits{}, d));
   const std::string all = d.formatAll();
-  EXPECT_NE(all.find("p.json: /platforms/tv/bytes_per_pixel: error: expected an integer in [8,1024], got 4"),
+  EXPECT_NE(all.find("p.json:4:31: error: expected an integer in [8,1024], got 4"),
             std::string::npos) << all;
-  EXPECT_NE(all.find("p.json: /platforms/tv/features/1: error: expected a feature name"), std::string::npos) << all;
-  EXPECT_NE(all.find("p.json: /platforms/tv/features/2: error: feature \"fuzz\" is listed twice"), std::string::npos)
+  EXPECT_NE(all.find("p.json:4:74: error: expected a feature name"), std::string::npos) << all;
+  EXPECT_NE(all.find("p.json:4:83: error: feature \"fuzz\" is listed twice"), std::string::npos)
       << all;
-  EXPECT_NE(all.find("p.json: /platforms/Big: error: platform name \"Big\""), std::string::npos) << all;
-  EXPECT_NE(all.find("p.json: /platforms/watch: error: a new platform needs \"bytes_per_pixel\""), std::string::npos)
+  EXPECT_NE(all.find("p.json:5:12: error: platform name \"Big\""), std::string::npos) << all;
+  EXPECT_NE(all.find("p.json:6:14: error: a new platform needs \"bytes_per_pixel\""), std::string::npos)
       << all;
-  EXPECT_NE(all.find("p.json: /platforms/car/extends: error: expected the name of a platform defined before"),
+  EXPECT_NE(all.find("p.json:7:24: error: expected the name of a platform defined before"),
             std::string::npos) << all;
   EXPECT_EQ(t.names(), "mobile, console, pc-high");  // unchanged
   Diagnostics syntax("p.json");
@@ -126,12 +126,12 @@ TEST(SceneManifest, EveryMistakeIsLocated) {
   EXPECT_FALSE(s.has_value());
   const std::string all = d.formatAll();
   for (const char* want :
-       {"dir/s.json: /format: error: expected \"substrate-scene/1\", got \"substrate-scene/2\"",
-        "dir/s.json: /name: error: expected a C identifier", "dir/s.json: /platform: error: expected a platform name, got 3",
-        "dir/s.json: /lights: error: unknown key \"lights\"",
-        "dir/s.json: /materials/1: error: expected a material file path",
-        "dir/s.json: /materials/2: error: \"./a.json\" is already listed at /materials/0",
-        "dir/s.json: /materials/3: error: expected a material file path (relative to the manifest), got 7"})
+       {"dir/s.json:2:13: error: expected \"substrate-scene/1\", got \"substrate-scene/2\"",
+        "dir/s.json:2:42: error: expected a C identifier", "dir/s.json:2:67: error: expected a platform name, got 3",
+        "dir/s.json:2:80: error: unknown key \"lights\"",
+        "dir/s.json:3:27: error: expected a material file path",
+        "dir/s.json:3:31: error: \"./a.json\" is already listed at /materials/0",
+        "dir/s.json:3:43: error: expected a material file path (relative to the manifest), got 7"})
     EXPECT_NE(all.find(want), std::string::npos) << want << "\n" << all;
   // What could be read is kept for the scene build, which goes on to the
   // materials' errors: a.json once, the name and platform dropped.
@@ -146,7 +146,7 @@ TEST(SceneManifest, EveryMistakeIsLocated) {
   Diagnostics empty("s.json");
   EXPECT_FALSE(parseSceneManifest("s.json", R"({"format": "substrate-scene/1", "name": "x", "materials": []})",
                                   ReadLimits{}, empty));
-  EXPECT_NE(empty.formatAll().find("s.json: /materials: error: expected a non-empty array"), std::string::npos);
+  EXPECT_NE(empty.formatAll().find("s.json:1:59: error: expected a non-empty array"), std::string::npos);
   Diagnostics syntax("s.json");
   EXPECT_FALSE(parseSceneManifest("s.json", "{\n  \"name\": \"x\",,\n}", ReadLimits{}, syntax));
   EXPECT_NE(syntax.formatAll().find("s.json:2:"), std::string::npos) << syntax.formatAll();

@@ -296,8 +296,7 @@ TEST(Simplify, AnUnreachableBudgetIsAClearError) {
   auto r = compileText("translucent_absorbing.json", readExample("translucent_absorbing.json"), o, d);
   EXPECT_FALSE(r);
   EXPECT_EQ(d.formatAll(),
-            "translucent_absorbing.json: /: error: material does not fit the budget of 12 bytes per pixel and 8 "
-            "closures: the smallest reachable size is 16 bytes per pixel with 1 closure(s)\n");
+            "translucent_absorbing.json:1:1: error: material does not fit the budget of 12 bytes per pixel and 8 closures: the smallest reachable size is 16 bytes per pixel with 1 closure(s) [/]\n");
 }
 
 TEST(Simplify, DisablingFoldsHazeAndFuzzInsteadOfDroppingThem) {

@@ -13,16 +13,17 @@ const char* severityName(Severity s) {
   }
   return "error";
 }
+/// The file as diagnostics name it: text without a file name is stdin's.
+std::string_view displayName(const std::string& file) {
+  return file.empty() ? std::string_view("<stdin>") : std::string_view(file);
+}
 }  // namespace
 
 std::string Diagnostic::format() const {
-  if (hasPointer) {
-    return fmt::format("{}: {}: {}: {}", file, pointer.empty() ? "/" : pointer,
-                       severityName(severity), message);
-  }
-  // Not located in the text (the file cannot be opened or read): the path alone.
-  if (line <= 0) return fmt::format("{}: {}: {}", file, severityName(severity), message);
-  return fmt::format("{}:{}:{}: {}: {}", file, line, column, severityName(severity), message);
+  const std::string where = line > 0 ? fmt::format("{}:{}:{}", displayName(file), line, column)
+                                     : std::string(displayName(file));
+  if (!hasPointer) return fmt::format("{}: {}: {}", where, severityName(severity), message);
+  return fmt::format("{}: {}: {} [{}]", where, severityName(severity), message, pointer.empty() ? "/" : pointer);
 }
 
 void Diagnostics::push(Diagnostic d) {
@@ -36,51 +37,47 @@ void Diagnostics::push(Diagnostic d) {
   list_.push_back(std::move(d));
 }
 
-void Diagnostics::errorAt(int line, int column, std::string message) {
+void Diagnostics::located(Severity severity, std::string file, int line, int column, std::string message,
+                          std::optional<std::string> pointer) {
   Diagnostic d;
-  d.file = file_;
-  d.line = line;
-  d.column = column;
-  d.message = std::move(message);
-  push(std::move(d));
-}
-
-void Diagnostics::errorIn(std::string file, int line, int column, std::string message) {
-  Diagnostic d;
+  d.severity = severity;
   d.file = std::move(file);
   d.line = line;
   d.column = column;
+  d.hasPointer = pointer.has_value();
+  if (pointer) d.pointer = std::move(*pointer);
   d.message = std::move(message);
   push(std::move(d));
 }
 
-void Diagnostics::error(std::string pointer, std::string message) {
-  Diagnostic d;
-  d.file = file_;
-  d.pointer = std::move(pointer);
-  d.hasPointer = true;
-  d.message = std::move(message);
-  push(std::move(d));
+void Diagnostics::pointed(Severity severity, std::string pointer, std::string message) {
+  int line = 0, column = 0;
+  if (locator_ && !locator_->locate(pointer, line, column)) line = column = 0;
+  located(severity, file_, line, column, std::move(message), std::move(pointer));
+}
+
+void Diagnostics::errorAt(int line, int column, std::string message) {
+  located(Severity::Error, file_, line, column, std::move(message));
+}
+
+void Diagnostics::errorAt(int line, int column, std::string message, std::string pointer) {
+  located(Severity::Error, file_, line, column, std::move(message), std::move(pointer));
+}
+
+void Diagnostics::errorIn(std::string file, int line, int column, std::string message) {
+  located(Severity::Error, std::move(file), line, column, std::move(message));
 }
 
 void Diagnostics::warningAt(int line, int column, std::string message) {
-  Diagnostic d;
-  d.severity = Severity::Warning;
-  d.file = file_;
-  d.line = line;
-  d.column = column;
-  d.message = std::move(message);
-  push(std::move(d));
+  located(Severity::Warning, file_, line, column, std::move(message));
+}
+
+void Diagnostics::error(std::string pointer, std::string message) {
+  pointed(Severity::Error, std::move(pointer), std::move(message));
 }
 
 void Diagnostics::warning(std::string pointer, std::string message) {
-  Diagnostic d;
-  d.severity = Severity::Warning;
-  d.file = file_;
-  d.pointer = std::move(pointer);
-  d.hasPointer = true;
-  d.message = std::move(message);
-  push(std::move(d));
+  pointed(Severity::Warning, std::move(pointer), std::move(message));
 }
 
 void Diagnostics::fail(std::string message) {
@@ -107,7 +104,7 @@ std::string Diagnostics::formatAll() const {
     out += '\n';
   }
   if (dropped_ > 0) {
-    out += fmt::format("{}: error: too many errors ({} more not shown)\n", file_, dropped_);
+    out += fmt::format("{}: error: too many errors ({} more not shown)\n", displayName(file_), dropped_);
   }
   return out;
 }

@@ -4,13 +4,15 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <deque>
 #include <memory>
-#include <unordered_set>
+#include <unordered_map>
 #include <vector>
 
 #include <fmt/format.h>
@@ -182,76 +184,286 @@ bool preScan(const std::string& text, const ReadLimits& limits, Diagnostics& dia
   return true;
 }
 
+// Objects with up to this many keys find a key by scanning their members
+// (the builder's duplicate check and the locator's lookup alike); larger ones
+// keep a hash index from key to member ordinal, so n keys cost O(n).
+constexpr std::size_t kLinearKeys = 16;
+using KeyIndex = std::unordered_map<std::string, std::uint32_t>;
+
+/// Where every value of a parsed document starts, as a tree parallel to the
+/// DOM: per value 16 bytes, per member or element 4 more, plus each member's
+/// key. A JSON pointer is located by walking its tokens down the tree; the
+/// DOM is not needed (the locator outlives it).
+class JsonLocations final : public SourceLocator {
+ public:
+  bool locate(std::string_view pointer, int& line, int& column) const override {
+    if (nodes_.empty()) return false;
+    std::uint32_t at = 0;
+    std::string token;
+    while (!pointer.empty() && pointer[0] == '/') {
+      const std::size_t end = pointer.find('/', 1);
+      unescapeToken(pointer.substr(1, end == std::string_view::npos ? std::string_view::npos : end - 1), token);
+      pointer = end == std::string_view::npos ? std::string_view() : pointer.substr(end);
+      const std::optional<std::uint32_t> child = childOf(at, token);
+      if (!child) break;  // a missing member or element: its container
+      at = *child;
+    }
+    lineColumn(nodes_[at].offset, line, column);
+    return true;
+  }
+
+  /// 1-based line and byte column of an offset (binary search of the line starts).
+  void lineColumn(std::size_t offset, int& line, int& column) const {
+    const auto next = std::upper_bound(lineStarts_.begin(), lineStarts_.end(), offset);
+    line = static_cast<int>(next - lineStarts_.begin());
+    column = static_cast<int>(offset - *(next - 1)) + 1;
+  }
+
+ private:
+  friend class LocationRecorder;
+  static constexpr std::uint32_t kNoKey = UINT32_MAX;
+  struct Node {
+    std::uint32_t offset = 0;         // the value's first byte
+    std::uint32_t key = kNoKey;       // members: index into keyStarts_
+    std::uint32_t firstChild = 0;     // containers: index into children_
+    std::uint32_t childCount : 31 = 0;
+    std::uint32_t isArray : 1 = 0;
+  };
+
+  /// RFC 6901: "~1" is '/', "~0" is '~'.
+  static void unescapeToken(std::string_view raw, std::string& out) {
+    out.clear();
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      if (raw[i] == '~' && i + 1 < raw.size() && (raw[i + 1] == '0' || raw[i + 1] == '1')) {
+        out += raw[++i] == '1' ? '/' : '~';
+      } else {
+        out += raw[i];
+      }
+    }
+  }
+
+  std::string_view keyOf(const Node& n) const {
+    if (n.key == kNoKey) return {};
+    return std::string_view(keys_).substr(keyStarts_[n.key], keyStarts_[n.key + 1] - keyStarts_[n.key]);
+  }
+
+  /// The node of container `at`'s member or element named by `token`.
+  std::optional<std::uint32_t> childOf(std::uint32_t at, const std::string& token) const {
+    const Node& n = nodes_[at];
+    std::optional<std::uint32_t> ordinal;
+    if (n.isArray) {
+      // An index: decimal digits, no leading zero (RFC 6901).
+      if (token.empty() || token.size() > 9 || (token[0] == '0' && token.size() > 1)) return std::nullopt;
+      std::uint32_t i = 0;
+      for (char c : token) {
+        if (c < '0' || c > '9') return std::nullopt;
+        i = i * 10 + static_cast<std::uint32_t>(c - '0');
+      }
+      ordinal = i;
+    } else if (auto big = largeObjects_.find(at); big != largeObjects_.end()) {
+      if (auto it = big->second.find(token); it != big->second.end()) ordinal = it->second;
+    } else {
+      for (std::uint32_t i = 0; i < n.childCount && !ordinal; ++i)
+        if (keyOf(nodes_[children_[n.firstChild + i]]) == token) ordinal = i;
+    }
+    if (!ordinal || *ordinal >= n.childCount) return std::nullopt;
+    return children_[n.firstChild + *ordinal];
+  }
+
+  std::vector<Node> nodes_;                   // [0] is the document
+  std::vector<std::uint32_t> children_;       // each container's children, contiguous
+  std::string keys_;                          // every member's key, concatenated
+  std::vector<std::uint32_t> keyStarts_;      // where key i starts in keys_ (and a final end)
+  std::vector<std::uint32_t> lineStarts_{0};  // the offset of each line's first byte
+  std::unordered_map<std::uint32_t, KeyIndex> largeObjects_;  // objects of over kLinearKeys members
+};
+
+/// Records where each value starts while the SAX parser reads. Every callback
+/// is for one token; the recorder finds it by skipping whitespace, ',' and
+/// ':' from the end of the previous one and steps over it (a second look at
+/// the bytes, without building anything). A JSON string cannot hold a raw
+/// newline, so every line break is in the whitespace skipped, and the line
+/// table is built by the same skip. Cost: linear in the text, no pointer
+/// strings (deep nesting costs nothing more per value).
+class LocationRecorder {
+ public:
+  explicit LocationRecorder(const std::string& text)
+      : text_(text), on_(text.size() < (std::size_t{1} << 31)), out_(std::make_shared<JsonLocations>()) {}
+
+  bool enabled() const { return on_; }
+
+  /// A scalar value: returns where it starts.
+  std::size_t value() {
+    if (!on_) return 0;
+    return addNode(nextToken());
+  }
+  /// '{' or '[': returns where it starts.
+  std::size_t beginContainer(bool isArray) {
+    if (!on_) return 0;
+    const std::size_t at = addNode(nextToken());
+    out_->nodes_.back().isArray = isArray;
+    open_.push_back({static_cast<std::uint32_t>(out_->nodes_.size() - 1), static_cast<std::uint32_t>(pending_.size())});
+    return at;
+  }
+  /// '}' or ']': the container's children become contiguous; `index`, a large
+  /// object's key index, is kept for lookups.
+  void endContainer(std::unique_ptr<KeyIndex> index) {
+    if (!on_) return;
+    nextToken();
+    const Open o = open_.back();
+    open_.pop_back();
+    JsonLocations::Node& n = out_->nodes_[o.node];
+    n.firstChild = static_cast<std::uint32_t>(out_->children_.size());
+    n.childCount = static_cast<std::uint32_t>(pending_.size() - o.firstPending) & 0x7FFFFFFFu;
+    out_->children_.insert(out_->children_.end(), pending_.begin() + o.firstPending, pending_.end());
+    pending_.resize(o.firstPending);
+    if (index) out_->largeObjects_.emplace(o.node, std::move(*index));
+  }
+  /// A member's key (as parsed): returns where it starts.
+  std::size_t key(const std::string& k) {
+    if (!on_) return 0;
+    const std::size_t at = nextToken();
+    pendingKey_ = static_cast<std::uint32_t>(out_->keyStarts_.size());
+    out_->keyStarts_.push_back(static_cast<std::uint32_t>(out_->keys_.size()));
+    out_->keys_ += k;
+    return at;
+  }
+  /// Line and column of an offset already passed (0, 0 when not recording).
+  void lineColumn(std::size_t offset, int& line, int& column) const {
+    line = column = 0;
+    if (on_) out_->lineColumn(offset, line, column);
+  }
+  /// The table, once the parse succeeded (nullptr when not recording).
+  std::shared_ptr<const SourceLocator> finish() {
+    if (!on_ || out_->nodes_.empty()) return nullptr;
+    out_->keyStarts_.push_back(static_cast<std::uint32_t>(out_->keys_.size()));
+    return std::move(out_);
+  }
+
+ private:
+  struct Open {
+    std::uint32_t node;          // the container's node
+    std::uint32_t firstPending;  // where its children start in pending_
+  };
+
+  std::size_t addNode(std::size_t at) {
+    const auto index = static_cast<std::uint32_t>(out_->nodes_.size());
+    JsonLocations::Node& n = out_->nodes_.emplace_back();
+    n.offset = static_cast<std::uint32_t>(at);
+    n.key = pendingKey_;
+    pendingKey_ = JsonLocations::kNoKey;
+    if (!open_.empty()) pending_.push_back(index);
+    return at;
+  }
+
+  /// The start of the token the parser has just read; moves past it.
+  std::size_t nextToken() {
+    const std::size_t n = text_.size();
+    std::size_t i = cursor_;
+    for (; i < n; ++i) {
+      const char c = text_[i];
+      if (c == '\n') out_->lineStarts_.push_back(static_cast<std::uint32_t>(i + 1));
+      else if (c != ' ' && c != '\t' && c != '\r' && c != ',' && c != ':') break;
+    }
+    const std::size_t start = i;
+    if (i >= n) return cursor_ = n, n;
+    switch (text_[i]) {
+      case '"':
+        for (++i; i < n && text_[i] != '"'; ++i)
+          if (text_[i] == '\\') ++i;
+        ++i;
+        break;
+      case 't': case 'n': i += 4; break;
+      case 'f': i += 5; break;
+      case '{': case '}': case '[': case ']': ++i; break;
+      default:  // a number
+        while (i < n && (std::isdigit(static_cast<unsigned char>(text_[i])) || text_[i] == '-' || text_[i] == '+' ||
+                         text_[i] == '.' || text_[i] == 'e' || text_[i] == 'E'))
+          ++i;
+    }
+    cursor_ = std::min(i, n);
+    return start;
+  }
+
+  const std::string& text_;
+  const bool on_;
+  std::shared_ptr<JsonLocations> out_;
+  std::size_t cursor_ = 0;                 // just past the last token
+  std::vector<Open> open_;                 // the open containers, innermost last
+  std::vector<std::uint32_t> pending_;     // the open containers' children so far
+  std::uint32_t pendingKey_ = JsonLocations::kNoKey;
+};
+
 /// SAX handler building an ordered DOM while enforcing what plain JSON allows
 /// but a material file must not contain. JSON pointers are built only when a
 /// diagnostic needs one (from the stack of open containers).
 class StrictDomBuilder {
  public:
   StrictDomBuilder(const std::string& text, const ReadLimits& limits, Diagnostics& diags)
-      : text_(text), limits_(limits), diags_(diags) {}
+      : text_(text), limits_(limits), diags_(diags), locations_(text) {}
 
   Json result;
   bool failed = false;
 
-  bool null() { return put(Json(nullptr)); }
-  bool boolean(bool v) { return put(Json(v)); }
-  bool number_integer(Json::number_integer_t v) { return put(Json(v)); }
-  bool number_unsigned(Json::number_unsigned_t v) { return put(Json(v)); }
+  bool null() { return scalar(Json(nullptr)); }
+  bool boolean(bool v) { return scalar(Json(v)); }
+  bool number_integer(Json::number_integer_t v) { return scalar(Json(v)); }
+  bool number_unsigned(Json::number_unsigned_t v) { return scalar(Json(v)); }
   bool number_float(Json::number_float_t v, const std::string& lexeme) {
-    if (!std::isfinite(v)) {
-      diags_.error(pointerForNext(), fmt::format("number {} is out of range (it overflows a double)",
-                                                 quoteForDiagnostic(lexeme, 32)));
-      failed = true;
+    if (!std::isfinite(v)) {  // nlohmann rejects these itself; kept should it ever pass one
+      reject(locations_.value(), [&] { return pointerForNext(); },
+             fmt::format("number {} is out of range (it overflows a double)", quoteForDiagnostic(lexeme, 32)));
       return put(Json(0.0));
     }
-    return put(Json(v));
+    return scalar(Json(v));
   }
   bool string(std::string& v) {
     if (v.size() > limits_.maxStringBytes) {
-      diags_.error(pointerForNext(), fmt::format("string of {} bytes is longer than the limit of {} bytes (the "
-                                                 "string-length limit)",
-                                                 v.size(), limits_.maxStringBytes));
-      failed = true;
+      reject(locations_.value(), [&] { return pointerForNext(); },
+             fmt::format("string of {} bytes is longer than the limit of {} bytes (the string-length limit)",
+                         v.size(), limits_.maxStringBytes));
       return put(Json(std::string()));
     }
-    return put(Json(std::move(v)));
+    return scalar(Json(std::move(v)));
   }
   bool binary(Json::binary_t&) { return false; }
   bool start_object(std::size_t) {
+    locations_.beginContainer(false);
     Json* slot = slotForNext();
     *slot = Json::object();
     stack_.push_back(Frame{slot});
     return true;
   }
   bool key(std::string& k) {
+    const std::size_t at = locations_.key(k);
     Frame& f = stack_.back();
     f.keyTooLong = k.size() > limits_.maxKeyBytes;
     if (f.keyTooLong) {
-      diags_.error(pointerAt(stack_.size() - 1),
-                   fmt::format("key {} of {} bytes is longer than the limit of {} bytes (the key-length limit; keys "
-                               "are ids, pin and setting names)",
-                               quoteForDiagnostic(k, 32), k.size(), limits_.maxKeyBytes));
-      failed = true;
+      reject(at, [&] { return pointerAt(stack_.size() - 1); },
+             fmt::format("key {} of {} bytes is longer than the limit of {} bytes (the key-length limit; keys "
+                         "are ids, pin and setting names)",
+                         quoteForDiagnostic(k, 32), k.size(), limits_.maxKeyBytes));
     }
     f.duplicate = !insertKey(f, k);
     f.key = std::move(k);
-    if (f.duplicate) {
-      diags_.error(pointerAt(stack_.size()), fmt::format("duplicate key {}", quoteForDiagnostic(f.key)));
-      failed = true;
-    }
+    if (f.duplicate)
+      reject(at, [&] { return pointerAt(stack_.size()); }, fmt::format("duplicate key {}", quoteForDiagnostic(f.key)));
     return true;
   }
   bool end_object() {
+    locations_.endContainer(std::move(stack_.back().keys));
     stack_.pop_back();
     return true;
   }
   bool start_array(std::size_t) {
+    locations_.beginContainer(true);
     Json* slot = slotForNext();
     *slot = Json::array();
     stack_.push_back(Frame{slot});
     return true;
   }
   bool end_array() {
+    locations_.endContainer(nullptr);
     stack_.pop_back();
     return true;
   }
@@ -270,15 +482,14 @@ class StrictDomBuilder {
     return false;
   }
 
- private:
-  // Objects with up to this many keys find duplicates by scanning their
-  // (ordered) items; larger ones keep a hash set, so n keys cost O(n).
-  static constexpr std::size_t kLinearKeys = 16;
+  /// Where the document's values start (after a successful parse).
+  std::shared_ptr<const SourceLocator> locations() { return locations_.finish(); }
 
+ private:
   struct Frame {
     Json* node;
     std::string key;                                 // objects: the current key
-    std::unique_ptr<std::unordered_set<std::string>> keys;  // objects past kLinearKeys keys
+    std::unique_ptr<KeyIndex> keys;                  // objects past kLinearKeys keys: key -> ordinal
     bool duplicate = false;                          // the current key repeats an earlier one
     bool keyTooLong = false;                         // the current key is over the limit
   };
@@ -290,10 +501,10 @@ class StrictDomBuilder {
       for (const auto& [name, value] : items)
         if (name == k) return false;
       if (items.size() < kLinearKeys) return true;
-      f.keys = std::make_unique<std::unordered_set<std::string>>();
-      for (const auto& [name, value] : items) f.keys->insert(name);
+      f.keys = std::make_unique<KeyIndex>();
+      for (const auto& [name, value] : items) f.keys->emplace(name, static_cast<std::uint32_t>(f.keys->size()));
     }
-    return f.keys->insert(k).second;
+    return f.keys->emplace(k, static_cast<std::uint32_t>(items.size())).second;
   }
 
   /// The length in the file of a token nlohmann returned with control bytes
@@ -369,10 +580,24 @@ class StrictDomBuilder {
     *slot = std::move(v);
     return true;
   }
+  bool scalar(Json v) {
+    locations_.value();
+    return put(std::move(v));
+  }
+  /// A value that parses but is refused: located at `offset`, named by the
+  /// pointer `pointerOf()` builds (O(depth): not built past the error limit).
+  template <typename PointerOf>
+  void reject(std::size_t offset, PointerOf pointerOf, std::string message) {
+    int line, col;
+    locations_.lineColumn(offset, line, col);
+    diags_.errorAt(line, col, std::move(message), diags_.limitReached() ? std::string() : pointerOf());
+    failed = true;
+  }
 
   const std::string& text_;
   const ReadLimits& limits_;
   Diagnostics& diags_;
+  LocationRecorder locations_;
   std::vector<Frame> stack_;
   std::deque<Json> scratch_;  // values of duplicate keys (stable addresses)
 };
@@ -404,6 +629,7 @@ std::optional<Json> parseJsonDocument(const std::string& text, const ReadLimits&
     return std::nullopt;
   }
   if (!ok || builder.failed) return std::nullopt;
+  diags.setLocator(builder.locations());
   return std::move(builder.result);
 }
 

@@ -1,6 +1,8 @@
 // Reading a material file: size limit, a nesting pre-scan, and a strict JSON
 // parse (duplicate keys, byte-order marks and non-finite numbers rejected)
-// into an order-preserving DOM. Syntax errors are reported as file:line:col.
+// into an order-preserving DOM. Syntax errors are reported as file:line:col;
+// the parse also records where each value starts, so that later diagnostics,
+// which name a JSON pointer, are printed at their value's line:col too.
 #pragma once
 #include <cstddef>
 #include <optional>
@@ -32,7 +34,10 @@ std::optional<std::string> readSourceFile(const std::string& path, const ReadLim
 
 /// Parses JSON text. All syntax problems are reported with line:col; values
 /// that parse but are unacceptable (duplicate keys, NaN/Inf, huge strings)
-/// are reported with their JSON pointer. Returns nullopt on any error.
+/// are reported with their line:col and JSON pointer. Returns nullopt on any
+/// error. On success, `diags` gets the document's SourceLocator: every later
+/// pointer diagnostic is located at its value's first byte (a missing member
+/// at its object's). Texts of 2 GiB or more are parsed without locations.
 std::optional<Json> parseJsonDocument(const std::string& text, const ReadLimits& limits,
                                       Diagnostics& diags);
 
@@ -40,7 +45,8 @@ std::optional<Json> parseJsonDocument(const std::string& text, const ReadLimits&
 /// "an array of N", "an object", a number.
 std::string kindOfJson(const Json& j);
 
-/// 1-based line and column (in bytes) of a byte offset in text.
+/// 1-based line and column (in bytes; a tab is one byte) of a byte offset in
+/// text. Lines end at '\n' (so a CRLF file counts lines as an LF one).
 void lineColumnOf(const std::string& text, std::size_t offset, int& line, int& column);
 
 }  // namespace substratec

@@ -56,6 +56,8 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
     }
     auto doc = parseJsonDocument(json, limits, diags);
     if (!doc) return std::nullopt;
+    // A .glb's JSON chunk: its lines are not the file's, so its pointers stay unlocated.
+    if (binBytes) diags.setLocator(nullptr);
     ok = importGltfDocument(*doc, fileName, diags, &out);
     // The buffers and images a .gltf or .glb refers to (gltf_resources.h);
     // a .materials.json extract has none.

@@ -26,6 +26,7 @@ std::optional<SceneManifest> readSceneManifest(const std::string& manifestPath, 
     return std::nullopt;
   }
   SceneManifest scene;
+  scene.locator = diags.locator();
   for (auto it = doc->begin(); it != doc->end(); ++it) {
     const std::string& key = it.key();
     if (key == "$schema" || key == "description") {

@@ -1,8 +1,9 @@
 // The scene manifest, `substrate-scene/1` (schema/substrate-scene.schema.json,
 // docs/scenes.md): a name, the material files the scene uses, and optionally
 // the platform it is built for. Read with the materials' strict JSON reader;
-// every problem is located by JSON pointer (or line:col for syntax).
+// every problem is located at its line:col (and named by JSON pointer).
 #pragma once
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -26,6 +27,7 @@ struct SceneManifest {
   std::vector<SceneMaterialRef> materials;
   std::optional<std::string> platform;  // "platform", when given
   std::string platformPointer;          // "/platform"
+  std::shared_ptr<const SourceLocator> locator;  // locates the pointers above in the manifest's text
 };
 
 /// Parses the manifest text; `manifestPath` locates relative material paths.

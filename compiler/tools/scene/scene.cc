@@ -34,6 +34,7 @@ std::optional<Platform> choosePlatform(const SceneOptions& o, const SceneManifes
                               table.names());
   } else {
     Diagnostics d(o.manifest);
+    d.setLocator(scene.locator);
     d.error(scene.platformPointer,
             fmt::format("unknown platform {} (known: {})", quoteForDiagnostic(*name), table.names()));
     b.status = SceneStatus::BadInput;
@@ -86,6 +87,7 @@ SceneBuild buildScene(const SceneOptions& o) {
   {  // Every material's files go into one directory: names must differ (also in letter
      // case: file systems that ignore it, and the upper-case macros of one kernel).
     Diagnostics d(o.manifest);
+    d.setLocator(scene->locator);
     std::map<std::string, std::size_t> seen;
     for (std::size_t i = 0; i < built.size(); ++i) {
       if (!built[i].ok) continue;
