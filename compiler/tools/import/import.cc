@@ -48,7 +48,8 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
   } else {
     std::string json = text;
     std::optional<std::size_t> binBytes;
-    if (kind == SourceKind::Glb || (kind == SourceKind::Gltf && looksLikeGlb(text))) {
+    const bool glb = kind == SourceKind::Glb || (kind == SourceKind::Gltf && looksLikeGlb(text));
+    if (glb) {
       auto chunk = glbJsonChunk(text, diags);
       if (!chunk) return std::nullopt;
       json = std::move(*chunk);
@@ -57,7 +58,7 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
     auto doc = parseJsonDocument(json, limits, diags);
     if (!doc) return std::nullopt;
     // A .glb's JSON chunk: its lines are not the file's, so its pointers stay unlocated.
-    if (binBytes) diags.setLocator(nullptr);
+    if (glb) diags.setLocator(nullptr);
     ok = importGltfDocument(*doc, fileName, diags, &out);
     // The buffers and images a .gltf or .glb refers to (gltf_resources.h);
     // a .materials.json extract has none.
