@@ -213,9 +213,14 @@ struct Context::Impl {
   double timestampPeriodNs = 1;  // VkPhysicalDeviceLimits::timestampPeriod
   bool shaderFloat16 = false;    // enabled on the device (VkPhysicalDeviceVulkan12Features)
   bool lost = false;  // a fence wait timed out or the device was lost: leak, never wait
+  VkFence lostFence = VK_NULL_HANDLE;  // the fence of the dispatch that timed out (leaked with it)
 
   ~Impl() {
     if (lost) {  // objects may still be in use by the device; leaking them (and the log) is the only safe choice
+      // One more bounded wait (60 s) for the work that timed out: a process
+      // that exits while lavapipe's threads still run it crashes in their
+      // teardown. Work that never finishes is leaked all the same.
+      if (lostFence) (void)vk.vkWaitForFences(device, 1, &lostFence, VK_TRUE, 60'000'000'000ull);
       (void)log.release();
       return;
     }
@@ -911,6 +916,7 @@ bool Context::Impl::submitAndWait(DispatchObjects& objs, Diagnostics& diags) {
   const VkResult waited = vk.vkWaitForFences(device, 1, &objs.fence, VK_TRUE, options.fenceTimeoutNs);
   if (waited == VK_SUCCESS) return true;
   lost = true;  // the work may still be running: its objects are leaked, the Context is done
+  lostFence = objs.fence;
   return fail(diags, waited == VK_TIMEOUT ? "vkWaitForFences timed out after " +
                                                std::to_string(options.fenceTimeoutNs / 1000000) +
                                                " ms (the Context is unusable now)"
