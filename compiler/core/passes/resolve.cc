@@ -259,16 +259,31 @@ class Resolver {
  private:
   // --- top level
   void readTop();
+  void readHeader();
+  bool indexNamedNodes();
+  bool readNamedNodeBodies();
+  void checkOutput();
   void readSettings(const Json& s, const std::string& ptr);
   void readInputs(const Json& s, const std::string& ptr);
+  void readInput(const std::string& name, const Json& v, const std::string& p);
+  void readInputKey(Input& in, Json::const_iterator k, const std::string& p, bool& ok);
   void classifyNodes();
+  void classifyAdds(const std::vector<std::string>& adds);
   int resolveValueNode(const std::string& id);
   int resolveSubstrateNode(const std::string& id);
 
   // --- values
   PinRef readValuePin(const Json& j, const std::string& ptr, const std::string& pinName);
+  PinRef readInputPin(const std::string& s, const std::string& ptr);
+  PinRef readReferencePin(const std::string& s, const std::string& ptr, const std::string& pinName);
+  void selectNamedOutput(PinRef& r, const OpSpec* spec, const std::string& id, const std::string& output,
+                         const std::string& ptr, const std::string& pinName);
+  PinRef readInlineValuePin(const Json& j, const std::string& ptr, const std::string& pinName);
   int makeInlineValueNode(const Json& j, const std::string& ptr);
   void readValueNodeBody(int index, const Json& j, const std::string& ptr, const OpSpec& spec);
+  void checkValueNodeKeys(const Json& j, const std::string& ptr, const OpSpec& spec);
+  void readTextureRefPin(const Json& v, const std::string& pp, std::uint16_t& attr, PinRef& pin);
+  void readChannelsPin(const Json& v, const std::string& pp, std::uint16_t& attr, PinRef& pin);
   bool expectPinType(PinRef& pin, PinKind kind, const std::string& ptr, bool* color = nullptr);
   PinRef defaultPin(const PinSpec& ps);
 
@@ -368,41 +383,7 @@ std::optional<ResolvedDoc> Resolver::run() {
 }
 
 void Resolver::readTop() {
-  static const std::set<std::string> known = {"$schema", "format", "name", "settings",
-                                              "inputs", "nodes", "output", "description"};
-  for (auto it = doc_.begin(); it != doc_.end(); ++it)
-    if (!known.count(it.key()))
-      d_.error("/" + pointerToken(it.key()),
-               fmt::format("unknown key {} (expected one of: format, name, settings, inputs, nodes, output)",
-                           quoteForDiagnostic(it.key())));
-
-  auto fmtIt = doc_.find("format");
-  if (fmtIt == doc_.end()) {
-    d_.error("", "missing required key \"format\" (expected \"substrate-material/1\")");
-  } else if (!fmtIt->is_string() || fmtIt->get<std::string>() != "substrate-material/1") {
-    d_.error("/format", fmt::format("expected \"substrate-material/1\", got {}", kindOfJson(*fmtIt)));
-  }
-  if (auto it = doc_.find("$schema"); it != doc_.end() && !it->is_string())
-    d_.error("/$schema", "expected a string");
-  if (auto it = doc_.find("description"); it != doc_.end() && !it->is_string())
-    d_.error("/description", "expected a string");
-
-  auto nameIt = doc_.find("name");
-  if (nameIt == doc_.end()) {
-    d_.error("", "missing required key \"name\"");
-  } else if (!nameIt->is_string()) {
-    d_.error("/name", fmt::format("expected a C identifier string, got {}", kindOfJson(*nameIt)));
-  } else if (const std::string& name = nameIt->get_ref<const std::string&>();
-             name.size() > limits_.maxIdentifierBytes && isUsableIdentifier(name, name.size())) {
-    d_.error("/name", identifierError("name", name));
-  } else if (!isUsableIdentifier(nameIt->get<std::string>(), limits_.maxIdentifierBytes)) {
-    d_.error("/name", fmt::format("{} is not usable as a name: it must be a C identifier of at most {} "
-                                  "bytes, without \"__\", not beginning with '_' or \"gl_\" (in any case), not "
-                                  "ending with '_', and not a C/GLSL/HLSL keyword or built-in function",
-                                  quoteForDiagnostic(nameIt->get<std::string>()), limits_.maxIdentifierBytes));
-  } else {
-    out_.name = nameIt->get<std::string>();
-  }
+  readHeader();
 
   if (auto it = doc_.find("settings"); it != doc_.end()) readSettings(*it, "/settings");
   if (auto it = doc_.find("inputs"); it != doc_.end()) readInputs(*it, "/inputs");
@@ -439,25 +420,77 @@ void Resolver::readTop() {
   // Every named node gets its index first, so that references never recurse
   // (a chain of 100k named nodes must not deepen the stack); then each body
   // is read, in file order, so unused nodes are checked too.
+  if (!indexNamedNodes() || !readNamedNodeBodies()) return;
+  checkOutput();
+}
+
+/// The top-level keys, "format", "$schema", "description" and "name" (into out_.name).
+void Resolver::readHeader() {
+  static const std::set<std::string> known = {"$schema", "format", "name", "settings",
+                                              "inputs", "nodes", "output", "description"};
+  for (auto it = doc_.begin(); it != doc_.end(); ++it)
+    if (!known.count(it.key()))
+      d_.error("/" + pointerToken(it.key()),
+               fmt::format("unknown key {} (expected one of: format, name, settings, inputs, nodes, output)",
+                           quoteForDiagnostic(it.key())));
+
+  auto fmtIt = doc_.find("format");
+  if (fmtIt == doc_.end()) {
+    d_.error("", "missing required key \"format\" (expected \"substrate-material/1\")");
+  } else if (!fmtIt->is_string() || fmtIt->get<std::string>() != "substrate-material/1") {
+    d_.error("/format", fmt::format("expected \"substrate-material/1\", got {}", kindOfJson(*fmtIt)));
+  }
+  if (auto it = doc_.find("$schema"); it != doc_.end() && !it->is_string())
+    d_.error("/$schema", "expected a string");
+  if (auto it = doc_.find("description"); it != doc_.end() && !it->is_string())
+    d_.error("/description", "expected a string");
+
+  auto nameIt = doc_.find("name");
+  if (nameIt == doc_.end()) {
+    d_.error("", "missing required key \"name\"");
+  } else if (!nameIt->is_string()) {
+    d_.error("/name", fmt::format("expected a C identifier string, got {}", kindOfJson(*nameIt)));
+  } else if (const std::string& name = nameIt->get_ref<const std::string&>();
+             name.size() > limits_.maxIdentifierBytes && isUsableIdentifier(name, name.size())) {
+    d_.error("/name", identifierError("name", name));
+  } else if (!isUsableIdentifier(nameIt->get<std::string>(), limits_.maxIdentifierBytes)) {
+    d_.error("/name", fmt::format("{} is not usable as a name: it must be a C identifier of at most {} "
+                                  "bytes, without \"__\", not beginning with '_' or \"gl_\" (in any case), not "
+                                  "ending with '_', and not a C/GLSL/HLSL keyword or built-in function",
+                                  quoteForDiagnostic(nameIt->get<std::string>()), limits_.maxIdentifierBytes));
+  } else {
+    out_.name = nameIt->get<std::string>();
+  }
+}
+
+/// Gives every named node its index in out_.values or out_.substrate, in file
+/// order; false past the node-count limit (reported by budget()).
+bool Resolver::indexNamedNodes() {
   for (auto it = nodes_->begin(); it != nodes_->end(); ++it) {
     const std::string& id = it.key();
     std::string p = "/nodes/" + pointerToken(id);
     if (isValueKindName(id)) {
-      if (!budget(p)) return;
+      if (!budget(p)) return false;
       namedValue_[id] = static_cast<int>(out_.values.size());
       out_.values.emplace_back();
       out_.values.back().id = id;
       out_.values.back().pointer = p;
     } else if (isSubstrateName(id)) {
-      if (!budget(p)) return;
+      if (!budget(p)) return false;
       namedSubstrate_[id] = static_cast<int>(out_.substrate.size());
       out_.substrate.emplace_back();
       out_.substrate.back().id = id;
       out_.substrate.back().pointer = p;
     }
   }
+  return true;
+}
+
+/// Reads the body of every named node, in file order; false once the
+/// diagnostic limit is reached.
+bool Resolver::readNamedNodeBodies() {
   for (auto it = nodes_->begin(); it != nodes_->end(); ++it) {
-    if (d_.limitReached()) return;
+    if (d_.limitReached()) return false;
     const std::string& id = it.key();
     std::string p = "/nodes/" + pointerToken(id);
     std::string kind = isValueKindName(id) || isSubstrateName(id) ? (*it)["kind"].get<std::string>() : "";
@@ -470,6 +503,11 @@ void Resolver::readTop() {
       fillSubstrateNode(namedSubstrate_[id], *it, p, kind == "add" ? TreeOp::Add : *substrateKind(kind));
     }
   }
+  return true;
+}
+
+/// Checks that "output" names a Substrate node and records it in out_.output.
+void Resolver::checkOutput() {
   if (!outputId_.empty()) {
     if (!namedKind_.count(outputId_)) {
       if (inputIndex_.count(outputId_))
@@ -558,113 +596,123 @@ void Resolver::readInputs(const Json& s, const std::string& ptr) {
       badInputs_.insert(name);
       continue;
     }
-    Input in;
-    in.name = name;
-    in.pointer = p;
-    bool ok = true;
-    auto t = v.find("type");
-    if (t == v.end() || !t->is_string()) {
-      d_.error(p + (t == v.end() ? "" : "/type"),
-               "expected \"type\": one of float, vec2, vec3, color, texture2d");
-      badInputs_.insert(name);
-      continue;
-    }
-    std::string ts = t->get<std::string>();
-    if (ts == "float") in.type = VType::Float;
-    else if (ts == "vec2") in.type = VType::Vec2;
-    else if (ts == "vec3") in.type = VType::Vec3;
-    else if (ts == "color") { in.type = VType::Vec3; in.isColor = true; }
-    else if (ts == "texture2d") in.type = VType::Texture;
-    else {
-      d_.error(p + "/type", fmt::format("unknown input type {} (expected float, vec2, vec3, color or texture2d)",
-                                        quoteForDiagnostic(ts)));
-      badInputs_.insert(name);
-      continue;
-    }
-    for (auto k = v.begin(); k != v.end(); ++k) {
-      const std::string& key = k.key();
-      std::string kp = p + "/" + pointerToken(key);
-      if (key == "type" || key == "description") {
-        if (key == "description" && !k->is_string()) d_.error(kp, "expected a string");
-        continue;
-      }
-      if (key == "colorspace") {
-        if (in.type != VType::Texture) d_.error(kp, "\"colorspace\" applies to texture2d inputs only");
-        else if (!k->is_string() || (k->get<std::string>() != "srgb" && k->get<std::string>() != "linear"))
-          d_.error(kp, fmt::format("expected \"srgb\" or \"linear\", got {}", kindOfJson(*k)));
-        continue;
-      }
-      if (key == "min" || key == "max") {
-        // A number bounds every component; an array bounds each component.
-        auto& dst = key == "min" ? in.min : in.max;
-        int n = componentCount(in.type);
-        if (in.type == VType::Texture) {
-          d_.error(kp, fmt::format("\"{}\" does not apply to a texture2d input", key));
-          ok = false;
-        } else if (k->is_number()) {
-          double x = k->get<double>();
-          dst = std::array<double, 4>{x, x, x, x};
-        } else if (k->is_array() && static_cast<int>(k->size()) == n && n > 1 &&
-                   std::all_of(k->begin(), k->end(), [](const Json& e) { return e.is_number(); })) {
-          std::array<double, 4> a{0, 0, 0, 0};
-          for (int i = 0; i < n; ++i) a[i] = (*k)[i].get<double>();
-          dst = a;
-        } else {
-          d_.error(kp, fmt::format("expected a number{}, got {}", n > 1 ? fmt::format(" or {} numbers", n) : "",
-                                   kindOfJson(*k)));
-          ok = false;
-        }
-        continue;
-      }
-      if (key == "default") {
-        if (in.type == VType::Texture) {
-          d_.error(kp, "a texture2d input has no default (it is bound at run time)");
-          ok = false;
-          continue;
-        }
-        int n = componentCount(in.type);
-        if (k->is_number() && (n == 1 || in.isColor)) {
-          double x = k->get<double>();
-          in.defaultValue = {x, x, x, 0};
-        } else if (k->is_array() && static_cast<int>(k->size()) == n && n > 1 &&
-                   std::all_of(k->begin(), k->end(), [](const Json& e) { return e.is_number(); })) {
-          for (int i = 0; i < n; ++i) in.defaultValue[i] = (*k)[i].get<double>();
-        } else {
-          d_.error(kp, fmt::format("expected a {} default ({}), got {}", typeWord(in.type, in.isColor),
-                                   n == 1 ? "a number" : fmt::format("an array of {} numbers", n),
-                                   kindOfJson(*k)));
-          ok = false;
-        }
-        continue;
-      }
-      d_.error(kp, fmt::format("unknown input key {} (expected type, default, min, max, description)",
-                               quoteForDiagnostic(key)));
-    }
-    if (in.type != VType::Texture && !v.contains("default")) {
-      d_.error(p, fmt::format("missing \"default\" for {} input", typeWord(in.type, in.isColor)));
+    readInput(name, v, p);
+  }
+}
+
+/// Input `name` (its JSON `v`, at pointer `p`) into out_.inputs; a bad one
+/// into badInputs_, so that references to it stay silent.
+void Resolver::readInput(const std::string& name, const Json& v, const std::string& p) {
+  Input in;
+  in.name = name;
+  in.pointer = p;
+  bool ok = true;
+  auto t = v.find("type");
+  if (t == v.end() || !t->is_string()) {
+    d_.error(p + (t == v.end() ? "" : "/type"),
+             "expected \"type\": one of float, vec2, vec3, color, texture2d");
+    badInputs_.insert(name);
+    return;
+  }
+  std::string ts = t->get<std::string>();
+  if (ts == "float") in.type = VType::Float;
+  else if (ts == "vec2") in.type = VType::Vec2;
+  else if (ts == "vec3") in.type = VType::Vec3;
+  else if (ts == "color") { in.type = VType::Vec3; in.isColor = true; }
+  else if (ts == "texture2d") in.type = VType::Texture;
+  else {
+    d_.error(p + "/type", fmt::format("unknown input type {} (expected float, vec2, vec3, color or texture2d)",
+                                      quoteForDiagnostic(ts)));
+    badInputs_.insert(name);
+    return;
+  }
+  for (auto k = v.begin(); k != v.end(); ++k) readInputKey(in, k, p, ok);
+  if (in.type != VType::Texture && !v.contains("default")) {
+    d_.error(p, fmt::format("missing \"default\" for {} input", typeWord(in.type, in.isColor)));
+    ok = false;
+  }
+  for (int i = 0; in.min && in.max && i < componentCount(in.type); ++i) {
+    if ((*in.min)[i] > (*in.max)[i]) {
+      d_.error(p + "/min", fmt::format("min {:g} is greater than max {:g}", (*in.min)[i], (*in.max)[i]));
       ok = false;
+      break;
     }
-    for (int i = 0; in.min && in.max && i < componentCount(in.type); ++i) {
-      if ((*in.min)[i] > (*in.max)[i]) {
-        d_.error(p + "/min", fmt::format("min {:g} is greater than max {:g}", (*in.min)[i], (*in.max)[i]));
-        ok = false;
+  }
+  if (ok && in.type != VType::Texture && v.contains("default")) {
+    for (int i = 0; i < componentCount(in.type); ++i) {
+      double x = in.defaultValue[i];
+      if ((in.min && x < (*in.min)[i]) || (in.max && x > (*in.max)[i])) {
+        d_.error(p + "/default", fmt::format("default {:g} is outside [{}, {}]", x,
+                                             in.min ? fmt::format("{:g}", (*in.min)[i]) : "-inf",
+                                             in.max ? fmt::format("{:g}", (*in.max)[i]) : "inf"));
         break;
       }
     }
-    if (ok && in.type != VType::Texture && v.contains("default")) {
-      for (int i = 0; i < componentCount(in.type); ++i) {
-        double x = in.defaultValue[i];
-        if ((in.min && x < (*in.min)[i]) || (in.max && x > (*in.max)[i])) {
-          d_.error(p + "/default", fmt::format("default {:g} is outside [{}, {}]", x,
-                                               in.min ? fmt::format("{:g}", (*in.min)[i]) : "-inf",
-                                               in.max ? fmt::format("{:g}", (*in.max)[i]) : "inf"));
-          break;
-        }
-      }
-    }
-    inputIndex_[name] = static_cast<int>(out_.inputs.size());
-    out_.inputs.push_back(std::move(in));
   }
+  inputIndex_[name] = static_cast<int>(out_.inputs.size());
+  out_.inputs.push_back(std::move(in));
+}
+
+/// Key `k` of input `in` (at pointer `p`) other than its type; `ok` turns
+/// false when the key makes the default unusable.
+void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string& p, bool& ok) {
+  const std::string& key = k.key();
+  std::string kp = p + "/" + pointerToken(key);
+  if (key == "type" || key == "description") {
+    if (key == "description" && !k->is_string()) d_.error(kp, "expected a string");
+    return;
+  }
+  if (key == "colorspace") {
+    if (in.type != VType::Texture) d_.error(kp, "\"colorspace\" applies to texture2d inputs only");
+    else if (!k->is_string() || (k->get<std::string>() != "srgb" && k->get<std::string>() != "linear"))
+      d_.error(kp, fmt::format("expected \"srgb\" or \"linear\", got {}", kindOfJson(*k)));
+    return;
+  }
+  if (key == "min" || key == "max") {
+    // A number bounds every component; an array bounds each component.
+    auto& dst = key == "min" ? in.min : in.max;
+    int n = componentCount(in.type);
+    if (in.type == VType::Texture) {
+      d_.error(kp, fmt::format("\"{}\" does not apply to a texture2d input", key));
+      ok = false;
+    } else if (k->is_number()) {
+      double x = k->get<double>();
+      dst = std::array<double, 4>{x, x, x, x};
+    } else if (k->is_array() && static_cast<int>(k->size()) == n && n > 1 &&
+               std::all_of(k->begin(), k->end(), [](const Json& e) { return e.is_number(); })) {
+      std::array<double, 4> a{0, 0, 0, 0};
+      for (int i = 0; i < n; ++i) a[i] = (*k)[i].get<double>();
+      dst = a;
+    } else {
+      d_.error(kp, fmt::format("expected a number{}, got {}", n > 1 ? fmt::format(" or {} numbers", n) : "",
+                               kindOfJson(*k)));
+      ok = false;
+    }
+    return;
+  }
+  if (key == "default") {
+    if (in.type == VType::Texture) {
+      d_.error(kp, "a texture2d input has no default (it is bound at run time)");
+      ok = false;
+      return;
+    }
+    int n = componentCount(in.type);
+    if (k->is_number() && (n == 1 || in.isColor)) {
+      double x = k->get<double>();
+      in.defaultValue = {x, x, x, 0};
+    } else if (k->is_array() && static_cast<int>(k->size()) == n && n > 1 &&
+               std::all_of(k->begin(), k->end(), [](const Json& e) { return e.is_number(); })) {
+      for (int i = 0; i < n; ++i) in.defaultValue[i] = (*k)[i].get<double>();
+    } else {
+      d_.error(kp, fmt::format("expected a {} default ({}), got {}", typeWord(in.type, in.isColor),
+                               n == 1 ? "a number" : fmt::format("an array of {} numbers", n),
+                               kindOfJson(*k)));
+      ok = false;
+    }
+    return;
+  }
+  d_.error(kp, fmt::format("unknown input key {} (expected type, default, min, max, description)",
+                           quoteForDiagnostic(key)));
 }
 
 /// Decides for every named node whether it is a value node or a Substrate
@@ -707,8 +755,12 @@ void Resolver::classifyNodes() {
       d_.error(p + "/kind", fmt::format("unknown node kind {}", quoteForDiagnostic(kind)));
     }
   }
-  // Named adds: an add is Substrate if an operand is Substrate. Inline content
-  // decides directly; references to other named adds propagate backwards.
+  classifyAdds(adds);
+}
+
+/// Named adds: an add is Substrate if an operand is Substrate. Inline content
+/// decides directly; references to other named adds propagate backwards.
+void Resolver::classifyAdds(const std::vector<std::string>& adds) {
   std::unordered_map<std::string, std::vector<std::string>> referencedBy;
   std::deque<std::string> queue;
   std::function<bool(const Json&, const std::string&)> scan = [&](const Json& j,
@@ -804,20 +856,7 @@ PinRef Resolver::defaultPin(const PinSpec& ps) {
 void Resolver::readValueNodeBody(int index, const Json& j, const std::string& ptr, const OpSpec& spec) {
   std::vector<PinRef> pins(spec.pins.size());
   std::uint16_t attr = 0;
-  for (auto it = j.begin(); it != j.end(); ++it) {
-    const std::string& key = it.key();
-    if (key == "kind" || key == "comment") {
-      if (key == "comment" && !it->is_string()) d_.error(ptr + "/comment", "expected a string");
-      continue;
-    }
-    auto ps = std::find_if(spec.pins.begin(), spec.pins.end(), [&](const PinSpec& p) { return key == p.name; });
-    if (ps == spec.pins.end()) {
-      std::string list;
-      for (const auto& p : spec.pins) list += (list.empty() ? "" : ", ") + std::string(p.name);
-      d_.error(ptr + "/" + pointerToken(key), fmt::format("unknown pin {} for a {} node (pins: {})",
-                                                          quoteForDiagnostic(key), spec.kind, list));
-    }
-  }
+  checkValueNodeKeys(j, ptr, spec);
   for (std::size_t i = 0; i < spec.pins.size(); ++i) {
     const PinSpec& ps = spec.pins[i];
     std::string pp = ptr + "/" + ps.name;
@@ -836,48 +875,12 @@ void Resolver::readValueNodeBody(int index, const Json& j, const std::string& pt
         pins[i].type = a ? geometryAttrType(*a) : VType::Invalid;
         break;
       }
-      case PinKind::TextureRef: {
-        if (v.is_string() && !v.get<std::string>().empty() && v.get<std::string>()[0] == '$') {
-          std::string n = v.get<std::string>().substr(1);
-          auto f = inputIndex_.find(n);
-          if (f == inputIndex_.end()) {
-            if (!badInputs_.count(n)) d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic("$" + n)));
-          } else if (out_.inputs[f->second].type != VType::Texture) {
-            d_.error(pp, fmt::format("input {} is a {}, expected a texture2d input",
-                                     quoteForDiagnostic("$" + n),
-                                     typeWord(out_.inputs[f->second].type, out_.inputs[f->second].isColor)));
-          } else {
-            attr = static_cast<std::uint16_t>(f->second);
-            pins[i].type = VType::Texture;
-          }
-        } else {
-          d_.error(pp, fmt::format("expected a texture2d input reference like \"$albedo\", got {}", kindOfJson(v)));
-        }
+      case PinKind::TextureRef:
+        readTextureRefPin(v, pp, attr, pins[i]);
         break;
-      }
-      case PinKind::Channels: {
-        bool ok = v.is_string() && !v.get<std::string>().empty() && v.get<std::string>().size() <= 4;
-        std::uint16_t packed = 0;
-        if (ok) {
-          std::string s = v.get<std::string>();
-          for (std::size_t c = 0; c < s.size(); ++c) {
-            int idx = -1;
-            switch (s[c]) {
-              case 'x': case 'r': idx = 0; break;
-              case 'y': case 'g': idx = 1; break;
-              case 'z': case 'b': idx = 2; break;
-              case 'w': case 'a': idx = 3; break;
-              default: ok = false;
-            }
-            if (idx >= 0) packed |= static_cast<std::uint16_t>(idx << (2 * c));
-          }
-          packed |= static_cast<std::uint16_t>(s.size() << 8);
-        }
-        if (!ok) d_.error(pp, fmt::format("expected 1 to 4 channels from xyzw or rgba, got {}", kindOfJson(v)));
-        attr = ok ? packed : 0;
-        pins[i].type = ok ? VType::Float : VType::Invalid;  // marker only
+      case PinKind::Channels:
+        readChannelsPin(v, pp, attr, pins[i]);
         break;
-      }
       default:
         pins[i] = readValuePin(v, pp, ps.name);
         break;
@@ -885,6 +888,68 @@ void Resolver::readValueNodeBody(int index, const Json& j, const std::string& pt
   }
   out_.values[index].pins = std::move(pins);
   out_.values[index].attr = attr;
+}
+
+/// Reports every key of value node `j` that is neither "kind", "comment" nor a pin of `spec`.
+void Resolver::checkValueNodeKeys(const Json& j, const std::string& ptr, const OpSpec& spec) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& key = it.key();
+    if (key == "kind" || key == "comment") {
+      if (key == "comment" && !it->is_string()) d_.error(ptr + "/comment", "expected a string");
+      continue;
+    }
+    auto ps = std::find_if(spec.pins.begin(), spec.pins.end(), [&](const PinSpec& p) { return key == p.name; });
+    if (ps == spec.pins.end()) {
+      std::string list;
+      for (const auto& p : spec.pins) list += (list.empty() ? "" : ", ") + std::string(p.name);
+      d_.error(ptr + "/" + pointerToken(key), fmt::format("unknown pin {} for a {} node (pins: {})",
+                                                          quoteForDiagnostic(key), spec.kind, list));
+    }
+  }
+}
+
+/// A texture pin `v` (a "$name" texture2d input reference) into `attr` (the input index) and `pin`.
+void Resolver::readTextureRefPin(const Json& v, const std::string& pp, std::uint16_t& attr, PinRef& pin) {
+  if (v.is_string() && !v.get<std::string>().empty() && v.get<std::string>()[0] == '$') {
+    std::string n = v.get<std::string>().substr(1);
+    auto f = inputIndex_.find(n);
+    if (f == inputIndex_.end()) {
+      if (!badInputs_.count(n)) d_.error(pp, fmt::format("unknown input {}", quoteForDiagnostic("$" + n)));
+    } else if (out_.inputs[f->second].type != VType::Texture) {
+      d_.error(pp, fmt::format("input {} is a {}, expected a texture2d input",
+                               quoteForDiagnostic("$" + n),
+                               typeWord(out_.inputs[f->second].type, out_.inputs[f->second].isColor)));
+    } else {
+      attr = static_cast<std::uint16_t>(f->second);
+      pin.type = VType::Texture;
+    }
+  } else {
+    d_.error(pp, fmt::format("expected a texture2d input reference like \"$albedo\", got {}", kindOfJson(v)));
+  }
+}
+
+/// A swizzle pin `v` (1-4 of xyzw or rgba) packed into `attr`; `pin` is typed as a marker only.
+void Resolver::readChannelsPin(const Json& v, const std::string& pp, std::uint16_t& attr, PinRef& pin) {
+  bool ok = v.is_string() && !v.get<std::string>().empty() && v.get<std::string>().size() <= 4;
+  std::uint16_t packed = 0;
+  if (ok) {
+    std::string s = v.get<std::string>();
+    for (std::size_t c = 0; c < s.size(); ++c) {
+      int idx = -1;
+      switch (s[c]) {
+        case 'x': case 'r': idx = 0; break;
+        case 'y': case 'g': idx = 1; break;
+        case 'z': case 'b': idx = 2; break;
+        case 'w': case 'a': idx = 3; break;
+        default: ok = false;
+      }
+      if (idx >= 0) packed |= static_cast<std::uint16_t>(idx << (2 * c));
+    }
+    packed |= static_cast<std::uint16_t>(s.size() << 8);
+  }
+  if (!ok) d_.error(pp, fmt::format("expected 1 to 4 channels from xyzw or rgba, got {}", kindOfJson(v)));
+  attr = ok ? packed : 0;
+  pin.type = ok ? VType::Float : VType::Invalid;  // marker only
 }
 
 PinRef Resolver::readValuePin(const Json& j, const std::string& ptr, const std::string& pinName) {
@@ -909,126 +974,145 @@ PinRef Resolver::readValuePin(const Json& j, const std::string& ptr, const std::
     r.type = vectorType(r.literalCount);
     return r;
   }
-  if (j.is_string()) {
-    std::string s = j.get<std::string>();
-    if (!s.empty() && s[0] == '$') {
-      std::string n = s.substr(1);
-      auto f = inputIndex_.find(n);
-      if (f == inputIndex_.end()) {
-        if (!badInputs_.count(n)) d_.error(ptr, fmt::format("unknown input {}", quoteForDiagnostic(s)));
-        return r;
-      }
-      if (out_.inputs[f->second].type == VType::Texture) {
-        d_.error(ptr, fmt::format("{} is a texture2d input; sample it with a \"texture\" node", quoteForDiagnostic(s)));
-        return r;
-      }
-      r.tag = PinRef::Input;
-      r.index = f->second;
-      r.type = out_.inputs[f->second].type;
-      return r;
-    }
-    {
-      char* end = nullptr;
-      std::strtod(s.c_str(), &end);
-      if (!s.empty() && end && *end == '\0') {
-        d_.error(ptr, fmt::format("expected a number, got the string {} (remove the quotes)", quoteForDiagnostic(s)));
-        return r;
-      }
-    }
-    std::string id = s, output;
-    if (auto dot = s.find('.'); dot != std::string::npos) {
-      id = s.substr(0, dot);
-      output = s.substr(dot + 1);
-    }
-    if (!namedKind_.count(id)) {
-      if (inputIndex_.count(id))
-        d_.error(ptr, fmt::format("unknown node {}; to use the input write {}", quoteForDiagnostic(id),
-                                  quoteForDiagnostic("$" + id)));
-      else
-        d_.error(ptr, fmt::format("unknown node {}", quoteForDiagnostic(id)));
-      return r;
-    }
-    if (isSubstrateName(id)) {
-      d_.error(ptr, fmt::format("expected a value, got Substrate node {}", quoteForDiagnostic(id)));
-      return r;
-    }
-    if (namedKind_[id] != 1) return r;  // already reported
-    int index = resolveValueNode(id);
-    if (index < 0) return r;
-    r.tag = PinRef::Node;
-    r.index = index;
-    const OpSpec* spec = findOpSpec(kindOf(*namedJson_[id]));
-    if (!spec) return r;
-    if (output.empty()) {
-      if (spec->outputs.size() > 1 && spec->op != Op::Sample) {
-        // An unnamed reference to a multi-output helper picks the output named
-        // like the pin (f0 -> .f0), which is what an author writing it means.
-        auto f = std::find(spec->outputs.begin(), spec->outputs.end(), pinName);
-        if (f == spec->outputs.end()) {
-          std::string list;
-          for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
-          d_.error(ptr, fmt::format("node {} has several outputs; name one ({})", quoteForDiagnostic(id), list));
-          r.tag = PinRef::Default;
-          return r;
-        }
-        r.output = static_cast<int>(f - spec->outputs.begin());
-      }
-    } else {
-      auto f = std::find(spec->outputs.begin(), spec->outputs.end(), output);
-      if (f == spec->outputs.end()) {
-        if (spec->outputs.empty())
-          d_.error(ptr, fmt::format("node {} has a single output; write {} without a suffix",
-                                    quoteForDiagnostic(id), quoteForDiagnostic(id)));
-        else {
-          std::string list;
-          for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
-          d_.error(ptr, fmt::format("node {} has no output {} (outputs: {})", quoteForDiagnostic(id),
-                                    quoteForDiagnostic("." + output), list));
-        }
-        r.tag = PinRef::Default;
-        return r;
-      }
-      r.output = static_cast<int>(f - spec->outputs.begin());
-    }
+  if (j.is_string()) return readReferencePin(j.get<std::string>(), ptr, pinName);
+  if (j.is_object()) return readInlineValuePin(j, ptr, pinName);
+  d_.error(ptr, fmt::format("expected a value (a number, an array of 2-4 numbers, a reference or an inline "
+                            "node), got {}", kindOfJson(j)));
+  return r;
+}
+
+/// A pin given as "$input": the input, unless unknown or a texture.
+PinRef Resolver::readInputPin(const std::string& s, const std::string& ptr) {
+  PinRef r;
+  std::string n = s.substr(1);
+  auto f = inputIndex_.find(n);
+  if (f == inputIndex_.end()) {
+    if (!badInputs_.count(n)) d_.error(ptr, fmt::format("unknown input {}", quoteForDiagnostic(s)));
     return r;
   }
-  if (j.is_object()) {
-    auto k = j.find("kind");
-    if (k == j.end() || !k->is_string()) {
-      d_.error(ptr, "inline node is missing \"kind\"");
+  if (out_.inputs[f->second].type == VType::Texture) {
+    d_.error(ptr, fmt::format("{} is a texture2d input; sample it with a \"texture\" node", quoteForDiagnostic(s)));
+    return r;
+  }
+  r.tag = PinRef::Input;
+  r.index = f->second;
+  r.type = out_.inputs[f->second].type;
+  return r;
+}
+
+/// A pin given as a string `s`: an input "$name", or a reference "id" or
+/// "id.output" to a named value node.
+PinRef Resolver::readReferencePin(const std::string& s, const std::string& ptr, const std::string& pinName) {
+  PinRef r;
+  if (!s.empty() && s[0] == '$') return readInputPin(s, ptr);
+  {
+    char* end = nullptr;
+    std::strtod(s.c_str(), &end);
+    if (!s.empty() && end && *end == '\0') {
+      d_.error(ptr, fmt::format("expected a number, got the string {} (remove the quotes)", quoteForDiagnostic(s)));
       return r;
     }
-    std::string kind = k->get<std::string>();
-    if (isSubstrateValue(j)) {
-      d_.error(ptr, fmt::format("expected a value, got an inline Substrate node ({})", kind));
-      return r;
-    }
-    const OpSpec* spec = findOpSpec(kind);
-    if (!spec) {
-      d_.error(ptr + "/kind", fmt::format("unknown node kind {}", quoteForDiagnostic(kind)));
-      return r;
-    }
-    int index = makeInlineValueNode(j, ptr);
-    if (index < 0) return r;
-    r.tag = PinRef::Node;
-    r.index = index;
+  }
+  std::string id = s, output;
+  if (auto dot = s.find('.'); dot != std::string::npos) {
+    id = s.substr(0, dot);
+    output = s.substr(dot + 1);
+  }
+  if (!namedKind_.count(id)) {
+    if (inputIndex_.count(id))
+      d_.error(ptr, fmt::format("unknown node {}; to use the input write {}", quoteForDiagnostic(id),
+                                quoteForDiagnostic("$" + id)));
+    else
+      d_.error(ptr, fmt::format("unknown node {}", quoteForDiagnostic(id)));
+    return r;
+  }
+  if (isSubstrateName(id)) {
+    d_.error(ptr, fmt::format("expected a value, got Substrate node {}", quoteForDiagnostic(id)));
+    return r;
+  }
+  if (namedKind_[id] != 1) return r;  // already reported
+  int index = resolveValueNode(id);
+  if (index < 0) return r;
+  r.tag = PinRef::Node;
+  r.index = index;
+  const OpSpec* spec = findOpSpec(kindOf(*namedJson_[id]));
+  if (!spec) return r;
+  selectNamedOutput(r, spec, id, output, ptr, pinName);
+  return r;
+}
+
+/// The output of node `id` (of kind `spec`) that reference `r` reads: `output`
+/// when named, else the one named like the pin of a multi-output helper.
+void Resolver::selectNamedOutput(PinRef& r, const OpSpec* spec, const std::string& id, const std::string& output,
+                                 const std::string& ptr, const std::string& pinName) {
+  if (output.empty()) {
     if (spec->outputs.size() > 1 && spec->op != Op::Sample) {
+      // An unnamed reference to a multi-output helper picks the output named
+      // like the pin (f0 -> .f0), which is what an author writing it means.
       auto f = std::find(spec->outputs.begin(), spec->outputs.end(), pinName);
       if (f == spec->outputs.end()) {
         std::string list;
         for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
-        d_.error(ptr, fmt::format("inline {} node has several outputs ({}) and none is named \"{}\"; "
-                                  "make it a named node and reference one output",
-                                  kind, list, pinName));
+        d_.error(ptr, fmt::format("node {} has several outputs; name one ({})", quoteForDiagnostic(id), list));
         r.tag = PinRef::Default;
-        return r;
+        return;
       }
       r.output = static_cast<int>(f - spec->outputs.begin());
     }
+  } else {
+    auto f = std::find(spec->outputs.begin(), spec->outputs.end(), output);
+    if (f == spec->outputs.end()) {
+      if (spec->outputs.empty())
+        d_.error(ptr, fmt::format("node {} has a single output; write {} without a suffix",
+                                  quoteForDiagnostic(id), quoteForDiagnostic(id)));
+      else {
+        std::string list;
+        for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
+        d_.error(ptr, fmt::format("node {} has no output {} (outputs: {})", quoteForDiagnostic(id),
+                                  quoteForDiagnostic("." + output), list));
+      }
+      r.tag = PinRef::Default;
+      return;
+    }
+    r.output = static_cast<int>(f - spec->outputs.begin());
+  }
+}
+
+/// A pin given as an inline value node `j`.
+PinRef Resolver::readInlineValuePin(const Json& j, const std::string& ptr, const std::string& pinName) {
+  PinRef r;
+  auto k = j.find("kind");
+  if (k == j.end() || !k->is_string()) {
+    d_.error(ptr, "inline node is missing \"kind\"");
     return r;
   }
-  d_.error(ptr, fmt::format("expected a value (a number, an array of 2-4 numbers, a reference or an inline "
-                            "node), got {}", kindOfJson(j)));
+  std::string kind = k->get<std::string>();
+  if (isSubstrateValue(j)) {
+    d_.error(ptr, fmt::format("expected a value, got an inline Substrate node ({})", kind));
+    return r;
+  }
+  const OpSpec* spec = findOpSpec(kind);
+  if (!spec) {
+    d_.error(ptr + "/kind", fmt::format("unknown node kind {}", quoteForDiagnostic(kind)));
+    return r;
+  }
+  int index = makeInlineValueNode(j, ptr);
+  if (index < 0) return r;
+  r.tag = PinRef::Node;
+  r.index = index;
+  if (spec->outputs.size() > 1 && spec->op != Op::Sample) {
+    auto f = std::find(spec->outputs.begin(), spec->outputs.end(), pinName);
+    if (f == spec->outputs.end()) {
+      std::string list;
+      for (auto* o : spec->outputs) list += (list.empty() ? "." : ", .") + std::string(o);
+      d_.error(ptr, fmt::format("inline {} node has several outputs ({}) and none is named \"{}\"; "
+                                "make it a named node and reference one output",
+                                kind, list, pinName));
+      r.tag = PinRef::Default;
+      return r;
+    }
+    r.output = static_cast<int>(f - spec->outputs.begin());
+  }
   return r;
 }
 
