@@ -164,6 +164,34 @@ unsigned featureBits(const ClosureLayout& c) {
   return b;
 }
 
+/// The code that quantizes a basis field `f` (its `field` is "normal" or
+/// "tangent_angle"): from the first closure of its basis, the tangent from the
+/// first with anisotropy.
+std::string packedBasisFieldCode(const StorageLayout& L, const LayoutField& f, const std::string& field,
+                                 const std::vector<int>& closureIndex) {
+  const bool multi = L.closures.size() > 1;
+  auto closure = [&](int i) { return fmt::format("closures[{}]", closureIndex[i]); };
+  int first = 0;
+  for (std::size_t i = 0; i < L.closures.size(); ++i)
+    if (L.closures[i].basis == f.basis) {
+      first = static_cast<int>(i);
+      break;
+    }
+  const std::string n = closure(first) + ".N";
+  if (field == "normal") return fmt::format("substrate_q_normal({}, dither)", n);
+  // tangent_angle, in the frame of the normal as the unpacker decodes it
+  bool elided = !multi || (f.basis == 0 && L.basis0NormalElided);
+  std::string stored = elided ? "substrate_top_layer_normal_as_stored(topN, dither)"
+                              : fmt::format("substrate_normal_as_stored({}, dither)", n);
+  int aniso = first;
+  for (std::size_t i = 0; i < L.closures.size(); ++i)
+    if (L.closures[i].basis == f.basis && (L.closures[i].storedFeatures & kFeatAnisotropy)) {
+      aniso = static_cast<int>(i);
+      break;
+    }
+  return fmt::format("substrate_tangent_angle_encode({}.T, {}, dither)", closure(aniso), stored);
+}
+
 /// The statements that pack every field of `L`, at static bit offsets, from
 /// `closures[closureIndex[i]]` for the layout's closure i. `topN` is the
 /// top-layer normal already computed (for a tangent angle in its frame).
@@ -223,27 +251,7 @@ std::string packFields(const Material& m, const StorageLayout& L, const std::vec
       put(fmt::format("substrate_q_glint({0}.glintValue, {0}.glintUv, {0}.glintUvDerivatives, dither, glint{1})", c, k), 8);
       for (const char* part : {"x", "y", "z", "w"}) put(fmt::format("glint{}.{}", k, part), 32);
     } else if (f.basis >= 0) {
-      int first = 0;
-      for (std::size_t i = 0; i < L.closures.size(); ++i)
-        if (L.closures[i].basis == f.basis) {
-          first = static_cast<int>(i);
-          break;
-        }
-      const std::string n = closure(first) + ".N";
-      if (field == "normal") {
-        put(fmt::format("substrate_q_normal({}, dither)", n), f.bits);
-      } else {  // tangent_angle, in the frame of the normal as the unpacker decodes it
-        bool elided = !multi || (f.basis == 0 && L.basis0NormalElided);
-        std::string stored = elided ? "substrate_top_layer_normal_as_stored(topN, dither)"
-                                    : fmt::format("substrate_normal_as_stored({}, dither)", n);
-        int aniso = first;
-        for (std::size_t i = 0; i < L.closures.size(); ++i)
-          if (L.closures[i].basis == f.basis && (L.closures[i].storedFeatures & kFeatAnisotropy)) {
-            aniso = static_cast<int>(i);
-            break;
-          }
-        put(fmt::format("substrate_tangent_angle_encode({}.T, {}, dither)", closure(aniso), stored), f.bits);
-      }
+      put(packedBasisFieldCode(L, f, field, closureIndex), f.bits);
     }
   }
   return s;

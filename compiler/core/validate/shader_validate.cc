@@ -198,6 +198,77 @@ std::size_t spirvInstructionCount(const std::vector<uint32_t>& words) {
   return n;
 }
 
+namespace {
+
+/// SPIR-V from a linked program, into result.spirv; for HLSL legalized when
+/// spirv-val rejects the raw module. False (the log says why) when it fails.
+bool spirvFromProgram(glslang::TProgram& program, EShLanguage stage, bool hlsl, const ShaderSource& src,
+                      ShaderValidation& result) {
+  // glslang's GLSL front end declares storage buffers in the StorageBuffer
+  // class for SPIR-V >= 1.3, but its HLSL front end (12.0) keeps the
+  // Uniform + BufferBlock form that SPIR-V 1.4 removed, which spirv-val rejects
+  // for (RW)StructuredBuffer and ByteAddressBuffer. Ask for the 1.3 form.
+  program.getIntermediate(stage)->setUseStorageBuffer();
+
+  glslang::SpvOptions spvOptions;
+  spvOptions.generateDebugInfo = false;
+  spvOptions.validate = false;
+  spvOptions.disableOptimizer = true;
+  spv::SpvBuildLogger logger;
+  glslang::GlslangToSpv(*program.getIntermediate(stage), result.spirv, &logger, &spvOptions);
+  const std::string spvLog = logger.getAllMessages();
+  appendLog(result.log, spvLog);
+  if (containsLine(spvLog, "error") || result.spirv.empty()) return false;
+
+  // HLSL: glslang's raw output is often not valid Vulkan SPIR-V (e.g. structs
+  // holding textures and samplers) until its legalization passes run; they
+  // cost more than everything else here, so they run only when spirv-val
+  // rejects the raw module. Either way the module kept is one spirv-val accepts.
+  if (hlsl && !spirvValid(result.spirv, nullptr, src.name, "spirv-val")) {
+    std::vector<uint32_t> legalized;
+    spv::SpvBuildLogger legalizeLogger;
+    spvOptions.disableOptimizer = false;  // glslang runs legalization only with its optimizer on
+    glslang::GlslangToSpv(*program.getIntermediate(stage), legalized, &legalizeLogger, &spvOptions);
+    const std::string legalizeLog = legalizeLogger.getAllMessages();
+    if (legalizeLog != spvLog) appendLog(result.log, legalizeLog);
+    if (containsLine(legalizeLog, "error") || legalized.empty()) return false;
+    result.spirv = std::move(legalized);
+  }
+  return true;
+}
+
+/// Checks the module's one entry point and runs spirv-val (and, when asked,
+/// spirv-opt and spirv-val again) on result.spirv; sets result.ok when all pass.
+void validateSpirvModule(const ShaderSource& src, const ValidateOptions& options, ShaderValidation& result) {
+  const std::vector<std::string> entries = entryPointNames(result.spirv);
+  if (entries.size() != 1 || entries.front() != src.entryPoint) {
+    appendLog(result.log, fmt::format("{}: expected exactly one entry point \"{}\", the module has {}", src.name,
+                                      src.entryPoint, entries.size()));
+    return;
+  }
+
+  if (!spirvValid(result.spirv, &result.log, src.name, "spirv-val")) return;
+  result.instructionCount = spirvInstructionCount(result.spirv);
+
+  if (options.optimize) {
+    std::vector<uint32_t> optimized;
+    spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
+    optimizer.SetMessageConsumer(collectInto(result.log, src.name, "spirv-opt"));
+    optimizer.RegisterPerformancePasses();
+    if (!optimizer.Run(result.spirv.data(), result.spirv.size(), &optimized, spvtools::ValidatorOptions(),
+                       /*skip_validation=*/true)) {
+      appendLog(result.log, fmt::format("{}: spirv-opt performance passes failed", src.name));
+      return;
+    }
+    if (!spirvValid(optimized, &result.log, src.name, "spirv-val (optimized)")) return;
+    result.optimizedInstructionCount = spirvInstructionCount(optimized);
+    result.optimized = std::move(optimized);
+  }
+  result.ok = true;
+}
+
+}  // namespace
+
 ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptions& options) {
   initializeGlslangOnce();
   ShaderValidation result;
@@ -249,63 +320,8 @@ ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptio
     return result;
   }
 
-  // glslang's GLSL front end declares storage buffers in the StorageBuffer
-  // class for SPIR-V >= 1.3, but its HLSL front end (12.0) keeps the
-  // Uniform + BufferBlock form that SPIR-V 1.4 removed, which spirv-val rejects
-  // for (RW)StructuredBuffer and ByteAddressBuffer. Ask for the 1.3 form.
-  program.getIntermediate(stage)->setUseStorageBuffer();
-
-  glslang::SpvOptions spvOptions;
-  spvOptions.generateDebugInfo = false;
-  spvOptions.validate = false;
-  spvOptions.disableOptimizer = true;
-  spv::SpvBuildLogger logger;
-  glslang::GlslangToSpv(*program.getIntermediate(stage), result.spirv, &logger, &spvOptions);
-  const std::string spvLog = logger.getAllMessages();
-  appendLog(result.log, spvLog);
-  if (containsLine(spvLog, "error") || result.spirv.empty()) return result;
-
-  // HLSL: glslang's raw output is often not valid Vulkan SPIR-V (e.g. structs
-  // holding textures and samplers) until its legalization passes run; they
-  // cost more than everything else here, so they run only when spirv-val
-  // rejects the raw module. Either way the module kept is one spirv-val accepts.
-  if (hlsl && !spirvValid(result.spirv, nullptr, src.name, "spirv-val")) {
-    std::vector<uint32_t> legalized;
-    spv::SpvBuildLogger legalizeLogger;
-    spvOptions.disableOptimizer = false;  // glslang runs legalization only with its optimizer on
-    glslang::GlslangToSpv(*program.getIntermediate(stage), legalized, &legalizeLogger, &spvOptions);
-    const std::string legalizeLog = legalizeLogger.getAllMessages();
-    if (legalizeLog != spvLog) appendLog(result.log, legalizeLog);
-    if (containsLine(legalizeLog, "error") || legalized.empty()) return result;
-    result.spirv = std::move(legalized);
-  }
-
-  const std::vector<std::string> entries = entryPointNames(result.spirv);
-  if (entries.size() != 1 || entries.front() != src.entryPoint) {
-    appendLog(result.log, fmt::format("{}: expected exactly one entry point \"{}\", the module has {}", src.name,
-                                      src.entryPoint, entries.size()));
-    return result;
-  }
-
-  if (!spirvValid(result.spirv, &result.log, src.name, "spirv-val")) return result;
-  result.instructionCount = spirvInstructionCount(result.spirv);
-
-  if (options.optimize) {
-    std::vector<uint32_t> optimized;
-    spvtools::Optimizer optimizer(SPV_ENV_VULKAN_1_2);
-    optimizer.SetMessageConsumer(collectInto(result.log, src.name, "spirv-opt"));
-    optimizer.RegisterPerformancePasses();
-    if (!optimizer.Run(result.spirv.data(), result.spirv.size(), &optimized, spvtools::ValidatorOptions(),
-                       /*skip_validation=*/true)) {
-      appendLog(result.log, fmt::format("{}: spirv-opt performance passes failed", src.name));
-      return result;
-    }
-    if (!spirvValid(optimized, &result.log, src.name, "spirv-val (optimized)")) return result;
-    result.optimizedInstructionCount = spirvInstructionCount(optimized);
-    result.optimized = std::move(optimized);
-  }
-
-  result.ok = true;
+  if (!spirvFromProgram(program, stage, hlsl, src, result)) return result;
+  validateSpirvModule(src, options, result);
   return result;
 }
 

@@ -57,50 +57,7 @@ bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName,
   for (pugi::xml_node n : root.children()) {
     if (n.type() != pugi::node_element) continue;
     if (isInclude(n)) {
-      const std::string href = n.attribute("href").as_string();
-      int line = includeLine, column = includeColumn;
-      if (depth == 0) lineColumnOf(self->text, static_cast<std::size_t>(n.offset_debug()), line, column);
-      auto fail = [&](const std::string& m) {
-        diags.errorAt(line, column, m);
-        ok = false;
-      };
-      if (href.empty()) {
-        fail("xi:include without an href");
-        continue;
-      }
-      if (depth + 1 > kMaxIncludeDepth || docs_.size() >= kMaxDocuments) {
-        fail(fmt::format("xi:include '{}': more than {} levels or {} files of includes", href, kMaxIncludeDepth,
-                         kMaxDocuments));
-        continue;
-      }
-      const std::filesystem::path path = std::filesystem::path(dir) / href;
-      Reading next{fileIdOf(path.string()), path.string(),
-                   (std::filesystem::path(reading.display).parent_path() / href).string()};
-      // A cycle: the file is one of those being read (the same file, however
-      // its path is spelled; by path only where it has no identity).
-      auto same = [&](const Reading& r) {
-        return next.id && r.id ? *next.id == *r.id : path.lexically_normal() == std::filesystem::path(r.path).lexically_normal();
-      };
-      if (auto open = std::find_if(loading_.begin(), loading_.end(), same); open != loading_.end()) {
-        std::string chain;
-        for (auto it = open; it != loading_.end(); ++it) chain += it->display + " -> ";
-        int holderLine = 0, holderColumn = 0;  // in the file that holds this include
-        lineColumnOf(self->text, static_cast<std::size_t>(std::max<std::ptrdiff_t>(n.offset_debug(), 0)), holderLine,
-                     holderColumn);
-        diags.errorIn(reading.display, holderLine, holderColumn,
-                      fmt::format("xi:include '{}' closes a cycle of includes ({}{})", href, chain, open->display));
-        ok = false;
-        continue;
-      }
-      Diagnostics readDiags(href);
-      auto included = readSourceFile(path.string(), limits, readDiags);
-      if (!included) {
-        fail(fmt::format("xi:include '{}': {}", href,
-                         readDiags.all().empty() ? std::string("cannot read it") : readDiags.all().front().message));
-        continue;
-      }
-      const std::string name = std::filesystem::path(href).filename().string();
-      if (!loadOne(*included, name, next, path.parent_path().string(), depth + 1, line, column, limits, diags)) ok = false;
+      if (!loadInclude(n, *self, reading, dir, depth, includeLine, includeColumn, limits, diags)) ok = false;
       continue;
     }
     const std::string name = n.attribute("name").as_string();
@@ -109,6 +66,54 @@ bool MtlxDocument::loadOne(const std::string& text, const std::string& fileName,
   }
   loading_.pop_back();
   return ok;
+}
+
+/// One xi:include of the file being read (`self`, at `reading`): its file read
+/// and loaded in turn, unless the href is missing, the include too deep or one
+/// too many, a cycle, or the file unreadable (each an error at the include).
+bool MtlxDocument::loadInclude(pugi::xml_node n, const Loaded& self, const Reading& reading, const std::string& dir,
+                               int depth, int includeLine, int includeColumn, const ReadLimits& limits,
+                               Diagnostics& diags) {
+  const std::string href = n.attribute("href").as_string();
+  int line = includeLine, column = includeColumn;
+  if (depth == 0) lineColumnOf(self.text, static_cast<std::size_t>(n.offset_debug()), line, column);
+  auto fail = [&](const std::string& m) {
+    diags.errorAt(line, column, m);
+    return false;
+  };
+  if (href.empty()) {
+    return fail("xi:include without an href");
+  }
+  if (depth + 1 > kMaxIncludeDepth || docs_.size() >= kMaxDocuments) {
+    return fail(fmt::format("xi:include '{}': more than {} levels or {} files of includes", href, kMaxIncludeDepth,
+                            kMaxDocuments));
+  }
+  const std::filesystem::path path = std::filesystem::path(dir) / href;
+  Reading next{fileIdOf(path.string()), path.string(),
+               (std::filesystem::path(reading.display).parent_path() / href).string()};
+  // A cycle: the file is one of those being read (the same file, however
+  // its path is spelled; by path only where it has no identity).
+  auto same = [&](const Reading& r) {
+    return next.id && r.id ? *next.id == *r.id : path.lexically_normal() == std::filesystem::path(r.path).lexically_normal();
+  };
+  if (auto open = std::find_if(loading_.begin(), loading_.end(), same); open != loading_.end()) {
+    std::string chain;
+    for (auto it = open; it != loading_.end(); ++it) chain += it->display + " -> ";
+    int holderLine = 0, holderColumn = 0;  // in the file that holds this include
+    lineColumnOf(self.text, static_cast<std::size_t>(std::max<std::ptrdiff_t>(n.offset_debug(), 0)), holderLine,
+                 holderColumn);
+    diags.errorIn(reading.display, holderLine, holderColumn,
+                  fmt::format("xi:include '{}' closes a cycle of includes ({}{})", href, chain, open->display));
+    return false;
+  }
+  Diagnostics readDiags(href);
+  auto included = readSourceFile(path.string(), limits, readDiags);
+  if (!included) {
+    return fail(fmt::format("xi:include '{}': {}", href,
+                            readDiags.all().empty() ? std::string("cannot read it") : readDiags.all().front().message));
+  }
+  const std::string name = std::filesystem::path(href).filename().string();
+  return loadOne(*included, name, next, path.parent_path().string(), depth + 1, line, column, limits, diags);
 }
 
 pugi::xml_node MtlxDocument::find(const std::string& name) const {

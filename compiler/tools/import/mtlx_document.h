@@ -54,6 +54,8 @@ class MtlxDocument {
   };
   bool loadOne(const std::string& text, const std::string& fileName, const Reading& reading, const std::string& dir,
                int depth, int includeLine, int includeColumn, const ReadLimits& limits, Diagnostics& diags);
+  bool loadInclude(pugi::xml_node n, const Loaded& self, const Reading& reading, const std::string& dir, int depth,
+                   int includeLine, int includeColumn, const ReadLimits& limits, Diagnostics& diags);
   const Loaded* owner(pugi::xml_node n) const;
 
   std::vector<std::unique_ptr<Loaded>> docs_;

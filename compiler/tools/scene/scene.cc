@@ -43,6 +43,148 @@ std::optional<Platform> choosePlatform(const SceneOptions& o, const SceneManifes
   return std::nullopt;
 }
 
+/// Every material's files go into one directory: their names must differ (also
+/// in letter case: file systems that ignore it, and the upper-case macros of one
+/// kernel). Reports each clash at the manifest entry; true when there was one.
+bool reportSceneNameClashes(const SceneOptions& o, const SceneManifest& scene, const std::vector<MaterialBuild>& built,
+                            SceneBuild& b) {
+  Diagnostics d(o.manifest);
+  d.setLocator(scene.locator);
+  std::map<std::string, std::size_t> seen;
+  for (std::size_t i = 0; i < built.size(); ++i) {
+    if (!built[i].ok) continue;
+    std::string key = built[i].summary.name;
+    for (char& c : key) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (auto [at, fresh] = seen.emplace(key, i); !fresh)
+      d.error(scene.materials[i].pointer,
+              fmt::format("material {} ({}) has the name of {} ({}){}: their shaders would overwrite each other",
+                          quoteForDiagnostic(built[i].summary.name), scene.materials[i].path,
+                          scene.materials[at->second].pointer, scene.materials[at->second].path,
+                          built[at->second].summary.name == built[i].summary.name
+                              ? ""
+                              : fmt::format(" but for letter case ({})",
+                                            quoteForDiagnostic(built[at->second].summary.name))));
+  }
+  b.messages += d.formatAll();
+  return d.hasErrors();
+}
+
+/// Whether the scene generates shaders for target `t`.
+bool sceneGenerates(const SceneOptions& o, Target t) {
+  return !((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl));
+}
+
+/// The lighting: what the materials store after simplification, and no more.
+/// The tile classification and one lighting shader per tile class, per target.
+Generated generateSceneLighting(const SceneOptions& o, const SceneShape& shape) {
+  Generated lighting;
+  for (Target t : {Target::Glsl, Target::Hlsl}) {
+    if (!sceneGenerates(o, t)) continue;
+    const Syntax& syn = syntaxFor(t);
+    lighting.files.push_back({tileClassificationFileName(shape, syn), emitTileClassification(shape, syn)});
+    for (const SceneLightingClass& k : shape.classes)
+      lighting.files.push_back({sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn)});
+  }
+  return lighting;
+}
+
+/// The SPIR-V instruction counts of each validated lighting file, by file name.
+using SceneCounts = std::map<std::string, const EntryReport*>;
+
+/// A file's {"instructions", "optimized_instructions"}, or {} when it was not validated.
+J sceneInstructions(const SceneCounts& counts, const std::string& file) {
+  J j = J::object();
+  if (auto it = counts.find(file); it != counts.end())
+    j = {{"instructions", it->second->instructions}, {"optimized_instructions", it->second->optimizedInstructions}};
+  return j;
+}
+
+/// scene.json's "lighting" entries, one a tile class; adds the instructions of
+/// the first target's lighting shaders to `total`.
+J sceneLightingReport(const SceneOptions& o, const SceneShape& shape, const SceneCounts& counts, std::size_t& total) {
+  const Syntax& first = syntaxFor(o.batch.generate.glsl ? Target::Glsl : Target::Hlsl);
+  J entries = J::array();
+  for (const SceneLightingClass& k : shape.classes) {
+    J e = {{"class", tileClassName(k.cls)},
+           {"features", featureArray(k.features)},
+           {"max_closures", k.maxClosures},
+           {"words", k.maxWords},
+           {"materials", k.materials}};
+    J files = J::object();
+    for (Target t : {Target::Glsl, Target::Hlsl}) {
+      if (!sceneGenerates(o, t)) continue;
+      const std::string file = sceneLightingFileName(shape, k.cls, syntaxFor(t));
+      files[std::string(syntaxFor(t).name)] = {{"file", file}, {"spirv", sceneInstructions(counts, file)}};
+    }
+    e["shaders"] = files;
+    if (auto it = counts.find(sceneLightingFileName(shape, k.cls, first)); it != counts.end())
+      total += it->second->instructions;
+    entries.push_back(e);
+  }
+  return entries;
+}
+
+/// scene.json's "materials": one entry a material, in manifest order.
+J sceneMaterialsReport(const SceneManifest& scene, const std::vector<MaterialBuild>& built) {
+  J materials = J::array();
+  for (std::size_t i = 0; i < built.size(); ++i) {
+    const MaterialSummary& s = built[i].summary;
+    materials.push_back({{"name", s.name},
+                         {"file", scene.materials[i].written},
+                         {"bytes_per_pixel", s.bytes},
+                         {"closures", s.closures},
+                         {"layout", std::string(layoutClassName(s.layoutClass))},
+                         {"features", featureArray(s.features)},
+                         {"runtime_simple", s.runtimeSimple},
+                         {"budget", {{"bytes_per_pixel", s.budgetBytes}, {"max_closures", s.maxClosures}}},
+                         {"simplification_steps", s.simplificationSteps}});
+  }
+  return materials;
+}
+
+/// scene.json: the platform, what the materials need at most, the lighting
+/// shaders with their SPIR-V sizes, and every material's summary.
+J sceneReport(const SceneOptions& o, const SceneManifest& scene, const std::optional<Platform>& platform,
+              const std::vector<MaterialBuild>& built, const SceneShape& shape, const SceneCounts& counts) {
+  J report;
+  report["format"] = "substrate-scene-report/1";
+  report["scene"] = scene.name;
+  if (platform) {
+    const Platform& p = *platform;
+    report["platform"] = {{"name", p.name}, {"bytes_per_pixel", p.bytesPerPixel}, {"max_closures", p.maxClosures},
+                          {"features", featureArray(p.allowedFeatures)}};
+  } else {
+    report["platform"] = nullptr;
+  }
+  std::uint16_t features = 0;
+  int maxBytes = 0;
+  for (const MaterialBuild& m : built) {
+    features |= m.summary.features;
+    maxBytes = std::max(maxBytes, m.summary.bytes);
+  }
+  report["features"] = featureArray(features);
+  report["max_bytes_per_pixel"] = maxBytes;
+  report["max_closures"] = shape.maxClosures;
+  report["words"] = shape.maxWords;
+  report["material_buffer_slices"] = materialBufferSlices(shape);
+  J classes = J::array();
+  for (const SceneLightingClass& k : shape.classes) classes.push_back(tileClassName(k.cls));
+  report["tile_classes"] = classes;
+  std::size_t total = 0;
+  J entries = sceneLightingReport(o, shape, counts, total);
+  report["lighting_spirv_instructions"] = total;
+  report["lighting"] = entries;
+  J classify = J::object();
+  for (Target t : {Target::Glsl, Target::Hlsl}) {
+    if (!sceneGenerates(o, t)) continue;
+    const std::string file = tileClassificationFileName(shape, syntaxFor(t));
+    classify[std::string(syntaxFor(t).name)] = {{"file", file}, {"spirv", sceneInstructions(counts, file)}};
+  }
+  report["tile_classification"] = classify;
+  report["materials"] = sceneMaterialsReport(scene, built);
+  return report;
+}
+
 }  // namespace
 
 SceneBuild buildScene(const SceneOptions& o) {
@@ -84,43 +226,14 @@ SceneBuild buildScene(const SceneOptions& o) {
     bad = bad || !m.ok;
     b.cacheHits += m.fromCache;
   }
-  {  // Every material's files go into one directory: names must differ (also in letter
-     // case: file systems that ignore it, and the upper-case macros of one kernel).
-    Diagnostics d(o.manifest);
-    d.setLocator(scene->locator);
-    std::map<std::string, std::size_t> seen;
-    for (std::size_t i = 0; i < built.size(); ++i) {
-      if (!built[i].ok) continue;
-      std::string key = built[i].summary.name;
-      for (char& c : key) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      if (auto [at, fresh] = seen.emplace(key, i); !fresh)
-        d.error(scene->materials[i].pointer,
-                fmt::format("material {} ({}) has the name of {} ({}){}: their shaders would overwrite each other",
-                            quoteForDiagnostic(built[i].summary.name), scene->materials[i].path,
-                            scene->materials[at->second].pointer, scene->materials[at->second].path,
-                            built[at->second].summary.name == built[i].summary.name
-                                ? ""
-                                : fmt::format(" but for letter case ({})",
-                                              quoteForDiagnostic(built[at->second].summary.name))));
-    }
-    b.messages += d.formatAll();
-    bad = bad || d.hasErrors();
-  }
+  if (reportSceneNameClashes(o, *scene, built, b)) bad = true;
   if (internal) return b.status = SceneStatus::InternalError, b;
   if (bad) return b.status = SceneStatus::BadInput, b;
 
-  // The lighting: what the materials store after simplification, and no more.
   std::vector<SceneMaterialShape> shapes;
   for (const MaterialBuild& m : built) shapes.push_back(m.summary.shape());
   const SceneShape shape = sceneShape(scene->name, shapes, o.batch.generate.emit.diffuseModel);
-  Generated lighting;
-  for (Target t : {Target::Glsl, Target::Hlsl}) {
-    if ((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl)) continue;
-    const Syntax& syn = syntaxFor(t);
-    lighting.files.push_back({tileClassificationFileName(shape, syn), emitTileClassification(shape, syn)});
-    for (const SceneLightingClass& k : shape.classes)
-      lighting.files.push_back({sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn)});
-  }
+  Generated lighting = generateSceneLighting(o, shape);
   if (o.batch.validate) {
     validateGenerated(lighting, {.optimize = true}, static_cast<std::size_t>(std::max(0, o.batch.jobs)));
     if (!lighting.valid) {
@@ -128,83 +241,9 @@ SceneBuild buildScene(const SceneOptions& o) {
       return b.status = SceneStatus::InternalError, b;
     }
   }
-  std::map<std::string, const EntryReport*> counts;
+  SceneCounts counts;
   for (const EntryReport& e : lighting.entries) counts[e.file] = &e;
-
-  // scene.json
-  J report;
-  report["format"] = "substrate-scene-report/1";
-  report["scene"] = scene->name;
-  if (batch.compile.platform) {
-    const Platform& p = *batch.compile.platform;
-    report["platform"] = {{"name", p.name}, {"bytes_per_pixel", p.bytesPerPixel}, {"max_closures", p.maxClosures},
-                          {"features", featureArray(p.allowedFeatures)}};
-  } else {
-    report["platform"] = nullptr;
-  }
-  std::uint16_t features = 0;
-  int maxBytes = 0;
-  for (const MaterialBuild& m : built) {
-    features |= m.summary.features;
-    maxBytes = std::max(maxBytes, m.summary.bytes);
-  }
-  report["features"] = featureArray(features);
-  report["max_bytes_per_pixel"] = maxBytes;
-  report["max_closures"] = shape.maxClosures;
-  report["words"] = shape.maxWords;
-  report["material_buffer_slices"] = materialBufferSlices(shape);
-  J classes = J::array();
-  for (const SceneLightingClass& k : shape.classes) classes.push_back(tileClassName(k.cls));
-  report["tile_classes"] = classes;
-  const Syntax& first = syntaxFor(o.batch.generate.glsl ? Target::Glsl : Target::Hlsl);
-  std::size_t total = 0;
-  J entries = J::array();
-  auto instructions = [&](const std::string& file) {
-    J j = J::object();
-    if (auto it = counts.find(file); it != counts.end())
-      j = {{"instructions", it->second->instructions}, {"optimized_instructions", it->second->optimizedInstructions}};
-    return j;
-  };
-  for (const SceneLightingClass& k : shape.classes) {
-    J e = {{"class", tileClassName(k.cls)},
-           {"features", featureArray(k.features)},
-           {"max_closures", k.maxClosures},
-           {"words", k.maxWords},
-           {"materials", k.materials}};
-    J files = J::object();
-    for (Target t : {Target::Glsl, Target::Hlsl}) {
-      if ((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl)) continue;
-      const std::string file = sceneLightingFileName(shape, k.cls, syntaxFor(t));
-      files[std::string(syntaxFor(t).name)] = {{"file", file}, {"spirv", instructions(file)}};
-    }
-    e["shaders"] = files;
-    if (auto it = counts.find(sceneLightingFileName(shape, k.cls, first)); it != counts.end())
-      total += it->second->instructions;
-    entries.push_back(e);
-  }
-  report["lighting_spirv_instructions"] = total;
-  report["lighting"] = entries;
-  J classify = J::object();
-  for (Target t : {Target::Glsl, Target::Hlsl}) {
-    if ((t == Target::Glsl && !o.batch.generate.glsl) || (t == Target::Hlsl && !o.batch.generate.hlsl)) continue;
-    const std::string file = tileClassificationFileName(shape, syntaxFor(t));
-    classify[std::string(syntaxFor(t).name)] = {{"file", file}, {"spirv", instructions(file)}};
-  }
-  report["tile_classification"] = classify;
-  J materials = J::array();
-  for (std::size_t i = 0; i < built.size(); ++i) {
-    const MaterialSummary& s = built[i].summary;
-    materials.push_back({{"name", s.name},
-                         {"file", scene->materials[i].written},
-                         {"bytes_per_pixel", s.bytes},
-                         {"closures", s.closures},
-                         {"layout", std::string(layoutClassName(s.layoutClass))},
-                         {"features", featureArray(s.features)},
-                         {"runtime_simple", s.runtimeSimple},
-                         {"budget", {{"bytes_per_pixel", s.budgetBytes}, {"max_closures", s.maxClosures}}},
-                         {"simplification_steps", s.simplificationSteps}});
-  }
-  report["materials"] = materials;
+  const J report = sceneReport(o, *scene, batch.compile.platform, built, shape, counts);
 
   for (MaterialBuild& m : built) {
     for (OutputFile& f : m.files) b.files.push_back(std::move(f));
