@@ -218,10 +218,11 @@ TEST(DeepTrees, ATreeOfMoreThan1024NodesIsTheDocumentedError) {
   // 512 vertical operators over 513 slabs: 1025 nodes.
   const CliRun r = runOnFile(verticalChain(512).dump(), "vertical512.json", {"report"});
   EXPECT_EQ(r.status, kExitBadInput) << r.err;
-  EXPECT_NE(r.err.find("vertical512.json: /nodes/v0: error: the Substrate tree would have more than 1024 nodes after "
+  EXPECT_NE(r.err.find("vertical512.json:1:65409: error: the Substrate tree would have more than 1024 nodes after "
                        "instancing"),
             std::string::npos)
       << r.err;
+  EXPECT_NE(r.err.find("this is the tree-size limit [/nodes/v0]\n"), std::string::npos) << r.err;
   EXPECT_EQ(r.out, "");
   // One node fewer than the limit allows is the deepest legal chain (next test);
   // 1024 itself cannot be reached: a binary tree has an odd number of nodes.

@@ -1,7 +1,7 @@
 // Tests for pass 2, resolve (compiler/core/passes/resolve.h), written as the
 // "Errors" section of material-format.md: a good document resolves with every
 // reference turned into an index; every kind of mistake is one located
-// diagnostic (`file: /json/pointer: error: ...`), and all of them are
+// diagnostic (`file:line:col: error: ... [/json/pointer]`), and all of them are
 // reported in one run.
 #include "passes/resolve.h"
 
