@@ -25,7 +25,7 @@
 #include <fmt/format.h>
 
 #include "pipeline/pipeline.h"
-#include "reference/random_walk.h"
+#include "reference/ground_truth.h"
 #include "reference/reference.h"
 
 namespace {

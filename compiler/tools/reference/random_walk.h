@@ -104,6 +104,21 @@ struct WalkLayer {
   V3<double> f0{0.04, 0.04, 0.04}, f90{1, 1, 1}, diffuseAlbedo{0, 0, 0}, mfp{0, 0, 0};
   double roughness = 0.5, phaseAnisotropy = 0, thickness = 0;
   bool opaqueBase = false;  // MFP 0: a Lambertian of diffuseAlbedo (or a conductor) right under the interface
+  // --- issue 18: every feature of the shipping model (ground_truth.cc fills these)
+  bool conductor = false;       // a conductor interface (complex IOR from f0 and f90) hiding everything below
+  double anisotropy = 0;        // -1..1, mapped to (alpha_x, alpha_y) as the runtime maps it
+  double tangentAngle = 0;      // this layer's tangent, rotated about the stack's normal from the stack's x (radians)
+  double secondRoughness = 0.5, secondRoughnessWeight = 0;  // haze: a second GGX lobe of the interface, by weight
+  double fuzzAmount = 0, fuzzRoughness = 0.5;               // fuzz: a sheen layer on top of the interface
+  V3<double> fuzzColor{0, 0, 0};
+  V3<double> specularTint{1, 1, 1};  // the specular profile's tint of the interface's reflection (1: none)
+};
+
+/// A Monte Carlo estimate: the mean per channel, its standard error, and the
+/// number of independent walks behind it.
+struct Estimate {
+  V3<double> value{0, 0, 0}, standardError{0, 0, 0};
+  long samples = 0;
 };
 
 struct WalkOptions {
@@ -125,6 +140,10 @@ struct WalkOptions {
   /// an interface's relative IOR is n_k / n_{k-1} (that base under that coat is
   /// index-matched: no specular of its own, no extra trapping; eta < 1 allowed).
   bool absoluteIor = false;
+  /// Rough interfaces scatter once on the microsurface (the classic microfacet
+  /// BSDF, which loses the inter-facet bounces) instead of walking it
+  /// (microsurface.h): for the single-scattering gates and comparisons.
+  bool singleScatteringInterfaces = false;
 };
 
 /// f(wo, wi) * |cos(wi)| of the stack (directions in the local frame, z up; wo
@@ -132,46 +151,14 @@ struct WalkOptions {
 V3<double> layeredEval(const std::vector<WalkLayer>& stack, const V3<double>& wo, const V3<double>& wi,
                        const WalkOptions& options);
 
+/// layeredEval and layeredAlbedo with their standard errors (same walks, same bits).
+Estimate layeredEvalEstimate(const std::vector<WalkLayer>& stack, const V3<double>& wo, const V3<double>& wi,
+                             const WalkOptions& options);
+Estimate layeredAlbedoEstimate(const std::vector<WalkLayer>& stack, const V3<double>& wo, const WalkOptions& options);
+
 /// Directional albedo of the stack for view wo: the integral of layeredEval over
 /// wi, estimated with `samples` forward walks (per channel group) that sample wi.
 V3<double> layeredAlbedo(const std::vector<WalkLayer>& stack, const V3<double>& wo, const WalkOptions& options);
-
-/// The ground truth of a compiled material at one shading point: f * cos for
-/// light L and view g.V (world space, around the geometric normal g.N; the
-/// material's normals are not used). The tree of r.material (pass the result of
-/// a compilation that did not simplify: a budget and closure count large enough)
-/// expands into a weighted sum of stacks (groundTruthTerms), each walked by
-/// layeredEval with seed + i * 0x9E3779B9 for term i (term 0: the seed, so a
-/// one-term material is layeredEval of its stack). Inputs at their
-/// defaults; `tex` samples textures (unset: value_eval's constant sample).
-V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
-                       const WalkOptions& options);
-
-/// One term of groundTruth: weight * layeredEval(stack).
-struct WalkTerm {
-  double weight = 1;
-  std::vector<WalkLayer> stack;
-};
-
-/// The tree as a weighted sum of stacks, combined linearly with the tree walk's
-/// weights (tree_walk.cc): a slab is [slab] with its own coverage (1 unless
-/// simplification made one); horizontal: background (1 - mix), foreground mix
-/// (mix saturated); select: background step, foreground 1 - step, step =
-/// threshold >= value; add: both, weight 1 each; coverage weight: times the
-/// weight (saturated); vertical: every top term over every base term (weights
-/// multiplied, stacks concatenated), plus the base terms alone times
-/// 1 - (coverage of the top), plus the top terms alone times 1 - (coverage of the
-/// base). A layer's thickness is that of TreeInfo::layerVertical's vertical
-/// (else settings.surfaceThickness); its MFP is sss_mfp * sss_mfp_scale; it is
-/// opaque when every channel of the MFP is <= 0 and its thickness is > 0 (no
-/// thickness is no matter: the runtime's exp(-0 / 0) is 1). Terms of weight 0
-/// are dropped.
-std::vector<WalkTerm> groundTruthTerms(const CompileResult& r, const Geometry& g, const TextureFn& tex);
-
-/// The closure without the features the walk does not model (anisotropy, haze,
-/// fuzz, glints, specular profiles: their feature bits cleared, their values
-/// neutral): the part of the analytic model the ground truth can judge.
-Closure<double> layeringOnly(Closure<double> c);
 
 /// van de Hulst's spherical albedo of a semi-infinite medium of single-scattering
 /// albedo `omega` and HG anisotropy g (through the similarity relation).

@@ -15,7 +15,7 @@
 #include "emit/material_emitter.h"
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
-#include "reference/random_walk.h"
+#include "reference/ground_truth.h"
 
 namespace substratec::sweep {
 

@@ -1,0 +1,166 @@
+// The ground truth of a compiled material (reference/ground_truth.h): the tree
+// as a weighted sum of stacks, each walked by layeredEval.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "pipeline/pipeline.h"
+#include "reference/ground_truth.h"
+#include "test_util.h"
+
+namespace substratec {
+namespace {
+
+using namespace reference;
+using D3 = V3<double>;
+
+D3 dir(double mu, double phi) {
+  double s = std::sqrt(std::max(0.0, 1 - mu * mu));
+  return {s * std::cos(phi), s * std::sin(phi), mu};
+}
+
+WalkOptions opts(int samples, std::uint32_t seed = 1, int maxDepth = 64) {
+  WalkOptions o;
+  o.samples = samples;
+  o.seed = seed;
+  o.maxDepth = maxDepth;
+  return o;
+}
+
+CompileResult compileUnsimplified(const std::string& name, const std::string& text) {
+  Diagnostics d(name);
+  CompileOptions o;
+  o.budgetOverride = 1 << 20;
+  o.maxClosuresOverride = 64;
+  auto r = compileText(name, text, o, d);
+  EXPECT_TRUE(r) << d.formatAll();
+  if (!r) return CompileResult{};
+  EXPECT_TRUE(r->steps.empty()) << name << " was simplified";
+  return std::move(*r);
+}
+
+TEST(RandomWalkGroundTruth, TheTreeIsAWeightedSumOfStacks) {
+  // A coat of coverage 0.25 over a 70/30 mix of an opaque slab a and an SSS slab b:
+  //   coat/a 0.25 * 0.7, coat/b 0.25 * 0.3, a 0.75 * 0.7, b 0.75 * 0.3.
+  const std::string nodes = R"(
+    "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.1, "sss_mfp": 2, "sss_mfp_scale": 0.5},
+    "a": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.4},
+    "b": {"kind": "slab", "diffuse_albedo": [0.2, 0.3, 0.4], "f0": 0.04, "roughness": 0.6, "sss_mfp": [0.01, 0.02, 0.03]},
+    "mix": {"kind": "horizontal", "background": "a", "foreground": "b", "mix": 0.3},
+    "wc": {"kind": "coverage_weight", "a": "coat", "weight": 0.25},
+    "root": {"kind": "vertical", "top": "wc", "base": "mix", "thickness": 0.002})";
+  CompileResult r = compileUnsimplified("tree.json", test::material(nodes));
+  std::vector<WalkTerm> t = groundTruthTerms(r, Geometry{}, {});
+  ASSERT_EQ(t.size(), 4u);
+  const double w[4] = {0.175, 0.075, 0.525, 0.225};
+  const std::size_t layers[4] = {2, 2, 1, 1};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(t[i].weight, w[i], 1e-12) << i;
+    EXPECT_EQ(t[i].stack.size(), layers[i]) << i;
+  }
+  const WalkLayer& coat = t[0].stack[0];
+  EXPECT_DOUBLE_EQ(coat.thickness, 0.002);  // the vertical's
+  EXPECT_DOUBLE_EQ(coat.mfp[1], 1.0);       // sss_mfp * sss_mfp_scale
+  EXPECT_FALSE(coat.opaqueBase);
+  EXPECT_DOUBLE_EQ(coat.roughness, 0.1);
+  EXPECT_TRUE(t[0].stack[1].opaqueBase);    // a: MFP 0 is opaque
+  EXPECT_DOUBLE_EQ(t[0].stack[1].diffuseAlbedo[2], 0.5);
+  EXPECT_FALSE(t[1].stack[1].opaqueBase);   // b: an SSS medium
+  EXPECT_DOUBLE_EQ(t[1].stack[1].mfp[2], 0.03);
+  EXPECT_DOUBLE_EQ(t[1].stack[1].roughness, 0.6);
+}
+
+std::vector<std::filesystem::path> examples() {
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(SUBSTRATEC_SOURCE_DIR "/examples"))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string readText(const std::filesystem::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+TEST(RandomWalkGroundTruth, OneStackIsLayeredEvalInTheGeometricFrame) {
+  // row40_coating: a clear coat over the base slab, one term; in the identity
+  // frame groundTruth is layeredEval of that stack with the same seed.
+  const auto path = std::filesystem::path(SUBSTRATEC_SOURCE_DIR "/examples/row40_coating.json");
+  CompileResult r = compileUnsimplified(path.string(), readText(path));
+  Geometry g;
+  g.V = dir(0.6, 0.3);
+  std::vector<WalkTerm> t = groundTruthTerms(r, g, {});
+  ASSERT_EQ(t.size(), 1u);
+  ASSERT_EQ(t[0].stack.size(), 2u);
+  EXPECT_DOUBLE_EQ(t[0].stack[0].thickness, 0.0001);
+  EXPECT_DOUBLE_EQ(t[0].stack[0].roughness, 0.05);
+  EXPECT_DOUBLE_EQ(t[0].stack[1].mfp[0], 0.006);
+  D3 L = dir(0.8, 2.0);
+  D3 a = groundTruth(r, g, L, {}, opts(512, 9));
+  D3 b = layeredEval(t[0].stack, g.V, L, opts(512, 9));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-12 * b[c]);
+  // A tilted frame: the same directions relative to N give the same value.
+  Geometry tilted;
+  const D3 N = {0, std::sin(0.5), std::cos(0.5)}, T = {1, 0, 0}, B = {0, std::cos(0.5), -std::sin(0.5)};
+  auto world = [&](const D3& v) {
+    return D3{T[0] * v[0] + B[0] * v[1] + N[0] * v[2], T[1] * v[0] + B[1] * v[1] + N[1] * v[2],
+              T[2] * v[0] + B[2] * v[1] + N[2] * v[2]};
+  };
+  tilted.N = N;
+  tilted.T = T;
+  tilted.V = world(g.V);
+  D3 c = groundTruth(r, tilted, world(L), {}, opts(512, 9));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(c[k], b[k], 1e-9 * b[k]);
+  // Light below the horizon: nothing.
+  D3 below = groundTruth(r, g, D3{0.3, 0, -0.9}, {}, opts(64));
+  EXPECT_EQ(below[0] + below[1] + below[2], 0);
+}
+
+TEST(RandomWalkGroundTruth, RunsOnEveryExample) {
+  // Every example, unsimplified, at its defaults, for a few geometries (one
+  // with a procedural texture sampler): finite, non-negative, and not all zero.
+  const TextureFn tex = [](int, double u, double v) {
+    return std::array<double, 4>{0.5 + 0.4 * std::sin(7 * u), 0.5 + 0.4 * std::cos(5 * v), 0.3, 1};
+  };
+  int count = 0;
+  for (const auto& path : examples()) {
+    CompileResult r = compileUnsimplified(path.filename().string(), readText(path));
+    ASSERT_GE(r.material.root, 0) << path;
+    EXPECT_FALSE(groundTruthTerms(r, Geometry{}, {}).empty()) << path;
+    double total = 0;
+    for (int k = 0; k < 3; ++k) {
+      Geometry g;
+      if (k == 1) {
+        g.N = {0.2, -0.3, 0.93};
+        g.T = {1, 0.1, 0};
+      }
+      g.V = k == 2 ? dir(0.1, 0) : dir(0.7, 0.5);
+      g.uv0 = {0.25 + 0.3 * k, 0.75};
+      const D3 L = k == 1 ? D3{-0.3, 0.2, 0.93} : dir(0.5, 2.5);
+      D3 f = groundTruth(r, g, L, k == 1 ? tex : TextureFn{}, opts(64, 1 + k));
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_TRUE(std::isfinite(f[c])) << path << " geometry " << k;
+        EXPECT_GE(f[c], 0) << path << " geometry " << k;
+        total += f[c];
+      }
+    }
+    EXPECT_GT(total, 0) << path;
+    ++count;
+  }
+  EXPECT_GE(count, 16);
+}
+
+
+}  // namespace
+}  // namespace substratec
