@@ -28,10 +28,10 @@ D3 dir(double mu, double phi) {
 }
 
 /// Mean and standard error of microfacetDiffuse over `runs` independent seeds.
-struct Estimate {
+struct SeedSpread {
   double mean, stderr_;
 };
-Estimate estimate(double albedo, double r, const D3& wo, const D3& wi, int runs, int samples, std::uint32_t seed0) {
+SeedSpread estimate(double albedo, double r, const D3& wo, const D3& wi, int runs, int samples, std::uint32_t seed0) {
   double s = 0.0, s2 = 0.0;
   for (int k = 0; k < runs; ++k) {
     double v = microfacetDiffuse(albedo, r, wo, wi, samples, seed0 + static_cast<std::uint32_t>(k));
@@ -83,8 +83,8 @@ TEST(DiffuseReference, RoughnessToZeroConvergesToLambert) {
   for (double muI : {1.0, 0.866, 0.1}) {
     D3 wi = dir(muI, 2.5);
     double lambert = 1.0 / std::numbers::pi * muI;
-    Estimate e05 = estimate(1.0, 0.05, wo, wi, 8, 4000, 10);
-    Estimate e25 = estimate(1.0, 0.25, wo, wi, 8, 4000, 20);
+    SeedSpread e05 = estimate(1.0, 0.05, wo, wi, 8, 4000, 10);
+    SeedSpread e25 = estimate(1.0, 0.25, wo, wi, 8, 4000, 20);
     double d05 = e05.mean / lambert - 1.0, d25 = e25.mean / lambert - 1.0;
     std::printf("[ info ] muI %.3f: r=0.05 %+.4f (se %.4f), r=0.25 %+.4f (se %.4f) relative to Lambert\n", muI,
                 d05, e05.stderr_ / lambert, d25, e25.stderr_ / lambert);
@@ -112,8 +112,8 @@ TEST(DiffuseReference, IsReciprocalWithinNoise) {
   };
   for (Pair p : {Pair{1.0, 0.9, 0.3, 2.0}, Pair{0.5, 0.7, 0.15, 0.4}, Pair{0.75, 0.2, 0.6, 3.0}}) {
     D3 a = dir(p.muA, 0.0), b = dir(p.muB, p.phiB);
-    Estimate ab = estimate(1.0, p.r, a, b, 8, 20000, 1000);
-    Estimate ba = estimate(1.0, p.r, b, a, 8, 20000, 2000);
+    SeedSpread ab = estimate(1.0, p.r, a, b, 8, 20000, 1000);
+    SeedSpread ba = estimate(1.0, p.r, b, a, 8, 20000, 2000);
     double fab = ab.mean / b[2], fba = ba.mean / a[2];
     double se = std::hypot(ab.stderr_ / b[2], ba.stderr_ / a[2]);
     std::printf("[ info ] r %.2f: f(a,b) %.4f, f(b,a) %.4f, se %.4f\n", p.r, fab, fba, se);
