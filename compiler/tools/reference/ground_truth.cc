@@ -152,25 +152,65 @@ Closure<double> layeringOnly(Closure<double> c) {
   return c;
 }
 
-V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
-                       const WalkOptions& options) {
-  // The geometric frame: N, the tangent made orthogonal to it, B = N x T.
-  const V N = normalizedOr(g.N, V{0, 0, 1});
-  V t0, b0;
-  orthonormalBasis(N, t0, b0);
-  const V T = normalizedOr(g.T - N * dot(N, g.T), t0);
-  const V B = cross(N, T);
-  const V wo = normalizedOr(V{dot(g.V, T), dot(g.V, B), dot(g.V, N)}, V{0, 0, 1});
-  const V wi = normalizedOr(V{dot(L, T), dot(L, B), dot(L, N)}, V{0, 0, 1});
-  V sum{0, 0, 0};
-  if (!(wo[2] > 0) || !(wi[2] > 0)) return sum;
-  std::vector<WalkTerm> terms = groundTruthTerms(r, g, tex);
+namespace {
+
+/// The view and light in the local frame of the geometric normal and tangent
+/// (N, the tangent made orthogonal to it, B = N x T).
+struct LocalFrame {
+  V N, T, B;
+  explicit LocalFrame(const Geometry& g) {
+    N = normalizedOr(g.N, V{0, 0, 1});
+    V t0, b0;
+    orthonormalBasis(N, t0, b0);
+    T = normalizedOr(g.T - N * dot(N, g.T), t0);
+    B = cross(N, T);
+  }
+  V local(const V& w) const { return normalizedOr(V{dot(w, T), dot(w, B), dot(w, N)}, V{0, 0, 1}); }
+};
+
+/// Sums weight * estimate over the terms (term i walked with seed + i * 0x9E3779B9);
+/// independent terms: the standard errors add in quadrature.
+template <class F>
+Estimate sumTerms(const std::vector<WalkTerm>& terms, const WalkOptions& options, F&& walk) {
+  Estimate sum;
+  V var{0, 0, 0};
   for (std::size_t i = 0; i < terms.size(); ++i) {
     WalkOptions o = options;
     o.seed = options.seed + static_cast<std::uint32_t>(i) * 0x9E3779B9u;
-    sum = sum + layeredEval(terms[i].stack, wo, wi, o) * terms[i].weight;
+    const Estimate e = walk(terms[i].stack, o);
+    const double w = terms[i].weight;
+    sum.value = sum.value + e.value * w;
+    var = var + e.standardError * e.standardError * (w * w);
+    sum.samples += e.samples;
   }
+  for (int c = 0; c < 3; ++c) sum.standardError[c] = std::sqrt(var[c]);
   return sum;
+}
+
+}  // namespace
+
+Estimate groundTruthEstimate(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
+                             const WalkOptions& options) {
+  const LocalFrame f(g);
+  const V wo = f.local(g.V), wi = f.local(L);
+  if (!(wo[2] > 0) || !(wi[2] > 0)) return Estimate{};
+  return sumTerms(groundTruthTerms(r, g, tex), options, [&](const std::vector<WalkLayer>& stack, const WalkOptions& o) {
+    return layeredEvalEstimate(stack, wo, wi, o);
+  });
+}
+
+V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
+                       const WalkOptions& options) {
+  return groundTruthEstimate(r, g, L, tex, options).value;
+}
+
+Estimate groundTruthAlbedo(const CompileResult& r, const Geometry& g, const TextureFn& tex, const WalkOptions& options) {
+  const LocalFrame f(g);
+  const V wo = f.local(g.V);
+  if (!(wo[2] > 0)) return Estimate{};
+  return sumTerms(groundTruthTerms(r, g, tex), options, [&](const std::vector<WalkLayer>& stack, const WalkOptions& o) {
+    return layeredAlbedoEstimate(stack, wo, o);
+  });
 }
 
 }  // namespace substratec::reference

@@ -656,34 +656,62 @@ struct EvalWalk {
   }
 };
 
+/// The running mean and standard error of one group's per-walk contributions.
+struct Tally {
+  V sum{0, 0, 0}, sum2{0, 0, 0};
+  long n = 0;
+  void add(const V& x) {
+    sum = sum + x;
+    sum2 = sum2 + x * x;
+    ++n;
+  }
+  Estimate estimate(const V& offset = V{0, 0, 0}) const {
+    Estimate e;
+    e.samples = n;
+    if (n <= 0) {
+      e.value = offset;
+      return e;
+    }
+    const double dn = static_cast<double>(n);
+    const V mean = sum / dn;
+    e.value = offset + mean;
+    for (int c = 0; c < 3; ++c) {
+      const double var = n > 1 ? std::max(0.0, (sum2[c] / dn - mean[c] * mean[c]) * dn / (dn - 1)) : 0.0;
+      e.standardError[c] = std::sqrt(var / dn);
+    }
+    return e;
+  }
+};
+
 /// layeredEval for one group: sum over the walks of f(wo, wi) (no cosine), divided by the count.
-V evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, SplitMix64& rng) {
+Estimate evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, SplitMix64& rng) {
   const Resolved& s = grp.stack;
   const Interface& top = s.ifc[0];
   const V topReflection = bsdfF(top, wo, wi, Mode::Importance);
   const int last = s.lastLayer();
-  if (last < 0 || o.samples <= 0) return topReflection;  // a conductor alone
+  if (last < 0 || o.samples <= 0) return Tally{}.estimate(topReflection);  // a conductor alone
   const bool exitDelta = top.kind == Interface::Kind::Pass;
 
   std::vector<V> chainDir(static_cast<std::size_t>(last) + 1), chainW(static_cast<std::size_t>(last) + 1);
-  V sum{0, 0, 0};
+  Tally tally;
   for (int sample = 0; sample < o.samples; ++sample) {
+    V sum{0, 0, 0};
     double pB0 = kInf;
     const int chainLen = traceLightChain(s, last, wi, rng, chainDir, chainW, pB0);
     EvalWalk walk{s, wi, exitDelta, chainDir, chainW, chainLen, pB0, rng, sum};
-    if (!walk.enter(wo)) continue;
-    walk.run(o.maxDepth, grp.mask);
+    if (walk.enter(wo)) walk.run(o.maxDepth, grp.mask);
+    tally.add(sum);
   }
-  return topReflection + sum / static_cast<double>(o.samples);
+  return tally.estimate(topReflection);
 }
 
 /// layeredAlbedo for one group: the mean weight with which forward walks leave the top.
-V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& rng) {
+Estimate albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& rng) {
   const Resolved& s = grp.stack;
   const int n = static_cast<int>(s.ifc.size());
-  V sum{0, 0, 0};
-  if (o.samples <= 0) return sum;
+  Tally tally;
   for (int sample = 0; sample < o.samples; ++sample) {
+    V sum{0, 0, 0};
     V beta{1, 1, 1}, w = neg(wo);
     int k = 0;
     double t = 0;
@@ -747,8 +775,9 @@ V albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& r
         t = 0;
       }
     }
+    tally.add(sum);
   }
-  return sum / static_cast<double>(o.samples);
+  return tally.estimate();
 }
 
 V unitOr(const V& v, const V& fallback) {
@@ -759,15 +788,19 @@ V unitOr(const V& v, const V& fallback) {
 
 /// Runs `walk` per channel group and gathers each group's channels.
 template <class F>
-V perGroup(const std::vector<WalkLayer>& stack, const WalkOptions& o, std::uint64_t purpose, F&& walk) {
-  V out{0, 0, 0};
+Estimate perGroup(const std::vector<WalkLayer>& stack, const WalkOptions& o, std::uint64_t purpose, F&& walk) {
+  Estimate out;
   if (stack.empty()) return out;
   std::vector<Group> gs = groups(stack, o.albedoSeenThroughInterface, o.absoluteIor);
   for (std::size_t gi = 0; gi < gs.size(); ++gi) {
     SplitMix64 rng = walkStream(o.seed, purpose * 8 + gi);
-    V v = walk(gs[gi], rng);
+    Estimate v = walk(gs[gi], rng);
+    out.samples += v.samples;
     for (int c = 0; c < 3; ++c)
-      if (gs[gi].mask[c]) out[c] = v[c];
+      if (gs[gi].mask[c]) {
+        out.value[c] = v.value[c];
+        out.standardError[c] = v.standardError[c];
+      }
   }
   return out;
 }
@@ -832,18 +865,30 @@ double fresnelDielectric(double cosThetaI, double eta) {
   return 0.5 * (rParl * rParl + rPerp * rPerp);
 }
 
+Estimate layeredEvalEstimate(const std::vector<WalkLayer>& stack, const V3<double>& wo, const V3<double>& wi,
+                             const WalkOptions& options) {
+  if (!(wo[2] > 0) || !(wi[2] > 0)) return Estimate{};
+  const V o = unitOr(wo, V{0, 0, 1}), i = unitOr(wi, V{0, 0, 1});
+  Estimate f =
+      perGroup(stack, options, 1, [&](const Group& g, SplitMix64& rng) { return evalGroup(g, o, i, options, rng); });
+  f.value = f.value * i[2];
+  f.standardError = f.standardError * i[2];
+  return f;
+}
+
+Estimate layeredAlbedoEstimate(const std::vector<WalkLayer>& stack, const V3<double>& wo, const WalkOptions& options) {
+  if (!(wo[2] > 0)) return Estimate{};
+  const V o = unitOr(wo, V{0, 0, 1});
+  return perGroup(stack, options, 2, [&](const Group& g, SplitMix64& rng) { return albedoGroup(g, o, options, rng); });
+}
+
 V3<double> layeredEval(const std::vector<WalkLayer>& stack, const V3<double>& wo, const V3<double>& wi,
                        const WalkOptions& options) {
-  if (!(wo[2] > 0) || !(wi[2] > 0)) return {0, 0, 0};
-  const V o = unitOr(wo, V{0, 0, 1}), i = unitOr(wi, V{0, 0, 1});
-  V f = perGroup(stack, options, 1, [&](const Group& g, SplitMix64& rng) { return evalGroup(g, o, i, options, rng); });
-  return f * i[2];
+  return layeredEvalEstimate(stack, wo, wi, options).value;
 }
 
 V3<double> layeredAlbedo(const std::vector<WalkLayer>& stack, const V3<double>& wo, const WalkOptions& options) {
-  if (!(wo[2] > 0)) return {0, 0, 0};
-  const V o = unitOr(wo, V{0, 0, 1});
-  return perGroup(stack, options, 2, [&](const Group& g, SplitMix64& rng) { return albedoGroup(g, o, options, rng); });
+  return layeredAlbedoEstimate(stack, wo, options).value;
 }
 
 }  // namespace substratec::reference
