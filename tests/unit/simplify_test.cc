@@ -82,8 +82,8 @@ constexpr int kTrials = 300;
 
 TEST(Blend, HorizontalOfASlabWithItselfIsTheIdentity) {
   std::mt19937 rng(1);
-  Material m;
   for (int i = 0; i < kTrials; ++i) {
+    Material m;  // one per trial: evaluating a value costs the size of its DAG
     Slab s = randomSlab(m, rng);
     // Normals of randomSlab are unit, so normalize() keeps them.
     Slab r = blendHorizontal(m, s, s, m.values.scalar(std::uniform_real_distribution<double>(0, 1)(rng)));
@@ -94,8 +94,8 @@ TEST(Blend, HorizontalOfASlabWithItselfIsTheIdentity) {
 
 TEST(Blend, HorizontalWithWeightZeroOrOneIsOneSide) {
   std::mt19937 rng(2);
-  Material m;
   for (int i = 0; i < kTrials; ++i) {
+    Material m;  // one per trial: evaluating a value costs the size of its DAG
     Slab bg = randomSlab(m, rng), fg = randomSlab(m, rng);
     expectSameSlab(m, blendHorizontal(m, bg, fg, m.values.scalar(0)), bg, 1e-9, "w=0");
     expectSameSlab(m, blendHorizontal(m, bg, fg, m.values.scalar(1)), fg, 1e-9, "w=1");
@@ -104,8 +104,8 @@ TEST(Blend, HorizontalWithWeightZeroOrOneIsOneSide) {
 
 TEST(Blend, VerticalWithATopOfCoverageZeroIsTheBase) {
   std::mt19937 rng(3);
-  Material m;
   for (int i = 0; i < kTrials; ++i) {
+    Material m;  // one per trial: evaluating a value costs the size of its DAG
     Slab top = randomSlab(m, rng), base = randomSlab(m, rng, /*features=*/i % 2 == 0);
     top.coverage = m.values.scalar(0);
     Slab r = blendVertical(m, top, base, m.values.scalar(1e-3));
@@ -118,8 +118,8 @@ TEST(Blend, VerticalUnderAFullyTransparentTopKeepsTheBasesEnergy) {
   // A fully transparent top: the pair is the top's interface (here one that
   // reflects nothing) returning exactly the base's single-interface albedo.
   std::mt19937 rng(4);
-  Material m;
   for (int i = 0; i < kTrials; ++i) {
+    Material m;  // one per trial: evaluating a value costs the size of its DAG
     Slab top = randomSlab(m, rng), base = randomSlab(m, rng, /*features=*/false);
     top.pin(SlabPin::F0) = m.values.splat(VType::Vec3, 0);
     top.pin(SlabPin::F90) = m.values.splat(VType::Vec3, 0);  // reflects at no angle
@@ -145,8 +145,8 @@ TEST(Blend, VerticalUnderAFullyTransparentTopKeepsTheBasesEnergy) {
 TEST(Blend, CoverageAndEnergyNeverGrow) {
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(0.0, 1.0);
-  Material m;
   for (int i = 0; i < kTrials; ++i) {
+    Material m;  // one per trial: evaluating a value costs the size of its DAG
     Slab a = randomSlab(m, rng), b = randomSlab(m, rng);
     double ca = u(rng), cb = u(rng), w = u(rng), d = 2e-3 * u(rng);
     a.coverage = m.values.scalar(ca);
