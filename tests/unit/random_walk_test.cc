@@ -253,7 +253,7 @@ TEST(RandomWalkSmooth, ACoatOverALambertianMatchesTheAddingFormula) {
     for (double mu : {1.0, 0.6, 0.2}) {
       const double F = fresnel(mu, 1, n);
       const double R = F + (1 - F) * a * (1 - Fi) / (1 - a * Fi);
-      const int walks = 40000;
+      const int walks = a < 0.4 ? 200000 : (a < 0.7 ? 160000 : (a < 0.9 ? 60000 : 40000));
       const Estimate e = layeredAlbedoEstimate({slab}, dir(mu, 0), opts(walks, 7));
       EXPECT_REL(e.value[0], R, 0.005) << "a " << a << " mu " << mu << " se " << e.standardError[0];
       EXPECT_LT(e.standardError[0], 0.0015 * R) << "a " << a << " mu " << mu;
@@ -418,7 +418,7 @@ TEST(RandomWalkFurnace, SingleScatteringMatchesQuadrature) {
     white.roughness = r;
     white.opaqueBase = true;
     white.conductor = true;
-    WalkOptions o = opts(100000, 14);
+    WalkOptions o = opts(r < 0.5 ? 150000 : 800000, 14);
     o.singleScatteringInterfaces = true;
     const Estimate walked = layeredAlbedoEstimate({white}, wo, o);
     EXPECT_REL(walked.value[0], E, 0.002);
@@ -469,7 +469,9 @@ TEST(RandomWalkFurnace, EveryNonAbsorbingStackReturnsAllTheLight) {
   double lo = 2, hi = 0;
   for (const auto& stack : furnaceGrid())
     for (double mu : {1.0, 0.6, 0.2}) {
-      const Estimate e = layeredAlbedoEstimate(stack, dir(mu, 0.3), opts(400, 21));
+      WalkOptions o = opts(400, 21);
+      o.maxDepth = WalkOptions{}.maxDepth;
+      const Estimate e = layeredAlbedoEstimate(stack, dir(mu, 0.3), o);
       EXPECT_NEAR(e.value[0], 1.0, 0.005) << stack.size() << " layers, roughness " << stack.back().roughness
                                            << (stack.back().conductor ? " conductor" : " dielectric") << " mu " << mu;
       lo = std::min(lo, e.value[0]);
@@ -528,20 +530,22 @@ TEST(RandomWalkEval, IntegratesToTheForwardWalksAlbedo) {
                                    {{smooth, dusty, sssBase()}, true}};
   const D3 wo = dir(0.6, 0.4), mirror = {-wo[0], -wo[1], wo[2]};
   for (const Case& k : cases) {
-    const int m = 32;
+    const int m = 24;
     D3 integral{0, 0, 0};
     for (int i = 0; i < m; ++i)
       for (int j = 0; j < m; ++j) {
         double u1 = (i + 0.5) / m, u2 = (j + 0.5) / m;
         D3 wi = dir(std::sqrt(1 - u1), 2 * std::numbers::pi * u2);  // cosine-distributed: estimator pi f = pi eval / cos
         if (k.smoothTop && wi[0] * mirror[0] + wi[1] * mirror[1] + wi[2] * mirror[2] > std::cos(0.05)) continue;
-        D3 f = layeredEval(k.stack, wo, wi, opts(96, 100 + i * m + j));
+        D3 f = layeredEval(k.stack, wo, wi, opts(64, 100 + i * m + j, 1024));
         for (int c = 0; c < 3; ++c) integral[c] += std::numbers::pi * f[c] / wi[2] / (m * m);
       }
-    D3 albedo = layeredAlbedo(k.stack, wo, opts(40000, 15));
+    D3 albedo = layeredAlbedo(k.stack, wo, opts(40000, 15, 1024));
     const double r12 = k.smoothTop ? fresnel(wo[2], 1, 1.5) : 0;
     for (int c = 0; c < 3; ++c)
       EXPECT_REL(integral[c], albedo[c] - r12, 0.04) << k.stack.size() << " layers, channel " << c;
+    std::printf("eval vs albedo: %zu layers: %+.2f %+.2f %+.2f %%\n", k.stack.size(), 100 * (integral[0] / (albedo[0] - r12) - 1),
+                100 * (integral[1] / (albedo[1] - r12) - 1), 100 * (integral[2] / (albedo[2] - r12) - 1));
   }
 }
 
@@ -554,8 +558,8 @@ TEST(RandomWalkReciprocity, FIsSymmetricInViewAndLight) {
   int cases = 0;
   for (const auto& stack : stacks)
     for (auto [a, b] : {std::pair{dir(0.8, 0.1), dir(0.3, 2.0)}, std::pair{dir(0.95, 0), dir(0.2, 1.0)}}) {
-      const Estimate fab = layeredEvalEstimate(stack, a, b, opts(4096, 16));
-      const Estimate fba = layeredEvalEstimate(stack, b, a, opts(4096, 17));
+      const Estimate fab = layeredEvalEstimate(stack, a, b, opts(4096, 16, 1024));
+      const Estimate fba = layeredEvalEstimate(stack, b, a, opts(4096, 17, 1024));
       for (int c = 0; c < 3; ++c) {
         const double x = fab.value[c] / b[2], y = fba.value[c] / a[2];
         const double se = std::hypot(fab.standardError[c] / b[2], fba.standardError[c] / a[2]);
@@ -609,7 +613,9 @@ TEST(RandomWalkFeatures, HazeTintAndF90) {
   EXPECT_EQ(b[2], a[2]);
   cases += 3;
   // F90 < 1 of a dielectric darkens its grazing reflection.
-  WalkLayer coat = clearCoat(), dim = clearCoat();
+  WalkLayer coat = clearCoat();
+  coat.roughness = 0;  // F90 acts on single-scattering lobes only (random_walk.h)
+  WalkLayer dim = coat;
   dim.f90 = grey(0.5);
   const double r1 = layeredAlbedo({coat}, dir(0.1, 0), opts(4096, 43))[0];
   const double r2 = layeredAlbedo({dim}, dir(0.1, 0), opts(4096, 43))[0];

@@ -443,7 +443,7 @@ double underInterface(double A, double f0) {
 /// inter-facet bounces carry < 0.1 % of the energy (E_ss of GGX at alpha 0.02
 /// is 0.9996 at grazing... measured in random_walk_test) and the single
 /// scattering lobe is exact, cheaper and noiseless to evaluate.
-constexpr double kMultipleMinAlpha = 0.02;
+constexpr double kMultipleMinAlpha = 0.002;
 
 /// Gulbrandsen's edge tint from the slab's F0 and F90: g = F90 (1 - (1 - F0)^2.75).
 /// The factor is the g whose curve is closest to Schlick's with F90 = 1 (fitted

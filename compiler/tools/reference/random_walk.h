@@ -123,7 +123,7 @@ struct Estimate {
 
 struct WalkOptions {
   int samples = 4096;           // walks per channel group
-  int maxDepth = 64;            // events per walk (interfaces, media, base); see the cost note above
+  int maxDepth = 1024;            // events per walk (interfaces, media, base); see the cost note above
   std::uint32_t seed = 1;
   /// The albedo convention. false (the default, the model above): diffuse_albedo is
   /// the albedo of the medium alone (index-matched), the Lambertian's albedo.
