@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include <algorithm>
+#include <chrono>
 #include <array>
 #include <cmath>
 #include <complex>
@@ -671,6 +672,40 @@ TEST(RandomWalkDeterminism, TheSeedFixesEveryBit) {
   }
   D3 x = layeredAlbedo(stack, wo, opts(2048, 42)), y = layeredAlbedo(stack, wo, opts(2048, 42));
   for (int k = 0; k < 3; ++k) EXPECT_EQ(x[k], y[k]);
+}
+
+// The walk's cost (docs/performance.md), not a test: run it with
+//   build/bin/unit_tests --gtest_also_run_disabled_tests --gtest_filter='RandomWalkCost.*'
+// ms per layeredEval / layeredAlbedo at the default options (4096 samples,
+// maxDepth 1024), and in the single-scattering mode at maxDepth 64 (the walk
+// of issue 17 and before), one core.
+TEST(RandomWalkCost, DISABLED_MsPerEvaluation) {
+  WalkLayer coat = clearCoat();
+  coat.mfp = grey(1e6);
+  const std::vector<std::pair<const char*, std::vector<WalkLayer>>> stacks = {
+      {"coat over plastic", {coat, plastic()}}, {"SSS base", {sssBase()}}, {"conductor", {gold()}},
+      {"coat over conductor", {coat, gold()}}};
+  const D3 wo = dir(0.8, 0), wi = dir(0.8124, 2.1);
+  for (bool single : {false, true}) {
+    WalkOptions o;
+    if (single) {
+      o.singleScatteringInterfaces = true;
+      o.maxDepth = 64;
+    }
+    std::printf("samples %d, maxDepth %d%s\n", o.samples, o.maxDepth, single ? ", single scattering" : "");
+    for (const auto& [name, stack] : stacks) {
+      const int n = 10;
+      double sink = 0;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int i = 0; i < n; ++i) sink += layeredEval(stack, wo, wi, o)[0];
+      const auto t1 = std::chrono::steady_clock::now();
+      for (int i = 0; i < n; ++i) sink += layeredAlbedo(stack, wo, o)[0];
+      const auto t2 = std::chrono::steady_clock::now();
+      std::printf("  %-20s eval %7.2f ms  albedo %7.2f ms  (%g)\n", name,
+                  std::chrono::duration<double, std::milli>(t1 - t0).count() / n,
+                  std::chrono::duration<double, std::milli>(t2 - t1).count() / n, sink);
+    }
+  }
 }
 
 }  // namespace

@@ -1,10 +1,12 @@
 // The position-free random walk through a layer stack (random_walk.h has the
 // model and the estimator; this file follows it section by section):
 //   1. random numbers (splitmix64);
-//   2. the interfaces: GGX (pbrt-v4's TrowbridgeReitzDistribution: D, Smith
-//      Lambda, visible-normal sampling), the rough dielectric (pbrt-v4's
-//      DielectricBxDF, rough branch), the Schlick conductor, and the
-//      pass-through of an index-matched boundary;
+//   2. the interfaces: anisotropic GGX (pbrt-v4's TrowbridgeReitzDistribution:
+//      D, Smith Lambda, visible-normal sampling), the single-scattering rough
+//      dielectric and conductor (pbrt-v4's DielectricBxDF / ConductorBxDF,
+//      exact Fresnel), the microsurface walk (microsurface.h) behind one
+//      interface API (ifcSample / ifcF / ifcPdf, ifcSplit for the albedo walk),
+//      and the pass-through of an index-matched boundary;
 //   3. the media: Henyey-Greenstein, the albedo inversion;
 //   4. a stack resolved for one group of channels (same IORs and optical
 //      thicknesses), the walks (eval: NEE + MIS; albedo: forward).
