@@ -524,7 +524,12 @@ TEST(RandomWalkEval, IntegratesToTheForwardWalksAlbedo) {
   };
   WalkLayer polished = gold();
   polished.roughness = 0;  // under a rough coat: strategy A carries the paths
+  WalkLayer fuzzy = plastic();  // the sheen layer: its sampling against its f
+  fuzzy.fuzzAmount = 0.8;
+  fuzzy.fuzzRoughness = 0.6;
+  fuzzy.fuzzColor = {1, 0.6, 0.3};
   const std::vector<Case> cases = {{{plastic()}, false},
+                                   {{fuzzy}, false},
                                    {{dusty, sssBase()}, false},
                                    {{dusty, gold()}, false},
                                    {{dusty, polished}, false},
@@ -638,6 +643,9 @@ TEST(RandomWalkFeatures, HardCasesAreFinite) {
       L.thickness = 1e-3;
       L.anisotropy = r > 0 ? -1 : 1;
       L.secondRoughnessWeight = 0.5;
+      L.fuzzAmount = 1;
+      L.fuzzRoughness = r;
+      L.fuzzColor = grey(1);
       layers.push_back(L);
     }
   WalkLayer metal = gold();

@@ -21,7 +21,9 @@
 #include <numbers>
 #include <vector>
 
+#include "reference/bsdf.h"
 #include "reference/common.h"
+#include "reference/energy_lut.h"
 #include "reference/microsurface.h"
 #include "util/random.h"
 
@@ -131,6 +133,8 @@ struct Interface {
   V n{1, 1, 1}, k{0, 0, 0};        // conductor: complex IOR per channel
   double dielF0 = 0, dielF90 = 1;  // dielectric: F90 remap of exact Fresnel (F90 1: none)
   V tint{1, 1, 1};                 // reflection seen from above
+  double fuzzAmount = 0, fuzzRough = 0.5;  // the sheen layer on top (fuzz)
+  V fuzzColor{0, 0, 0};
 };
 
 struct BsdfSample {
@@ -139,6 +143,14 @@ struct BsdfSample {
   double pdf = 0;  // the (proxy) density of wi, for MIS
   bool reflect = false;
 };
+
+V unitOr(const V& v, const V& fallback) {
+  double l2 = dot(v, v);
+  if (!(l2 > 0) || !std::isfinite(l2)) return fallback;
+  return v / std::sqrt(l2);
+}
+
+V sampleCosine(double u1, double u2);
 
 V reflectAbout(const V& wo, const V& n) { return n * (2 * dot(wo, n)) - wo; }
 
@@ -272,7 +284,7 @@ V tintOf(const Interface& I, const V& wo, const V& wi) { return wo[2] > 0 && wi[
 
 /// f(wo, wi) of the interface (no cosine): the lobes' mixture; a stochastic
 /// (unbiased) estimate where a lobe walks its microsurface.
-V ifcF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng) {
+V coreF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng) {
   if (I.kind == Interface::Kind::Pass || wi[2] == 0) return {0, 0, 0};
   const V lo = toLocal(I, wo), li = toLocal(I, wi);
   V f{0, 0, 0};
@@ -288,7 +300,7 @@ V ifcF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng)
 
 /// The density (a proxy where a lobe walks its microsurface, pdfMicrosurface)
 /// with which ifcSample(wo, flags) returns wi.
-double ifcPdf(const Interface& I, const V& wo, const V& wi, int flags) {
+double corePdf(const Interface& I, const V& wo, const V& wi, int flags) {
   if (I.kind == Interface::Kind::Pass) return 0;
   const V lo = toLocal(I, wo), li = toLocal(I, wi);
   const int side = lo[2] * li[2] > 0 ? kReflection : kTransmission;
@@ -312,7 +324,7 @@ double ifcPdf(const Interface& I, const V& wo, const V& wi, int flags) {
 /// weight of a kept exit stays f / p_all — the restricted estimator is then
 /// the integral of f over the wanted side only, unbiased (the single-scattering
 /// lobes instead renormalize their Fresnel choice among the allowed lobes).
-bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
+bool coreSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
   if (I.kind == Interface::Kind::Pass) return false;
   const int l = (I.haze > 0 && (I.haze >= 1 || rng.uniform() < I.haze)) ? 1 : 0;
   const Lobe& L = I.lobe[l];
@@ -331,7 +343,7 @@ bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int 
   s.wi = toStack(I, s.wi);
   if (!(s.wi[2] != 0) || !std::isfinite(s.weight[0] + s.weight[1] + s.weight[2])) return false;
   s.weight = s.weight * tintOf(I, wo, s.wi);
-  s.pdf = ifcPdf(I, wo, s.wi, flags);
+  s.pdf = corePdf(I, wo, s.wi, flags);
   return s.pdf > 0;
 }
 
@@ -342,7 +354,7 @@ bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int 
 /// E[r.weight] + E[t.weight] is the interface's whole albedo, with no Bernoulli
 /// choice between them); on a microsurface walk the exit fills one of them.
 /// A zero weight: that side is absent.
-void ifcSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
+void coreSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
   r = BsdfSample{};
   t = BsdfSample{};
   const int l = (I.haze > 0 && (I.haze >= 1 || rng.uniform() < I.haze)) ? 1 : 0;
@@ -379,6 +391,81 @@ void ifcSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, B
     if (!std::isfinite(s->weight[0] + s->weight[1] + s->weight[2]) || s->wi[2] == 0) s->weight = V{0, 0, 0};
     s->weight = s->weight * tintOf(I, wo, s->wi);
     s->reflect = s == &r;
+  }
+}
+
+// The fuzz of a layer: a sheen layer on top of its interface, the runtime's
+// model as a layer (bsdf.cc, substrate_eval_closure): reflection the Charlie
+// sheen lobe amount * colour * charlieSheen / max(1, E_fuzz(mu_o)); everything
+// else crosses it straight, with weight 1 - amount * min(E_fuzz(mu), 1) at
+// each crossing (mu that of the direction above). An energy-conserving "mean
+// sheen layer" (what the sheen reflects at most, amount * min(E, 1), is what
+// it takes from the crossing light) — the LTC / table sheen of the runtime as
+// a layer, not a volumetric fibre walk. Light from below that the fuzz would
+// reflect back down is absorbed.
+
+double fuzzCatch(const Interface& I, double mu) {
+  return I.fuzzAmount * std::min(fuzzAlbedo(std::clamp(mu, 0.0, 1.0), I.fuzzRough), 1.0);
+}
+double fuzzPass(const Interface& I, double mu) { return I.fuzzAmount > 0 ? 1 - fuzzCatch(I, mu) : 1.0; }
+/// The sheen's f |cos wi| (wo, wi above).
+V sheenFcos(const Interface& I, const V& wo, const V& wi) {
+  const V h = unitOr(wo + wi, V{0, 0, 1});
+  const double e = fuzzAlbedo(std::clamp(wo[2], 0.0, 1.0), I.fuzzRough);
+  return I.fuzzColor * (I.fuzzAmount * charlieSheen(I.fuzzRough, wo[2], wi[2], h[2]) / std::max(1.0, e));
+}
+
+V ifcF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng) {
+  V f = coreF(I, wo, wi, mode, rng);
+  if (!(I.fuzzAmount > 0) || wi[2] == 0) return f;
+  if (wo[2] > 0) f = f * fuzzPass(I, wo[2]);
+  if (wi[2] > 0) f = f * fuzzPass(I, wi[2]);
+  if (wo[2] > 0 && wi[2] > 0) f = f + sheenFcos(I, wo, wi) / wi[2];
+  return f;
+}
+
+double ifcPdf(const Interface& I, const V& wo, const V& wi, int flags) {
+  const double p = corePdf(I, wo, wi, flags);
+  if (!(I.fuzzAmount > 0) || !(wo[2] > 0)) return p;
+  const double q = fuzzCatch(I, wo[2]);
+  return (1 - q) * p + ((flags & kReflection) && wi[2] > 0 ? q * wi[2] * kInvPi : 0);
+}
+
+/// The sheen picked with probability q (wo above): a cosine-sampled reflection.
+bool sheenSample(const Interface& I, const V& wo, double q, SplitMix64& rng, BsdfSample& s) {
+  s.wi = sampleCosine(rng.uniform(), rng.uniform());
+  if (!(s.wi[2] > 0)) return false;
+  s.weight = sheenFcos(I, wo, s.wi) / (q * s.wi[2] * kInvPi);
+  s.reflect = true;
+  return true;
+}
+
+bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
+  if (!(I.fuzzAmount > 0)) return coreSample(I, wo, rng, mode, flags, s);
+  const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
+  if (q > 0 && rng.uniform() < q) {
+    if (!(flags & kReflection) || !sheenSample(I, wo, q, rng, s)) return false;
+  } else {
+    if (!coreSample(I, wo, rng, mode, flags, s)) return false;
+    if (wo[2] > 0) s.weight = s.weight * (fuzzPass(I, wo[2]) / (1 - q));
+    if (s.wi[2] > 0) s.weight = s.weight * fuzzPass(I, s.wi[2]);
+  }
+  s.pdf = ifcPdf(I, wo, s.wi, flags);
+  return s.pdf > 0 && std::isfinite(s.weight[0] + s.weight[1] + s.weight[2]);
+}
+
+void ifcSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
+  if (!(I.fuzzAmount > 0)) return coreSplit(I, wo, rng, r, t);
+  const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
+  if (q > 0 && rng.uniform() < q) {
+    t = BsdfSample{};
+    if (!sheenSample(I, wo, q, rng, r)) r = BsdfSample{};
+    return;
+  }
+  coreSplit(I, wo, rng, r, t);
+  for (BsdfSample* x : {&r, &t}) {
+    if (wo[2] > 0) x->weight = x->weight * (fuzzPass(I, wo[2]) / (1 - q));
+    if (x->wi[2] > 0) x->weight = x->weight * fuzzPass(I, x->wi[2]);
   }
 }
 
@@ -486,6 +573,9 @@ void finishInterface(Interface& I, const WalkLayer& L, int rc, bool single) {
   I.lobe[0] = makeLobe(I, L.roughness, L.anisotropy, single);
   I.lobe[1] = makeLobe(I, L.secondRoughness, L.anisotropy, single);
   I.tint = vclamp(L.specularTint, 0.0, 1.0);
+  I.fuzzAmount = saturate1(L.fuzzAmount);
+  I.fuzzRough = saturate1(L.fuzzRoughness);
+  I.fuzzColor = vclamp(L.fuzzColor, 0.0, 1.0);
 }
 
 /// The stack with the IORs and optical thicknesses of channel `rc`; per-channel
@@ -563,6 +653,14 @@ WalkLayer sanitized(const WalkLayer& L) {
   s.roughness = orZero(L.roughness);
   s.phaseAnisotropy = orZero(L.phaseAnisotropy);
   s.thickness = orZero(L.thickness);
+  s.anisotropy = orZero(L.anisotropy);
+  s.tangentAngle = orZero(L.tangentAngle);
+  s.secondRoughness = orZero(L.secondRoughness);
+  s.secondRoughnessWeight = orZero(L.secondRoughnessWeight);
+  s.fuzzAmount = orZero(L.fuzzAmount);
+  s.fuzzRoughness = orZero(L.fuzzRoughness);
+  s.fuzzColor = orZero(L.fuzzColor);
+  s.specularTint = orZero(L.specularTint);
   return s;
 }
 
@@ -978,11 +1076,6 @@ Estimate albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitM
   return tally.estimate();
 }
 
-V unitOr(const V& v, const V& fallback) {
-  double l2 = dot(v, v);
-  if (!(l2 > 0) || !std::isfinite(l2)) return fallback;
-  return v / std::sqrt(l2);
-}
 
 /// Runs `walk` per channel group and gathers each group's channels.
 template <class F>

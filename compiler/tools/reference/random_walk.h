@@ -51,6 +51,17 @@
 //       lobes): sampling picks a lobe by its weight, f and the pdf mix.
 //     - specularTint multiplies the reflection of the interface seen from
 //       above (in [0, 1]: it absorbs the rest of F, never creates energy).
+//     - Fuzz: a sheen layer on top of the layer's interface — the runtime's
+//       model as a layer (bsdf.cc): reflection the Charlie sheen lobe amount *
+//       colour * charlieSheen / max(1, E_fuzz(mu_o)) (sampled by cosine with
+//       probability amount * min(E_fuzz(mu_o), 1)); everything else crosses it
+//       straight with weight 1 - amount * min(E_fuzz(mu), 1) at each crossing
+//       (mu of the direction above). An energy-conserving "mean sheen layer"
+//       (it reflects at most what it takes from the crossing light), the LTC /
+//       table sheen of the runtime as a layer, not a volumetric fibre walk;
+//       light from below that it would send back down is absorbed. Not
+//       reciprocal (the runtime's normalization by E_fuzz(mu_o) is not). Fuzz
+//       on an index-matched (F0 0) interface is not walked (a pass-through).
 //   * Medium of a layer that is not the bottom: thickness d (the vertical's
 //     thickness), extinction sigma_t = 1 / MFP per channel (MFP clamped to
 //     >= 1e-30), so optical thickness tau = d / MFP; single-scattering albedo
@@ -128,8 +139,7 @@
 //   long walks: the albedo of an SSS slab (F0 0.04, roughness 0.5) at A = 0.5
 //   / 0.8 / 0.95 was short by 0 / 6 / 22 % at maxDepth 64 (single scattering).
 //
-// NOT MODELLED: fuzz (WalkLayer's fuzz fields are not read yet: the sheen
-//   layer of issue 18 is not built), glints, emissive, SSS type (wrap /
+// NOT MODELLED: fuzz on an index-matched interface, glints, emissive, SSS type (wrap /
 //   diffusion: only the medium counts), F90 of rough (microsurface) dielectric
 //   lobes, thin-surface transmission (the bottom is semi-infinite or opaque),
 //   normal maps (ground_truth.cc's frame). Specular profiles enter as their
