@@ -186,6 +186,13 @@ struct Walk {
   /// The weight's factor of one refraction into relative index e.
   double refractionFactor(double e) const { return mode == Transport::Radiance ? 1 / (e * e) : 1.0; }
 
+  /// The conductor's Fresnel per channel (computed once for grey n, k).
+  V conductorFresnel(double c) const {
+    double f0 = fresnelConductor(c, m.n[0], m.k[0]);
+    if (m.n[1] == m.n[0] && m.n[2] == m.n[0] && m.k[1] == m.k[0] && m.k[2] == m.k[0]) return {f0, f0, f0};
+    return {f0, fresnelConductor(c, m.n[1], m.k[1]), fresnelConductor(c, m.n[2], m.k[2])};
+  }
+
   /// Samples the phase function at the current vertex (the ray arrived along w).
   bool scatter(SplitMix64& rng) {
     V v = neg(w);
@@ -193,8 +200,7 @@ struct Walk {
     V mn = sl.sampleDwi(v, u1, u2);
     double c = std::max(0.0, dot(v, mn));
     if (m.kind == Microsurface::Kind::Conductor) {
-      weight = mul(weight, V{fresnelConductor(c, m.n[0], m.k[0]), fresnelConductor(c, m.n[1], m.k[1]),
-                             fresnelConductor(c, m.n[2], m.k[2])});
+      weight = mul(weight, conductorFresnel(c));
       w = reflect(v, mn);
       return finite(w);
     }
@@ -220,9 +226,7 @@ struct Walk {
     if (c <= 0) return {0, 0, 0};
     double p = 0.25 * sl.Dwi(v, wh) / c;
     if (m.kind == Microsurface::Kind::Dielectric) return scale(V{1, 1, 1}, p * fresnelDielectric(c, eta()));
-    return scale(V{fresnelConductor(c, m.n[0], m.k[0]), fresnelConductor(c, m.n[1], m.k[1]),
-                   fresnelConductor(c, m.n[2], m.k[2])},
-                 p);
+    return scale(conductorFresnel(c), p);
   }
 
   /// phase(v, wl) where wl (local frame, wl.z < 0) is on the other side
