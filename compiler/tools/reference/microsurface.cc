@@ -186,6 +186,13 @@ struct Walk {
   /// The weight's factor of one refraction into relative index e.
   double refractionFactor(double e) const { return mode == Transport::Radiance ? 1 / (e * e) : 1.0; }
 
+  /// The conductor's Fresnel per channel (computed once for grey n, k).
+  V conductorFresnel(double c) const {
+    double f0 = fresnelConductor(c, m.n[0], m.k[0]);
+    if (m.n[1] == m.n[0] && m.n[2] == m.n[0] && m.k[1] == m.k[0] && m.k[2] == m.k[0]) return {f0, f0, f0};
+    return {f0, fresnelConductor(c, m.n[1], m.k[1]), fresnelConductor(c, m.n[2], m.k[2])};
+  }
+
   /// Samples the phase function at the current vertex (the ray arrived along w).
   bool scatter(SplitMix64& rng) {
     V v = neg(w);
@@ -193,8 +200,7 @@ struct Walk {
     V mn = sl.sampleDwi(v, u1, u2);
     double c = std::max(0.0, dot(v, mn));
     if (m.kind == Microsurface::Kind::Conductor) {
-      weight = mul(weight, V{fresnelConductor(c, m.n[0], m.k[0]), fresnelConductor(c, m.n[1], m.k[1]),
-                             fresnelConductor(c, m.n[2], m.k[2])});
+      weight = mul(weight, conductorFresnel(c));
       w = reflect(v, mn);
       return finite(w);
     }
@@ -220,9 +226,7 @@ struct Walk {
     if (c <= 0) return {0, 0, 0};
     double p = 0.25 * sl.Dwi(v, wh) / c;
     if (m.kind == Microsurface::Kind::Dielectric) return scale(V{1, 1, 1}, p * fresnelDielectric(c, eta()));
-    return scale(V{fresnelConductor(c, m.n[0], m.k[0]), fresnelConductor(c, m.n[1], m.k[1]),
-                   fresnelConductor(c, m.n[2], m.k[2])},
-                 p);
+    return scale(conductorFresnel(c), p);
   }
 
   /// phase(v, wl) where wl (local frame, wl.z < 0) is on the other side
@@ -243,14 +247,32 @@ struct Walk {
   }
 
   /// Next-event estimate towards the global exit wi (in the arrival frame):
-  /// phase(-w, wi) G_1(wi, h), shadowing towards the side wi is on.
+  /// phase(-w, wi) G_1(wi, h), shadowing towards the side wi is on. At the
+  /// first vertex G_1 is replaced by its expectation over the first hit's
+  /// height (C1(h) = U^(1 / (1 + Lambda_o)) from above the surface): the
+  /// height-correlated G2 / G1 of Heitz 2014 — same mean, less variance.
   V nextEvent(const V& wi) const {
     V wl = side > 0 ? wi : neg(wi);
     V v = neg(w);
-    if (wl[2] > 0) return scale(mul(weight, reflectionPhase(v, wl)), G1(sl, wl, h));
+    double lo = order == 1 ? sl.Lambda(v) : 0;
+    if (wl[2] > 0) {
+      double g = order == 1 ? firstShadowingSame(lo, sl.Lambda(wl)) : G1(sl, wl, h);
+      return scale(mul(weight, reflectionPhase(v, wl)), g);
+    }
     if (m.kind == Microsurface::Kind::Conductor) return {0, 0, 0};
-    double p = transmissionPhase(v, wl) * G1(sl, neg(wl), -h);
-    return scale(weight, p);
+    double g = order == 1 ? firstShadowingOther(lo, sl.Lambda(neg(wl))) : G1(sl, neg(wl), -h);
+    return scale(weight, transmissionPhase(v, wl) * g);
+  }
+  /// E[C1(h)^li] over the first hit: (1 + lo) / (1 + lo + li).
+  static double firstShadowingSame(double lo, double li) {
+    if (!std::isfinite(li)) return 0;
+    return (1 + lo) / (1 + lo + li);
+  }
+  /// E[(1 - C1(h))^li] over the first hit: a B(a, li + 1), a = 1 + lo.
+  static double firstShadowingOther(double lo, double li) {
+    if (!std::isfinite(li) || !std::isfinite(lo)) return 0;
+    double a = 1 + lo;
+    return a * std::exp(std::lgamma(a) + std::lgamma(li + 1) - std::lgamma(a + li + 1));
   }
 };
 
