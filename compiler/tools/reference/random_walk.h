@@ -129,12 +129,13 @@
 //   0.1 keeps 0.994 at NoV 0.2 (the furnace gate fails), at 1024 0.9992. Walks
 //   end early by roulette unless the stack is bright, so the cost is paid by
 //   bright stacks only.
-//   Cost (one core, -O2, 4096 samples, ms per layeredEval / layeredAlbedo;
-//   before = the single-scattering walk of commit 9c10eb0 at maxDepth 64):
-//     coat over plastic    11.4 / 6.8  ->  34.6 / 18.6
-//     SSS base (A 0.8/0.5/0.2)  29.6 / 19.3  ->  158 / 37.6 (72 / 17.8 at maxDepth 64)
-//     conductor             0.0 / 0.9  ->  4.4 / 3.1
-//     coat over conductor   9.1 / 4.9  ->  37.2 / 13.4
+//   Cost (one core, -O2, 4096 samples, ms per layeredEval / layeredAlbedo,
+//   measured back to back; before = the single-scattering walk of commit
+//   9c10eb0 at maxDepth 64):
+//     coat over plastic          5.1 / 3.5   ->  15.1 / 9.2
+//     SSS base (A 0.8/0.5/0.2)  13.3 / 6.6   ->  77 / 16.9
+//     conductor                  0.004 / 0.43 ->  2.1 / 1.4
+//     coat over conductor        4.6 / 2.3   ->  16.4 / 6.1
 //   (docs/performance.md: the command). Bright semi-infinite media need the
 //   long walks: the albedo of an SSS slab (F0 0.04, roughness 0.5) at A = 0.5
 //   / 0.8 / 0.95 was short by 0 / 6 / 22 % at maxDepth 64 (single scattering).
