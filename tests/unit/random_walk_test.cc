@@ -207,9 +207,9 @@ TEST(RandomWalkInversion, TheWalkOfTheInvertedMediumHasTheArtistsAlbedo) {
 
 TEST(RandomWalkIndexMatched, AClearCoatOfIorOneIsTheBaseAlone) {
   // F0 = 0 is an index-matched boundary; with thickness 0 (or an MFP 1e9 times
-  // the thickness) the coat is no matter at all. 16384 walks per estimate,
-  // noise ~1.2 % each: tolerance 6 % (measured: -0.3 .. +1.8 %); albedos
-  // (20000 walks) within 0.015 (measured <= 0.005).
+  // the thickness) the coat is no matter at all: coat + base equals the base
+  // within 4 combined standard errors (the Estimates'), eval (4096 walks) and
+  // albedo (8192 walks).
   WalkLayer none;
   none.f0 = grey(0);
   none.roughness = 0.2;
@@ -219,17 +219,21 @@ TEST(RandomWalkIndexMatched, AClearCoatOfIorOneIsTheBaseAlone) {
   thin.thickness = 1e-3;
   thin.mfp = grey(1e6);
   thin.diffuseAlbedo = grey(0.5);
+  int cases = 0;
   for (const WalkLayer& coat : {none, thin})
     for (const WalkLayer& base : {sssBase(), plastic()}) {
       for (auto [wo, wi] : {std::pair{dir(0.8, 0.1), dir(0.3, 2.0)}, std::pair{dir(0.5, 0), dir(0.6, 3.0)}}) {
-        D3 a = layeredEval({coat, base}, wo, wi, opts(16384, 3));
-        D3 b = layeredEval({base}, wo, wi, opts(16384, 4));
-        for (int c = 0; c < 3; ++c) EXPECT_REL(a[c], b[c], 0.06);
+        const Estimate a = layeredEvalEstimate({coat, base}, wo, wi, opts(4096, 3));
+        const Estimate b = layeredEvalEstimate({base}, wo, wi, opts(4096, 4));
+        for (int c = 0; c < 3; ++c, ++cases)
+          EXPECT_NEAR(a.value[c], b.value[c], 4 * std::hypot(a.standardError[c], b.standardError[c]));
       }
-      D3 a = layeredAlbedo({coat, base}, dir(0.7, 0), opts(20000, 5));
-      D3 b = layeredAlbedo({base}, dir(0.7, 0), opts(20000, 6));
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 0.015);
+      const Estimate a = layeredAlbedoEstimate({coat, base}, dir(0.7, 0), opts(8192, 5));
+      const Estimate b = layeredAlbedoEstimate({base}, dir(0.7, 0), opts(8192, 6));
+      for (int c = 0; c < 3; ++c, ++cases)
+        EXPECT_NEAR(a.value[c], b.value[c], 4 * std::hypot(a.standardError[c], b.standardError[c]));
     }
+  EXPECT_EQ(cases, 36);
 }
 
 TEST(RandomWalkSmooth, ACoatOverALambertianMatchesTheAddingFormula) {
