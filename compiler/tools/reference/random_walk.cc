@@ -1,10 +1,12 @@
 // The position-free random walk through a layer stack (random_walk.h has the
 // model and the estimator; this file follows it section by section):
 //   1. random numbers (splitmix64);
-//   2. the interfaces: GGX (pbrt-v4's TrowbridgeReitzDistribution: D, Smith
-//      Lambda, visible-normal sampling), the rough dielectric (pbrt-v4's
-//      DielectricBxDF, rough branch), the Schlick conductor, and the
-//      pass-through of an index-matched boundary;
+//   2. the interfaces: anisotropic GGX (pbrt-v4's TrowbridgeReitzDistribution:
+//      D, Smith Lambda, visible-normal sampling), the single-scattering rough
+//      dielectric and conductor (pbrt-v4's DielectricBxDF / ConductorBxDF,
+//      exact Fresnel), the microsurface walk (microsurface.h) behind one
+//      interface API (ifcSample / ifcF / ifcPdf, ifcSplit for the albedo walk),
+//      and the pass-through of an index-matched boundary;
 //   3. the media: Henyey-Greenstein, the albedo inversion;
 //   4. a stack resolved for one group of channels (same IORs and optical
 //      thicknesses), the walks (eval: NEE + MIS; albedo: forward).
@@ -19,7 +21,10 @@
 #include <numbers>
 #include <vector>
 
+#include "reference/bsdf.h"
 #include "reference/common.h"
+#include "reference/energy_lut.h"
+#include "reference/microsurface.h"
 #include "util/random.h"
 
 namespace substratec::reference {
@@ -59,21 +64,29 @@ double powerHeuristic(double a, double b) {
 
 // ---------------------------------------------------------------------------
 // 2. Interfaces.
+//
+// One place for every interface event: ifcSample / ifcF / ifcPdf (below) take
+// the interface's frame (its tangent rotation), its lobes (haze: two GGX
+// microsurfaces by weight), its tint and its scattering model: the microsurface
+// walk of microsurface.h (Heitz et al. 2016, every order) or, for the
+// single-scattering mode and near-smooth lobes, the classic single-scattering
+// microfacet BSDF (pbrt-v4's rough DielectricBxDF / ConductorBxDF, GGX with
+// height-correlated Smith).
 
-/// Isotropic GGX (Trowbridge-Reitz) with height-correlated Smith masking.
+/// Anisotropic GGX (Trowbridge-Reitz) with height-correlated Smith masking, in
+/// the lobe's own frame (x the tangent, alphaX along it).
 struct Ggx {
-  double a = kWalkMinAlpha;
+  double ax = kWalkMinAlpha, ay = kWalkMinAlpha;
 
   double D(const V& m) const {
     if (m[2] <= 0) return 0;
-    double a2 = a * a;
-    double d = a2 * m[2] * m[2] + (m[0] * m[0] + m[1] * m[1]);
-    return a2 / (std::numbers::pi * d * d);
+    double d = sq(m[0] / ax) + sq(m[1] / ay) + m[2] * m[2];
+    return 1 / (std::numbers::pi * ax * ay * d * d);
   }
   double lambda(const V& w) const {
     double c2 = w[2] * w[2];
     if (c2 == 0) return kInf;
-    double x = a * a * (w[0] * w[0] + w[1] * w[1]) / c2;
+    double x = (sq(ax * w[0]) + sq(ay * w[1])) / c2;
     return 0.5 * x / (std::sqrt(1 + x) + 1);  // (sqrt(1 + x) - 1) / 2 without cancellation
   }
   double G1(const V& w) const { return 1 / (1 + lambda(w)); }
@@ -85,7 +98,7 @@ struct Ggx {
   }
   /// Samples a visible normal from w (w flipped to the upper hemisphere first).
   V sample(const V& w, double u1, double u2) const {
-    V wh = normalize(V{a * w[0], a * w[1], w[2]});
+    V wh = normalize(V{ax * w[0], ay * w[1], w[2]});
     if (wh[2] < 0) wh = neg(wh);
     V t1 = wh[2] < 0.99999 ? normalize(cross(V{0, 0, 1}, wh)) : V{1, 0, 0};
     V t2 = cross(wh, t1);
@@ -96,26 +109,48 @@ struct Ggx {
     py = (1 - s) * h + s * py;
     double pz = std::sqrt(std::max(0.0, 1 - px * px - py * py));
     V nh = t1 * px + t2 * py + wh * pz;
-    return normalize(V{a * nh[0], a * nh[1], std::max(1e-6, nh[2])});
+    return normalize(V{ax * nh[0], ay * nh[1], std::max(1e-6, nh[2])});
   }
 };
 
 enum class Mode { Radiance, Importance };
 enum Flags : int { kReflection = 1, kTransmission = 2, kAll = 3 };
 
+/// One microsurface of an interface: its GGX slopes, and (multiple) whether
+/// the walk of microsurface.h scatters on it (else single scattering).
+struct Lobe {
+  Ggx ggx;
+  Microsurface ms;
+  bool multiple = false;
+};
+
 struct Interface {
   enum class Kind { Pass, Dielectric, Conductor } kind = Kind::Pass;
-  double eta = 1;  // dielectric: IOR below / IOR above
-  Ggx ggx;
-  V f0{0, 0, 0}, f90{1, 1, 1};  // conductor: Schlick per channel
+  double eta = 1;                  // dielectric: IOR below / IOR above
+  std::array<Lobe, 2> lobe{};      // [1]: the haze lobe
+  double haze = 0;                 // the weight of lobe[1]
+  double cosT = 1, sinT = 0;       // the tangent's rotation about z
+  V n{1, 1, 1}, k{0, 0, 0};        // conductor: complex IOR per channel
+  double dielF0 = 0, dielF90 = 1;  // dielectric: F90 remap of exact Fresnel (F90 1: none)
+  V tint{1, 1, 1};                 // reflection seen from above
+  double fuzzAmount = 0, fuzzRough = 0.5;  // the sheen layer on top (fuzz)
+  V fuzzColor{0, 0, 0};
 };
 
 struct BsdfSample {
-  V f{0, 0, 0};
+  V weight{0, 0, 0};  // f |cos wi| / p of the sampling that produced wi
   V wi{0, 0, 1};
-  double pdf = 0;
+  double pdf = 0;  // the (proxy) density of wi, for MIS
   bool reflect = false;
 };
+
+V unitOr(const V& v, const V& fallback) {
+  double l2 = dot(v, v);
+  if (!(l2 > 0) || !std::isfinite(l2)) return fallback;
+  return v / std::sqrt(l2);
+}
+
+V sampleCosine(double u1, double u2);
 
 V reflectAbout(const V& wo, const V& n) { return n * (2 * dot(wo, n)) - wo; }
 
@@ -135,10 +170,18 @@ bool refract(const V& wi, V n, double eta, double& etap, V& wt) {
   return true;
 }
 
-V schlick(const Interface& I, double c) {
-  double m = std::clamp(1 - c, 0.0, 1.0);
-  double m5 = m * m * m * m * m;
-  return I.f0 + (I.f90 - I.f0) * m5;
+/// Exact conductor Fresnel per channel.
+V conductorFresnel(const Interface& I, double c) {
+  V F;
+  for (int ch = 0; ch < 3; ++ch) F[ch] = fresnelConductor(std::clamp(c, 0.0, 1.0), I.n[ch], I.k[ch]);
+  return F;
+}
+
+/// Exact dielectric Fresnel, remapped by F90 (F' = F0 + (F90 - F0)(F - F0)/(1 - F0)).
+double dielectricFresnel(const Interface& I, double c) {
+  double F = fresnelDielectric(c, I.eta);
+  if (I.dielF90 == 1 || !(I.dielF0 < 1)) return F;
+  return std::clamp(I.dielF0 + (I.dielF90 - I.dielF0) * (F - I.dielF0) / (1 - I.dielF0), 0.0, 1.0);
 }
 
 /// The generalized half vector of (wo, wi) for the dielectric, facing +z; false
@@ -156,106 +199,274 @@ bool dielectricHalf(const Interface& I, const V& wo, const V& wi, V& wm, double&
   return !(dot(wm, wi) * ci < 0 || dot(wm, wo) * co < 0);
 }
 
-/// BSDF value (no cosine). wo: towards where the walk came from; wi: onward.
-V bsdfF(const Interface& I, const V& wo, const V& wi, Mode mode) {
-  switch (I.kind) {
-    case Interface::Kind::Pass: return {0, 0, 0};
-    case Interface::Kind::Conductor: {
-      if (wo[2] <= 0 || wi[2] <= 0) return {0, 0, 0};
-      V h = wo + wi;
-      double l2 = dot(h, h);
-      if (!(l2 > 0)) return {0, 0, 0};
-      h = h / std::sqrt(l2);
-      double s = I.ggx.D(h) * I.ggx.G(wo, wi) / (4 * wo[2] * wi[2]);
-      return schlick(I, std::fabs(dot(wo, h))) * s;
-    }
-    case Interface::Kind::Dielectric: {
-      V wm;
-      double etap;
-      bool reflect;
-      if (!dielectricHalf(I, wo, wi, wm, etap, reflect)) return {0, 0, 0};
-      double F = fresnelDielectric(dot(wo, wm), I.eta);
-      if (reflect) return splat3(I.ggx.D(wm) * I.ggx.G(wo, wi) * F / std::fabs(4 * wi[2] * wo[2]));
-      double denom = sq(dot(wi, wm) + dot(wo, wm) / etap) * wi[2] * wo[2];
-      double ft = I.ggx.D(wm) * (1 - F) * I.ggx.G(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / denom);
-      if (mode == Mode::Radiance) ft /= etap * etap;
-      return splat3(ft);
-    }
+/// Single-scattering BSDF value of one lobe (no cosine), in the lobe's frame.
+V ssF(const Interface& I, const Ggx& g, const V& wo, const V& wi, Mode mode) {
+  if (I.kind == Interface::Kind::Conductor) {
+    if (wo[2] <= 0 || wi[2] <= 0) return {0, 0, 0};
+    V h = wo + wi;
+    double l2 = dot(h, h);
+    if (!(l2 > 0)) return {0, 0, 0};
+    h = h / std::sqrt(l2);
+    return conductorFresnel(I, std::fabs(dot(wo, h))) * (g.D(h) * g.G(wo, wi) / (4 * wo[2] * wi[2]));
   }
-  return {0, 0, 0};
+  V wm;
+  double etap;
+  bool reflect;
+  if (!dielectricHalf(I, wo, wi, wm, etap, reflect)) return {0, 0, 0};
+  double F = dielectricFresnel(I, dot(wo, wm));
+  if (reflect) return splat3(g.D(wm) * g.G(wo, wi) * F / std::fabs(4 * wi[2] * wo[2]));
+  double denom = sq(dot(wi, wm) + dot(wo, wm) / etap) * wi[2] * wo[2];
+  double ft = g.D(wm) * (1 - F) * g.G(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / denom);
+  if (mode == Mode::Radiance) ft /= etap * etap;
+  return splat3(ft);
 }
 
-/// Solid-angle density with which bsdfSample(wo, flags) returns wi.
-double bsdfPdf(const Interface& I, const V& wo, const V& wi, int flags) {
-  switch (I.kind) {
-    case Interface::Kind::Pass: return 0;
-    case Interface::Kind::Conductor: {
-      if (!(flags & kReflection) || wo[2] <= 0 || wi[2] <= 0) return 0;
-      V h = wo + wi;
-      double l2 = dot(h, h);
-      if (!(l2 > 0)) return 0;
-      h = h / std::sqrt(l2);
-      return I.ggx.Dv(wo, h) / (4 * std::fabs(dot(wo, h)));
-    }
-    case Interface::Kind::Dielectric: {
-      V wm;
-      double etap;
-      bool reflect;
-      if (!dielectricHalf(I, wo, wi, wm, etap, reflect)) return 0;
-      double R = fresnelDielectric(dot(wo, wm), I.eta);
-      double pr = (flags & kReflection) ? R : 0, pt = (flags & kTransmission) ? 1 - R : 0;
-      if (pr == 0 && pt == 0) return 0;
-      if (reflect) return I.ggx.Dv(wo, wm) / (4 * std::fabs(dot(wo, wm))) * pr / (pr + pt);
-      double denom = sq(dot(wi, wm) + dot(wo, wm) / etap);
-      return I.ggx.Dv(wo, wm) * std::fabs(dot(wi, wm)) / denom * pt / (pr + pt);
-    }
+/// Solid-angle density with which ssSample(wo, flags) returns wi.
+double ssPdf(const Interface& I, const Ggx& g, const V& wo, const V& wi, int flags) {
+  if (I.kind == Interface::Kind::Conductor) {
+    if (!(flags & kReflection) || wo[2] <= 0 || wi[2] <= 0) return 0;
+    V h = wo + wi;
+    double l2 = dot(h, h);
+    if (!(l2 > 0)) return 0;
+    h = h / std::sqrt(l2);
+    return g.Dv(wo, h) / (4 * std::fabs(dot(wo, h)));
   }
-  return 0;
+  V wm;
+  double etap;
+  bool reflect;
+  if (!dielectricHalf(I, wo, wi, wm, etap, reflect)) return 0;
+  double R = dielectricFresnel(I, dot(wo, wm));
+  double pr = (flags & kReflection) ? R : 0, pt = (flags & kTransmission) ? 1 - R : 0;
+  if (pr == 0 && pt == 0) return 0;
+  if (reflect) return g.Dv(wo, wm) / (4 * std::fabs(dot(wo, wm))) * pr / (pr + pt);
+  double denom = sq(dot(wi, wm) + dot(wo, wm) / etap);
+  return g.Dv(wo, wm) * std::fabs(dot(wi, wm)) / denom * pt / (pr + pt);
 }
 
-/// Samples wi from wo (visible normals, then reflection or transmission by
-/// Fresnel among the allowed ones). Not for pass-through interfaces.
-bool bsdfSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
+/// Samples wi from wo on one lobe, single scattering (visible normals, then
+/// reflection or transmission by Fresnel among the allowed ones).
+bool ssSample(const Interface& I, const Ggx& g, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
   const double uc = rng.uniform(), u1 = rng.uniform(), u2 = rng.uniform();
   if (wo[2] == 0) return false;
-  if (I.kind == Interface::Kind::Conductor) {
-    if (!(flags & kReflection) || wo[2] <= 0) return false;
-    V wm = I.ggx.sample(wo, u1, u2);
-    V wi = reflectAbout(wo, wm);
-    if (wi[2] <= 0) return false;
-    double c = std::fabs(dot(wo, wm));
-    s.wi = wi;
-    s.pdf = I.ggx.Dv(wo, wm) / (4 * c);
-    s.f = schlick(I, c) * (I.ggx.D(wm) * I.ggx.G(wo, wi) / (4 * wo[2] * wi[2]));
-    s.reflect = true;
-    return s.pdf > 0;
-  }
-  if (I.kind != Interface::Kind::Dielectric) return false;
-  V wm = I.ggx.sample(wo, u1, u2);
-  double R = fresnelDielectric(dot(wo, wm), I.eta);
+  const bool conductor = I.kind == Interface::Kind::Conductor;
+  if (conductor && (!(flags & kReflection) || wo[2] <= 0)) return false;
+  V wm = g.sample(wo, u1, u2);
+  double R = conductor ? 1 : dielectricFresnel(I, dot(wo, wm));
   double pr = (flags & kReflection) ? R : 0, pt = (flags & kTransmission) ? 1 - R : 0;
   if (pr == 0 && pt == 0) return false;
   if (uc < pr / (pr + pt)) {
     V wi = reflectAbout(wo, wm);
     if (wo[2] * wi[2] <= 0) return false;
     s.wi = wi;
-    s.pdf = I.ggx.Dv(wo, wm) / (4 * std::fabs(dot(wo, wm))) * pr / (pr + pt);
-    s.f = splat3(I.ggx.D(wm) * I.ggx.G(wo, wi) * R / std::fabs(4 * wi[2] * wo[2]));
+    s.pdf = g.Dv(wo, wm) / (4 * std::fabs(dot(wo, wm))) * pr / (pr + pt);
     s.reflect = true;
-    return s.pdf > 0;
+  } else {
+    V wi;
+    double etap;
+    if (!refract(wo, wm, I.eta, etap, wi)) return false;
+    if (wo[2] * wi[2] >= 0 || wi[2] == 0) return false;
+    double denom = sq(dot(wi, wm) + dot(wo, wm) / etap);
+    s.wi = wi;
+    s.pdf = g.Dv(wo, wm) * std::fabs(dot(wi, wm)) / denom * pt / (pr + pt);
+    s.reflect = false;
   }
-  V wi;
-  double etap;
-  if (!refract(wo, wm, I.eta, etap, wi)) return false;
-  if (wo[2] * wi[2] >= 0 || wi[2] == 0) return false;
-  double denom = sq(dot(wi, wm) + dot(wo, wm) / etap);
-  s.wi = wi;
-  s.pdf = I.ggx.Dv(wo, wm) * std::fabs(dot(wi, wm)) / denom * pt / (pr + pt);
-  double ft = (1 - R) * I.ggx.D(wm) * I.ggx.G(wo, wi) * std::fabs(dot(wi, wm) * dot(wo, wm) / (wi[2] * wo[2] * denom));
-  if (mode == Mode::Radiance) ft /= etap * etap;
-  s.f = splat3(ft);
-  s.reflect = false;
+  if (!(s.pdf > 0)) return false;
+  s.weight = ssF(I, g, wo, s.wi, mode) * (std::fabs(s.wi[2]) / s.pdf);
+  return true;
+}
+
+Transport transport(Mode m) { return m == Mode::Radiance ? Transport::Radiance : Transport::Importance; }
+V toLocal(const Interface& I, const V& v) { return {I.cosT * v[0] + I.sinT * v[1], -I.sinT * v[0] + I.cosT * v[1], v[2]}; }
+V toStack(const Interface& I, const V& v) { return {I.cosT * v[0] - I.sinT * v[1], I.sinT * v[0] + I.cosT * v[1], v[2]}; }
+double lobeWeight(const Interface& I, int l) { return l == 0 ? 1 - I.haze : I.haze; }
+/// The tint of a reflection seen from above (specularTint), else 1.
+V tintOf(const Interface& I, const V& wo, const V& wi) { return wo[2] > 0 && wi[2] > 0 ? I.tint : V{1, 1, 1}; }
+
+/// f(wo, wi) of the interface (no cosine): the lobes' mixture; a stochastic
+/// (unbiased) estimate where a lobe walks its microsurface.
+V coreF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng) {
+  if (I.kind == Interface::Kind::Pass || wi[2] == 0) return {0, 0, 0};
+  const V lo = toLocal(I, wo), li = toLocal(I, wi);
+  V f{0, 0, 0};
+  for (int l = 0; l < 2; ++l) {
+    const double w = lobeWeight(I, l);
+    if (!(w > 0)) continue;
+    const Lobe& L = I.lobe[l];
+    V fl = L.multiple ? evalMicrosurface(L.ms, lo, li, transport(mode), rng) / std::fabs(li[2]) : ssF(I, L.ggx, lo, li, mode);
+    f = f + fl * w;
+  }
+  return f * tintOf(I, wo, wi);
+}
+
+/// The density (a proxy where a lobe walks its microsurface, pdfMicrosurface)
+/// with which ifcSample(wo, flags) returns wi.
+double corePdf(const Interface& I, const V& wo, const V& wi, int flags) {
+  if (I.kind == Interface::Kind::Pass) return 0;
+  const V lo = toLocal(I, wo), li = toLocal(I, wi);
+  const int side = lo[2] * li[2] > 0 ? kReflection : kTransmission;
+  double p = 0;
+  for (int l = 0; l < 2; ++l) {
+    const double w = lobeWeight(I, l);
+    if (!(w > 0)) continue;
+    const Lobe& L = I.lobe[l];
+    if (L.multiple)
+      p += (flags & side) ? w * pdfMicrosurface(L.ms, lo, li) : 0;
+    else
+      p += w * ssPdf(I, L.ggx, lo, li, flags);
+  }
+  return p;
+}
+
+/// Samples the interface from wo, restricted to `flags`. A lobe is picked by
+/// its weight (one-sample model of the mixture: the pick's probability cancels
+/// the mixture's weight). On a microsurface walk the exit side cannot be
+/// chosen: an exit on an unwanted side ends the path (returns false), and the
+/// weight of a kept exit stays f / p_all — the restricted estimator is then
+/// the integral of f over the wanted side only, unbiased (the single-scattering
+/// lobes instead renormalize their Fresnel choice among the allowed lobes).
+bool coreSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
+  if (I.kind == Interface::Kind::Pass) return false;
+  const int l = (I.haze > 0 && (I.haze >= 1 || rng.uniform() < I.haze)) ? 1 : 0;
+  const Lobe& L = I.lobe[l];
+  const V lo = toLocal(I, wo);
+  if (L.multiple) {
+    if (I.kind == Interface::Kind::Conductor && !(lo[2] > 0)) return false;
+    MicrosurfaceSample ms;
+    if (!sampleMicrosurface(L.ms, lo, transport(mode), rng, ms)) return false;
+    if (!(flags & (ms.reflected ? kReflection : kTransmission))) return false;
+    s.wi = ms.wi;
+    s.weight = ms.weight;
+    s.reflect = ms.reflected;
+  } else if (!ssSample(I, L.ggx, lo, rng, mode, flags, s)) {
+    return false;
+  }
+  s.wi = toStack(I, s.wi);
+  if (!(s.wi[2] != 0) || !std::isfinite(s.weight[0] + s.weight[1] + s.weight[2])) return false;
+  s.weight = s.weight * tintOf(I, wo, s.wi);
+  s.pdf = corePdf(I, wo, s.wi, flags);
   return s.pdf > 0;
+}
+
+/// Both lobes of one bounce off I from wo (the albedo walk's variance
+/// reduction at the top interface): on a single-scattering lobe one sampled
+/// microfacet normal gives the reflection r and the transmission t, each with
+/// its weight f |cos| / p (p the density of that lobe's direction alone, so
+/// E[r.weight] + E[t.weight] is the interface's whole albedo, with no Bernoulli
+/// choice between them); on a microsurface walk the exit fills one of them.
+/// A zero weight: that side is absent.
+void coreSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
+  r = BsdfSample{};
+  t = BsdfSample{};
+  const int l = (I.haze > 0 && (I.haze >= 1 || rng.uniform() < I.haze)) ? 1 : 0;
+  const Lobe& L = I.lobe[l];
+  const V lo = toLocal(I, wo);
+  if (L.multiple) {
+    if (I.kind == Interface::Kind::Conductor && !(lo[2] > 0)) return;
+    MicrosurfaceSample ms;
+    if (!sampleMicrosurface(L.ms, lo, Transport::Importance, rng, ms)) return;
+    BsdfSample& s = ms.reflected ? r : t;
+    s.wi = ms.wi;
+    s.weight = ms.weight;
+  } else {
+    rng.uniform();  // ssSample's draw pattern: the choice it no longer needs
+    const V wm = L.ggx.sample(lo, rng.uniform(), rng.uniform());
+    const V wr = reflectAbout(lo, wm);
+    const double pr = ssPdf(I, L.ggx, lo, wr, kReflection);
+    if (lo[2] * wr[2] > 0 && pr > 0) {
+      r.wi = wr;
+      r.weight = ssF(I, L.ggx, lo, wr, Mode::Importance) * (std::fabs(wr[2]) / pr);
+    }
+    V wt;
+    double etap;
+    if (I.kind == Interface::Kind::Dielectric && refract(lo, wm, I.eta, etap, wt) && lo[2] * wt[2] < 0) {
+      const double pt = ssPdf(I, L.ggx, lo, wt, kTransmission);
+      if (pt > 0) {
+        t.wi = wt;
+        t.weight = ssF(I, L.ggx, lo, wt, Mode::Importance) * (std::fabs(wt[2]) / pt);
+      }
+    }
+  }
+  for (BsdfSample* s : {&r, &t}) {
+    s->wi = toStack(I, s->wi);
+    if (!std::isfinite(s->weight[0] + s->weight[1] + s->weight[2]) || s->wi[2] == 0) s->weight = V{0, 0, 0};
+    s->weight = s->weight * tintOf(I, wo, s->wi);
+    s->reflect = s == &r;
+  }
+}
+
+// The fuzz of a layer: a sheen layer on top of its interface, the runtime's
+// model as a layer (bsdf.cc, substrate_eval_closure): reflection the Charlie
+// sheen lobe amount * colour * charlieSheen / max(1, E_fuzz(mu_o)); everything
+// else crosses it straight, with weight 1 - amount * min(E_fuzz(mu), 1) at
+// each crossing (mu that of the direction above). An energy-conserving "mean
+// sheen layer" (what the sheen reflects at most, amount * min(E, 1), is what
+// it takes from the crossing light) — the LTC / table sheen of the runtime as
+// a layer, not a volumetric fibre walk. Light from below that the fuzz would
+// reflect back down is absorbed.
+
+double fuzzCatch(const Interface& I, double mu) {
+  return I.fuzzAmount * std::min(fuzzAlbedo(std::clamp(mu, 0.0, 1.0), I.fuzzRough), 1.0);
+}
+double fuzzPass(const Interface& I, double mu) { return I.fuzzAmount > 0 ? 1 - fuzzCatch(I, mu) : 1.0; }
+/// The sheen's f |cos wi| (wo, wi above).
+V sheenFcos(const Interface& I, const V& wo, const V& wi) {
+  const V h = unitOr(wo + wi, V{0, 0, 1});
+  const double e = fuzzAlbedo(std::clamp(wo[2], 0.0, 1.0), I.fuzzRough);
+  return I.fuzzColor * (I.fuzzAmount * charlieSheen(I.fuzzRough, wo[2], wi[2], h[2]) / std::max(1.0, e));
+}
+
+V ifcF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng) {
+  V f = coreF(I, wo, wi, mode, rng);
+  if (!(I.fuzzAmount > 0) || wi[2] == 0) return f;
+  if (wo[2] > 0) f = f * fuzzPass(I, wo[2]);
+  if (wi[2] > 0) f = f * fuzzPass(I, wi[2]);
+  if (wo[2] > 0 && wi[2] > 0) f = f + sheenFcos(I, wo, wi) / wi[2];
+  return f;
+}
+
+double ifcPdf(const Interface& I, const V& wo, const V& wi, int flags) {
+  const double p = corePdf(I, wo, wi, flags);
+  if (!(I.fuzzAmount > 0) || !(wo[2] > 0)) return p;
+  const double q = fuzzCatch(I, wo[2]);
+  return (1 - q) * p + ((flags & kReflection) && wi[2] > 0 ? q * wi[2] * kInvPi : 0);
+}
+
+/// The sheen picked with probability q (wo above): a cosine-sampled reflection.
+bool sheenSample(const Interface& I, const V& wo, double q, SplitMix64& rng, BsdfSample& s) {
+  s.wi = sampleCosine(rng.uniform(), rng.uniform());
+  if (!(s.wi[2] > 0)) return false;
+  s.weight = sheenFcos(I, wo, s.wi) / (q * s.wi[2] * kInvPi);
+  s.reflect = true;
+  return true;
+}
+
+bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
+  if (!(I.fuzzAmount > 0)) return coreSample(I, wo, rng, mode, flags, s);
+  const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
+  if (q > 0 && rng.uniform() < q) {
+    if (!(flags & kReflection) || !sheenSample(I, wo, q, rng, s)) return false;
+  } else {
+    if (!coreSample(I, wo, rng, mode, flags, s)) return false;
+    if (wo[2] > 0) s.weight = s.weight * (fuzzPass(I, wo[2]) / (1 - q));
+    if (s.wi[2] > 0) s.weight = s.weight * fuzzPass(I, s.wi[2]);
+  }
+  s.pdf = ifcPdf(I, wo, s.wi, flags);
+  return s.pdf > 0 && std::isfinite(s.weight[0] + s.weight[1] + s.weight[2]);
+}
+
+void ifcSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
+  if (!(I.fuzzAmount > 0)) return coreSplit(I, wo, rng, r, t);
+  const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
+  if (q > 0 && rng.uniform() < q) {
+    t = BsdfSample{};
+    if (!sheenSample(I, wo, q, rng, r)) r = BsdfSample{};
+    return;
+  }
+  coreSplit(I, wo, rng, r, t);
+  for (BsdfSample* x : {&r, &t}) {
+    if (wo[2] > 0) x->weight = x->weight * (fuzzPass(I, wo[2]) / (1 - q));
+    if (x->wi[2] > 0) x->weight = x->weight * fuzzPass(I, x->wi[2]);
+  }
 }
 
 // ---------------------------------------------------------------------------
@@ -317,31 +528,78 @@ double underInterface(double A, double f0) {
   return std::clamp(A / (1 - r21 + r21 * A), 0.0, 1.0);
 }
 
+/// Microsurface walks on lobes rougher than this (alpha): below it the
+/// inter-facet bounces carry < 0.1 % of the energy (E_ss of GGX at alpha 0.02
+/// is 0.9996 at grazing... measured in random_walk_test) and the single
+/// scattering lobe is exact, cheaper and noiseless to evaluate.
+constexpr double kMultipleMinAlpha = 0.002;
+
+/// Gulbrandsen's edge tint from the slab's F0 and F90: g = F90 (1 - (1 - F0)^2.75).
+/// The factor is the g whose curve is closest to Schlick's with F90 = 1 (fitted
+/// over F0 in [0.02, 1]; random_walk.h has the differences), so the default
+/// F90 = 1 reads as the runtime's Schlick, and F90 < 1 lowers the edge tint.
+double edgeTint(double f0, double f90) {
+  return std::clamp(f90, 0.0, 1.0) * (1 - std::pow(1 - std::clamp(f0, 0.0, 1.0), 2.75));
+}
+
+/// One lobe of a layer's interface at a roughness: GGX alpha by the runtime's
+/// mapping (bsdf.cc ggxAlpha: a = sat(r)^2, (a (1 + A), a (1 - A)) in [1e-3, 1]).
+Lobe makeLobe(const Interface& I, double roughness, double anisotropy, bool single) {
+  Lobe L;
+  const double r = saturate1(roughness), a = r * r, A = std::clamp(anisotropy, -1.0, 1.0);
+  L.ggx.ax = std::clamp(a * (1 + A), kWalkMinAlpha, 1.0);
+  L.ggx.ay = std::clamp(a * (1 - A), kWalkMinAlpha, 1.0);
+  L.multiple = !single && std::max(L.ggx.ax, L.ggx.ay) > kMultipleMinAlpha;
+  L.ms.alphaX = L.ggx.ax;
+  L.ms.alphaY = L.ggx.ay;
+  L.ms.kind = I.kind == Interface::Kind::Conductor ? Microsurface::Kind::Conductor : Microsurface::Kind::Dielectric;
+  L.ms.eta = I.eta;
+  L.ms.n = I.n;
+  L.ms.k = I.k;
+  return L;
+}
+
+/// The interface of layer L (kind and eta set by the caller): frame, lobes, tint.
+void finishInterface(Interface& I, const WalkLayer& L, int rc, bool single) {
+  if (I.kind == Interface::Kind::Conductor)
+    for (int c = 0; c < 3; ++c) conductorIor(saturate1(L.f0[c]), edgeTint(L.f0[c], L.f90[c]), I.n[c], I.k[c]);
+  if (I.kind == Interface::Kind::Dielectric) {
+    I.dielF0 = sq((I.eta - 1) / (I.eta + 1));
+    I.dielF90 = saturate1(L.f90[rc]);
+  }
+  I.cosT = std::cos(L.tangentAngle);
+  I.sinT = std::sin(L.tangentAngle);
+  I.haze = saturate1(L.secondRoughnessWeight);
+  I.lobe[0] = makeLobe(I, L.roughness, L.anisotropy, single);
+  I.lobe[1] = makeLobe(I, L.secondRoughness, L.anisotropy, single);
+  I.tint = vclamp(L.specularTint, 0.0, 1.0);
+  I.fuzzAmount = saturate1(L.fuzzAmount);
+  I.fuzzRough = saturate1(L.fuzzRoughness);
+  I.fuzzColor = vclamp(L.fuzzColor, 0.0, 1.0);
+}
+
 /// The stack with the IORs and optical thicknesses of channel `rc`; per-channel
 /// weights (albedos, conductor Fresnel) for all channels.
-Resolved resolve(const std::vector<WalkLayer>& stack, const std::vector<V>& albedos, int rc, bool absoluteIor) {
+Resolved resolve(const std::vector<WalkLayer>& stack, const std::vector<V>& albedos, int rc, const WalkOptions& o) {
   Resolved r;
   double nAbove = 1;  // absoluteIor: the IOR of the layer above (air at the top)
   for (std::size_t i = 0; i < stack.size(); ++i) {
     const WalkLayer& L = stack[i];
     const bool bottom = i + 1 == stack.size() || L.opaqueBase;
     Interface I;
-    double rough = saturate1(L.roughness);
-    I.ggx.a = std::max(rough * rough, kWalkMinAlpha);
-    const bool conductor = L.opaqueBase && L.diffuseAlbedo[0] <= 0 && L.diffuseAlbedo[1] <= 0 && L.diffuseAlbedo[2] <= 0;
-    if (conductor) {
+    if (L.conductor) {
       I.kind = Interface::Kind::Conductor;
-      I.f0 = vclamp(L.f0, 0.0, 1.0);
-      I.f90 = vclamp(L.f90, 0.0, 1.0);
+      finishInterface(I, L, rc, o.singleScatteringInterfaces);
       r.ifc.push_back(I);
       r.med.push_back(Medium{});
       r.bottom = Bottom::Conductor;
       break;
     }
     const double n = iorFromF0(std::clamp(L.f0[rc], 0.0, kMaxF0));
-    I.eta = absoluteIor ? n / nAbove : n;
+    I.eta = o.absoluteIor ? n / nAbove : n;
     nAbove = n;
     I.kind = I.eta == 1 ? Interface::Kind::Pass : Interface::Kind::Dielectric;
+    finishInterface(I, L, rc, o.singleScatteringInterfaces);
     Medium M;
     M.g = std::clamp(L.phaseAnisotropy, -kMaxG, kMaxG);
     r.ifc.push_back(I);
@@ -371,6 +629,7 @@ std::vector<double> geometryKey(const Resolved& r) {
   for (std::size_t i = 0; i < r.ifc.size(); ++i) {
     k.push_back(static_cast<double>(r.ifc[i].kind));
     k.push_back(r.ifc[i].eta);
+    k.push_back(r.ifc[i].dielF90);
     k.push_back(r.med[i].tau);
   }
   k.push_back(static_cast<double>(r.bottom));
@@ -394,24 +653,32 @@ WalkLayer sanitized(const WalkLayer& L) {
   s.roughness = orZero(L.roughness);
   s.phaseAnisotropy = orZero(L.phaseAnisotropy);
   s.thickness = orZero(L.thickness);
+  s.anisotropy = orZero(L.anisotropy);
+  s.tangentAngle = orZero(L.tangentAngle);
+  s.secondRoughness = orZero(L.secondRoughness);
+  s.secondRoughnessWeight = orZero(L.secondRoughnessWeight);
+  s.fuzzAmount = orZero(L.fuzzAmount);
+  s.fuzzRoughness = orZero(L.fuzzRoughness);
+  s.fuzzColor = orZero(L.fuzzColor);
+  s.specularTint = orZero(L.specularTint);
   return s;
 }
 
 /// Channels grouped by geometryKey, each group's stack ready to walk.
-std::vector<Group> groups(const std::vector<WalkLayer>& rawStack, bool throughInterface, bool absoluteIor) {
+std::vector<Group> groups(const std::vector<WalkLayer>& rawStack, const WalkOptions& o) {
   std::vector<WalkLayer> stack;
   for (const WalkLayer& L : rawStack) stack.push_back(sanitized(L));
   std::vector<V> albedos;
   for (const WalkLayer& L : stack) {
     V a = vclamp(L.diffuseAlbedo, 0.0, 1.0);
-    if (throughInterface)
+    if (o.albedoSeenThroughInterface)
       for (int c = 0; c < 3; ++c) a[c] = underInterface(a[c], L.f0[c]);
     albedos.push_back(a);
   }
   std::vector<Group> out;
   std::vector<std::vector<double>> keys;
   for (int c = 0; c < 3; ++c) {
-    Resolved r = resolve(stack, albedos, c, absoluteIor);
+    Resolved r = resolve(stack, albedos, c, o);
     std::vector<double> key = geometryKey(r);
     std::size_t gi = 0;
     while (gi < keys.size() && keys[gi] != key) ++gi;
@@ -435,14 +702,18 @@ double maxMasked(const V& v, const std::array<bool, 3>& mask) {
   return m;
 }
 
-/// Russian roulette (pbrt's LayeredBxDF): false when the walk ends.
+/// Russian roulette after 3 events, when the largest channel of the
+/// throughput is below 0.25: the walk survives with probability mb / 0.25 and
+/// its throughput is raised to 0.25 (pbrt's LayeredBxDF raises it to 1 with
+/// probability mb: far noisier for dark stacks); false when the walk ends.
 bool roulette(V& beta, int depth, const std::array<bool, 3>& mask, SplitMix64& rng) {
+  constexpr double kFloor = 0.25;
   double mb = maxMasked(beta, mask);
   if (!(mb > 0)) return false;
-  if (depth > 3 && mb < 0.25) {
-    double q = std::max(0.0, 1 - mb);
-    if (rng.uniform() < q) return false;
-    beta = beta / (1 - q);
+  if (depth > 3 && mb < kFloor) {
+    const double survive = mb / kFloor;
+    if (rng.uniform() >= survive) return false;
+    beta = beta / survive;
   }
   return true;
 }
@@ -475,8 +746,8 @@ bool propagate(const Medium& M, const V& w, double& t, V& beta, SplitMix64& rng,
 /// An importance-sampled bounce off I from `from` (flags: which lobes):
 /// beta *= f |cos| / pdf and w = the sampled direction; false: no sample.
 bool bounce(const Interface& I, const V& from, int flags, SplitMix64& rng, V& beta, V& w, BsdfSample& bs) {
-  if (!bsdfSample(I, from, rng, Mode::Importance, flags, bs)) return false;
-  beta = beta * bs.f * (std::fabs(bs.wi[2]) / bs.pdf);
+  if (!ifcSample(I, from, rng, Mode::Importance, flags, bs)) return false;
+  beta = beta * bs.weight;
   w = bs.wi;
   return true;
 }
@@ -500,11 +771,11 @@ int traceLightChain(const Resolved& s, int last, const V& wi, SplitMix64& rng, s
       if (k == 0) wgt = wgt / std::fabs(c[2]);
     } else {
       BsdfSample bs;
-      if (!bsdfSample(I, from, rng, Mode::Radiance, kTransmission, bs)) break;
+      if (!ifcSample(I, from, rng, Mode::Radiance, kTransmission, bs)) break;
       c = bs.wi;
       // The cosine of the segment above I_k (towards the exit) for k >= 1;
       // at I_0 that segment is wi's, which the caller's |cos wi| carries.
-      wgt = wgt * bs.f * ((k == 0 ? 1.0 : std::fabs(from[2])) / bs.pdf);
+      wgt = wgt * bs.weight * ((k == 0 ? 1.0 : std::fabs(from[2])) / std::fabs(c[2]));
       if (k == 0) pB0 = bs.pdf;
     }
     if (!(c[2] < 0)) break;
@@ -542,9 +813,9 @@ struct EvalWalk {
   /// transmittance to I_0.
   void exitA(const V& w1, double pA, double tr) {
     if (exitDelta || !(w1[2] > 0)) return;
-    V fe = bsdfF(s.ifc[0], neg(w1), wi, Mode::Importance);
+    V fe = ifcF(s.ifc[0], neg(w1), wi, Mode::Importance, rng);
     if (isZero(fe)) return;
-    double pB = bsdfPdf(s.ifc[0], wi, neg(w1), kTransmission);
+    double pB = ifcPdf(s.ifc[0], wi, neg(w1), kTransmission);
     sum = sum + beta * fe * (tr * powerHeuristic(pA, pB));
   }
   /// The connection of a vertex of layer k to the light chain (strategy B):
@@ -560,9 +831,9 @@ struct EvalWalk {
       w = neg(wo);
     } else {
       BsdfSample bs;
-      if (!bsdfSample(s.ifc[0], wo, rng, Mode::Importance, kTransmission, bs)) return false;
+      if (!ifcSample(s.ifc[0], wo, rng, Mode::Importance, kTransmission, bs)) return false;
       w = bs.wi;
-      beta = bs.f * (std::fabs(w[2]) / bs.pdf);
+      beta = bs.weight;
     }
     return w[2] < 0;
   }
@@ -641,8 +912,8 @@ struct EvalWalk {
     }
     if (k < chainLen) {
       V lw = neg(chainDir[k]);
-      V fv = bsdfF(I, neg(w), lw, Mode::Importance);
-      if (!isZero(fv)) connectB(fv * std::fabs(lw[2]), bsdfPdf(I, neg(w), lw, kAll), std::exp(-trUp / std::fabs(lw[2])));
+      V fv = ifcF(I, neg(w), lw, Mode::Importance, rng);
+      if (!isZero(fv)) connectB(fv * std::fabs(lw[2]), ifcPdf(I, neg(w), lw, kAll), std::exp(-trUp / std::fabs(lw[2])));
     }
     BsdfSample bs;
     if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
@@ -683,54 +954,105 @@ struct Tally {
   }
 };
 
-/// layeredEval for one group: sum over the walks of f(wo, wi) (no cosine), divided by the count.
+/// layeredEval for one group: sum over the walks of f(wo, wi) (no cosine),
+/// divided by the count. Each walk adds one estimate of the top reflection
+/// f_0(wo, wi) (exact on single-scattering lobes, a microsurface walk else).
 Estimate evalGroup(const Group& grp, const V& wo, const V& wi, const WalkOptions& o, SplitMix64& rng) {
   const Resolved& s = grp.stack;
   const Interface& top = s.ifc[0];
-  const V topReflection = bsdfF(top, wo, wi, Mode::Importance);
   const int last = s.lastLayer();
-  if (last < 0 || o.samples <= 0) return Tally{}.estimate(topReflection);  // a conductor alone
   const bool exitDelta = top.kind == Interface::Kind::Pass;
-
-  std::vector<V> chainDir(static_cast<std::size_t>(last) + 1), chainW(static_cast<std::size_t>(last) + 1);
   Tally tally;
+  std::vector<V> chainDir(static_cast<std::size_t>(std::max(last, 0)) + 1), chainW(chainDir.size());
   for (int sample = 0; sample < o.samples; ++sample) {
-    V sum{0, 0, 0};
-    double pB0 = kInf;
-    const int chainLen = traceLightChain(s, last, wi, rng, chainDir, chainW, pB0);
-    EvalWalk walk{s, wi, exitDelta, chainDir, chainW, chainLen, pB0, rng, sum};
-    if (walk.enter(wo)) walk.run(o.maxDepth, grp.mask);
+    V sum = ifcF(top, wo, wi, Mode::Importance, rng);
+    if (last >= 0) {  // else a conductor alone
+      double pB0 = kInf;
+      const int chainLen = traceLightChain(s, last, wi, rng, chainDir, chainW, pB0);
+      EvalWalk walk{s, wi, exitDelta, chainDir, chainW, chainLen, pB0, rng, sum};
+      if (walk.enter(wo)) walk.run(o.maxDepth, grp.mask);
+    }
     tally.add(sum);
   }
-  return tally.estimate(topReflection);
+  return tally.estimate();
 }
 
-/// layeredAlbedo for one group: the mean weight with which forward walks leave the top.
-Estimate albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& rng) {
-  const Resolved& s = grp.stack;
-  const int n = static_cast<int>(s.ifc.size());
-  Tally tally;
-  for (int sample = 0; sample < o.samples; ++sample) {
-    V sum{0, 0, 0};
-    V beta{1, 1, 1}, w = neg(wo);
-    int k = 0;
-    double t = 0;
-    bool atTopFromAbove = true;  // the first event: I_0 from outside
-    for (int depth = 0; depth < o.maxDepth; ++depth) {
-      if (!roulette(beta, depth, grp.mask, rng)) break;
-      if (atTopFromAbove) {
-        atTopFromAbove = false;
-        const Interface& I = s.ifc[0];
-        if (I.kind != Interface::Kind::Pass) {
-          BsdfSample bs;
-          if (!bounce(I, wo, kAll, rng, beta, w, bs)) break;
-          if (w[2] > 0) {
-            sum = sum + beta;
-            break;
-          }
-        }
-        continue;
+/// One forward walk of albedoGroup: state (layer k, optical depth t, direction
+/// w, weight beta) and what has left through the top (sum). At the top
+/// interface, both ways in and out, the bounce is split (ifcSplit): what leaves
+/// is counted, what stays walks on.
+struct AlbedoWalk {
+  const Resolved& s;
+  SplitMix64& rng;
+  V sum{0, 0, 0}, beta{1, 1, 1}, w{0, 0, 0};
+  int k = 0;
+  double t = 0;
+
+  /// The first event: I_0 from outside; false: nothing enters.
+  bool enter(const V& wo) {
+    w = neg(wo);
+    const Interface& I = s.ifc[0];
+    if (I.kind == Interface::Kind::Pass) return true;
+    BsdfSample r, tr;
+    ifcSplit(I, wo, rng, r, tr);
+    sum = sum + r.weight;
+    if (isZero(tr.weight)) return false;
+    beta = tr.weight;
+    w = tr.wi;
+    return true;
+  }
+  /// At I_k from below; false: the walk ends.
+  bool up() {
+    const Interface& I = s.ifc[k];
+    bool crossed = true;
+    if (k == 0 && I.kind != Interface::Kind::Pass) {
+      BsdfSample r, tr;
+      ifcSplit(I, neg(w), rng, r, tr);
+      sum = sum + beta * tr.weight;
+      if (isZero(r.weight)) return false;
+      beta = beta * r.weight;
+      w = r.wi;
+      return true;
+    }
+    if (I.kind != Interface::Kind::Pass) {
+      BsdfSample bs;
+      if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
+      crossed = !bs.reflect;
+    }
+    if (crossed) {
+      if (k == 0) {
+        sum = sum + beta;
+        return false;
       }
+      --k;
+      t = s.med[k].tau;
+    }
+    return true;
+  }
+  /// At the bottom of layer k, going down; false: the walk ends.
+  bool down() {
+    if (k == static_cast<int>(s.ifc.size()) - 1) {  // the Lambertian base
+      if (s.bottom != Bottom::Lambert) return false;
+      w = sampleCosine(rng.uniform(), rng.uniform());
+      beta = beta * s.lambert;
+      return true;
+    }
+    const Interface& I = s.ifc[k + 1];
+    bool crossed = true;
+    if (I.kind != Interface::Kind::Pass) {
+      BsdfSample bs;
+      if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
+      crossed = !bs.reflect;
+    }
+    if (crossed) {
+      ++k;
+      t = 0;
+    }
+    return true;
+  }
+  void run(int maxDepth, const std::array<bool, 3>& mask) {
+    for (int depth = 0; depth < maxDepth; ++depth) {
+      if (!roulette(beta, depth, mask, rng)) break;
       const Medium& M = s.med[k];
       bool alive;
       if (propagate(M, w, t, beta, rng, alive)) {
@@ -738,60 +1060,29 @@ Estimate albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitM
         beta = beta * M.omega;
         continue;
       }
-      if (!alive) break;
-      if (w[2] > 0) {
-        const Interface& I = s.ifc[k];
-        bool up = true;
-        if (I.kind != Interface::Kind::Pass) {
-          BsdfSample bs;
-          if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) break;
-          up = !bs.reflect;
-        }
-        if (up) {
-          if (k == 0) {
-            sum = sum + beta;
-            break;
-          }
-          --k;
-          t = s.med[k].tau;
-        }
-        continue;
-      }
-      if (k == n - 1) {  // the Lambertian base
-        if (s.bottom != Bottom::Lambert) break;
-        w = sampleCosine(rng.uniform(), rng.uniform());
-        beta = beta * s.lambert;
-        continue;
-      }
-      const Interface& I = s.ifc[k + 1];
-      bool down = true;
-      if (I.kind != Interface::Kind::Pass) {
-        BsdfSample bs;
-        if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) break;
-        down = !bs.reflect;
-      }
-      if (down) {
-        ++k;
-        t = 0;
-      }
+      if (!alive || !(w[2] > 0 ? up() : down())) break;
     }
-    tally.add(sum);
+  }
+};
+
+/// layeredAlbedo for one group: the mean weight with which forward walks leave the top.
+Estimate albedoGroup(const Group& grp, const V& wo, const WalkOptions& o, SplitMix64& rng) {
+  Tally tally;
+  for (int sample = 0; sample < o.samples; ++sample) {
+    AlbedoWalk walk{grp.stack, rng};
+    if (walk.enter(wo)) walk.run(o.maxDepth - 1, grp.mask);
+    tally.add(walk.sum);
   }
   return tally.estimate();
 }
 
-V unitOr(const V& v, const V& fallback) {
-  double l2 = dot(v, v);
-  if (!(l2 > 0) || !std::isfinite(l2)) return fallback;
-  return v / std::sqrt(l2);
-}
 
 /// Runs `walk` per channel group and gathers each group's channels.
 template <class F>
 Estimate perGroup(const std::vector<WalkLayer>& stack, const WalkOptions& o, std::uint64_t purpose, F&& walk) {
   Estimate out;
   if (stack.empty()) return out;
-  std::vector<Group> gs = groups(stack, o.albedoSeenThroughInterface, o.absoluteIor);
+  std::vector<Group> gs = groups(stack, o);
   for (std::size_t gi = 0; gi < gs.size(); ++gi) {
     SplitMix64 rng = walkStream(o.seed, purpose * 8 + gi);
     Estimate v = walk(gs[gi], rng);

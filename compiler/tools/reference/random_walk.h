@@ -10,27 +10,58 @@
 // THE MODEL (per colour channel, channels independent)
 //   A stack of layers, top to bottom. Layer k is an interface I_k above a
 //   homogeneous slab of medium M_k; M_k lies between I_k and I_{k+1}.
-//   * Interface: GGX microfacets (isotropic; alpha = max(roughness^2, 1e-3),
-//     roughness the slab's perceptual roughness saturated), height-correlated
-//     Smith shadowing, single scattering on the microsurface (as pbrt's): a
-//     rough interface loses the energy of its inter-microfacet bounces. A white
-//     conductor keeps E(0.5) = 0.89 at roughness 0.45; a dielectric (F0 0.04)
-//     over a white Lambertian keeps 0.998 / 0.93 / 0.79 / 0.63 of the light at
-//     roughness 0.1 / 0.3 / 0.45 / 0.6 (light trapped under the interface meets
-//     it several times). No energy compensation: keep this in mind at
-//     roughness >= 0.3.
+//   * Interface: GGX microfacets, anisotropic by the runtime's mapping (bsdf.cc
+//     ggxAlpha: a = sat(roughness)^2, (alpha_x, alpha_y) = (a (1 + A), a (1 - A))
+//     clamped to [1e-3, 1], A = anisotropy), x along the layer's tangent
+//     (tangentAngle rotates the layer's microsurface about z), height-correlated
+//     Smith. Every interface event goes through one place (random_walk.cc,
+//     ifcSample / ifcF / ifcPdf). Rough lobes (max alpha > 0.002) scatter by
+//     the microsurface walk of Heitz et al. 2016 (microsurface.h): every order
+//     of inter-facet scattering (reflection, refraction, total internal
+//     reflection), energy conserving — the white furnace of every non-absorbing
+//     stack of random_walk_test's grid (rough dielectrics over a white
+//     Lambertian, white conductors at every roughness and anisotropy, clear
+//     coats over both, roughness 0.1 .. 1) is 0.9992 .. 1.0000. Lobes at the
+//     alpha floor, and every lobe under WalkOptions::singleScatteringInterfaces,
+//     use the classic single-scattering microfacet BSDF (pbrt-v4's), which
+//     loses the inter-facet energy (E_ss of a white conductor 0.893 at
+//     roughness 0.45, NoV 0.5; the grid's rough stacks fail the furnace there).
 //     - Dielectric: relative IOR (below over above) from the slab's own F0, per
 //       channel (a coloured F0 is a coloured IOR; channels walk apart):
 //       eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) (F0 clamped to 0.99), so each
 //       interface reflects F0 at normal incidence whatever lies above it
 //       (WalkOptions::absoluteIor: the other convention). Exact dielectric
-//       Fresnel; F90 is not used. F0 = 0 is eta = 1: an index-matched boundary,
-//       a pass-through (no reflection, no refraction). The walk carries energy
-//       (pbrt's Importance mode), the light chain radiance; f(wo, wi) of the
-//       stack is the same either way (reciprocity, tested).
-//     - Conductor: a slab whose medium is opaque (MFP 0) and whose diffuse albedo
-//       is 0 in every channel has a conductor interface: GGX reflection with
-//       Schlick's F = F0 + (F90 - F0)(1 - |wo.h|)^5 per channel, nothing below.
+//       Fresnel. F90 (of the channel that sets the group's IOR): reflectance
+//       remapped F' = F0 + (F90 - F0)(F - F0)/(1 - F0), transmission 1 - F', so
+//       F90 = 1 is exact Fresnel and energy is conserved — on single-scattering
+//       lobes only (microsurface.h's dielectric has no F90: rough dielectric
+//       lobes ignore it). F0 = 0 is eta = 1: an index-matched boundary, a
+//       pass-through. The walk carries energy (pbrt's Importance mode), the
+//       light chain radiance; f(wo, wi) is the same either way (reciprocity,
+//       tested).
+//     - Conductor: iff WalkLayer::conductor (explicit). Complex IOR per channel
+//       by Gulbrandsen 2014 from r = F0 and the edge tint g = F90 (1 - (1 -
+//       F0)^2.75): the factor is the g whose curve is closest to Schlick's with
+//       F90 = 1, so the default F90 = 1 reads as the runtime's Schlick (max
+//       difference over angles 0.056 / 0.027 / 0.024 / 0.012 / 0.014 / 0.006 at
+//       F0 0.02 / 0.04 / 0.3 / 0.56 / 0.9 / 0.97); F90 < 1 lowers the edge tint.
+//       Exact conductor Fresnel. A conductor hides everything below it.
+//     - Haze: the interface is the mixture of two microsurfaces, roughness and
+//       secondRoughness, by secondRoughnessWeight (as the runtime lerps its two
+//       lobes): sampling picks a lobe by its weight, f and the pdf mix.
+//     - specularTint multiplies the reflection of the interface seen from
+//       above (in [0, 1]: it absorbs the rest of F, never creates energy).
+//     - Fuzz: a sheen layer on top of the layer's interface — the runtime's
+//       model as a layer (bsdf.cc): reflection the Charlie sheen lobe amount *
+//       colour * charlieSheen / max(1, E_fuzz(mu_o)) (sampled by cosine with
+//       probability amount * min(E_fuzz(mu_o), 1)); everything else crosses it
+//       straight with weight 1 - amount * min(E_fuzz(mu), 1) at each crossing
+//       (mu of the direction above). An energy-conserving "mean sheen layer"
+//       (it reflects at most what it takes from the crossing light), the LTC /
+//       table sheen of the runtime as a layer, not a volumetric fibre walk;
+//       light from below that it would send back down is absorbed. Not
+//       reciprocal (the runtime's normalization by E_fuzz(mu_o) is not). Fuzz
+//       on an index-matched (F0 0) interface is not walked (a pass-through).
 //   * Medium of a layer that is not the bottom: thickness d (the vertical's
 //     thickness), extinction sigma_t = 1 / MFP per channel (MFP clamped to
 //     >= 1e-30), so optical thickness tau = d / MFP; single-scattering albedo
@@ -57,39 +88,63 @@
 //     (WalkOptions::albedoSeenThroughInterface: the other convention).
 //
 // THE ESTIMATOR (layeredEval)
-//   Per sample: the top reflection f_0(wo, wi) is exact; a light chain is
-//   sampled once from wi down through the stack (transmission only, a direction
-//   c_k in every layer, weight L_k = product of f|cos|/pdf and of the full-layer
-//   transmittances above); the walk enters from wo (transmission only) and
-//   scatters (medium: distance sampling, HG; interfaces: GGX visible normals;
-//   Lambertian: cosine) with Russian roulette (pbrt's: after 3 events, when the
-//   largest channel of the throughput is below 0.25) up to maxDepth events. At
-//   the top interface from below it samples reflection only: every path that
-//   leaves towards wi is counted at its last vertex v (a medium scattering, a
+//   Per sample: one estimate of the top reflection f_0(wo, wi) (exact on a
+//   single-scattering lobe; evalMicrosurface, unbiased and stochastic, on a
+//   microsurface); a light chain is sampled once from wi down through the
+//   stack (transmission only, a direction c_k in every layer, weight L_k =
+//   product of f|cos|/pdf and of the full-layer transmittances above); the
+//   walk enters from wo (transmission only) and scatters (medium: distance
+//   sampling, HG; interfaces: GGX visible normals or the microsurface walk;
+//   Lambertian: cosine) with Russian roulette (after 3 events, when the largest
+//   channel of the throughput is below 0.25: survival probability mb / 0.25,
+//   throughput raised to 0.25) up to maxDepth events. At the top interface from
+//   below it continues by reflection only. A restricted strategy (transmission
+//   only, reflection only) on a microsurface cannot choose its side: the walk
+//   samples every exit and a sample on the unwanted side ends the path; the
+//   kept sample's weight stays f/p_all, so the estimator integrates f over the
+//   wanted side only — unbiased (single-scattering lobes instead renormalize
+//   their Fresnel choice among the allowed lobes). Every path that leaves
+//   towards wi is counted at its last vertex v (a medium scattering, a
 //   reflection from above at an interface, the Lambertian base), by
 //     B: connecting v to the light chain of its layer (the unscattered way up
-//        through the interfaces above, sampled from wi), and, when v is in the
+//        through the interfaces above, sampled from wi; the interface's f by
+//        evalMicrosurface where it walks a microsurface), and, when v is in the
 //        top layer,
 //     A: the direction v sampled for the walk, if it leads up, evaluated
 //        through the top interface f_0(-w, wi) with the transmittance to it,
-//   weighted by the power heuristic on the pdfs of the two strategies (for a
-//   vertex below the top layer only B is used: weight 1). Channels whose
-//   interfaces (IORs) and optical thicknesses agree share one walk (throughput
-//   per channel); others get their own walks, each with `samples` walks.
+//   weighted by the power heuristic on the pdfs of the two strategies
+//   (pdfMicrosurface, a proxy, on microsurfaces: any positive density used
+//   the same way by both strategies keeps MIS unbiased; for a vertex below the
+//   top layer only B is used: weight 1). Channels whose interfaces (IORs, F90)
+//   and optical thicknesses agree share one walk (throughput per channel);
+//   others get their own walks, each with `samples` walks. layeredAlbedo walks
+//   forward; at the top interface (entering, and from below) it splits the
+//   bounce: one microfacet normal gives both the reflection and the
+//   transmission with their weights, what leaves is counted and what stays
+//   walks on (no Bernoulli choice: 3-8x less variance on the smooth gate).
 //   Deterministic: a splitmix64 stream from WalkOptions::seed.
-//   Cost (one core, RelWithDebInfo, 256 samples, maxDepth 64): groundTruth
-//   takes 0.07 .. 1.6 ms per evaluation over examples/*.json (row40_coating
-//   0.57, car_paint 0.68); a stack of coloured IOR or MFP walks per channel.
-//   maxDepth truncates the long walks of bright semi-infinite media: the
-//   albedo of an SSS slab (F0 0.04, roughness 0.5) at A = 0.5 / 0.8 / 0.95 is
-//   short by 0 / 6 / 22 % at maxDepth 64 and converged at 4096 (cost at 256
-//   samples: 0.87 -> 1.5 / 6.5 ms); skin_coated gains 16 % from 64 to 1024
-//   (1.6 -> 4.4 ms). Use maxDepth >= 1024 when an albedo exceeds 0.7.
+//   maxDepth (default 1024): with energy-conserving interfaces light trapped
+//   under a coat (total internal reflection) over a white base bounces many
+//   times; at maxDepth 256 a clear coat over a white conductor at roughness
+//   0.1 keeps 0.994 at NoV 0.2 (the furnace gate fails), at 1024 0.9992. Walks
+//   end early by roulette unless the stack is bright, so the cost is paid by
+//   bright stacks only.
+//   Cost (one core, -O2, 4096 samples, ms per layeredEval / layeredAlbedo,
+//   measured back to back; before = the single-scattering walk of commit
+//   9c10eb0 at maxDepth 64):
+//     coat over plastic          5.1 / 3.5   ->  15.1 / 9.2
+//     SSS base (A 0.8/0.5/0.2)  13.3 / 6.6   ->  77 / 16.9
+//     conductor                  0.004 / 0.43 ->  2.1 / 1.4
+//     coat over conductor        4.6 / 2.3   ->  16.4 / 6.1
+//   (docs/performance.md: the command). Bright semi-infinite media need the
+//   long walks: the albedo of an SSS slab (F0 0.04, roughness 0.5) at A = 0.5
+//   / 0.8 / 0.95 was short by 0 / 6 / 22 % at maxDepth 64 (single scattering).
 //
-// NOT MODELLED: anisotropy, haze (second roughness), fuzz, glints, specular
-//   profiles, emissive, SSS type (wrap / diffusion: only the medium counts),
-//   F90 of dielectrics, thin-surface transmission (the bottom is semi-infinite
-//   or opaque), normal maps (groundTruth uses the geometric frame).
+// NOT MODELLED: fuzz on an index-matched interface, glints, emissive, SSS type (wrap /
+//   diffusion: only the medium counts), F90 of rough (microsurface) dielectric
+//   lobes, thin-surface transmission (the bottom is semi-infinite or opaque),
+//   normal maps (ground_truth.cc's frame). Specular profiles enter as their
+//   tint only.
 #pragma once
 #include <cstdint>
 #include <vector>
@@ -123,7 +178,7 @@ struct Estimate {
 
 struct WalkOptions {
   int samples = 4096;           // walks per channel group
-  int maxDepth = 64;            // events per walk (interfaces, media, base); see the cost note above
+  int maxDepth = 1024;            // events per walk (interfaces, media, base); see the cost note above
   std::uint32_t seed = 1;
   /// The albedo convention. false (the default, the model above): diffuse_albedo is
   /// the albedo of the medium alone (index-matched), the Lambertian's albedo.
