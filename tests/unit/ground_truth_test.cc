@@ -13,6 +13,7 @@
 
 #include "diag/diagnostics.h"
 #include "pipeline/pipeline.h"
+#include "reference/common.h"
 #include "reference/ground_truth.h"
 #include "test_util.h"
 
@@ -159,6 +160,142 @@ TEST(RandomWalkGroundTruth, RunsOnEveryExample) {
     ++count;
   }
   EXPECT_GE(count, 16);
+}
+
+TEST(RandomWalkGroundTruth, MetalnessSlabSplitsIntoConductorAndDielectric) {
+  // car_paint: base = metalness_to_diffuse_f0(paint_color, 0.6, 0.5) under a clear coat.
+  const auto path = std::filesystem::path(SUBSTRATEC_SOURCE_DIR "/examples/car_paint.json");
+  CompileResult r = compileUnsimplified(path.string(), readText(path));
+  int withProvenance = 0;
+  for (const Slab& s : r.material.slabs) withProvenance += s.metalness.has_value();
+  EXPECT_EQ(withProvenance, 1);
+  std::vector<WalkTerm> t = groundTruthTerms(r, Geometry{}, {});
+  int metal = 0, dielectric = 0;
+  double total = 0;
+  for (const WalkTerm& w : t) {
+    total += w.weight;
+    const WalkLayer& base = w.stack.back();
+    if (base.conductor) {
+      ++metal;
+      EXPECT_NEAR(w.weight, 0.6, 1e-12);
+      EXPECT_DOUBLE_EQ(base.f0[0], 0.55);
+      EXPECT_DOUBLE_EQ(base.f0[1], 0.03);
+      EXPECT_DOUBLE_EQ(base.diffuseAlbedo[0], 0);
+    } else {
+      ++dielectric;
+      EXPECT_NEAR(w.weight, 0.4, 1e-12);
+      EXPECT_NEAR(base.f0[0], 0.04, 1e-12);  // 0.08 * specular
+      EXPECT_DOUBLE_EQ(base.diffuseAlbedo[0], 0.55);
+    }
+    EXPECT_EQ(w.stack.size(), 2u);  // the clear coat on top
+  }
+  EXPECT_EQ(metal, 1);
+  EXPECT_EQ(dielectric, 1);
+  EXPECT_NEAR(total, 1, 1e-12);
+}
+
+TEST(RandomWalkGroundTruth, NoProvenanceWhenOnlyF0ComesFromTheHelper) {
+  const std::string nodes = R"(
+    "h": {"kind": "metalness_to_diffuse_f0", "base_color": [0.8, 0.5, 0.2], "metallic": 0.5, "specular": 0.5},
+    "root": {"kind": "slab", "diffuse_albedo": 0.3, "f0": "h.f0", "roughness": 0.4})";
+  CompileResult r = compileUnsimplified("f0only.json", test::material(nodes));
+  int checked = 0;
+  for (const Slab& s : r.material.slabs) {
+    EXPECT_FALSE(s.metalness.has_value());
+    ++checked;
+  }
+  EXPECT_EQ(checked, 1);
+  std::vector<WalkTerm> t = groundTruthTerms(r, Geometry{}, {});
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_FALSE(t[0].stack[0].conductor);
+  // F0 0.42 in red: above the plausible dielectric range, a documented reading.
+  std::vector<std::string> ex = groundTruthExcluded(r);
+  EXPECT_NE(std::find(ex.begin(), ex.end(), "implausible dielectric f0"), ex.end());
+  // Both pins from the helper, constant arguments folded: the provenance survives.
+  const std::string both = R"(
+    "h": {"kind": "metalness_to_diffuse_f0", "base_color": [0.8, 0.5, 0.2], "metallic": 0.5, "specular": 0.5},
+    "root": {"kind": "slab", "diffuse_albedo": "h.diffuse_albedo", "f0": "h.f0", "roughness": 0.4})";
+  CompileResult r2 = compileUnsimplified("both.json", test::material(both));
+  ASSERT_EQ(r2.material.slabs.size(), 1u);
+  EXPECT_TRUE(r2.material.slabs[0].metalness.has_value());
+  EXPECT_EQ(groundTruthTerms(r2, Geometry{}, {}).size(), 2u);
+  EXPECT_TRUE(groundTruthExcluded(r2).empty());
+}
+
+TEST(RandomWalkGroundTruth, ATiltedNormalPinRotatesTheTruth) {
+  // A slab whose normal pin tilts by 0.4 rad about x equals the untilted slab
+  // seen with the view and light rotated the other way.
+  const double a = 0.4;
+  const std::string tilted = "\"root\": {\"kind\": \"slab\", \"diffuse_albedo\": 0.5, \"f0\": 0.04, \"roughness\": 0.3,"
+                             " \"normal\": [0, " + std::to_string(std::sin(a)) + ", " + std::to_string(std::cos(a)) + "]}";
+  const std::string flat = R"("root": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.3})";
+  CompileResult rt = compileUnsimplified("tilted.json", test::material(tilted));
+  CompileResult rf = compileUnsimplified("flat.json", test::material(flat));
+  const std::vector<WalkTerm> t = groundTruthTerms(rt, Geometry{}, {});
+  ASSERT_EQ(t.size(), 1u);
+  EXPECT_NEAR(t[0].N[1], std::sin(a), 1e-5);
+  // World directions; their coordinates in the tilted frame (T = x, N tilted, B = N x T).
+  using reference::detail::cross;
+  using reference::detail::dot;
+  const D3 N = t[0].N, T = t[0].T, B = cross(N, T);
+  int cases = 0;
+  for (double mu : {0.9, 0.5}) {
+    Geometry g;
+    g.V = dir(mu, 1.2);
+    const D3 L = dir(0.7, 3.9);
+    auto local = [&](const D3& w) { return D3{dot(w, T), dot(w, B), dot(w, N)}; };
+    Geometry gf;
+    gf.V = local(g.V);
+    const D3 a1 = groundTruth(rt, g, L, {}, opts(256, 3));
+    const D3 b1 = groundTruth(rf, gf, local(L), {}, opts(256, 3));
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a1[c], b1[c], 1e-9 * (1 + b1[c])) << mu;
+    ++cases;
+  }
+  EXPECT_EQ(cases, 2);
+}
+
+TEST(RandomWalkGroundTruth, ExcludedListsNameTheUnmodelledFeatures) {
+  auto excluded = [](const char* file) {
+    const auto path = std::filesystem::path(SUBSTRATEC_SOURCE_DIR "/examples") / file;
+    return groundTruthExcluded(compileUnsimplified(path.string(), readText(path)));
+  };
+  auto has = [](const std::vector<std::string>& v, const char* s) { return std::find(v.begin(), v.end(), s) != v.end(); };
+  EXPECT_TRUE(has(excluded("row60_glint.json"), "glint"));
+  EXPECT_TRUE(has(excluded("row44_specular_profile.json"), "specular profile"));
+  EXPECT_FALSE(has(excluded("row40_coating.json"), "glint"));
+  EXPECT_FALSE(has(excluded("car_paint.json"), "implausible dielectric f0"));  // its metalness is split
+}
+
+TEST(RandomWalkGroundTruth, FurnaceMaterialIsWhiteForBothSides) {
+  int count = 0;
+  for (const auto& path : examples()) {
+    CompileResult r = compileUnsimplified(path.filename().string(), readText(path));
+    CompileResult f = furnaceMaterial(r);
+    Geometry g;
+    g.V = dir(0.6, 0.2);
+    // The analytic side runs on it: finite closures.
+    MaterialResult<double> a = evaluateMaterial<double>(f, g, InputValues{}, {});
+    for (const auto& c : a.closures)
+      for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isfinite(c.diffuseAlbedo[k]) && std::isfinite(c.f0[k])) << path;
+    for (const WalkTerm& t : groundTruthTerms(f, g, {}))
+      for (const WalkLayer& L : t.stack) {
+        if (L.conductor && !L.opaqueBase) continue;
+        if (L.conductor) EXPECT_DOUBLE_EQ(L.f0[0] * (L.diffuseAlbedo[0] == 0), L.f0[0]) << path;
+        else if (L.opaqueBase) EXPECT_DOUBLE_EQ(L.diffuseAlbedo[1], 1.0) << path;
+      }
+    const Estimate e = groundTruthAlbedo(f, g, {}, opts(64, 5));
+    for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isfinite(e.value[k]) && e.value[k] <= 1.05) << path;
+    ++count;
+  }
+  EXPECT_GE(count, 16);
+  // A white Lambertian under a smooth coat: the furnace truth is ~1.
+  const std::string nodes = R"(
+    "h": {"kind": "metalness_to_diffuse_f0", "base_color": [0.8, 0.5, 0.2], "metallic": 0.3, "specular": 0.5},
+    "root": {"kind": "slab", "diffuse_albedo": "h.diffuse_albedo", "f0": "h.f0", "roughness": 0.0})";
+  CompileResult w = furnaceMaterial(compileUnsimplified("white.json", test::material(nodes)));
+  Geometry g;
+  const Estimate e = groundTruthAlbedo(w, g, {}, opts(2048, 7, 1024));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(e.value[k], 1.0, 0.02) << k;
 }
 
 
