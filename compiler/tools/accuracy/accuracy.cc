@@ -12,8 +12,10 @@
 #include <functional>
 #include <numbers>
 #include <thread>
+#include <type_traits>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "util/random.h"
 
@@ -270,6 +272,103 @@ Comparison compare(const Analytic& analytic, const Truth& truth) {
   else if (black == static_cast<int>(c.rows.size()))
     c.problems.insert(c.problems.begin(), "the truth is black at every NoV: nothing to compare");
   return c;
+}
+
+}  // namespace substratec::accuracy
+
+namespace substratec::accuracy {
+
+namespace {
+
+nlohmann::ordered_json rgbJson(const Rgb& c) { return nlohmann::ordered_json::array({c[0], c[1], c[2]}); }
+
+template <class T>
+nlohmann::ordered_json orNull(const std::optional<T>& v) {
+  if (!v) return nullptr;
+  if constexpr (std::is_same_v<T, Rgb>) return rgbJson(*v);
+  else return *v;
+}
+
+nlohmann::ordered_json rowJson(const ComparisonRow& r) {
+  nlohmann::ordered_json channels = nlohmann::ordered_json::array();
+  for (const auto& e : r.channelRelError) channels.push_back(orNull(e));
+  return {{"nov", r.nov},
+          {"analytic", rgbJson(r.analytic)},
+          {"truth", rgbJson(r.truth)},
+          {"truth_stderr", rgbJson(r.truthStderr)},
+          {"truth_walks", r.truthWalks},
+          {"rel_error", orNull(r.relError)},
+          {"rel_error_rgb", channels},
+          {"brdf_median_rel_error", orNull(r.brdfMedianRelError)},
+          {"brdf_p95_rel_error", orNull(r.brdfP95RelError)},
+          {"brdf_points", {{"counted", r.brdfCounted}, {"total", r.brdfTotal}}},
+          {"reciprocity_max_ratio", r.reciprocityMaxRatio},
+          {"reciprocity_pairs", r.reciprocityPairs},
+          {"furnace_analytic", orNull(r.furnaceAnalytic)},
+          {"furnace_truth", orNull(r.furnaceTruth)},
+          {"furnace_truth_stderr", orNull(r.furnaceTruthStderr)}};
+}
+
+nlohmann::ordered_json comparisonJson(const Comparison& c) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (const auto& r : c.rows) rows.push_back(rowJson(r));
+  return {{"rows", rows}, {"excluded", c.excluded}, {"problems", c.problems}};
+}
+
+std::string num(const std::optional<double>& v, const char* format) {
+  return v ? fmt::format(fmt::runtime(format), *v) : std::string("—");
+}
+
+std::string comparisonTable(const Comparison& c) {
+  std::string out = fmt::format("{:>4}  {:<22}  {:<22}  {:<22}  {:>8}  {:>8}  {:>8}  {:>7}  {:>6}  {:>7}  {:>7}\n",
+                                "nov", "analytic", "truth", "± stderr", "rel_err", "brdf_med", "brdf_p95", "points",
+                                "recip", "furn_a", "furn_t");
+  auto rgb = [](const Rgb& v) { return fmt::format("{:.4f} {:.4f} {:.4f}", v[0], v[1], v[2]); };
+  auto lum = [](const std::optional<Rgb>& v) { return v ? fmt::format("{:.4f}", luminance(*v)) : std::string("—"); };
+  for (const auto& r : c.rows)
+    out += fmt::format("{:>4.1f}  {:<22}  {:<22}  {:<22}  {:>8}  {:>8}  {:>8}  {:>7}  {:>6.3f}  {:>7}  {:>7}\n", r.nov,
+                       rgb(r.analytic), rgb(r.truth), rgb(r.truthStderr), num(r.relError, "{:+.2%}"),
+                       num(r.brdfMedianRelError, "{:.2%}"), num(r.brdfP95RelError, "{:.2%}"),
+                       fmt::format("{}/{}", r.brdfCounted, r.brdfTotal), r.reciprocityMaxRatio,
+                       lum(r.furnaceAnalytic), lum(r.furnaceTruth));
+  std::string excluded;
+  for (const auto& e : c.excluded) excluded += (excluded.empty() ? "" : ", ") + e;
+  out += "excluded: " + (excluded.empty() ? std::string("none") : excluded) + "\n";
+  for (const auto& p : c.problems) out += "problem: " + p + "\n";
+  return out;
+}
+
+}  // namespace
+
+std::string formatJson(const Report& report) {
+  nlohmann::ordered_json nol = nlohmann::ordered_json::array();
+  for (double mu : report.options.gridNoL) nol.push_back(mu);
+  nlohmann::ordered_json j = {
+      {"material", report.material},
+      {"bytes", report.bytes},
+      {"closures", report.closures},
+      {"truth_samples", report.vsAuthored.truthSamples},
+      {"truth_eval_samples", report.vsAuthored.truthEvalSamples},
+      {"brdf_threshold", report.options.brdfThreshold},
+      {"grid", {{"nol", nol}, {"azimuths", report.options.gridAzimuths}}},
+      {"diffuse_model", report.options.diffuseModel},
+  };
+  const nlohmann::ordered_json authored = comparisonJson(report.vsAuthored);
+  for (auto it = authored.begin(); it != authored.end(); ++it) j[it.key()] = it.value();
+  j["truth_compiled"] = report.vsCompiled ? comparisonJson(*report.vsCompiled) : nlohmann::ordered_json(nullptr);
+  return j.dump(2) + "\n";
+}
+
+std::string formatTable(const Report& report) {
+  std::string out = fmt::format(
+      "accuracy of {} (as compiled: {} B, {} closures; truth: {} walks per albedo, {} per grid point; BRDF grid {} "
+      "directions, counted where the truth exceeds {:g} of its max)\n",
+      report.material, report.bytes, report.closures, report.vsAuthored.truthSamples,
+      report.vsAuthored.truthEvalSamples, report.options.gridNoL.size() * report.options.gridAzimuths,
+      report.options.brdfThreshold);
+  out += "-- against the truth of the authored material\n" + comparisonTable(report.vsAuthored);
+  if (report.vsCompiled) out += "-- against the truth of the compiled closures\n" + comparisonTable(*report.vsCompiled);
+  return out;
 }
 
 }  // namespace substratec::accuracy

@@ -133,4 +133,20 @@ Comparison compare(const Analytic& analytic, const Truth& truth);
 /// Rec. 709 luminance.
 double luminance(const Rgb& c);
 
+/// What the command prints about one material: the comparison with the truth
+/// of the authored material and, when the compiled material differs from it,
+/// with the truth of the compiled closures (like for like).
+struct Report {
+  std::string material;
+  int bytes = 0, closures = 0;  // of the material as compiled
+  Options options;
+  Comparison vsAuthored;
+  std::optional<Comparison> vsCompiled;
+};
+
+/// The report as JSON (docs/accuracy.md, "The accuracy metric": every key).
+std::string formatJson(const Report& report);
+/// The report as a table, one row per NoV.
+std::string formatTable(const Report& report);
+
 }  // namespace substratec::accuracy
