@@ -315,20 +315,22 @@ nlohmann::ordered_json comparisonJson(const Comparison& c) {
   return {{"rows", rows}, {"excluded", c.excluded}, {"problems", c.problems}};
 }
 
-std::string num(const std::optional<double>& v, const char* format) {
-  return v ? fmt::format(fmt::runtime(format), *v) : std::string("—");
+/// A relative error in percent ("—" when there is none); `sign`: with its sign.
+std::string percent(const std::optional<double>& v, bool sign) {
+  if (!v) return "—";
+  return sign ? fmt::format("{:+.2f} %", 100 * *v) : fmt::format("{:.2f} %", 100 * *v);
 }
 
 std::string comparisonTable(const Comparison& c) {
-  std::string out = fmt::format("{:>4}  {:<22}  {:<22}  {:<22}  {:>8}  {:>8}  {:>8}  {:>7}  {:>6}  {:>7}  {:>7}\n",
+  std::string out = fmt::format("{:>4}  {:<22}  {:<22}  {:<22}  {:>9}  {:>9}  {:>9}  {:>7}  {:>6}  {:>7}  {:>7}\n",
                                 "nov", "analytic", "truth", "± stderr", "rel_err", "brdf_med", "brdf_p95", "points",
                                 "recip", "furn_a", "furn_t");
   auto rgb = [](const Rgb& v) { return fmt::format("{:.4f} {:.4f} {:.4f}", v[0], v[1], v[2]); };
   auto lum = [](const std::optional<Rgb>& v) { return v ? fmt::format("{:.4f}", luminance(*v)) : std::string("—"); };
   for (const auto& r : c.rows)
-    out += fmt::format("{:>4.1f}  {:<22}  {:<22}  {:<22}  {:>8}  {:>8}  {:>8}  {:>7}  {:>6.3f}  {:>7}  {:>7}\n", r.nov,
-                       rgb(r.analytic), rgb(r.truth), rgb(r.truthStderr), num(r.relError, "{:+.2%}"),
-                       num(r.brdfMedianRelError, "{:.2%}"), num(r.brdfP95RelError, "{:.2%}"),
+    out += fmt::format("{:>4.1f}  {:<22}  {:<22}  {:<22}  {:>9}  {:>9}  {:>9}  {:>7}  {:>6.3f}  {:>7}  {:>7}\n", r.nov,
+                       rgb(r.analytic), rgb(r.truth), rgb(r.truthStderr), percent(r.relError, true),
+                       percent(r.brdfMedianRelError, false), percent(r.brdfP95RelError, false),
                        fmt::format("{}/{}", r.brdfCounted, r.brdfTotal), r.reciprocityMaxRatio,
                        lum(r.furnaceAnalytic), lum(r.furnaceTruth));
   std::string excluded;
