@@ -37,14 +37,16 @@ inline constexpr std::array<double, 6> kNoV{1, 0.8, 0.6, 0.4, 0.2, 0.1};
 
 struct Options {
   /// Walks per truth albedo (per NoV and channel group); also of the furnace.
-  int samples = 4096;
+  int samples = 32768;
   /// Walks per truth f * cos grid point (per channel group).
-  int evalSamples = 256;
+  int evalSamples = 2048;
   /// Importance samples per strategy of envIntegrated (the analytic albedo).
   int envSamples = 4096;
   /// The light grid: every NoL of gridNoL at gridAzimuths azimuths
   /// phi_j = 2 pi j / gridAzimuths (phi 0: the view's side; pi: the mirror side).
-  std::vector<double> gridNoL{0.95, 0.8, 0.6, 0.4, 0.2, 0.1};
+  /// No NoL of the grid is one of kNoV: no grid point is a view's exact mirror
+  /// direction, where a smooth lobe's peak would set the max of the threshold.
+  std::vector<double> gridNoL{0.95, 0.85, 0.7, 0.5, 0.3, 0.15};
   int gridAzimuths = 8;
   /// A grid point counts in the BRDF error when lum(truth) > brdfThreshold *
   /// the grid's max lum(truth) (at that NoV); reciprocity counts a pair when
