@@ -70,6 +70,18 @@ enum Feature : std::uint16_t {
 inline constexpr int kFeatureCount = 9;
 std::string_view featureName(int bit);  // scene/report names: "f90", "anisotropy", ...
 
+/// Provenance of a slab whose diffuse_albedo and f0 pins are the two outputs
+/// of ONE metalness_to_diffuse_f0 node (diffuse = b (1 - m), f0 = 0.08 s (1 - m)
+/// + b m): that node's arguments, so the ground truth can walk the
+/// conductor/dielectric mix the author meant instead of the folded pins
+/// (reference/ground_truth.h). Invisible to generated code and IR dumps. Valid
+/// only while the slab's pins are still `diffuse` and `f0` (simplification
+/// drops it when it blends them).
+struct MetalnessSource {
+  ValueId baseColor = kNoValue, metallic = kNoValue, specular = kNoValue;  // Vec3, Float, Float
+  ValueId diffuse = kNoValue, f0 = kNoValue;                               // the helper's outputs (the pins)
+};
+
 struct Slab {
   std::string id;       // source node id (with instance suffix when instanced twice)
   std::string pointer;  // JSON pointer of the slab node
@@ -79,6 +91,7 @@ struct Slab {
   bool sssTypeExplicit = false;
   std::uint16_t features = 0;     // filled by the feature pass
   int basis = -1;                 // filled by the shared-bases pass
+  std::optional<MetalnessSource> metalness;  // set by build_tree when both pins come from one helper
   // Set only on slabs made by simplification (parameter blending):
   ValueId coverage = kNoValue;    // the slab's own coverage (kNoValue: 1)
   ValueId thickness = kNoValue;   // accumulated layer thickness (kNoValue: none)

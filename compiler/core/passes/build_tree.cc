@@ -59,6 +59,7 @@ class TreeBuilder {
         slab.pins[p] = pinToValue(src.slabPins[p], info.type, table_, m_);
         if (src.slabPins[p].tag == PinRef::Node) checkConstantRange(slab.pins[p], info, src.pointer);
       }
+      slab.metalness = metalnessSource(src, slab);
       slab.specularProfileInput = src.specularProfileInput;
       slab.sssType = src.sssType;
       slab.sssTypeExplicit = src.sssTypeExplicit;
@@ -66,6 +67,28 @@ class TreeBuilder {
       m_.slabs.push_back(std::move(slab));
     }
     return index;
+  }
+
+  /// The metalness_to_diffuse_f0 node whose outputs 0 and 1 are the slab's
+  /// diffuse_albedo and f0 pins (the same node), read from the resolved
+  /// document (the DAG may have folded the helper into constants): its
+  /// arguments as DAG values. The DAG is hash-consed and append-only, so
+  /// pinToValue of the helper's pins returns the ids its outputs were built
+  /// from (base_color broadcast to grey, as build_values does).
+  std::optional<MetalnessSource> metalnessSource(const SNode& src, const Slab& slab) {
+    const PinRef& d = src.slabPins[static_cast<int>(SlabPin::DiffuseAlbedo)];
+    const PinRef& f = src.slabPins[static_cast<int>(SlabPin::F0)];
+    if (d.tag != PinRef::Node || f.tag != PinRef::Node || d.index != f.index || d.output != 0 || f.output != 1)
+      return std::nullopt;
+    const VNode& v = doc_.values[d.index];
+    if (v.op != Op::MetalnessToDiffuseF0 || v.pins.size() < 3) return std::nullopt;
+    MetalnessSource ms;
+    ms.baseColor = m_.values.broadcast(pinToValue(v.pins[0], VType::Invalid, table_, m_), VType::Vec3);
+    ms.metallic = pinToValue(v.pins[1], VType::Invalid, table_, m_);
+    ms.specular = pinToValue(v.pins[2], VType::Invalid, table_, m_);
+    ms.diffuse = slab.pin(SlabPin::DiffuseAlbedo);
+    ms.f0 = slab.pin(SlabPin::F0);
+    return ms;
   }
 
   /// The first instance of an author node keeps its id; every other name

@@ -85,6 +85,11 @@ void collapse(Material& m, int n, BlendRule rule) {
   merged.id = node.id;
   merged.pointer = node.pointer;
   merged.collapsedFrom = std::string(treeOpName(node.op));
+  // The metalness provenance holds only while the pins are still the helper's
+  // outputs (a coverage weight keeps them; a blend does not).
+  if (merged.metalness && (merged.metalness->diffuse != merged.pin(SlabPin::DiffuseAlbedo) ||
+                           merged.metalness->f0 != merged.pin(SlabPin::F0)))
+    merged.metalness.reset();
   TreeNode& dst = m.nodes[n];
   dst.op = TreeOp::Slab;
   dst.left = dst.right = -1;

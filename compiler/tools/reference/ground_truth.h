@@ -26,7 +26,15 @@ V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<doubl
 struct WalkTerm {
   double weight = 1;
   std::vector<WalkLayer> stack;
+  V3<double> N{0, 0, 1}, T{1, 0, 0};  // the term's shading frame (world): its top slab's normal and tangent
 };
+
+/// Dielectric F0 above this (IOR above ~1.9) is outside the plausible range of
+/// dielectrics: walked as is (the IOR its F0 gives) and listed by
+/// groundTruthExcluded as "implausible dielectric f0".
+inline constexpr double kPlausibleDielectricF0 = 0.1;
+/// The MFP of a furnace coat: clear (no extinction over any thickness).
+inline constexpr double kClearMfp = 1e30;
 
 /// The tree as a weighted sum of stacks, combined linearly with the tree walk's
 /// weights (tree_walk.cc): a slab is [slab] with its own coverage (1 unless
