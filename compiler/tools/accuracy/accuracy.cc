@@ -19,13 +19,6 @@
 
 #include "util/random.h"
 
-// TODO(i18-truth): reference::furnaceMaterial and groundTruthExcluded are
-// implemented on branch i18-truth; until it is merged the furnace is left out
-// (empty optionals) and the exclusion list says so. Removed at the merge.
-#ifndef SUBSTRATEC_ACCURACY_TRUTH_MERGED
-#define SUBSTRATEC_ACCURACY_TRUTH_MERGED 0
-#endif
-
 namespace substratec::accuracy {
 
 namespace {
@@ -141,23 +134,17 @@ reference::WalkOptions walkOptions(int samples, std::uint32_t seed) {
 Truth truthOf(const CompileResult& authored, const Options& options) {
   const std::vector<Rgb> grid = lightGrid(options);
   const std::size_t perView = grid.size() + 2;  // albedo, furnace, the grid
-#if SUBSTRATEC_ACCURACY_TRUTH_MERGED
   const CompileResult furnace = reference::furnaceMaterial(authored);
-#endif
   Truth truth;
   truth.samples = options.samples;
   truth.evalSamples = options.evalSamples;
   truth.brdfThreshold = options.brdfThreshold;
-#if SUBSTRATEC_ACCURACY_TRUTH_MERGED
   truth.excluded = reference::groundTruthExcluded(authored);
-#else
-  truth.excluded = {"(the truth's exclusion list: not wired yet)"};
-#endif
   truth.rows.resize(kNoV.size());
   for (std::size_t v = 0; v < kNoV.size(); ++v) {
     truth.rows[v].nov = kNoV[v];
     truth.rows[v].grid.resize(grid.size());
-    if (SUBSTRATEC_ACCURACY_TRUTH_MERGED) truth.rows[v].furnace = reference::Estimate{};
+    truth.rows[v].furnace = reference::Estimate{};
   }
   parallelFor(kNoV.size() * perView, options.threads, [&](std::size_t i) {
     const std::size_t v = i / perView, k = i % perView;
@@ -165,11 +152,8 @@ Truth truthOf(const CompileResult& authored, const Options& options) {
     TruthRow& row = truth.rows[v];
     if (k == 0)
       row.albedo = reference::groundTruthAlbedo(authored, g, {}, walkOptions(options.samples, seedOf(options.seed, i)));
-    else if (k == 1) {
-#if SUBSTRATEC_ACCURACY_TRUTH_MERGED
+    else if (k == 1)
       row.furnace = reference::groundTruthAlbedo(furnace, g, {}, walkOptions(options.samples, seedOf(options.seed, i)));
-#endif
-    }
     else
       row.grid[k - 2] = reference::groundTruthEstimate(authored, g, grid[k - 2], {},
                                                        walkOptions(options.evalSamples, seedOf(options.seed, i)));
@@ -179,9 +163,7 @@ Truth truthOf(const CompileResult& authored, const Options& options) {
 
 Analytic analyticOf(const CompileResult& compiled, const Options& options) {
   const std::vector<Rgb> grid = lightGrid(options);
-#if SUBSTRATEC_ACCURACY_TRUTH_MERGED
   const CompileResult furnace = reference::furnaceMaterial(compiled);
-#endif
   Analytic a;
   a.rows.resize(kNoV.size());
   parallelFor(kNoV.size(), options.threads, [&](std::size_t v) {
@@ -190,9 +172,7 @@ Analytic analyticOf(const CompileResult& compiled, const Options& options) {
     const reference::Geometry g = viewGeometry(kNoV[v]);
     const Rgb V{g.V[0], g.V[1], g.V[2]};
     row.albedo = analyticAlbedo(compiled, g, options, 2 * v);
-#if SUBSTRATEC_ACCURACY_TRUTH_MERGED
     row.furnace = analyticAlbedo(furnace, g, options, 2 * v + 1);
-#endif
     const auto closures = reference::evaluateMaterial<double>(compiled, g, {}, {}).closures;
     row.grid.reserve(grid.size());
     double maxLum = 0;
