@@ -20,7 +20,7 @@ using substratec::clitest::CliResult;
 namespace {
 
 const std::string kRow12 = std::string(SUBSTRATEC_SOURCE_DIR) + "/examples/row12_simple.json";
-const std::vector<std::string> kCommands = {"report", "compile", "preview", "sweep", "stability", "import", "scene"};
+const std::vector<std::string> kCommands = {"report", "compile", "preview", "sweep", "accuracy", "stability", "import", "scene"};
 
 /// The option lines of `command --help`: each option with the line CLI11
 /// may wrap its description onto.
@@ -117,7 +117,7 @@ TEST(CliUsage, AnUnknownCommandIsNamedAndTheCommandsListed) {
     EXPECT_NE(r.err.find(args.empty() ? "a command is required" : "unknown command \"" + args[0] + "\""),
               std::string::npos)
         << r.err;
-    EXPECT_NE(r.err.find("(the commands: report, compile, preview, sweep, stability, import, scene)"), std::string::npos)
+    EXPECT_NE(r.err.find("(the commands: report, compile, preview, sweep, accuracy, stability, import, scene)"), std::string::npos)
         << r.err;
   }
   EXPECT_EQ(cli({"--version"}).status, 0);  // an option first is not a command

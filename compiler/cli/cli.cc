@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "accuracy/accuracy.h"
 #include "batch/batch.h"
 #include "cli/cli_options.h"
 #include "cli/command_outputs.h"
@@ -731,6 +732,78 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   return printSweep(a, full.material.name, rows, outputs, out, err);
 }
 
+// ----- accuracy ----------------------------------------------------------------
+
+struct AccuracyArgs {
+  MaterialInput in;
+  CompileFlags compile;
+  bool json = false;
+  int samples = accuracy::Options{}.samples;
+  int evalSamples = accuracy::Options{}.evalSamples;
+  int threads = 0;
+  std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
+};
+
+void addAccuracyOptions(CLI::App* c, AccuracyArgs& a) {
+  addMaterialInput(c, a.in);
+  addBudgetOptions(c, a.compile,
+                   {"Bytes per pixel budget (overrides settings.bytes_per_pixel)",
+                    "Closure budget (overrides settings.max_closures)"});
+  c->add_flag("--json", a.json, "Print the comparison as JSON (docs/accuracy.md)");
+  c->add_option("--samples", a.samples, "Random walks per truth albedo (per NoV and channel group)")
+      ->transform(cli::inRange(1, 1 << 22, "walks"))->capture_default_str();
+  c->add_option("--eval-samples", a.evalSamples, "Random walks per truth BRDF grid point (per channel group)")
+      ->transform(cli::inRange(1, 1 << 22, "walks"))->capture_default_str();
+  c->add_option("-j,--jobs", a.threads, "Threads (the results do not depend on them)")
+      ->transform(cli::inRange(1, 256, "threads"))->default_str("the machine's threads");
+  addDiffuseOption(c, a.diffuse);
+  addMaxInputSize(c, a.compile);
+}
+
+/// `accuracy`: the material as compiled (its settings, --budget,
+/// --full-simplification) against the Monte Carlo truth of the authored
+/// material (compiled without simplification) and, when they differ, against
+/// the truth of the compiled closures. A comparison with problems (a black
+/// truth: nothing to compare) is printed and exits with bad input.
+int runAccuracy(const AccuracyArgs& a, std::ostream& out, std::ostream& err) {
+  const CompileOptions o = toCompileOptions(a.compile);
+  CommandOutputs outputs(out);
+  int status = kExitOk;
+  auto sources = loadFile(a.in, false, o.read, outputs, err, status);
+  if (!sources) return status;
+  const import::MaterialSource& s = sources->front();
+  CompileOptions unsimplified = o;
+  unsimplified.budgetOverride = 1024;
+  unsimplified.maxClosuresOverride = 8;
+  unsimplified.fullSimplification = false;
+  Diagnostics diags(s.displayName), ignored(s.displayName);
+  auto compiled = compileText(s.displayName, s.text, o, diags);
+  err << diags.formatAll();
+  if (!compiled) return compileFailure(s, err);
+  auto authored = compileText(s.displayName, s.text, unsimplified, ignored);  // compiled: so does the authored tree
+  if (!authored) return printInternalError(err, "the unsimplified material does not compile: " + ignored.errorMessages());
+  accuracy::Options ao;
+  ao.samples = a.samples;
+  ao.evalSamples = a.evalSamples;
+  ao.threads = a.threads;
+  ao.diffuseModel = diffuseModelNumber(diffuseModelOf(a.diffuse));
+  accuracy::Report report;
+  report.material = compiled->material.name;
+  report.bytes = compiled->after.bytes();
+  report.closures = static_cast<int>(compiled->after.closures.size());
+  report.options = ao;
+  const accuracy::Analytic analytic = accuracy::analyticOf(*compiled, ao);
+  report.vsAuthored = accuracy::compare(analytic, accuracy::truthOf(*authored, ao));
+  const bool differs = !compiled->steps.empty() || compiled->after.bytes() != authored->after.bytes() ||
+                       compiled->after.closures.size() != authored->after.closures.size();
+  if (differs) report.vsCompiled = accuracy::compare(analytic, accuracy::truthOf(*compiled, ao));
+  out << (a.json ? accuracy::formatJson(report) : accuracy::formatTable(report));
+  if (report.vsAuthored.problems.empty()) return kExitOk;
+  std::string problems;
+  for (const auto& p : report.vsAuthored.problems) problems += (problems.empty() ? "" : "; ") + p;
+  return printError(err, kExitBadInput, fmt::format("{}: no accuracy to report: {}", s.displayName, problems));
+}
+
 // ----- stability ---------------------------------------------------------------
 
 struct StabilityArgs {
@@ -1104,6 +1177,10 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
               runPreview),
       command(app, "sweep", "Cost against error at the full budget and at each simplification step", addSweepOptions,
               runSweep),
+      command(app, "accuracy",
+              "The shipping model against the Monte Carlo truth: albedo, BRDF, reciprocity and furnace per NoV "
+              "(docs/accuracy.md)",
+              addAccuracyOptions, runAccuracy),
       command(app, "stability", "Hard cases: non-finite values on the CPU and on lavapipe, white furnace",
               addStabilityOptions, runStability),
       command(app, "import",

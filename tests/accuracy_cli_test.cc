@@ -1,0 +1,62 @@
+// `substratec accuracy` (docs/accuracy.md, "The accuracy metric"): its JSON
+// has every key of every row; it reads MaterialX like report does; a file that
+// does not load exits non-zero with a located message. Cheap: low --samples.
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cli_util.h"
+
+namespace {
+
+using substratec::clitest::cli;
+using substratec::clitest::CliResult;
+
+const std::string kSourceDir = SUBSTRATEC_SOURCE_DIR;
+
+TEST(AccuracyCli, JsonHasEveryKeyOfEveryNoV) {
+  CliResult r = cli({"accuracy", kSourceDir + "/examples/row12_simple.json", "--json", "--samples", "256",
+                     "--eval-samples", "32", "-j", "2"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["truth_samples"], 256);
+  EXPECT_TRUE(j.contains("excluded"));
+  EXPECT_TRUE(j.contains("truth_compiled"));
+  ASSERT_EQ(j["rows"].size(), 6u);
+  int checked = 0;
+  for (const auto& row : j["rows"]) {
+    for (const char* key : {"nov", "analytic", "truth", "truth_stderr", "rel_error", "brdf_median_rel_error",
+                            "brdf_p95_rel_error", "reciprocity_max_ratio", "furnace_analytic", "furnace_truth"})
+      EXPECT_TRUE(row.contains(key)) << key;
+    EXPECT_TRUE(row["rel_error"].is_number());
+    ++checked;
+  }
+  EXPECT_EQ(checked, 6);
+  // Deterministic for a given --samples.
+  EXPECT_EQ(cli({"accuracy", kSourceDir + "/examples/row12_simple.json", "--json", "--samples", "256",
+                 "--eval-samples", "32", "-j", "1"}).out,
+            r.out);
+}
+
+TEST(AccuracyCli, ReadsMaterialX) {
+  const std::string mtlx =
+      kSourceDir + "/tests/import/corpus/materialx/UsdPreviewSurface/usd_preview_surface_plastic.mtlx";
+  CliResult r = cli({"accuracy", mtlx, "--samples", "128", "--eval-samples", "16"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("rel_err"), std::string::npos) << r.out;
+}
+
+TEST(AccuracyCli, ABadFileFailsWithAMessage) {
+  CliResult missing = cli({"accuracy", kSourceDir + "/examples/no_such_material.json"});
+  EXPECT_EQ(missing.status, 1);
+  EXPECT_NE(missing.err.find("no_such_material.json"), std::string::npos) << missing.err;
+  EXPECT_EQ(missing.out, "");
+  const std::string bad = kSourceDir + "/tests/bad/282_include_cycle.mtlx";
+  CliResult cycle = cli({"accuracy", bad});
+  EXPECT_EQ(cycle.status, 1);
+  EXPECT_NE(cycle.err.find("282_include_cycle"), std::string::npos) << cycle.err;
+}
+
+}  // namespace

@@ -1,0 +1,142 @@
+// The accuracy metric (accuracy/accuracy.h): a slab whose analytic model and
+// truth agree, determinism (same samples, same bits; the thread count changes
+// no bit), every row present, and a black truth reported rather than passed.
+// Cheap: a few hundred walks per figure.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "accuracy/accuracy.h"
+#include "diag/diagnostics.h"
+#include "pipeline/pipeline.h"
+#include "test_util.h"
+
+namespace substratec {
+namespace {
+
+CompileResult compileSlab(const std::string& slab) {
+  Diagnostics d("slab.json");
+  CompileOptions o;
+  o.budgetOverride = 1024;
+  o.maxClosuresOverride = 8;
+  auto r = compileText("slab.json", test::material(R"("root": )" + slab), o, d);
+  EXPECT_TRUE(r) << d.formatAll();
+  return r ? std::move(*r) : CompileResult{};
+}
+
+accuracy::Options cheap(int threads) {
+  accuracy::Options o;
+  o.samples = 2048;
+  o.evalSamples = 64;
+  o.envSamples = 1024;
+  o.threads = threads;
+  o.diffuseModel = reference::kDiffuseLambert;
+  return o;
+}
+
+bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+TEST(Accuracy, ALambertianSlabAgreesWithItsTruthNearNormalIncidence) {
+  // No specular to speak of (F0 0): the walk's Lambertian and the analytic
+  // Lambert diffuse are the same model; they part only at grazing views, where
+  // the analytic model's Schlick Fresnel (F90 1) takes from the diffuse.
+  const CompileResult r = compileSlab(R"({"kind": "slab", "diffuse_albedo": 0.5, "f0": 0, "roughness": 0.5})");
+  const accuracy::Options o = cheap(2);
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  EXPECT_TRUE(c.problems.empty());
+  int checked = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.brdfMedianRelError && row.brdfP95RelError);
+    EXPECT_EQ(row.brdfTotal, 48);
+    EXPECT_GT(row.brdfCounted, 0);
+    EXPECT_GE(row.reciprocityMaxRatio, 1.0);
+    EXPECT_GT(row.truthWalks, 0);
+    if (row.nov < 0.8) continue;
+    EXPECT_NEAR(*row.relError, 0, 0.005);
+    EXPECT_LT(*row.brdfMedianRelError, 0.01);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(row.truth[k], 0.5, 0.005);
+    ++checked;
+  }
+  EXPECT_EQ(checked, 2);
+}
+
+TEST(Accuracy, SameSamplesSameBitsWhateverTheThreads) {
+  const CompileResult r =
+      compileSlab(R"({"kind": "slab", "diffuse_albedo": [0.6, 0.3, 0.2], "f0": 0.04, "roughness": 0.3})");
+  accuracy::Options one = cheap(1), two = cheap(2);
+  one.samples = two.samples = 256;
+  const accuracy::Comparison a = accuracy::compare(accuracy::analyticOf(r, one), accuracy::truthOf(r, one));
+  const accuracy::Comparison b = accuracy::compare(accuracy::analyticOf(r, two), accuracy::truthOf(r, two));
+  const accuracy::Comparison again = accuracy::compare(accuracy::analyticOf(r, two), accuracy::truthOf(r, two));
+  ASSERT_EQ(a.rows.size(), accuracy::kNoV.size());
+  ASSERT_EQ(b.rows.size(), a.rows.size());
+  int compared = 0;
+  for (std::size_t v = 0; v < a.rows.size(); ++v)
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_TRUE(sameBits(a.rows[v].truth[k], b.rows[v].truth[k]));
+      EXPECT_TRUE(sameBits(a.rows[v].truthStderr[k], b.rows[v].truthStderr[k]));
+      EXPECT_TRUE(sameBits(a.rows[v].analytic[k], b.rows[v].analytic[k]));
+      EXPECT_TRUE(sameBits(b.rows[v].truth[k], again.rows[v].truth[k]));
+      EXPECT_TRUE(sameBits(*a.rows[v].brdfP95RelError, *b.rows[v].brdfP95RelError));
+      ++compared;
+    }
+  EXPECT_EQ(compared, 18);
+  // Another seed is another estimate (the seeds do reach the walks).
+  accuracy::Options other = one;
+  other.seed = 2;
+  EXPECT_FALSE(sameBits(accuracy::truthOf(r, other).rows[0].albedo.value[0], a.rows[0].truth[0]));
+}
+
+TEST(Accuracy, ABlackTruthIsReportedNotPassed) {
+  // compare() on a truth that is 0 everywhere: no relative error, no BRDF
+  // error, and problems that say so (the command exits non-zero on them).
+  accuracy::Truth black;
+  accuracy::Analytic analytic;
+  for (double nov : accuracy::kNoV) {
+    black.rows.push_back({nov, reference::Estimate{}, std::vector<reference::Estimate>(48), std::nullopt});
+    analytic.rows.push_back({nov, accuracy::Rgb{0.1, 0.1, 0.1}, std::vector<accuracy::Rgb>(48, {0.01, 0.01, 0.01}),
+                             1, 0, std::nullopt});
+  }
+  const accuracy::Comparison c = accuracy::compare(analytic, black);
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  for (const auto& row : c.rows) {
+    EXPECT_FALSE(row.relError);
+    EXPECT_FALSE(row.brdfMedianRelError);
+    EXPECT_FALSE(row.brdfP95RelError);
+    EXPECT_EQ(row.brdfCounted, 0);
+    for (const auto& e : row.channelRelError) EXPECT_FALSE(e);
+  }
+  ASSERT_FALSE(c.problems.empty());
+  EXPECT_NE(c.problems.front().find("black at every NoV"), std::string::npos) << c.problems.front();
+  EXPECT_EQ(c.problems.size(), accuracy::kNoV.size() + 1);
+}
+
+TEST(Accuracy, TheJsonHasEveryKeyOfEveryRow) {
+  const CompileResult r = compileSlab(R"({"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.5})");
+  const accuracy::Options o = cheap(2);
+  accuracy::Report report;
+  report.material = "m";
+  report.options = o;
+  report.vsAuthored = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  const auto j = nlohmann::json::parse(accuracy::formatJson(report));
+  for (const char* key : {"truth_samples", "excluded", "problems", "rows", "truth_compiled", "brdf_threshold", "grid"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  ASSERT_EQ(j["rows"].size(), accuracy::kNoV.size());
+  int checked = 0;
+  for (const auto& row : j["rows"])
+    for (const char* key : {"nov", "analytic", "truth", "truth_stderr", "rel_error", "brdf_median_rel_error",
+                            "brdf_p95_rel_error", "reciprocity_max_ratio", "furnace_analytic", "furnace_truth"}) {
+      EXPECT_TRUE(row.contains(key)) << key;
+      ++checked;
+    }
+  EXPECT_EQ(checked, 60);
+  EXPECT_NE(accuracy::formatTable(report).find("rel_err"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace substratec
