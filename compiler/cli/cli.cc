@@ -36,6 +36,7 @@
 #include "report/report.h"
 #include "scene/scene.h"
 #include "stability/stability.h"
+#include "storage/pack.h"
 #include "sweep/sweep.h"
 #include "validate/toolchain.h"
 
@@ -579,7 +580,16 @@ int previewSteps(const PreviewArgs& a, const import::MaterialSource& s, const Co
                  std::vector<sweep::Step>& steps, std::ostream& err) {
   if (a.sweep) {
     CompileResult full;
-    return simplificationSteps(s, o, steps, full, err);
+    if (int failed = simplificationSteps(s, o, steps, full, err); failed != kExitOk) return failed;
+    // An authored tree the storage format cannot hold has no code to render.
+    std::erase_if(steps, [&](const sweep::Step& e) {
+      const int closures = static_cast<int>(e.result.after.closures.size());
+      if (closures <= packfmt::kMaxClosures) return false;
+      err << fmt::format("note: '{}' ({} closures) is not rendered: the storage format packs at most {}\n", e.label,
+                         closures, packfmt::kMaxClosures);
+      return true;
+    });
+    return kExitOk;
   }
   Diagnostics diags(s.displayName);
   auto r = compileText(s.displayName, s.text, o, diags);
@@ -657,8 +667,9 @@ struct SweepArgs {
   int pixels = 1 << 20;
   int runs = 5;
   std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
-  int groundTruthProbes = 128;
-  int groundTruthSamples = 1024;
+  int truthSamples = sweep::Options{}.truthSamples;
+  int truthEvalSamples = sweep::Options{}.truthEvalSamples;
+  int threads = 0;
   std::string precision = "float";
 };
 
@@ -675,11 +686,14 @@ void addSweepOptions(CLI::App* c, SweepArgs& a) {
       ->transform(cli::inRange(1, 100, "runs"))->capture_default_str();
   addDiffuseOption(c, a.diffuse);
   addMaxInputSize(c, a.compile);
-  c->add_option("--ground-truth-probes", a.groundTruthProbes,
-                "Shading points walked for rel_mse_vs_ground_truth (0: skip the column)")
-      ->transform(cli::inRange(0, 1024, "shading points"))->capture_default_str();
-  c->add_option("--ground-truth-samples", a.groundTruthSamples, "Random walks per shading point and channel group")
-      ->transform(cli::inRange(1, 1 << 20, "walks"))->capture_default_str();
+  c->add_option("--truth-samples", a.truthSamples,
+                "Random walks per truth albedo (per NoV and channel group; 0: no truth columns)")
+      ->transform(cli::inRange(0, 1 << 22, "walks"))->capture_default_str();
+  c->add_option("--truth-eval-samples", a.truthEvalSamples,
+                "Random walks per truth BRDF grid point (per channel group)")
+      ->transform(cli::inRange(1, 1 << 22, "walks"))->capture_default_str();
+  c->add_option("-j,--jobs", a.threads, "Threads of the truths (the results do not depend on them)")
+      ->transform(cli::inRange(1, 256, "threads"))->default_str("the machine's threads");
   addPrecisionOption(c, a.precision);
 }
 
@@ -696,7 +710,7 @@ int printSweep(const SweepArgs& a, const std::string& name, const std::vector<sw
   auto best = sweep::cheapestWithin(rows, a.maxError);
   if (!best)
     return printError(err, kExitBadInput,
-                      fmt::format("no step of '{}' is within rel_mse {} (the full budget's is {:.3e})", name,
+                      fmt::format("no step of '{}' is within rel_mse {} (the first row's is {:.3e})", name,
                                   a.maxError, rows.empty() ? 0.0 : rows.front().relMse));
   const sweep::Row& row = rows[*best];
   (a.json || a.csv ? err : out) << fmt::format("budget {} ({}: {} B, {} closures, rel_mse {:.3e})\n", row.budget,
@@ -706,7 +720,8 @@ int printSweep(const SweepArgs& a, const std::string& name, const std::vector<sw
 
 /// The material at its full budget and at each simplification step: cost
 /// (bytes, closures, instructions, lavapipe time) against error (vs the
-/// unsimplified tree). --max-error chooses the cheapest row within the error.
+/// authored tree; the accuracy metric against the truths). --max-error
+/// chooses the cheapest measured row within the error.
 int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   const CompileOptions o = toCompileOptions(a.compile);
   CommandOutputs outputs(out);
@@ -723,8 +738,9 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   so.pixels = a.pixels;
   so.timedRuns = a.runs;
   so.diffuseModel = diffuseModelOf(a.diffuse);
-  so.groundTruthProbes = a.groundTruthProbes;
-  so.groundTruthSamples = a.groundTruthSamples;
+  so.truthSamples = a.truthSamples;
+  so.truthEvalSamples = a.truthEvalSamples;
+  so.truthThreads = a.threads;
   so.precision = precisionOf(a.precision);
   std::vector<sweep::Row> rows;
   Diagnostics failure(full.material.name);
@@ -772,10 +788,7 @@ int runAccuracy(const AccuracyArgs& a, std::ostream& out, std::ostream& err) {
   auto sources = loadFile(a.in, false, o.read, outputs, err, status);
   if (!sources) return status;
   const import::MaterialSource& s = sources->front();
-  CompileOptions unsimplified = o;
-  unsimplified.budgetOverride = 1024;
-  unsimplified.maxClosuresOverride = 8;
-  unsimplified.fullSimplification = false;
+  const CompileOptions unsimplified = unsimplifiedOptions(o);
   Diagnostics diags(s.displayName), ignored(s.displayName);
   auto compiled = compileText(s.displayName, s.text, o, diags);
   err << diags.formatAll();

@@ -1,5 +1,6 @@
 // `substratec sweep` (issue 6): cost against error at the full budget and at
 // each simplification step; and the CIEDE2000 it reports.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -50,23 +51,46 @@ TEST(DeltaE2000, MatchesSharmasTestData) {
   EXPECT_EQ(substratec::sweep::deltaE2000({0.2, 0.4, 0.6}, {0.2, 0.4, 0.6}), 0.0);
 }
 
+/// The worst directional-albedo rel_error of a row's comparison with a truth.
+double worstAlbedoError(const nlohmann::json& row, const char* truth) {
+  return row.at(truth).at("worst").at("rel_error").get<double>();
+}
+
+/// `text` written to a temporary material file, removed when it goes out of scope.
+struct TempMaterial {
+  fs::path path;
+  TempMaterial(const std::string& name, const std::string& text)
+      : path(fs::temp_directory_path() / ("substratec_sweep_" + name + ".json")) {
+    std::ofstream(path) << text;
+  }
+  ~TempMaterial() { fs::remove(path); }
+};
+
 TEST(Sweep, RowsGoFromTheFullBudgetDownWithCostAndError) {
-  CliRun r = cli({"sweep", example("row40_coating.json"), "--json", "--pixels", "4096", "--runs", "2"});
+  CliRun r = cli({"sweep", example("row40_coating.json"), "--json", "--pixels", "4096", "--runs", "2",
+                  "--truth-samples", "4096", "--truth-eval-samples", "128"});
   ASSERT_EQ(r.status, 0) << r.err;
   auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["material"], "row40_coating");
   const auto& rows = j["rows"];
   ASSERT_GE(rows.size(), 2u) << "a coating over a base simplifies at least once";
-  // The full budget fits the whole tree: no error.
+  // The material's settings do not simplify it: its first row is the authored tree, no error.
+  EXPECT_EQ(rows[0]["label"], "full budget");
   EXPECT_EQ(rows[0]["rel_mse"], 0.0);
   EXPECT_EQ(rows[0]["max_abs"], 0.0);
   for (std::size_t i = 0; i < rows.size(); ++i) {
     SCOPED_TRACE(i);
     for (const char* key : {"budget", "bytes", "closures", "spirv_instructions", "gpu_ns_per_pixel", "rel_mse",
-                            "max_abs", "p99_abs", "delta_e2000", "rel_mse_vs_ground_truth"})
+                            "max_abs", "p99_abs", "delta_e2000", "vs_authored_truth", "vs_own_truth"})
       EXPECT_TRUE(rows[i].contains(key)) << key;
-    const double vsTruth = rows[i]["rel_mse_vs_ground_truth"].get<double>();
-    EXPECT_TRUE(vsTruth > 0 && vsTruth < 1) << vsTruth;
+    for (const char* truth : {"vs_authored_truth", "vs_own_truth"}) {
+      const auto& t = rows[i][truth];
+      ASSERT_EQ(t["rows"].size(), 6u) << truth << ": one row per NoV";
+      EXPECT_TRUE(t["problems"].empty()) << t["problems"];
+      const double e = worstAlbedoError(rows[i], truth);
+      EXPECT_TRUE(std::isfinite(e) && std::abs(e) < 1) << truth << " " << e;
+      for (const auto& v : t["rows"]) EXPECT_GT(v["truth_walks"].get<long>(), 0);
+    }
     EXPECT_GT(rows[i]["gpu_ns_per_pixel"].get<double>(), 0.0);
     EXPECT_GT(rows[i]["spirv_instructions"].get<int>(), 0);
     EXPECT_LE(rows[i]["p99_abs"].get<double>(), rows[i]["max_abs"].get<double>());
@@ -76,39 +100,109 @@ TEST(Sweep, RowsGoFromTheFullBudgetDownWithCostAndError) {
     }
   }
   EXPECT_EQ(rows.back()["closures"], 1) << "down to one closure";
-  // The coat's layering, as the analytic model does it, against the random
-  // walk through the same stack (measured 0.028; the one-closure row 0.079).
-  EXPECT_LT(rows[0]["rel_mse_vs_ground_truth"].get<double>(), 0.05);
-  EXPECT_GT(rows.back()["rel_mse_vs_ground_truth"].get<double>(), rows[0]["rel_mse_vs_ground_truth"].get<double>())
+  // The authored row's own closures are the authored material's: one truth, the same comparison.
+  EXPECT_EQ(rows[0]["vs_own_truth"], rows[0]["vs_authored_truth"]);
+  // The collapsed coat is compared with two different truths; it moves away
+  // from the authored material's (measured: worst albedo error -14 % for the
+  // full tree, +35 % for the one-closure row, +7 % against its own closures).
+  EXPECT_NE(rows.back()["vs_own_truth"], rows.back()["vs_authored_truth"]);
+  EXPECT_GT(std::abs(worstAlbedoError(rows.back(), "vs_authored_truth")),
+            std::abs(worstAlbedoError(rows[0], "vs_authored_truth")))
       << "collapsing the coat moves away from the truth";
 }
 
-TEST(Sweep, TheGroundTruthAgreesWhereTheModelIsExact) {
-  // A conductor: one GGX lobe, the same in the walk (single scattering) and in
-  // the runtime, which adds only the energy compensation of the bounces between
-  // microfacets — next to nothing at low roughness, more as it grows.
+TEST(Sweep, AMaterialThatSimplifiesItselfStartsAtTheAuthoredTree) {
+  // row40_coating with settings that force one closure: the steps the material
+  // itself takes are measured against what the artist made.
+  std::ifstream in(example("row40_coating.json"));
+  nlohmann::json m = nlohmann::json::parse(in);
+  m["settings"] = {{"max_closures", 1}};
+  TempMaterial file("self_simplified", m.dump());
+  CliRun r = cli({"sweep", file.path.string(), "--json", "--pixels", "4096", "--runs", "1", "--truth-samples",
+                  "2048", "--truth-eval-samples", "64"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out)["rows"];
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(rows[0]["label"], "authored");
+  EXPECT_EQ(rows[0]["closures"], 2);
+  EXPECT_EQ(rows[0]["rel_mse"], 0.0) << "the reference of rel_mse is the authored tree";
+  EXPECT_EQ(rows[1]["label"], "full budget");
+  EXPECT_EQ(rows[1]["closures"], 1);
+  EXPECT_GT(rows[1]["rel_mse"].get<double>(), 1e-4) << "what the material's own settings cost";
+  EXPECT_EQ(rows[0]["vs_own_truth"], rows[0]["vs_authored_truth"]);
+  EXPECT_NE(rows[1]["vs_own_truth"], rows[1]["vs_authored_truth"]);
+}
+
+TEST(Sweep, AnAuthoredTreeTheFormatCannotPackIsMeasuredWithoutCode) {
+  // Nine slabs side by side, under settings of two closures: the authored tree
+  // has nine, more than the storage format's eight.
+  nlohmann::json m = {{"format", "substrate-material/1"}, {"name", "nine"}, {"settings", {{"max_closures", 2}}}};
+  std::string previous;
+  for (int i = 0; i < 9; ++i) {
+    const std::string slab = "s" + std::to_string(i);
+    m["nodes"][slab] = {{"kind", "slab"}, {"diffuse_albedo", {0.1 * i, 0.5, 0.9 - 0.1 * i}}, {"f0", 0.04},
+                        {"roughness", 0.1 * i}};
+    if (!previous.empty()) {
+      const std::string mix = "m" + std::to_string(i);
+      m["nodes"][mix] = {{"kind", "horizontal"}, {"background", previous}, {"foreground", slab},
+                         {"mix", 1.0 / (i + 1)}};
+      previous = mix;
+    } else {
+      previous = slab;
+    }
+  }
+  m["output"] = previous;
+  TempMaterial file("nine", m.dump());
+  CliRun r = cli({"sweep", file.path.string(), "--json", "--pixels", "1024", "--runs", "1", "--truth-samples", "0"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out)["rows"];
+  ASSERT_GE(rows.size(), 2u);
+  EXPECT_EQ(rows[0]["label"], "authored");
+  EXPECT_EQ(rows[0]["closures"], 9);
+  EXPECT_TRUE(rows[0]["spirv_instructions"].is_null());
+  EXPECT_TRUE(rows[0]["gpu_ns_per_pixel"].is_null());
+  EXPECT_TRUE(rows[0]["vs_authored_truth"].is_null()) << "--truth-samples 0: no truth";
+  EXPECT_GT(rows[1]["gpu_ns_per_pixel"].get<double>(), 0.0);
+  EXPECT_LE(rows[1]["closures"].get<int>(), 2);
+  // --max-error never chooses a row without code.
+  CliRun exact = cli({"sweep", file.path.string(), "--pixels", "1024", "--runs", "1", "--truth-samples", "0",
+                      "--max-error", "1e30"});
+  ASSERT_EQ(exact.status, 0) << exact.err;
+  EXPECT_EQ(exact.out.find("(authored:"), std::string::npos) << exact.out;
+  EXPECT_NE(exact.out.find("storage format cannot pack"), std::string::npos) << exact.out;
+  // preview --sweep renders the steps it can and says which one it cannot.
+  const fs::path png = fs::temp_directory_path() / "substratec_sweep_nine.png";
+  CliRun preview = cli({"preview", file.path.string(), "--sweep", "--size", "32", "-o", png.string()});
+  EXPECT_EQ(preview.status, 0) << preview.err;
+  EXPECT_NE(preview.err.find("'authored' (9 closures) is not rendered"), std::string::npos) << preview.err;
+  fs::remove(png);
+}
+
+TEST(Sweep, TheTruthAgreesWhereTheModelIsExact) {
+  // A conductor: one GGX lobe with the runtime's energy compensation of the
+  // bounces between microfacets, against the walk's multiple-scattering
+  // microsurface: the directional albedos agree (measured worst over NoV at
+  // 8,192 walks: -0.3 % at roughness 0.1, -1.9 % at 0.35, -1.2 % at 0.6).
   auto vsTruth = [](double roughness) {
-    const fs::path file = fs::temp_directory_path() / "substratec_sweep_conductor.json";
-    std::ofstream(file) << R"({"format": "substrate-material/1", "name": "conductor", "nodes": {"root": {"kind": "slab",
-      "diffuse_albedo": [0, 0, 0], "f0": [0.95, 0.64, 0.54], "roughness": )"
-                        << roughness << R"(}}, "output": "root"})";
-    CliRun r = cli({"sweep", file.string(), "--json", "--pixels", "4096", "--runs", "1"});
-    fs::remove(file);
+    TempMaterial file("conductor", R"({"format": "substrate-material/1", "name": "conductor", "nodes": {"root":
+      {"kind": "slab", "diffuse_albedo": [0, 0, 0], "f0": [0.95, 0.64, 0.54], "roughness": )" +
+                                       std::to_string(roughness) + R"(}}, "output": "root"})");
+    CliRun r = cli({"sweep", file.path.string(), "--json", "--pixels", "1024", "--runs", "1", "--truth-samples",
+                    "8192", "--truth-eval-samples", "16"});
     EXPECT_EQ(r.status, 0) << r.err;
-    return r.status == 0 ? nlohmann::json::parse(r.out)["rows"][0]["rel_mse_vs_ground_truth"].get<double>() : 1.0;
+    return r.status == 0 ? worstAlbedoError(nlohmann::json::parse(r.out)["rows"][0], "vs_authored_truth") : 1.0;
   };
-  const double smooth = vsTruth(0.1), medium = vsTruth(0.35), rough = vsTruth(0.6);
-  EXPECT_LT(smooth, 1e-5);  // measured 2.7e-7
-  EXPECT_LT(medium, 2e-3);  // 3.8e-4
-  EXPECT_LT(rough, 2e-2);   // 9.5e-3: the energy the walk's single-scattering interface loses
-  EXPECT_LT(smooth, medium);
-  EXPECT_LT(medium, rough);
+  EXPECT_LT(std::abs(vsTruth(0.1)), 0.008);
+  EXPECT_LT(std::abs(vsTruth(0.35)), 0.03);
+  EXPECT_LT(std::abs(vsTruth(0.6)), 0.03);
 }
 
 TEST(Sweep, MaxErrorChoosesTheCheapestRowWithinIt) {
-  CliRun any = cli({"sweep", example("row40_coating.json"), "--pixels", "4096", "--runs", "1", "--max-error", "1e30"});
+  CliRun any = cli({"sweep", example("row40_coating.json"), "--pixels", "4096", "--runs", "1", "--truth-samples", "0",
+                    "--max-error", "1e30"});
   ASSERT_EQ(any.status, 0) << any.err;
-  CliRun exact = cli({"sweep", example("row40_coating.json"), "--pixels", "4096", "--runs", "1", "--max-error", "0"});
+  CliRun exact = cli({"sweep", example("row40_coating.json"), "--pixels", "4096", "--runs", "1", "--truth-samples",
+                      "0", "--max-error", "0"});
   ASSERT_EQ(exact.status, 0) << exact.err;
   // Anything goes: the smallest row; nothing but exactness: the full budget.
   EXPECT_NE(any.out.find("budget "), std::string::npos) << any.out;
@@ -120,8 +214,8 @@ TEST(Sweep, MaxErrorChoosesTheCheapestRowWithinIt) {
 TEST(Sweep, CsvAndPlot) {
   const fs::path svg = fs::temp_directory_path() / "substratec_sweep_test.svg";
   fs::remove(svg);
-  CliRun r = cli({"sweep", example("row12_simple.json"), "--csv", "--pixels", "4096", "--runs", "1", "--plot",
-                  svg.string()});
+  CliRun r = cli({"sweep", example("row12_simple.json"), "--csv", "--pixels", "4096", "--runs", "1", "--truth-samples",
+                  "256", "--truth-eval-samples", "16", "--plot", svg.string()});
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_EQ(r.out.rfind("label,budget,bytes,closures,spirv_instructions,gpu_ns_per_pixel,rel_mse,", 0), 0u) << r.out;
   std::ifstream in(svg);

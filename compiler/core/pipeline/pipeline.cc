@@ -132,6 +132,15 @@ StorageLayout repriceMaterial(Material& m) {
   return computeLayout(m, analyzeTree(m));
 }
 
+CompileOptions unsimplifiedOptions(CompileOptions base) {
+  constexpr int kNothingExceeds = 1 << 20;
+  base.budgetOverride = kNothingExceeds;
+  base.maxClosuresOverride = kNothingExceeds;
+  base.fullSimplification = false;
+  base.platform.reset();  // a platform caps the budget and disallows features
+  return base;
+}
+
 std::optional<CompileResult> compileText(const std::string& displayName, const std::string& text,
                                          const CompileOptions& options, Diagnostics& diags) {
   (void)displayName;  // diagnostics already carry the file name

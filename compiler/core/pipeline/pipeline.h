@@ -33,6 +33,13 @@ struct CompileOptions {
   bool timePasses = false;                 // record per-pass wall time
 };
 
+/// `base` without any simplification: a byte and closure budget nothing
+/// exceeds, no full simplification. What the authored tree compiles to (the
+/// reference of sweep's and accuracy's comparisons); it may hold more closures
+/// than the storage format packs (packfmt::kMaxClosures), so its code cannot
+/// always be generated.
+CompileOptions unsimplifiedOptions(CompileOptions base);
+
 struct PassTiming {
   std::string pass;
   double milliseconds = 0;

@@ -52,15 +52,31 @@ double dot3(const Rgb& a, const Rgb& b) { return a[0] * b[0] + a[1] * b[1] + a[2
 
 Rgb add(const Rgb& a, const Rgb& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
 
+/// The shipping model's closures at geometry g, with the features the truth
+/// never walks (reference::groundTruthExcluded) at their mean, as the truth
+/// walks them: a glint at density 1 (glintFactor's expectation is 1: the plain
+/// lobe) and no specular profile (tint 1). Compared at one shading point, a
+/// glint is its noise at that point (mostly 0 without uv derivatives), which
+/// is not an error of the model.
+std::vector<reference::Closure<double>> comparableClosures(const CompileResult& r, const reference::Geometry& g) {
+  auto closures = reference::evaluateMaterial<double>(r, g, {}, {}).closures;
+  for (auto& c : closures) {
+    c.features &= ~(reference::kFeatureGlint | reference::kFeatureSpecularProfile);
+    c.glintValue = 1;
+    c.specularProfile = 0;
+  }
+  return closures;
+}
+
 /// The analytic directional albedo at geometry g: sum over closures of
 /// viewThroughput(N.V) * envIntegrated (white environment), closure i
 /// integrated with its own seed.
 Rgb analyticAlbedo(const CompileResult& r, const reference::Geometry& g, const Options& o, std::uint64_t salt) {
-  const auto m = reference::evaluateMaterial<double>(r, g, {}, {});
+  const auto closures = comparableClosures(r, g);
   const Rgb V{g.V[0], g.V[1], g.V[2]};
   Rgb sum{0, 0, 0};
-  for (std::size_t i = 0; i < m.closures.size(); ++i) {
-    const reference::Closure<double>& c = m.closures[i];
+  for (std::size_t i = 0; i < closures.size(); ++i) {
+    const reference::Closure<double>& c = closures[i];
     const Rgb t = reference::viewThroughput<double>(c, dot3(c.N, V));
     const Rgb e = reference::envIntegrated(
         c, V, [](const Rgb&) { return Rgb{1, 1, 1}; }, o.diffuseModel, o.envSamples, seedOf(o.seed, salt * 64 + i));
@@ -173,7 +189,7 @@ Analytic analyticOf(const CompileResult& compiled, const Options& options) {
     const Rgb V{g.V[0], g.V[1], g.V[2]};
     row.albedo = analyticAlbedo(compiled, g, options, 2 * v);
     row.furnace = analyticAlbedo(furnace, g, options, 2 * v + 1);
-    const auto closures = reference::evaluateMaterial<double>(compiled, g, {}, {}).closures;
+    const auto closures = comparableClosures(compiled, g);
     row.grid.reserve(grid.size());
     double maxLum = 0;
     for (const Rgb& L : grid) {
@@ -184,7 +200,7 @@ Analytic analyticOf(const CompileResult& compiled, const Options& options) {
     for (std::size_t j = 0; j < grid.size(); ++j) {
       reference::Geometry swapped = g;
       swapped.V = grid[j];
-      const auto seenFromL = reference::evaluateMaterial<double>(compiled, swapped, {}, {}).closures;
+      const auto seenFromL = comparableClosures(compiled, swapped);
       const double fcosBack = luminance(analyticFCos(seenFromL, grid[j], V, options.diffuseModel));
       if (!(luminance(row.grid[j]) > options.brdfThreshold * maxLum) || !(fcosBack > options.brdfThreshold * maxLum))
         continue;
@@ -289,12 +305,6 @@ nlohmann::ordered_json rowJson(const ComparisonRow& r) {
           {"furnace_truth_stderr", orNull(r.furnaceTruthStderr)}};
 }
 
-nlohmann::ordered_json comparisonJson(const Comparison& c) {
-  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
-  for (const auto& r : c.rows) rows.push_back(rowJson(r));
-  return {{"rows", rows}, {"excluded", c.excluded}, {"problems", c.problems}};
-}
-
 /// A relative error in percent ("—" when there is none); `sign`: with its sign.
 std::string percent(const std::optional<double>& v, bool sign) {
   if (!v) return "—";
@@ -321,6 +331,25 @@ std::string comparisonTable(const Comparison& c) {
 }
 
 }  // namespace
+
+nlohmann::ordered_json comparisonJson(const Comparison& c) {
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (const auto& r : c.rows) rows.push_back(rowJson(r));
+  return {{"rows", rows}, {"excluded", c.excluded}, {"problems", c.problems}};
+}
+
+Worst worstOf(const Comparison& c) {
+  Worst w;
+  for (const ComparisonRow& r : c.rows) {
+    if (r.relError && (!w.relError || std::abs(*r.relError) > std::abs(*w.relError))) {
+      w.relError = r.relError;
+      w.relErrorNoV = r.nov;
+    }
+    if (r.brdfP95RelError) w.brdfP95 = std::max(w.brdfP95.value_or(0.0), *r.brdfP95RelError);
+    w.reciprocityMaxRatio = std::max(w.reciprocityMaxRatio, r.reciprocityMaxRatio);
+  }
+  return w;
+}
 
 std::string formatJson(const Report& report) {
   nlohmann::ordered_json nol = nlohmann::ordered_json::array();

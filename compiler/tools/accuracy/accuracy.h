@@ -23,6 +23,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include "pipeline/pipeline.h"
 #include "reference/ground_truth.h"
 #include "reference/random_walk.h"
@@ -131,6 +133,21 @@ struct Comparison {
 };
 
 Comparison compare(const Analytic& analytic, const Truth& truth);
+
+/// The worst figures of a comparison over its views: the largest |rel_error|
+/// (with its sign, and its NoV), the largest BRDF p95 and the largest
+/// reciprocity ratio; empty optionals where no view has the figure.
+struct Worst {
+  std::optional<double> relError;
+  double relErrorNoV = 0;
+  std::optional<double> brdfP95;
+  double reciprocityMaxRatio = 1;
+};
+Worst worstOf(const Comparison& c);
+
+/// One comparison as JSON: {"rows": [...], "excluded": [...], "problems": [...]}
+/// (docs/accuracy.md: every key of a row).
+nlohmann::ordered_json comparisonJson(const Comparison& c);
 
 /// Rec. 709 luminance.
 double luminance(const Rgb& c);

@@ -138,9 +138,7 @@ std::optional<std::vector<BlendStepError>> measureBlendError(const std::string& 
   std::vector<BlendStepError> out;
   if (budgets.empty()) return out;
   // The reference: the material without any simplification (a budget nothing exceeds).
-  CompileOptions none;
-  none.budgetOverride = 1 << 20;
-  none.maxClosuresOverride = 1 << 20;
+  const CompileOptions none = unsimplifiedOptions({});
   auto unsimplified = compileText(diags.file(), text, none, diags);
   if (!unsimplified) return std::nullopt;
   const std::vector<double> y = blendProbeRadiance(*unsimplified);

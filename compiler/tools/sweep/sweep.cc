@@ -4,7 +4,7 @@
 #include <cmath>
 #include <numbers>
 #include <set>
-#include <thread>
+#include <iterator>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -25,31 +25,22 @@ constexpr uint32_t kProbeSeed = 0x5ee9u;
 using V3 = std::array<double, 3>;
 
 /// Linear radiance (rgb per probe) of a material through the double reference:
-/// direct light + split-sum environment + emissive, as the forward pass sums them
-/// (and in `*directOnly`, if set, the direct light alone of the closures'
-/// layeringOnly parts).
+/// direct light + split-sum environment + emissive, as the forward pass sums them.
 std::vector<double> radiance(const CompileResult& r, const std::vector<gpu::Sample>& probes, int diffuseModel,
-                             std::vector<std::vector<reference::Closure<double>>>* closures,
-                             std::vector<double>* directOnly = nullptr) {
+                             std::vector<std::vector<reference::Closure<double>>>* closures) {
   std::vector<double> out;
   out.reserve(probes.size() * 3);
   for (const gpu::Sample& s : probes) {
     auto m = reference::evaluateMaterial<double>(r, s.geometry, {}, gpu::sampleTexture);
-    V3 sum{0, 0, 0}, directSum{0, 0, 0};
+    V3 sum{0, 0, 0};
     for (const auto& c : m.closures) {
       const V3 direct = reference::lightClosure<double>(c, s.geometry.V, s.light, s.radiance, diffuseModel);
-      if (directOnly) {
-        const V3 layered =
-            reference::lightClosure<double>(reference::layeringOnly(c), s.geometry.V, s.light, s.radiance, diffuseModel);
-        for (int k = 0; k < 3; ++k) directSum[k] += layered[k];
-      }
       const double NoV = c.N[0] * s.geometry.V[0] + c.N[1] * s.geometry.V[1] + c.N[2] * s.geometry.V[2];
       const V3 viewT = reference::viewThroughput<double>(c, NoV);
       const V3 env = reference::envSplitSum<double>(c, s.geometry.V, s.prefiltered, s.irradiance, diffuseModel);
       for (int k = 0; k < 3; ++k) sum[k] += direct[k] + viewT[k] * (env[k] + c.emissive[k]);
     }
     out.insert(out.end(), sum.begin(), sum.end());
-    if (directOnly) directOnly->insert(directOnly->end(), directSum.begin(), directSum.end());
     if (closures) closures->push_back(std::move(m.closures));
   }
   return out;
@@ -119,43 +110,6 @@ std::array<double, 3> toLab(const std::array<double, 3>& rgb) {
   return {116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)};
 }
 
-double dot3(const std::array<double, 3>& a, const std::array<double, 3>& b) {
-  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-/// Indices of the first `count` probes seen and lit from above the geometric
-/// surface (the walk is zero elsewhere, and so is every closure's direct light).
-std::vector<std::size_t> groundTruthProbes(const std::vector<gpu::Sample>& probes, int count) {
-  std::vector<std::size_t> out;
-  for (std::size_t i = 0; i < probes.size() && static_cast<int>(out.size()) < count; ++i) {
-    const auto& g = probes[i].geometry;
-    if (dot3(g.N, g.V) > 1e-3 && dot3(g.N, probes[i].light) > 1e-3) out.push_back(i);
-  }
-  return out;
-}
-
-/// The ground truth's direct radiance (rgb per chosen probe), the probes walked
-/// on every core (each with its own seed: the result does not depend on the
-/// thread count).
-std::vector<double> groundTruthDirect(const CompileResult& full, const std::vector<gpu::Sample>& probes,
-                                      const std::vector<std::size_t>& chosen, int samples) {
-  std::vector<double> out(chosen.size() * 3, 0.0);
-  const unsigned threads = std::max(1u, std::min<unsigned>(std::thread::hardware_concurrency(), 8));
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t)
-    pool.emplace_back([&, t] {
-      for (std::size_t j = t; j < chosen.size(); j += threads) {
-        const gpu::Sample& s = probes[chosen[j]];
-        reference::WalkOptions o = groundTruthOptions(samples);
-        o.seed = 1 + static_cast<std::uint32_t>(chosen[j]) * 0x2545F491u;
-        const auto f = reference::groundTruth(full, s.geometry, s.light, gpu::sampleTexture, o);
-        for (int k = 0; k < 3; ++k) out[j * 3 + k] = f[k] * s.radiance[k];
-      }
-    });
-  for (auto& th : pool) th.join();
-  return out;
-}
-
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return 0;
   std::sort(v.begin(), v.end());
@@ -168,15 +122,6 @@ double relMse(const std::vector<double>& x, const std::vector<double>& y) {
   double sum = 0;
   for (std::size_t i = 0; i < x.size(); ++i) sum += (x[i] - y[i]) * (x[i] - y[i]) / (y[i] * y[i] + 0.01);
   return x.empty() ? 0 : sum / static_cast<double>(x.size());
-}
-
-reference::WalkOptions groundTruthOptions(int samples) {
-  reference::WalkOptions o;
-  o.samples = samples;
-  o.maxDepth = 1024;
-  o.albedoSeenThroughInterface = true;
-  o.absoluteIor = true;
-  return o;
 }
 
 double deltaE2000(const std::array<double, 3>& linearA, const std::array<double, 3>& linearB) {
@@ -231,11 +176,7 @@ bool simplificationSteps(const std::string& path, const std::string& text, const
     if (!r) diags = std::move(own);  // the last compile that failed is the one reported
     return r;
   };
-  CompileOptions unsimplified = base;
-  unsimplified.budgetOverride = 1024;
-  unsimplified.maxClosuresOverride = 8;
-  unsimplified.fullSimplification = false;
-  auto whole = compile(unsimplified);
+  auto whole = compile(unsimplifiedOptions(base));
   CompileOptions own = base;
   own.fullSimplification = false;
   auto first = compile(own);
@@ -246,6 +187,8 @@ bool simplificationSteps(const std::string& path, const std::string& text, const
   auto all = compile(collapse);
   if (!whole || !first || !all) return false;
   *full = *whole;
+  // The authored tree first when the material's own settings simplify it.
+  if (!first->steps.empty()) steps->push_back({*whole, kAuthoredLabel, whole->after.bytes()});
   std::set<std::pair<int, int>> seen{{first->after.bytes(), static_cast<int>(first->after.closures.size())}};
   steps->push_back({*first, "full budget", first->budgetBytes});
   for (std::size_t i = 0; i < all->steps.size(); ++i) {
@@ -267,12 +210,34 @@ bool simplificationSteps(const std::string& path, const std::string& text, const
   return true;
 }
 
+namespace {
+
+/// The accuracy module's options for the sweep's truths.
+accuracy::Options accuracyOptions(const Options& o) {
+  accuracy::Options a;
+  a.samples = o.truthSamples;
+  a.evalSamples = o.truthEvalSamples;
+  a.threads = o.truthThreads;
+  a.diffuseModel = diffuseModelNumber(o.diffuseModel);
+  return a;
+}
+
+/// Whether `r` has the authored material's closures (so its truth): it took
+/// no simplification step and prices the same.
+bool sameClosures(const CompileResult& r, const CompileResult& authored) {
+  return r.steps.empty() && r.after.bytes() == authored.after.bytes() &&
+         r.after.closures.size() == authored.after.closures.size();
+}
+
+}  // namespace
+
 bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileResult& full, const Options& o,
              std::vector<Row>* rows, Diagnostics& diags) {
   const std::vector<gpu::Sample> probes = gpu::makeSamples(kProbes, kProbeSeed);
   const std::vector<double> y = radiance(full, probes, diffuseModelNumber(o.diffuseModel), nullptr);
-  const std::vector<std::size_t> chosen = groundTruthProbes(probes, o.groundTruthProbes);
-  const std::vector<double> truth = groundTruthDirect(full, probes, chosen, o.groundTruthSamples);
+  const accuracy::Options ao = accuracyOptions(o);
+  std::optional<accuracy::Truth> authoredTruth;
+  if (o.truthSamples > 0) authoredTruth = accuracy::truthOf(full, ao);
   for (const Step& step : steps) {
     const CompileResult& r = step.result;
     Row row;
@@ -280,21 +245,26 @@ bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileRes
     row.budget = step.budget;
     row.bytes = r.after.bytes();
     row.closures = static_cast<int>(r.after.closures.size());
-    if (!forwardInstructions(r, o, &row.spirvInstructions, diags)) return false;
-    if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, diags)) return false;
-    if (o.precision == Precision::Half) {
+    row.gpuMeasured = row.closures <= packfmt::kMaxClosures;  // else the storage format cannot hold it
+    if (row.gpuMeasured) {
+      if (!forwardInstructions(r, o, &row.spirvInstructions, diags)) return false;
+      if (!nsPerPixel(ctx, r, o, &row.gpuNsPerPixel, diags)) return false;
+    }
+    if (row.gpuMeasured && o.precision == Precision::Half) {
       BothPrecisions both;
       if (!runBothPrecisions(ctx, r, Target::Glsl, probes, {}, &both, diags)) return false;
       const PrecisionError e = precisionError(both, gpu::resultStride(r));
       row.relMseVsFloat32 = e.relMse;
       row.maxAbsVsFloat32 = e.maxAbs;
     }
+    if (authoredTruth) {
+      const accuracy::Analytic analytic = accuracy::analyticOf(r, ao);
+      row.vsAuthoredTruth = accuracy::compare(analytic, *authoredTruth);
+      row.vsOwnTruth = sameClosures(r, full) ? *row.vsAuthoredTruth
+                                             : accuracy::compare(analytic, accuracy::truthOf(r, ao));
+    }
     std::vector<std::vector<reference::Closure<double>>> closures;
-    std::vector<double> direct;
-    const std::vector<double> x = radiance(r, probes, diffuseModelNumber(o.diffuseModel), &closures, &direct);
-    std::vector<double> directChosen;
-    for (std::size_t j : chosen) directChosen.insert(directChosen.end(), &direct[j * 3], &direct[j * 3] + 3);
-    row.relMseVsGroundTruth = relMse(directChosen, truth);
+    const std::vector<double> x = radiance(r, probes, diffuseModelNumber(o.diffuseModel), &closures);
     std::vector<double> abs(x.size());
     for (std::size_t i = 0; i < x.size(); ++i) {
       abs[i] = std::abs(x[i] - y[i]);
@@ -325,7 +295,7 @@ bool measure(gpu::Context& ctx, const std::vector<Step>& steps, const CompileRes
 std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double maxError) {
   std::optional<std::size_t> best;
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    if (!(rows[i].relMse <= maxError)) continue;
+    if (!rows[i].gpuMeasured || !(rows[i].relMse <= maxError)) continue;
     if (!best || rows[i].bytes < rows[*best].bytes ||
         (rows[i].bytes == rows[*best].bytes && rows[i].gpuNsPerPixel < rows[*best].gpuNsPerPixel))
       best = i;
@@ -335,24 +305,65 @@ std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double m
 
 namespace {
 /// Whether the rows carry the half-vs-float32 columns (Options::precision Half).
-bool halfColumns(const std::vector<Row>& rows) { return !rows.empty() && rows.front().relMseVsFloat32.has_value(); }
+bool halfColumns(const std::vector<Row>& rows) {
+  return std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.relMseVsFloat32.has_value(); });
+}
+}  // namespace
+
+namespace {
+
+/// A relative error in percent with its sign, or `none`.
+std::string percentOr(const std::optional<double>& v, const char* none) {
+  return v ? fmt::format("{:+.2f}%", 100 * *v) : std::string(none);
+}
+
+/// The worst albedo error and BRDF p95 of a row's comparison, formatted (`none` where absent).
+std::pair<std::string, std::string> worstText(const std::optional<accuracy::Comparison>& c, const char* none) {
+  if (!c) return {none, none};
+  const accuracy::Worst w = accuracy::worstOf(*c);
+  return {percentOr(w.relError, none), w.brdfP95 ? fmt::format("{:.2f}%", 100 * *w.brdfP95) : std::string(none)};
+}
+
+nlohmann::ordered_json truthJson(const std::optional<accuracy::Comparison>& c) {
+  if (!c) return nullptr;
+  const accuracy::Worst w = accuracy::worstOf(*c);
+  nlohmann::ordered_json j;
+  j["worst"] = {{"rel_error", w.relError ? nlohmann::ordered_json(*w.relError) : nlohmann::ordered_json(nullptr)},
+                {"rel_error_nov", w.relErrorNoV},
+                {"brdf_p95_rel_error", w.brdfP95 ? nlohmann::ordered_json(*w.brdfP95) : nlohmann::ordered_json(nullptr)},
+                {"reciprocity_max_ratio", w.reciprocityMaxRatio}};
+  const nlohmann::ordered_json full = accuracy::comparisonJson(*c);
+  for (auto it = full.begin(); it != full.end(); ++it) j[it.key()] = it.value();
+  return j;
+}
+
 }  // namespace
 
 std::string formatTable(const std::string& material, const std::vector<Row>& rows) {
   const bool half = halfColumns(rows);
   std::string s = fmt::format("----- SWEEP - {}{} -----\n", material, half ? " (half precision)" : "");
-  s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>10}", "row", "budget",
-                   "bytes", "closures", "spirv_instr", "ns/pixel", "rel_mse", "max_abs", "p99_abs", "dE00_avg",
-                   "dE00_max", "mse_vs_gt");
+  s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>10} {:>10} {:>10}",
+                   "row", "budget", "bytes", "closures", "spirv_instr", "ns/pixel", "rel_mse", "max_abs", "p99_abs",
+                   "dE00_avg", "dE00_max", "alb_vs_gt", "p95_vs_gt", "alb_vs_own");
   s += half ? fmt::format(" {:>10} {:>10}\n", "mse_vs_f32", "abs_vs_f32") : "\n";
   for (const Row& r : rows) {
-    s += fmt::format(
-        "{:<20} {:>6} {:>5} {:>8} {:>11} {:>10.1f} {:>10.3e} {:>10.3e} {:>10.3e} {:>8.3f} {:>8.3f} {:>10.3e}",
-        r.label, r.budget, r.bytes, r.closures, r.spirvInstructions, r.gpuNsPerPixel, r.relMse, r.maxAbs, r.p99Abs,
-        r.deltaE2000Mean, r.deltaE2000Max, r.relMseVsGroundTruth);
+    const auto [albTruth, p95Truth] = worstText(r.vsAuthoredTruth, "-");
+    const auto [albOwn, p95Own] = worstText(r.vsOwnTruth, "-");
+    s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10.3e} {:>10.3e} {:>10.3e} {:>8.3f} {:>8.3f} {:>10} "
+                     "{:>10} {:>10}",
+                     r.label, r.budget, r.bytes, r.closures,
+                     r.gpuMeasured ? std::to_string(r.spirvInstructions) : "-",
+                     r.gpuMeasured ? fmt::format("{:.1f}", r.gpuNsPerPixel) : "-", r.relMse, r.maxAbs, r.p99Abs,
+                     r.deltaE2000Mean, r.deltaE2000Max, albTruth, p95Truth, albOwn);
     s += half ? fmt::format(" {:>10.3e} {:>10.3e}\n", r.relMseVsFloat32.value_or(0), r.maxAbsVsFloat32.value_or(0))
               : "\n";
   }
+  if (std::any_of(rows.begin(), rows.end(), [](const Row& r) { return r.vsAuthoredTruth.has_value(); }))
+    s += "alb_vs_gt / p95_vs_gt: the worst directional-albedo error over NoV and the worst BRDF p95 against the truth "
+         "of the authored material; alb_vs_own: against the truth of the row's own closures (docs/accuracy.md)\n";
+  if (std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.gpuMeasured; }))
+    s += fmt::format("-: the authored tree holds more than {} closures, which the storage format cannot pack\n",
+                     packfmt::kMaxClosures);
   return s;
 }
 
@@ -367,13 +378,14 @@ std::string formatJson(const std::string& material, const std::vector<Row>& rows
     row["budget"] = r.budget;
     row["bytes"] = r.bytes;
     row["closures"] = r.closures;
-    row["spirv_instructions"] = r.spirvInstructions;
-    row["gpu_ns_per_pixel"] = r.gpuNsPerPixel;
+    row["spirv_instructions"] = r.gpuMeasured ? nlohmann::ordered_json(r.spirvInstructions) : nullptr;
+    row["gpu_ns_per_pixel"] = r.gpuMeasured ? nlohmann::ordered_json(r.gpuNsPerPixel) : nullptr;
     row["rel_mse"] = r.relMse;
     row["max_abs"] = r.maxAbs;
     row["p99_abs"] = r.p99Abs;
     row["delta_e2000"] = {{"mean", r.deltaE2000Mean}, {"max", r.deltaE2000Max}};
-    row["rel_mse_vs_ground_truth"] = r.relMseVsGroundTruth;
+    row["vs_authored_truth"] = truthJson(r.vsAuthoredTruth);
+    row["vs_own_truth"] = truthJson(r.vsOwnTruth);
     if (r.relMseVsFloat32) row["rel_mse_vs_float32"] = *r.relMseVsFloat32;
     if (r.maxAbsVsFloat32) row["max_abs_vs_float32"] = *r.maxAbsVsFloat32;
     j["rows"].push_back(row);
@@ -385,12 +397,20 @@ std::string formatCsv(const std::vector<Row>& rows) {
   const bool half = halfColumns(rows);
   std::string s =
       "label,budget,bytes,closures,spirv_instructions,gpu_ns_per_pixel,rel_mse,max_abs,p99_abs,delta_e2000_mean,"
-      "delta_e2000_max,rel_mse_vs_ground_truth";
+      "delta_e2000_max,albedo_rel_error_vs_truth,brdf_p95_vs_truth,albedo_rel_error_vs_own_truth,brdf_p95_vs_own_truth";
   s += half ? ",rel_mse_vs_float32,max_abs_vs_float32\n" : "\n";
+  auto worst = [](const std::optional<accuracy::Comparison>& c) -> std::pair<std::string, std::string> {
+    if (!c) return {"", ""};
+    const accuracy::Worst w = accuracy::worstOf(*c);
+    return {w.relError ? fmt::format("{:.6e}", *w.relError) : "", w.brdfP95 ? fmt::format("{:.6e}", *w.brdfP95) : ""};
+  };
   for (const Row& r : rows) {
-    s += fmt::format("{},{},{},{},{},{:.3f},{:.6e},{:.6e},{:.6e},{:.4f},{:.4f},{:.6e}", r.label, r.budget, r.bytes,
-                     r.closures, r.spirvInstructions, r.gpuNsPerPixel, r.relMse, r.maxAbs, r.p99Abs, r.deltaE2000Mean,
-                     r.deltaE2000Max, r.relMseVsGroundTruth);
+    const auto [albTruth, p95Truth] = worst(r.vsAuthoredTruth);
+    const auto [albOwn, p95Own] = worst(r.vsOwnTruth);
+    s += fmt::format("{},{},{},{},{},{},{:.6e},{:.6e},{:.6e},{:.4f},{:.4f},{},{},{},{}", r.label, r.budget, r.bytes,
+                     r.closures, r.gpuMeasured ? std::to_string(r.spirvInstructions) : "",
+                     r.gpuMeasured ? fmt::format("{:.3f}", r.gpuNsPerPixel) : "", r.relMse, r.maxAbs, r.p99Abs,
+                     r.deltaE2000Mean, r.deltaE2000Max, albTruth, p95Truth, albOwn, p95Own);
     s += half ? fmt::format(",{:.6e},{:.6e}\n", r.relMseVsFloat32.value_or(0), r.maxAbsVsFloat32.value_or(0)) : "\n";
   }
   return s;
@@ -454,13 +474,15 @@ std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
   // stretching them (or making every coordinate NaN).
   auto ly = [](double e) { return std::isnan(e) ? 8.0 : std::clamp(std::log10(std::max(e, 1e-8)), -8.0, 8.0); };
   auto lx = [](double ns) { return std::isfinite(ns) ? std::clamp(ns, 0.0, 1e12) : 1e12; };
-  for (const Row& r : rows) {
+  std::vector<Row> measured;  // a row without code has no time: not plotted
+  std::copy_if(rows.begin(), rows.end(), std::back_inserter(measured), [](const Row& r) { return r.gpuMeasured; });
+  for (const Row& r : measured) {
     xMin = std::min(xMin, lx(r.gpuNsPerPixel));
     xMax = std::max(xMax, lx(r.gpuNsPerPixel));
     yMin = std::min(yMin, ly(r.relMse));
     yMax = std::max(yMax, ly(r.relMse));
   }
-  if (rows.empty()) xMin = xMax = yMin = yMax = 0;
+  if (measured.empty()) xMin = xMax = yMin = yMax = 0;
   if (xMax - xMin < 1e-9) xMax = xMin + 1;
   yMin = std::floor(yMin);
   yMax = std::max(std::ceil(yMax), yMin + 1);
@@ -494,7 +516,7 @@ std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
   // Rotated by -90 degrees about its anchor: its extent runs up and down from
   // (16, middle), its glyphs' height to the left of x = 16.
   s += fmt::format("<text x=\"16\" y=\"{0}\" transform=\"rotate(-90 16 {0})\" text-anchor=\"middle\">rel_mse vs the "
-                   "full tree (log10)</text>\n",
+                   "authored tree (log10)</text>\n",
                    (T + H - B) / 2);
   for (int e = static_cast<int>(yMin); e <= static_cast<int>(yMax); ++e)
     s += text(L - 6, py(e) + 4, fmt::format("1e{}", e), kFont, "end");
@@ -502,7 +524,7 @@ std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
     const double x = xMin + (xMax - xMin) * k / 4;
     s += text(L + (W - L - R) * k / 4, H - B + 16, fmt::format("{:.0f}", x), kFont, "middle");
   }
-  for (const Row& r : rows) {
+  for (const Row& r : measured) {
     const double x = px(r.gpuNsPerPixel), y = py(ly(r.relMse));
     s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"#c0392b\"/>\n", x, y);
     const std::string label = fmt::format("{} ({} B, {} cl)", r.label, r.bytes, r.closures);

@@ -1,10 +1,13 @@
-// `substratec sweep`: what each byte and each instruction buys. The material
-// at its full budget and after each simplification step down to one closure;
-// for each row its cost (bytes, closures, SPIR-V instructions of the forward
-// shader after the performance passes, lavapipe ns per shading point) and its
-// error against the unsimplified tree (relative MSE, max and 99th-percentile
-// absolute error of linear radiance; CIEDE2000 of the packed colours) and
-// against the Monte Carlo ground truth of layering (reference::groundTruth).
+// `substratec sweep`: what each byte and each instruction buys. The authored
+// material (no simplification at all), the material at its own budget, and
+// after each simplification step down to one closure; for each row its cost
+// (bytes, closures, SPIR-V instructions of the forward shader after the
+// performance passes, lavapipe ns per shading point) and its error against
+// the authored tree (relative MSE, max and 99th-percentile absolute error of
+// linear radiance; CIEDE2000 of the packed colours: the GPU parity of the
+// steps), and the accuracy metric (accuracy/accuracy.h, docs/accuracy.md)
+// against the Monte Carlo truth of the authored material and against the truth
+// of the row's own closures.
 #pragma once
 #include <array>
 #include <optional>
@@ -15,42 +18,48 @@
 #include "emit/material_emitter.h"
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
-#include "reference/ground_truth.h"
+#include "accuracy/accuracy.h"
 
 namespace substratec::sweep {
 
 /// One material of the sweep: compiled at a budget, and what to call it.
 struct Step {
   CompileResult result;
-  std::string label;  // "full budget", "step 3", "full simplification"
-  int budget = 0;     // the byte budget it was compiled with
+  std::string label;  // "authored", "full budget", "step 3", "full simplification"
+  int budget = 0;     // the byte budget it was compiled with (authored: the bytes it needs)
 };
 
-/// The material at its own budget, after each simplification step that
-/// changes its size (compiled with that step's bytes and closures as the
+/// The first row's label when the material's own settings simplify it.
+inline constexpr const char* kAuthoredLabel = "authored";
+
+/// The authored material (pipeline's unsimplifiedOptions: every closure, any
+/// size; first, and only when the material's own settings simplify it), the
+/// material at its own budget ("full budget"), after each simplification step
+/// that changes its size (compiled with that step's bytes and closures as the
 /// budget: simplification is deterministic, deepest first, so it stops
-/// there), and fully simplified. Also the unsimplified material (`*full`), the
-/// reference of the errors. False with the diagnostics of the (last) compile that failed in `diags`.
+/// there), and fully simplified. Also the authored material in `*full`, the
+/// reference of the errors. False with the diagnostics of the (last) compile
+/// that failed in `diags`.
 bool simplificationSteps(const std::string& path, const std::string& text, const CompileOptions& base,
                          std::vector<Step>* steps, CompileResult* full, Diagnostics& diags);
 
 struct Row {
   std::string label;
   int budget = 0, bytes = 0, closures = 0;
+  /// False for an authored tree the storage format cannot hold (more than
+  /// packfmt::kMaxClosures closures): no code, so no instructions and no time
+  /// (null in JSON, "—" in the table, not plotted, never chosen by --max-error).
+  bool gpuMeasured = true;
   std::size_t spirvInstructions = 0;  // forward shader (GLSL), after SPIRV-Tools' performance passes
   double gpuNsPerPixel = 0;           // median of the timed dispatches, lighting one point (1 light + environment)
   double relMse = 0;                  // mean((x − y)² / (y² + 0.01)) over the probe set, y the unsimplified tree
   double maxAbs = 0, p99Abs = 0;      // of |x − y|
   double deltaE2000Mean = 0, deltaE2000Max = 0;  // packed vs exact colours (diffuse albedo, F0, F90, fuzz colour)
-  /// The same rel_mse of the direct light alone (no environment, no emissive),
-  /// without the features the walk does not model (anisotropy, haze, fuzz,
-  /// glints, specular profiles), against the random walk through the
-  /// unsimplified tree's stacks
-  /// (reference::groundTruth, in the analytic model's conventions: see
-  /// groundTruthOptions), over the probes where view and light are both above
-  /// the geometric surface. It holds the analytic model's own error (row 1) and
-  /// what simplification adds to it or takes from it.
-  double relMseVsGroundTruth = 0;
+  /// The accuracy metric (docs/accuracy.md) of the row's analytic model
+  /// against the truth of the authored material (what the artist made) and
+  /// against the truth of the row's own closures (what the approximation
+  /// makes of them); empty when Options::truthSamples is 0.
+  std::optional<accuracy::Comparison> vsAuthoredTruth, vsOwnTruth;
   /// Options::precision Half only: the half-precision forward kernel's lit
   /// radiance (direct + environment + emissive) against the float32 one's on
   /// lavapipe over the same probes (sweep/precision.h).
@@ -61,23 +70,20 @@ struct Options {
   int pixels = 1 << 20;  // shading points per timed dispatch
   int timedRuns = 5;     // after one untimed warm-up; the median is reported
   DiffuseModel diffuseModel = kDefaultDiffuseModel;
-  int groundTruthProbes = 128;    // probes walked (the first ones lit from above and seen from above)
-  int groundTruthSamples = 1024;  // walks per probe and channel group
+  /// Walks of the truths (accuracy::Options::samples and evalSamples); 0
+  /// samples: no truth columns. Smaller than `accuracy`'s defaults: a sweep
+  /// walks one truth per distinct row.
+  int truthSamples = 8192, truthEvalSamples = 512;
+  int truthThreads = 0;  // 0: the machine's; the figures do not depend on it
   Precision precision = Precision::Float;  // of the timed kernels and the counted forward shader
 };
-
-/// The walk's options for the sweep's ground truth: the conventions of the
-/// analytic model (diffuse_albedo is the albedo seen through the slab's own
-/// interface; each F0 is against air, so equal slabs are index-matched), deep
-/// enough walks for bright media (maxDepth 1024), deterministic seeds.
-reference::WalkOptions groundTruthOptions(int samples);
 
 /// Measures every step. `gpu` runs the timing kernels. False, with errors reported, on a failure.
 bool measure(gpu::Context& gpu, const std::vector<Step>& steps, const CompileResult& full, const Options& options,
              std::vector<Row>* rows, Diagnostics& diags);
 
-/// The cheapest row (fewest bytes, then fewest ns per pixel) whose rel_mse is
-/// at most `maxError`, if any.
+/// The cheapest measured row (fewest bytes, then fewest ns per pixel) whose
+/// rel_mse is at most `maxError`, if any.
 std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double maxError);
 
 /// Outputs: a text table, `{"material": ..., "rows": [...]}`, CSV, and an SVG
