@@ -36,7 +36,7 @@ def albedo_cell(r):
     if r["rel_error"] is None or t <= 0:
         return "— (black)"
     band = 2 * lum(r["truth_stderr"]) / t * (1 + r["rel_error"])
-    return "%s ±%.1f" % (pct(r["rel_error"]), 100 * band)
+    return "%s ±%s" % (pct(r["rel_error"]), ("%.1f" if band >= 0.001 else "%.2f") % (100 * band))
 
 
 def worst(rows, key):
@@ -84,9 +84,9 @@ def main():
                  rev, samples, eval_samples), "",
              "Each NoV cell is the directional albedo's `rel_error` = lum(analytic) / lum(truth) − 1 "
              "(Rec. 709 luminance, no floor) and, after ±, twice the truth's standard error relative to "
-             "it (in %%: an error inside the band is noise). BRDF median / p95: the largest over the six "
+             "it (in %: an error inside the band is noise). BRDF median / p95: the largest over the six "
              "NoV of the luminance relative error of f·cos on the 48-direction light grid (points where the "
-             "truth exceeds 1 %% of its max). Reciprocity: the analytic model's largest max(r, 1/r). "
+             "truth exceeds 1 % of its max). Reciprocity: the analytic model's largest max(r, 1/r). "
              "Furnace: the directional albedo (luminance) of the same stack with every albedo 1 and no "
              "absorption, analytic / truth; the truth is 1 for a stack that neither absorbs nor transmits "
              "(a translucent bottom slab, an MFP at the surface thickness, lets light through). Excluded: "

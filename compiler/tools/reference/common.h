@@ -192,6 +192,15 @@ V3<T> safeNormalize(const V3<T>& v, const V3<T>& fallback) {
   return fallback;
 }
 
+// v / |v|, or `fallback` when |v|² is not positive and finite (the walks'
+// normalization; no GLSL counterpart).
+template <class T>
+V3<T> unitOr(const V3<T>& v, const V3<T>& fallback) {
+  T l2 = dot(v, v);
+  if (!(l2 > T(0)) || !std::isfinite(l2)) return fallback;
+  return v / std::sqrt(l2);
+}
+
 // substrate_orthonormal_basis (Duff et al. 2017), s from the sign bit of N.z.
 template <class T>
 void orthonormalBasis(const V3<T>& N, V3<T>& Tn, V3<T>& Bn) {

@@ -18,12 +18,6 @@ using namespace detail;
 namespace {
 
 using V = V3<double>;
-double clampUnit(double x) { return std::clamp(x, 0.0, 1.0); }
-V normalizedOr(const V& v, const V& fallback) {
-  double l2 = dot(v, v);
-  if (!(l2 > 0) || !std::isfinite(l2)) return fallback;
-  return v / std::sqrt(l2);
-}
 
 }  // namespace
 
@@ -51,12 +45,12 @@ class TreeExpansion {
     switch (node.op) {
       case TreeOp::Slab: {
         const Slab& s = m_.slabs[node.slab];
-        double c = s.coverage == kNoValue ? 1.0 : clampUnit(scalar(s.coverage));
+        double c = s.coverage == kNoValue ? 1.0 : saturate(scalar(s.coverage));
         out.push_back({c, {node.slab}});
         break;
       }
       case TreeOp::Horizontal: {
-        double w = clampUnit(scalar(node.a));
+        double w = saturate(scalar(node.a));
         append(out, expand(node.left), 1 - w);
         append(out, expand(node.right), w);
         break;
@@ -71,7 +65,7 @@ class TreeExpansion {
         append(out, expand(node.left), 1);
         append(out, expand(node.right), 1);
         break;
-      case TreeOp::CoverageWeight: append(out, expand(node.left), clampUnit(scalar(node.a))); break;
+      case TreeOp::CoverageWeight: append(out, expand(node.left), saturate(scalar(node.a))); break;
       case TreeOp::Vertical: {
         std::vector<SlabTerm> top = expand(node.left), base = expand(node.right);
         double ct = 0, cb = 0;
@@ -111,15 +105,15 @@ namespace {
 // substrate_tangent_to_world, substrate_orthogonal_tangent), in world space.
 V pinToWorld(const V& v, const V& N, const V& Tg) {
   const double mx = std::max({std::fabs(v[0]), std::fabs(v[1]), std::fabs(v[2])});
-  if (!(mx >= 1.1754943508222875e-38) || std::isinf(mx)) return normalizedOr(N, V{0, 0, 1});
+  if (!(mx >= 1.1754943508222875e-38) || std::isinf(mx)) return unitOr(N, V{0, 0, 1});
   const V vs = v / mx;
-  return normalizedOr(Tg * vs[0] + cross(N, Tg) * vs[1] + N * vs[2], normalizedOr(N, V{0, 0, 1}));
+  return unitOr(Tg * vs[0] + cross(N, Tg) * vs[1] + N * vs[2], unitOr(N, V{0, 0, 1}));
 }
 V tangentOrthogonalTo(const V& N, const V& Tg) {
   V t0, b0;
   orthonormalBasis(N, t0, b0);
   if (!std::isfinite(dot(Tg, Tg))) return t0;
-  return normalizedOr(Tg - N * dot(N, Tg), t0);
+  return unitOr(Tg - N * dot(N, Tg), t0);
 }
 
 /// Reads the slabs of a material (values evaluated at one point) into walk layers.
@@ -168,8 +162,8 @@ class LayerReader {
     L.conductor = L.opaqueBase && max3(L.diffuseAlbedo) <= 0;
     L.anisotropy = std::clamp(scalar(s.pin(SlabPin::Anisotropy)), -1.0, 1.0);
     L.secondRoughness = scalar(s.pin(SlabPin::SecondRoughness));
-    L.secondRoughnessWeight = clampUnit(scalar(s.pin(SlabPin::SecondRoughnessWeight)));
-    L.fuzzAmount = clampUnit(scalar(s.pin(SlabPin::FuzzAmount)));
+    L.secondRoughnessWeight = saturate(scalar(s.pin(SlabPin::SecondRoughnessWeight)));
+    L.fuzzAmount = saturate(scalar(s.pin(SlabPin::FuzzAmount)));
     L.fuzzColor = vec3(s.pin(SlabPin::FuzzColor));
     L.fuzzRoughness = scalar(s.pin(SlabPin::FuzzRoughness));
     L.specularTint = splat3(1.0);  // SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint (the LUT: excluded)
@@ -208,10 +202,10 @@ std::vector<WalkTerm> splitMetalness(const LayerReader& reader, const std::vecto
   for (std::size_t k = 0; k < slabs.size(); ++k) {
     const MetalnessSource* ms = reader.metalness(slabs[k]);
     if (!ms) continue;
-    const double m = clampUnit(reader.scalar(ms->metallic));
+    const double m = saturate(reader.scalar(ms->metallic));
     V base = reader.vec3(ms->baseColor);
-    for (double& c : base) c = clampUnit(c);
-    const double spec = clampUnit(reader.scalar(ms->specular));
+    for (double& c : base) c = saturate(c);
+    const double spec = saturate(reader.scalar(ms->specular));
     std::vector<WalkTerm> next;
     for (const WalkTerm& t : done) {
       if (k >= t.stack.size()) {  // the stack already ended above (a conductor)
@@ -266,7 +260,7 @@ namespace {
 /// A direction in the local frame of a term (its top slab's N, T; B = N x T).
 V localIn(const WalkTerm& t, const V& w) {
   const V B = cross(t.N, t.T);
-  return normalizedOr(V{dot(w, t.T), dot(w, B), dot(w, t.N)}, V{0, 0, 1});
+  return unitOr(V{dot(w, t.T), dot(w, B), dot(w, t.N)}, V{0, 0, 1});
 }
 
 /// Sums weight * walk(term) over the terms (term i walked with seed + i *
@@ -294,7 +288,7 @@ V worldOf(const std::array<double, 3>& a) { return V{a[0], a[1], a[2]}; }
 
 Estimate groundTruthEstimate(const CompileResult& r, const Geometry& g, const V3<double>& L, const TextureFn& tex,
                              const WalkOptions& options) {
-  const V view = normalizedOr(worldOf(g.V), V{0, 0, 1}), light = normalizedOr(L, V{0, 0, 1});
+  const V view = unitOr(worldOf(g.V), V{0, 0, 1}), light = unitOr(L, V{0, 0, 1});
   if (!(dot(view, worldOf(g.N)) > 0) || !(dot(light, worldOf(g.N)) > 0)) return Estimate{};
   return sumTerms(groundTruthTerms(r, g, tex), options, [&](const WalkTerm& t, const WalkOptions& o) {
     const V wo = localIn(t, view), wi = localIn(t, light);
@@ -309,7 +303,7 @@ V3<double> groundTruth(const CompileResult& r, const Geometry& g, const V3<doubl
 }
 
 Estimate groundTruthAlbedo(const CompileResult& r, const Geometry& g, const TextureFn& tex, const WalkOptions& options) {
-  const V view = normalizedOr(worldOf(g.V), V{0, 0, 1});
+  const V view = unitOr(worldOf(g.V), V{0, 0, 1});
   if (!(dot(view, worldOf(g.N)) > 0)) return Estimate{};
   return sumTerms(groundTruthTerms(r, g, tex), options, [&](const WalkTerm& t, const WalkOptions& o) {
     const V wo = localIn(t, view);

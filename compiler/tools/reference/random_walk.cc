@@ -144,12 +144,6 @@ struct BsdfSample {
   bool reflect = false;
 };
 
-V unitOr(const V& v, const V& fallback) {
-  double l2 = dot(v, v);
-  if (!(l2 > 0) || !std::isfinite(l2)) return fallback;
-  return v / std::sqrt(l2);
-}
-
 V sampleCosine(double u1, double u2);
 
 V reflectAbout(const V& wo, const V& n) { return n * (2 * dot(wo, n)) - wo; }
@@ -518,7 +512,6 @@ struct Resolved {
   int lastLayer() const { return bottom == Bottom::Conductor ? static_cast<int>(ifc.size()) - 2 : static_cast<int>(ifc.size()) - 1; }
 };
 
-double saturate1(double x) { return std::clamp(x, 0.0, 1.0); }
 
 /// The albedo under a slab's own interface (WalkOptions::albedoSeenThroughInterface):
 /// the A' whose light, re-reflected inside by the interface (cosine-weighted
@@ -546,7 +539,7 @@ double edgeTint(double f0, double f90) {
 /// mapping (bsdf.cc ggxAlpha: a = sat(r)^2, (a (1 + A), a (1 - A)) in [1e-3, 1]).
 Lobe makeLobe(const Interface& I, double roughness, double anisotropy, bool single) {
   Lobe L;
-  const double r = saturate1(roughness), a = r * r, A = std::clamp(anisotropy, -1.0, 1.0);
+  const double r = saturate(roughness), a = r * r, A = std::clamp(anisotropy, -1.0, 1.0);
   L.ggx.ax = std::clamp(a * (1 + A), kWalkMinAlpha, 1.0);
   L.ggx.ay = std::clamp(a * (1 - A), kWalkMinAlpha, 1.0);
   L.multiple = !single && std::max(L.ggx.ax, L.ggx.ay) > kMultipleMinAlpha;
@@ -562,19 +555,19 @@ Lobe makeLobe(const Interface& I, double roughness, double anisotropy, bool sing
 /// The interface of layer L (kind and eta set by the caller): frame, lobes, tint.
 void finishInterface(Interface& I, const WalkLayer& L, int rc, bool single) {
   if (I.kind == Interface::Kind::Conductor)
-    for (int c = 0; c < 3; ++c) conductorIor(saturate1(L.f0[c]), edgeTint(L.f0[c], L.f90[c]), I.n[c], I.k[c]);
+    for (int c = 0; c < 3; ++c) conductorIor(saturate(L.f0[c]), edgeTint(L.f0[c], L.f90[c]), I.n[c], I.k[c]);
   if (I.kind == Interface::Kind::Dielectric) {
     I.dielF0 = sq((I.eta - 1) / (I.eta + 1));
-    I.dielF90 = saturate1(L.f90[rc]);
+    I.dielF90 = saturate(L.f90[rc]);
   }
   I.cosT = std::cos(L.tangentAngle);
   I.sinT = std::sin(L.tangentAngle);
-  I.haze = saturate1(L.secondRoughnessWeight);
+  I.haze = saturate(L.secondRoughnessWeight);
   I.lobe[0] = makeLobe(I, L.roughness, L.anisotropy, single);
   I.lobe[1] = makeLobe(I, L.secondRoughness, L.anisotropy, single);
   I.tint = vclamp(L.specularTint, 0.0, 1.0);
-  I.fuzzAmount = saturate1(L.fuzzAmount);
-  I.fuzzRough = saturate1(L.fuzzRoughness);
+  I.fuzzAmount = saturate(L.fuzzAmount);
+  I.fuzzRough = saturate(L.fuzzRoughness);
   I.fuzzColor = vclamp(L.fuzzColor, 0.0, 1.0);
 }
 
