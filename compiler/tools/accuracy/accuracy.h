@@ -14,6 +14,9 @@
 //   r = f(v, l) / f(l, v), where both are significant;
 // - white furnace: the same on reference::furnaceMaterial (albedos 1, no
 //   absorption), whose truth is 1.
+// A glint and a specular profile, which the truth does not walk, are compared
+// at their mean on both sides (the analytic closures with glint density 1 and
+// no profile).
 // Split in truth / analytic / compare so that a caller (the sweep) walks a
 // truth once and compares several analytic models with it.
 #pragma once
