@@ -18,7 +18,8 @@
 //
 // Public functions (overloaded on float, float2, float3, float4 where marked [n]):
 //   math nodes    substrate_safe_div [n], substrate_value_pow [n],
-//                 substrate_value_sqrt [n], substrate_value_normalize [n]
+//                 substrate_value_sqrt [n], substrate_value_normalize [n],
+//                 substrate_value_exp [n]
 //   helper nodes  substrate_metalness_to_diffuse, substrate_metalness_to_f0,
 //                 substrate_ior_to_f0, substrate_haziness_second_roughness,
 //                 substrate_haziness_weight, substrate_transmittance_to_mfp,
@@ -81,6 +82,14 @@ float substrate_value_sqrt(float x) { return sqrt(max(x, 0.0)); }
 float2 substrate_value_sqrt(float2 x) { return sqrt(max(x, SUBSTRATE_SPLAT2(0.0))); }
 float3 substrate_value_sqrt(float3 x) { return sqrt(max(x, SUBSTRATE_SPLAT3(0.0))); }
 float4 substrate_value_sqrt(float4 x) { return sqrt(max(x, SUBSTRATE_SPLAT4(0.0))); }
+
+// exp: e^x per component (the simplifier's transmittance exp(-d / mfp)).
+// float: an overflowing power (x above ~88.72) is clamped to FLT_MAX, the
+// float nearest to the CPU's double value (which is capped there too).
+float substrate_value_exp(float x) { return min(exp(x), SUBSTRATE_VALUES_FLT_MAX); }
+float2 substrate_value_exp(float2 x) { return min(exp(x), SUBSTRATE_SPLAT2(SUBSTRATE_VALUES_FLT_MAX)); }
+float3 substrate_value_exp(float3 x) { return min(exp(x), SUBSTRATE_SPLAT3(SUBSTRATE_VALUES_FLT_MAX)); }
+float4 substrate_value_exp(float4 x) { return min(exp(x), SUBSTRATE_SPLAT4(SUBSTRATE_VALUES_FLT_MAX)); }
 
 // normalize: x / length(x); the zero vector gives the zero vector. On a float:
 // x / |x|, i.e. -1, 0 or 1.

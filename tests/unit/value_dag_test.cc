@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 
@@ -322,6 +323,15 @@ TEST_F(ValueDagTest, Fold_PowClampsANegativeBase) {
 TEST_F(ValueDagTest, Fold_PowOfZeroWithNegativeExponentIsZero) {
   expectScalar(dag.make(Op::Pow, VType::Float, {f(0), f(-1)}), 0);
   expectScalar(dag.make(Op::Pow, VType::Float, {f(-2), f(-0.5)}), 0);
+}
+
+TEST_F(ValueDagTest, Fold_ExpOverflowsToTheLargestFloat) {
+  // As the runtime's substrate_value_exp: finite for every finite input, a
+  // float's overflow (x above ~88.72) capped at FLT_MAX.
+  expectScalar(dag.make(Op::Exp, VType::Float, {f(0)}), 1);
+  expectScalar(dag.make(Op::Exp, VType::Float, {f(-1e30)}), 0);
+  expectScalar(dag.make(Op::Exp, VType::Float, {f(89)}), FLT_MAX);
+  expectScalar(dag.make(Op::Exp, VType::Float, {f(1e30)}), FLT_MAX);
 }
 
 TEST_F(ValueDagTest, Fold_NonFiniteResultIsNotFolded) {

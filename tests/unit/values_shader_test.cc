@@ -94,6 +94,10 @@ float4 substrate_values_test(float4 a, float4 b, float4 c, float4 d) {
   o.xy += substrate_value_normalize(a.xy);
   o.xyz += substrate_value_normalize(a.xyz);
   o += substrate_value_normalize(a);
+  o.x += substrate_value_exp(a.x);
+  o.xy += substrate_value_exp(a.xy);
+  o.xyz += substrate_value_exp(a.xyz);
+  o += substrate_value_exp(a);
   // Helper nodes.
   o.xyz += substrate_metalness_to_diffuse(a.xyz, b.x, b.y);
   o.xyz += substrate_metalness_to_f0(a.xyz, b.x, b.y);
@@ -121,6 +125,7 @@ const std::set<std::string> kPublicFunctions = {
     "substrate_value_pow",
     "substrate_value_sqrt",
     "substrate_value_normalize",
+    "substrate_value_exp",
     "substrate_metalness_to_diffuse",
     "substrate_metalness_to_f0",
     "substrate_ior_to_f0",

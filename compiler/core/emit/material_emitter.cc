@@ -228,7 +228,7 @@ std::string Emitter::opExpr(const ValueNode& n) {
     case Op::Pow: return call("substrate_value_pow");
     case Op::Dot: return call("dot");
     case Op::Step: return call("step");
-    case Op::Exp: return call("exp");
+    case Op::Exp: return call("substrate_value_exp");
     case Op::Swizzle: {
       std::string sw;
       for (int i = 0; i < componentCount(n.type); ++i) sw += "xyzw"[(n.attr >> (2 * i)) & 3];

@@ -1,6 +1,7 @@
 #include "ir/value.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstring>
 #include <functional>
@@ -221,7 +222,10 @@ bool evalConstOp(Op op, std::uint16_t attr, VType rt, const std::array<double, 4
       for (int i = 0; i < n; ++i) out[i] = a[i][0];
       return true;
     case Op::Step: out[0] = a[1][0] >= a[0][0] ? 1.0 : 0.0; return true;
-    case Op::Exp: return unary([](double x) { return std::exp(std::min(x, 700.0)); });
+    case Op::Exp:
+      // Capped at the largest float, as the runtime's substrate_value_exp (a
+      // float overflows from x ~ 88.72): finite for every finite input.
+      return unary([](double x) { return std::min(std::exp(std::min(x, 700.0)), double{FLT_MAX}); });
     case Op::MetalnessToDiffuseF0: {
       auto r = helpers::metalnessToDiffuseF0(vec3(0), a[1][0], a[2][0]);
       const auto& v = attr == 0 ? r.diffuse_albedo : r.f0;
