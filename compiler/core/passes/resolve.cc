@@ -402,6 +402,8 @@ void Resolver::readTop() {
     d_.error("", "missing required key \"output\" (the id of the root Substrate node)");
   } else if (!outIt->is_string()) {
     d_.error("/output", fmt::format("expected a Substrate node id, got {}", kindOfJson(*outIt)));
+  } else if (outIt->get_ref<const std::string&>().empty()) {  // checkOutput reads "" as "not given"
+    d_.error("/output", "expected a Substrate node id, got an empty string");
   } else {
     outputId_ = outIt->get<std::string>();
   }
