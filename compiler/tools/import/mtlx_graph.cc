@@ -110,6 +110,11 @@ pugi::xml_node MtlxValues::resolveNodeName(pugi::xml_node user, const std::strin
 std::pair<pugi::xml_node, std::string> MtlxValues::resolveGraphOutput(pugi::xml_node graph, const std::string& output,
                                                                       pugi::xml_node at) {
   pugi::xml_node out = output.empty() ? graph.child("output") : graph.find_child_by_attribute("output", "name", output.c_str());
+  if (out && output.empty() && out.next_sibling("output")) {  // MaterialX: several outputs need a name
+    error(at, fmt::format("node graph '{}' has several outputs: the connection must name one (output=\"...\")",
+                          str(graph, "name")));
+    return {};
+  }
   if (!out) {
     error(at, fmt::format("node graph '{}' has no output '{}'", str(graph, "name"), output));
     return {};
