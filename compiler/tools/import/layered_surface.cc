@@ -1,5 +1,6 @@
 #include "import/layered_surface.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace substratec::import {
@@ -158,6 +159,15 @@ void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
     } else if (!transmits) {
       blend = "translucent_grey";
     }
+    // A presence that folds to a constant 0 (alpha or opacity 0 given as a
+    // literal, or below a mask's cutoff) would leave the compiler no matter
+    // at all ("no matter is left after static culling"): the source's
+    // invisible material is kept as what it is, a material whose coverage
+    // input is 0, which compiles and which an author can still raise.
+    if (const auto c = literalOf(weight); c && std::all_of(c->begin(), c->end(), [](double x) { return !(x > 0); }))
+      weight = w.floatInput("presence", 0.0, 0.0, 1.0,
+                            "the source's opacity, 0: a fully transparent surface (an input, not a constant, so "
+                            "that the material keeps its matter)");
     root = w.node("presence", Json{{"kind", "coverage_weight"}, {"a", root}, {"weight", weight}});
   }
   if (blend != "opaque") w.setSetting("blend_mode", blend);
