@@ -7,7 +7,8 @@
 // returns BSDF * NoL (no weight, no throughput of the layers above): GGX
 // specular (+ haze lobe) with Schlick/F90 Fresnel and Turquin 2019 energy
 // compensation, the diffuse model SUBSTRATE_DIFFUSE_MODEL scaled by
-// (1 - E_spec), SSS wrap, Charlie fuzz on top, glints and specular profiles.
+// (1 - E_spec(NoV)) (1 - E~(NoL)) / (1 - Ē~), SSS wrap, Charlie fuzz on
+// top, glints and specular profiles.
 // Formulas and references: README.md.
 #ifndef SUBSTRATE_BSDF_H
 #define SUBSTRATE_BSDF_H 1
@@ -174,6 +175,67 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float NoV, floa
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
   albedo = msaturate((f0 * SUBSTRATE_M(dfg.x) + f90 * SUBSTRATE_M(dfg.y)) * w);
   return w;
+}
+
+// Karis' analytic fit ("Physically Based Shading on Mobile", 2014; UE's
+// EnvBRDFApprox) of an interface's directional albedo, E~(mu, r) = F0 A + F90 B:
+// c = r (-1, -0.0275, -0.572, 0.022) + (1, 0.0425, 1.04, -0.04),
+// a = min(c.x^2, 2^(-9.28 mu)) c.x + c.y, (A, B) = (-1.04, 1.04) a + c.zw.
+// A dozen instructions where the tables' E_spec costs eight fetches.
+float2 substrate_interface_albedo_fit(float mu, float roughness) {
+  float r = saturate(roughness);
+  float4 c = r * float4(-1.0, -0.0275, -0.572, 0.022) + float4(1.0, 0.0425, 1.04, -0.04);
+  float a = min(c.x * c.x, exp2(-9.28 * mu)) * c.x + c.y;
+  return float2(-1.04, 1.04) * a + c.zw;
+}
+
+// (X, Y): the cosine-weighted means over the hemisphere, 2 int A mu dmu and
+// 2 int B mu dmu, of the fit above at roughness r, as lower bounds: X is a
+// quartic in r (least squares on 257 roughnesses, within 2.6e-4 of the
+// midpoint rule with 4,096 points) and Y = 1 - 0.55 r - X (A + B = 1 - 0.55 r
+// exactly), each lowered by 3e-4 (tests/unit/reference_test.cc,
+// ReferenceEnergy.TheDiffuseLightCouplingKeepsTheViewsAlbedo).
+float2 substrate_interface_albedo_means(float roughness) {
+  float r = saturate(roughness);
+  float x = 0.946226516 + r * (-0.496317088 + r * (0.014998938 + r * (0.037845306 + r * -0.050608685)));
+  return float2(x - 3e-4, 1.0 - 0.55 * r - x - 3e-4);
+}
+
+// The diffuse lobe's light-side coupling, (1 - E~(NoL)) / (1 - Ē~)
+// (Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017's coupling of a lobe
+// under an interface): light entering at a grazing NoL is mostly reflected by
+// the interface and feeds the diffuse less (x 0.25 at NoL 0.05 under a smooth
+// F0 0.04, x 1.05 at normal incidence). E~ is Karis' fit (above), Ē~ = F0 X + F90 Y
+// its cosine-weighted mean over the hemisphere (substrate_interface_albedo_means,
+// lower bounds), so the coupling's mean is at most 1 (within 5e-4 of it for
+// F0 <= 0.1): the diffuse's directional albedo along the view,
+// albedo (1 - E_spec(NoV)), is kept, and the lobe is reciprocal in its Fresnel
+// terms to the fit's accuracy. Haze: the fit and the means of both lobes
+// blended by the haze weight before the division (the mean stays 1). The
+// isotropic fit serves an anisotropic lobe too. The denominator is at least
+// 1e-3 (F0 -> 1: the coupling underestimates, never adds). An inverted edge
+// (F90 < F0) reflects least at grazing, so its coupling would grow toward the
+// horizon, where the rough diffuse models weigh light more than Lambert's
+// cosine does (a white furnace of 1.026 at F0 1, F90 0, r 0.5, NoV 0.1 with
+// Chan 2024): there the coupling is at most 1. One scalar for the three
+// channels, from the means of F0 and F90 (any scalar interface keeps the mean
+// of 1; one division instead of three). Float; converted once (<= 1000). No
+// table: the fit and the means' polynomial cost about as much as one fetch.
+mfloat substrate_diffuse_light_coupling(mfloat3 f0, mfloat3 f90, float NoL, float roughness, float hazeRoughness,
+                                        float hazeWeight) {
+  float mu = max(NoL, SUBSTRATE_MIN_COS);
+  float2 ab = substrate_interface_albedo_fit(mu, roughness);
+  float2 m = substrate_interface_albedo_means(roughness);
+  if (hazeWeight > 0.0) {
+    ab = lerp(ab, substrate_interface_albedo_fit(mu, hazeRoughness), hazeWeight);
+    m = lerp(m, substrate_interface_albedo_means(hazeRoughness), hazeWeight);
+  }
+  float F0 = dot(SUBSTRATE_F3(f0), SUBSTRATE_SPLAT3(1.0 / 3.0));
+  float F90 = dot(SUBSTRATE_F3(f90), SUBSTRATE_SPLAT3(1.0 / 3.0));
+  float numerator = max(1.0 - F0 * ab.x - F90 * ab.y, 0.0);
+  float denominator = max(1.0 - F0 * m.x - F90 * m.y, 1e-3);
+  float cap = F90 < F0 ? 1.0 : 1000.0;
+  return SUBSTRATE_M(min(numerator / denominator, cap));
 }
 
 // ---------------------------------------------------------------------------
@@ -502,13 +564,16 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 #endif
   }
 
-  // Diffuse, below the specular interface.
+  // Diffuse, below the specular interface: what the interface lets in along
+  // the view, 1 - E_spec(NoV), and along the light, the coupling (not for the
+  // wrap lobe, which reaches below the horizon: it keeps the view's term).
   mfloat3 albedo = SUBSTRATE_M3(saturate(c.diffuseAlbedo));
   mfloat3 diffuse;
   if (isWrap) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
-    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
+    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
+              substrate_diffuse_light_coupling(f0, f90, NoLc, roughness, hazeRoughness, hazeWeight);
   }
   float3 result = spec + SUBSTRATE_F3(diffuse * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
 

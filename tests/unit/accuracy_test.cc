@@ -41,8 +41,11 @@ bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
 TEST(Accuracy, ALambertianSlabAgreesWithItsTruthNearNormalIncidence) {
   // No specular to speak of (F0 0): the walk's Lambertian and the analytic
-  // Lambert diffuse are the same model; they part only at grazing views, where
-  // the analytic model's Schlick Fresnel (F90 1) takes from the diffuse.
+  // Lambert diffuse are the same model; they part where the analytic model's
+  // Schlick Fresnel (F90 1) takes from the diffuse: at grazing views, and, by
+  // the diffuse's light-side coupling, for grazing lights (about 1.7 % of the
+  // BRDF at the grid's median near normal view: the coupling's 1 / (1 - E_avg)
+  // with E_avg 0.05 lifts the rest).
   const CompileResult r = compileSlab(R"({"kind": "slab", "diffuse_albedo": 0.5, "f0": 0, "roughness": 0.5})");
   const accuracy::Options o = cheap(2);
   const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
@@ -58,11 +61,28 @@ TEST(Accuracy, ALambertianSlabAgreesWithItsTruthNearNormalIncidence) {
     EXPECT_GT(row.truthWalks, 0);
     if (row.nov < 0.8) continue;
     EXPECT_NEAR(*row.relError, 0, 0.005);
-    EXPECT_LT(*row.brdfMedianRelError, 0.01);
+    EXPECT_LT(*row.brdfMedianRelError, 0.025);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(row.truth[k], 0.5, 0.005);
     ++checked;
   }
   EXPECT_EQ(checked, 2);
+}
+
+TEST(Accuracy, ADiffuseUnderAnInterfaceIsReciprocal) {
+  // The diffuse lobe takes 1 - E_spec from the view and, by the light-side
+  // coupling, (1 - E_spec(NoL)) / (1 - E_avg) from the light: f(v, l) = f(l, v)
+  // for its part. Before the coupling this slab read 1.16 (the lobe took the
+  // interface's reflection along the view alone).
+  const CompileResult r = compileSlab(R"({"kind": "slab", "diffuse_albedo": 0.8, "f0": 0.04, "roughness": 0.45})");
+  const accuracy::Options o = cheap(2);
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  int pairs = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    EXPECT_LT(row.reciprocityMaxRatio, 1.05);
+    pairs += row.reciprocityPairs;
+  }
+  EXPECT_GE(pairs, 100);
 }
 
 TEST(Accuracy, SameSamplesSameBitsWhateverTheThreads) {

@@ -133,6 +133,46 @@ V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T
   return specularEnergyAniso(f0, f90, NoV, roughness, T(0), albedo);
 }
 
+// substrate_interface_albedo_fit: c = r (-1, -0.0275, -0.572, 0.022) + (1, 0.0425, 1.04, -0.04),
+// a = min(c.x^2, 2^(-9.28 mu)) c.x + c.y, (A, B) = (-1.04 a + c.z, 1.04 a + c.w).
+template <class T>
+V2<T> interfaceAlbedoFit(T mu, T roughness) {
+  const T r = saturate(roughness);
+  const T c0 = T(1) - r, c1 = T(0.0425) - T(0.0275) * r, c2 = T(1.04) - T(0.572) * r, c3 = T(-0.04) + T(0.022) * r;
+  const T a = std::min(c0 * c0, std::exp2(T(-9.28) * mu)) * c0 + c1;
+  return {T(-1.04) * a + c2, T(1.04) * a + c3};
+}
+
+// substrate_interface_albedo_means: x = quartic(r) (the shader's coefficients),
+// (x - 3e-4, 1 - 0.55 r - x - 3e-4).
+template <class T>
+V2<T> interfaceAlbedoMeans(T roughness) {
+  const T r = saturate(roughness);
+  const T x = T(0.946226516) +
+              r * (T(-0.496317088) + r * (T(0.014998938) + r * (T(0.037845306) + r * T(-0.050608685))));
+  return {x - T(3e-4), T(1) - T(0.55) * r - x - T(3e-4)};
+}
+
+// substrate_diffuse_light_coupling: min(max(1 - f0 A - f90 B, 0) / max(1 - f0 X - f90 Y, 1e-3), cap)
+// at max(NoL, 1e-4) with f0, f90 the means of the three channels, (A, B) and
+// (X, Y) blended toward the haze lobe's by its weight first; cap 1 when
+// f90 < f0, else 1000. One scalar for the three channels.
+template <class T>
+T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T hazeRoughness, T hazeWeight) {
+  const T mu = std::max(NoL, K<T>::minCos);
+  V2<T> ab = interfaceAlbedoFit(mu, roughness);
+  V2<T> m = interfaceAlbedoMeans(roughness);
+  if (hazeWeight > T(0)) {
+    const V2<T> ab2 = interfaceAlbedoFit(mu, hazeRoughness), m2 = interfaceAlbedoMeans(hazeRoughness);
+    ab = {lerp(ab[0], ab2[0], hazeWeight), lerp(ab[1], ab2[1], hazeWeight)};
+    m = {lerp(m[0], m2[0], hazeWeight), lerp(m[1], m2[1], hazeWeight)};
+  }
+  const T F0 = (f0[0] + f0[1] + f0[2]) / T(3), F90 = (f90[0] + f90[1] + f90[2]) / T(3);
+  const T numerator = std::max(T(1) - F0 * ab[0] - F90 * ab[1], T(0));
+  const T denominator = std::max(T(1) - F0 * m[0] - F90 * m[1], T(1e-3));
+  return std::min(numerator / denominator, F90 < F0 ? T(1) : T(1000));
+}
+
 // ---------------------------------------------------------------------------
 // Diffuse models.
 
@@ -423,8 +463,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
   // Diffuse, below the specular interface.
   V3<T> albedo = saturate(c.diffuseAlbedo);
+  // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
-                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
+                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
+                            diffuseLightCoupling(f0, f90, NoLc, roughness, hazeRoughness, hazeWeight);
   V3<T> result = spec + diff * (splat3(T(1)) - specAlbedo);
 
   if (c.features & kFeatureFuzz) {
@@ -456,6 +498,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T);                                            \
   template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, V3<T>&);                          \
   template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, T, T, V3<T>&);                  \
+  template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
+  template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
+  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
   template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \

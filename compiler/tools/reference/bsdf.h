@@ -24,6 +24,14 @@ template <class T> V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
 V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo);
+/// substrate_interface_albedo_fit: Karis' (A, B), E~ = F0 A + F90 B.
+template <class T> V2<T> interfaceAlbedoFit(T mu, T roughness);
+/// substrate_interface_albedo_means: (X, Y), the fit's hemispherical means (lower bounds).
+template <class T> V2<T> interfaceAlbedoMeans(T roughness);
+/// substrate_diffuse_light_coupling: (1 - E~(NoL)) / max(1 - Ē~, 1e-3), haze-blended,
+/// one scalar from the channels' mean F0 and F90.
+template <class T>
+T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T hazeRoughness, T hazeWeight);
 
 // Diffuse models (BRDF * NoL).
 template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);
