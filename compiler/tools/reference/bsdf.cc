@@ -163,9 +163,8 @@ T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T 
   V2<T> ab = interfaceAlbedoFit(mu, roughness);
   V2<T> m = interfaceAlbedoMeans(roughness);
   if (hazeWeight > T(0)) {
-    const V2<T> ab2 = interfaceAlbedoFit(mu, hazeRoughness), m2 = interfaceAlbedoMeans(hazeRoughness);
-    ab = {lerp(ab[0], ab2[0], hazeWeight), lerp(ab[1], ab2[1], hazeWeight)};
-    m = {lerp(m[0], m2[0], hazeWeight), lerp(m[1], m2[1], hazeWeight)};
+    ab = lerp(ab, interfaceAlbedoFit(mu, hazeRoughness), hazeWeight);
+    m = lerp(m, interfaceAlbedoMeans(hazeRoughness), hazeWeight);
   }
   const T F0 = (f0[0] + f0[1] + f0[2]) / T(3), F90 = (f90[0] + f90[1] + f90[2]) / T(3);
   const T numerator = std::max(T(1) - F0 * ab[0] - F90 * ab[1], T(0));
