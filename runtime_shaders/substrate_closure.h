@@ -89,6 +89,12 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_EXTRA_INTERFACES
 #define SUBSTRATE_USE_EXTRA_INTERFACES 1
 #endif
+// 1: some closure lies under a layer (coverageAbove may be > 0), so the
+// lighting compiles the layers' part: their throughput, the closure's
+// interface relative to them, what their underside gives back to the diffuse.
+#ifndef SUBSTRATE_USE_LAYERS
+#define SUBSTRATE_USE_LAYERS 1
+#endif
 // 1: every closure the shader lights has a unit N (the generated material
 // function guarantees it for a unit g.N: its normals go through
 // substrate_tangent_to_world, which normalizes, or are g.N itself), so

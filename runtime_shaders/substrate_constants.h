@@ -37,6 +37,18 @@
 // the bound): Q^n for the n interfaces past the ones the lighting counts.
 #define SUBSTRATE_EXTRA_INTERFACE 0.91
 
+// The layers above a closure are read as one dielectric interface of IOR 1.5
+// (F0 0.04) over their media (issue 19, step 2; runtime_shaders/README.md,
+// "Closures under layers"): the closure's own interface is relative to it
+// (substrate_closure_fresnel_ends), light crosses the media along the
+// refracted direction (substrate_coat_path_length), and the diffuse gets back
+// what the interface's underside reflects down (substrate_closure_coat_diffuse).
+//   SQRT_F0: sqrt(F0) of the interface above, (1.5 - 1) / (1.5 + 1);
+//   TRAP: 1.5^2 * 0.59634, the IOR squared times the interface's hemispherical
+//         reflectance seen from inside (total internal reflection included).
+#define SUBSTRATE_COAT_SQRT_F0 0.2
+#define SUBSTRATE_COAT_TRAP 1.34177
+
 // The tree walk's guard against a division by a coverage of 0 (substrate_tree.h).
 #define SUBSTRATE_TREE_EPSILON 1e-6
 

@@ -45,19 +45,36 @@ float substrate_interfaces_transmission(float mu, uint extra) {
   return g;
 }
 
-// lerp(1, T_N^(1/max(mu, 1e-4)) * (1 - (1 - mu)^5)^(1 + extraInterfaces),
+// The path length, per unit thickness, of a direction at cosine mu above the
+// layers once refracted into them (read as a dielectric of IOR 1.5,
+// substrate_constants.h): 1 / mu_t, mu_t = sqrt(1 - (1 - mu^2) / 1.5^2) =
+// sqrt(1.25 + mu^2) / 1.5, so 1.5 rsqrt(1.25 + mu^2), in [1, 1.342]. Light
+// crosses the media above along it: with mu itself a grazing ray crossed them
+// 13x farther than it does (1 / 0.1 against 1 / 0.75), and the interfaces'
+// (1 - F0), which topTransmittance holds, was raised to the power 1 / mu too.
+float substrate_coat_path_length(float mu) {
+  float m = saturate(mu);
+  return 1.5 * rsqrt(1.25 + m * m);
+}
+
+// lerp(1, T_N^(1/mu_t) * (1 - (1 - mu)^5)^(1 + extraInterfaces),
 // coverageAbove): the transmittance of the layers above along a direction at
-// cosine mu (their media and their interfaces), blended by their coverage. No
+// cosine mu (their media along the refracted path 1 / mu_t =
+// substrate_coat_path_length(mu), T_N clamped to [1e-30, 1] as
+// substrate_transmittance_at_cosine does, and their interfaces), blended by their coverage. No
 // transcendental when nothing covers the closure (top layers). The remap
 // (exp, log) and the interface term (1 - (1 - mu)^5 cancels at grazing) are
 // float; the throughput, in [0, 1], is mfloat.
 mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
+#if SUBSTRATE_USE_LAYERS
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
-    float3 through = substrate_transmittance_at_cosine(c.topTransmittance, mu) *
+    float3 t = clamp(c.topTransmittance, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE), SUBSTRATE_SPLAT3(1.0));
+    float3 through = exp(log(t) * substrate_coat_path_length(mu)) *
                      substrate_interfaces_transmission(mu, c.extraInterfaces);
     return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
   }
+#endif
   return SUBSTRATE_MSPLAT3(1.0);
 }
 
@@ -110,12 +127,10 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
 
 // What a closure's interface reflects at cosine NoV (its directional albedo,
 // E_spec = (F0 (E - B) + F90 B) W): the primary lobe's, lerped toward the haze
-// lobe's by the haze weight. The environment and the translucency both remove
-// it from what reaches the diffuse or passes through.
-mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
-  mfloat3 f0;
-  mfloat3 f90;
-  substrate_closure_fresnel_ends(c, f0, f90);
+// lobe's by the haze weight, from the closure's Fresnel ends f0, f90
+// (substrate_closure_fresnel_ends). The environment and the translucency both
+// remove it from what reaches the diffuse or passes through.
+mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float NoV) {
   mfloat3 specAlbedo;
   substrate_specular_energy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
 #if SUBSTRATE_USE_HAZE
@@ -126,6 +141,14 @@ mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
   }
 #endif
   return specAlbedo;
+}
+
+// The same from the closure's own Fresnel ends (substrate_closure_fresnel_ends).
+mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
+  mfloat3 f0;
+  mfloat3 f90;
+  substrate_closure_fresnel_ends(c, f0, f90);
+  return substrate_closure_specular_albedo_of(c, f0, f90, NoV);
 }
 
 // ---------------------------------------------------------------------------
@@ -207,7 +230,10 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
     return SUBSTRATE_SPLAT3(0.0);
   }
   float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
-  mfloat3 specAlbedo = substrate_closure_specular_albedo(c, NoV);
+  mfloat3 f0;
+  mfloat3 f90;
+  substrate_closure_fresnel_ends(c, f0, f90);
+  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, NoV);
   // Radiance (HDR) is float; the weights that multiply it are mfloat.
   float3 spec = SUBSTRATE_F3(specAlbedo) * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE
@@ -216,7 +242,8 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   }
 #endif
   float3 irr = max(irradiance, SUBSTRATE_SPLAT3(0.0)) * SUBSTRATE_INV_PI;
-  float3 diffuse = SUBSTRATE_F3(SUBSTRATE_M3(saturate(c.diffuseAlbedo)) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo)) * irr;
+  float3 diffuse = SUBSTRATE_F3(SUBSTRATE_M3(saturate(c.diffuseAlbedo)) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo)) *
+                   substrate_closure_coat_diffuse(c, f0, f90) * irr;
   mfloat3 specLight = substrate_closure_light_throughput(c, NoV);
   mfloat3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
   float3 result = spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight);
@@ -235,7 +262,7 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 
 // coverage:      saturate(c.weight), the share of the pixel this closure covers;
 // transmittance: what the covered part lets through from behind, per channel:
-//                lerp(1, T_N^(1/NoV), coverageAbove) (the layers above, along V)
+//                substrate_closure_above_throughput(c, NoV) (the layers above, along V)
 //                * (1 - E_spec(NoV)) (reflected by the interface)
 //                * (1 - fuzzAmount min(E_fuzz, 1)) (caught by the fuzz).
 // The caller blends dst = colour + dst * ((1 - coverage) + coverage * transmittance)

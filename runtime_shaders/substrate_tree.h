@@ -54,6 +54,13 @@ void substrate_layer_above(inout float c, inout float3 t, float cLayer, float3 t
 // With coverage the bound holds too: the pair (C, T) of substrate_layer_above
 // never lets through more than the product of the layers (Jensen: x^(1/mu) is
 // convex), and each covered path crosses at most the interfaces counted.
+// Since issue 19 (step 2) the media are crossed along the cosine refracted
+// into the layers (substrate_coat_path_length: at most 1.342 times the thickness), so Q^(n-1-k) no
+// longer bounds those interfaces at grazing; it need not: a closure's own
+// interface is now relative to the layers above (substrate_closure_fresnel_ends),
+// so a stack of coats of one IOR has one interface, the top's, and Q only
+// darkens. Furnace.RandomStacksOfTwoToEightSlabsNeverGainEnergy and
+// Furnace.StacksOfWhiteTransparentSlabsAtEveryDepth hold every depth to 1.001.
 // Q is SUBSTRATE_EXTRA_INTERFACE (substrate_constants.h, via substrate_closure.h).
 float substrate_extra_interfaces(float n) {
   return pow(SUBSTRATE_EXTRA_INTERFACE, n);

@@ -14,6 +14,7 @@
 #define SUBSTRATE_USE_SPECULAR_PROFILE 0
 #define SUBSTRATE_USE_EMISSIVE 0
 #define SUBSTRATE_USE_EXTRA_INTERFACES 0
+#define SUBSTRATE_USE_LAYERS 1
 #define SUBSTRATE_DIFFUSE_MODEL 2
 #define CLEAR_COAT_OVER_GLINTS_CLOSURE_COUNT 2
 #define CLEAR_COAT_OVER_GLINTS_WORD_COUNT 10
@@ -63,7 +64,7 @@ void clear_coat_over_glints_evaluate(SubstrateGeometry g, out SubstrateClosure c
   substrate_layer_above(ca_paint, ta_paint, C_coat, T_coat * (1.0 - float3(0.04, 0.04, 0.04)));  // under 'coat' (vertical 'root')
   substrate_closure_init(closures[1]);
   closures[1].diffuseAlbedo = clear_coat_over_glints_inputs.i_paint_color;
-  closures[1].f0 = float3(0.04, 0.04, 0.04);
+  closures[1].f0 = float3(0.25, 0.25, 0.25);
   closures[1].roughness = substrate_variance_to_roughness(substrate_roughness_to_variance(clear_coat_over_glints_inputs.i_paint_roughness) + va_paint);
   closures[1].N = substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T);
   closures[1].glintValue = clear_coat_over_glints_inputs.i_glint_density;

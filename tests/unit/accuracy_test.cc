@@ -4,6 +4,7 @@
 // Cheap: a few hundred walks per figure.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -83,6 +84,51 @@ TEST(Accuracy, ADiffuseUnderAnInterfaceIsReciprocal) {
     pairs += row.reciprocityPairs;
   }
   EXPECT_GE(pairs, 100);
+}
+
+TEST(Accuracy, ACoatGivesBackWhatItsUndersideReflects) {
+  // Issue 19, step 2: a nearly smooth coat of F0 0.04 over a Lambertian of
+  // albedo 0.5 under its own F0 0.04 (bench/materials' two coat controls: clear,
+  // and absorbing red light). The base is index-matched to the coat (its F0 is
+  // taken relative to it), the media are crossed along the refracted cosine,
+  // and the light the coat's underside sends back down returns. Before: the
+  // clear coat read -3.0 / -4.0 / -5.8 / -6.3 / -7.0 / -10.5 % (NoV 1 .. 0.1),
+  // the absorbing one +13.5 .. -11.5 %, BRDF medians 77 % and 58 %, reciprocity
+  // 1.16; the issue's goal is +-5 % for NoV >= 0.2 and +-8 % at 0.1, BRDF
+  // median <= 10 % and reciprocity within 1.05.
+  int rows = 0;
+  for (const char* mfp : {"10", "[0.2, 1, 5]"}) {
+    SCOPED_TRACE(mfp);
+    Diagnostics d("coat.json");
+    CompileOptions co;
+    co.budgetOverride = 1024;
+    co.maxClosuresOverride = 8;
+    const std::string nodes =
+        std::string(R"("coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": )") +
+        mfp + R"(}, "base": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.05},
+           "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.1})";
+    auto r = compileText("coat.json", test::material(nodes), co, d);
+    ASSERT_TRUE(r) << d.formatAll();
+    accuracy::Options o = cheap(2);
+    o.samples = 8192;
+    o.evalSamples = 512;  // the BRDF grid's noise near the coat's mirror peak at 64 walks reads ~19 %
+    const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(*r, o), accuracy::truthOf(*r, o));
+    ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+    for (const auto& row : c.rows) {
+      SCOPED_TRACE(row.nov);
+      ASSERT_TRUE(row.relError && row.brdfMedianRelError);
+      EXPECT_LE(std::fabs(*row.relError), row.nov >= 0.2 ? 0.05 : 0.08);
+      EXPECT_LE(*row.brdfMedianRelError, 0.10);
+      EXPECT_LE(row.reciprocityMaxRatio, 1.05);
+      ASSERT_TRUE(row.furnaceAnalytic);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_GE((*row.furnaceAnalytic)[k], 0.97);
+        EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+      }
+      ++rows;
+    }
+  }
+  EXPECT_EQ(rows, 12);
 }
 
 TEST(Accuracy, SameSamplesSameBitsWhateverTheThreads) {

@@ -336,9 +336,10 @@ TEST(Furnace, StackClosuresCarryUpToFourInterfacesAndFoldTheRest) {
     EXPECT_EQ(c.extraInterfaces, static_cast<std::uint32_t>(extra)) << k;
     EXPECT_EQ(r->after.closures[static_cast<std::size_t>(k)].extraInterfaces, extra) << k;
     EXPECT_NEAR(c.topTransmittance[0], std::pow(0.91, std::max(k - 4, 0)), 1e-12) << k;
-    if (k > 0) {  // the lighting: the interface term to the power 1 + extra
-      const double mu = 0.3, gmu = 1 - std::pow(1 - mu, 5);
-      const double want = std::pow(c.topTransmittance[0], 1 / mu) * std::pow(gmu, 1 + extra);
+    if (k > 0) {  // the lighting: the interface term to the power 1 + extra, the media
+      // along the cosine refracted into the layers (IOR 1.5)
+      const double mu = 0.3, gmu = 1 - std::pow(1 - mu, 5), mut = std::sqrt(1 - (1 - mu * mu) / 2.25);
+      const double want = std::pow(c.topTransmittance[0], 1 / mut) * std::pow(gmu, 1 + extra);
       EXPECT_NEAR(reference::viewThroughput<double>(c, mu)[0], want, 1e-9) << k;
       EXPECT_NEAR(reference::lightThroughput<double>(c, mu)[0], want, 1e-9) << k;
     }

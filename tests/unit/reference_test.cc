@@ -790,12 +790,14 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
   // the optical depth only, and for the specular only as the lobe narrows. The
   // integrated reference crosses them along every light direction. Measured worst
   // relative error over roughness 0.3..0.7, NoV 0.3..1, coverage above 0.6:
-  //   clear coat (T_N = 0.98, 0.95, 0.9):  12.1 % (split sum low: a rough lobe
+  //   clear coat (T_N = 0.98, 0.95, 0.9):  6.3 % (split sum low: a rough lobe
   //     reaches steeper, clearer directions than the mirror one, and the
-  //     interfaces' 1 - (1 - mu)^5 falls fast toward grazing); 6.6 % before the
-  //     interface term (substrate_interface_transmission) existed;
-  //   absorbing coat (T_N = 0.5):          22.0 % (the diffuse sees
-  //     lerp(1, 2 E3(-ln T_N), 0.6) = 0.61 where split sum takes lerp(1, T_N^2, 0.6) = 0.55).
+  //     interfaces' 1 - (1 - mu)^5 falls fast toward grazing); 12.1 % before the
+  //     media were crossed along the refracted cosine (issue 19, step 2), 6.6 %
+  //     before the interface term (substrate_interface_transmission) existed;
+  //   absorbing coat (T_N = 0.5):          7.1 % (the diffuse sees the mean of
+  //     T_N^(1 / mu_t) where split sum takes T_N^(1 / mu_t(0.5))); 22.0 % when the
+  //     media were crossed along mu itself (2 E3(-ln T_N) against T_N^2).
   const V3<double> one{1, 1, 1}, pi{M_PI, M_PI, M_PI};
   struct Coat {
     const char* name;
@@ -803,7 +805,7 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
     double lo, hi;  // the measured worst error lies in [lo, hi)
   };
   for (const Coat& coat : {Coat{"clear coat", {0.98, 0.95, 0.9}, 0.03, 0.15},
-                           Coat{"absorbing coat", {0.5, 0.5, 0.5}, 0.1, 0.25}}) {
+                           Coat{"absorbing coat", {0.5, 0.5, 0.5}, 0.03, 0.15}}) {
     double worst = 0, worstSigned = 0;
     for (double r : {0.3, 0.5, 0.7})
       for (double NoV : {0.3, 0.6, 1.0}) {
@@ -827,14 +829,22 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
     EXPECT_LT(worst, coat.hi) << coat.name;  // ... of a bounded size
   }
   // The diffuse alone: the mean-cosine approximation against its exact value.
-  // e3 = integral over mu in (0, 1] of mu exp(-tau / mu) (1 - (1 - mu)^5): the
-  // medium's E3(tau) with the interface term, midpoint rule.
+  // e3 = integral over mu in (0, 1] of mu exp(-tau / mu_t) (1 - (1 - mu)^5): the
+  // medium's E3(tau) along the cosine refracted into the layers (IOR 1.5,
+  // mu_t = sqrt(1 - (1 - mu^2) / 2.25)) with the interface term, midpoint rule.
+  auto refracted = [](double mu) { return std::sqrt(1 - (1 - mu * mu) / 2.25); };
   double e3 = 0;
   const double tau = -std::log(0.5);
   for (int i = 0; i < 100000; ++i) {
     const double mu = (i + 0.5) / 100000;
-    e3 += mu * std::exp(-tau / mu) * (1 - std::pow(1 - mu, 5)) / 100000;
+    e3 += mu * std::exp(-tau / refracted(mu)) * (1 - std::pow(1 - mu, 5)) / 100000;
   }
+  // What the diffuse gets back from the coat's underside (substrate_closure_coat_diffuse):
+  // 1 / lerp(1, D, 0.6), D = G_0 T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4) with
+  // T_i = 0.96 (the interface's share), T_m = 0.5 / 0.96 (the medium's), A = 0.7; the
+  // closure's own interface (F0 0, F90 0) adds no covariance term.
+  const double ti = 0.96, tm = 0.5 / 0.96;
+  const double back = 1 / (0.4 + 0.6 * (0.95238 * ti * (1 - 0.12 * (1 - ti)) + 1.34177 * 0.7 * (1 - std::pow(tm, 4))));
   Closure<double> c;
   c.diffuseAlbedo = {0.7, 0.7, 0.7};
   c.f0 = {0, 0, 0};
@@ -845,8 +855,9 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
   c.topTransmittance = {0.5, 0.5, 0.5};
   const D3 V = directionAt({0, 0, 1}, 0.8, 0);
   const V3<double> ref = envIntegrated(c, V, [&](const V3<double>&) { return one; }, kDiffuseLambert, 8192, 6);
-  EXPECT_NEAR(ref[0], 0.7 * (0.4 + 0.6 * 2 * e3), 2e-3);
-  EXPECT_NEAR(envSplitSum(c, V, one, pi, kDiffuseLambert)[0], 0.7 * (0.4 + 0.6 * 0.25 * (1 - std::pow(0.5, 5))), 1e-12);
+  EXPECT_NEAR(ref[0], 0.7 * (0.4 + 0.6 * 2 * e3) * back, 2e-3);
+  EXPECT_NEAR(envSplitSum(c, V, one, pi, kDiffuseLambert)[0],
+              0.7 * (0.4 + 0.6 * std::pow(0.5, 1 / refracted(0.5)) * (1 - std::pow(0.5, 5))) * back, 1e-9);
 }
 
 // ---------------------------------------------------------------------------

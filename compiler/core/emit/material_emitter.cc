@@ -42,9 +42,13 @@ std::string useDefines(std::uint16_t features) {
 }
 
 std::string extraInterfacesDefine(const StorageLayout& layout) {
-  bool any = false;
-  for (const ClosureLayout& c : layout.closures) any = any || c.extraInterfaces > 0;
-  return fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", any ? 1 : 0);
+  bool any = false, layered = false;
+  for (const ClosureLayout& c : layout.closures) {
+    any = any || c.extraInterfaces > 0;
+    layered = layered || !c.isTop;
+  }
+  return fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n#define SUBSTRATE_USE_LAYERS {}\n", any ? 1 : 0,
+                     layered ? 1 : 0);
 }
 
 bool translucentBlend(const Material& m) {

@@ -50,7 +50,9 @@ std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayo
 std::string useDefines(std::uint16_t features);
 /// `#define SUBSTRATE_USE_EXTRA_INTERFACES 0|1`: 1 when a closure of `layout`
 /// lies under more than one interface (ClosureLayout::extraInterfaces > 0),
-/// so the lighting compiles the interface term's power only for stacks.
+/// so the lighting compiles the interface term's power only for stacks; and
+/// `#define SUBSTRATE_USE_LAYERS 0|1`: 1 when a closure lies under a layer
+/// (not ClosureLayout::isTop), so the lighting compiles the layers' part.
 std::string extraInterfacesDefine(const StorageLayout& layout);
 
 /// Shared by the entry, kernel and scene emitters.

@@ -133,6 +133,7 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
   s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
   // Extra interfaces are in closure headers only: a lone closure is on top.
   s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
+  s += fmt::format("#define SUBSTRATE_USE_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);  // so are layers
   s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", diffuseModelNumber(scene.diffuseModel));
   s += fmt::format("#define SUBSTRATE_MAX_CLOSURES {}\n", k.maxClosures);
   s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", k.maxWords);

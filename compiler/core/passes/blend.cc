@@ -1,6 +1,7 @@
 #include "passes/blend.h"
 
 #include "ir/value_eval.h"
+#include "substrate_constants.h"  // runtime_shaders/: SUBSTRATE_COAT_*
 
 namespace substratec {
 
@@ -31,6 +32,14 @@ class Ex {
     return d_.make(Op::Lerp, r, {bc(a, r), bc(b, r), bc(t, r)});
   }
   ValueId sat(ValueId a) { return d_.make(Op::Saturate, type(a), {a}); }
+  ValueId min(ValueId a, ValueId b) { return bin(Op::Min, a, b); }
+  ValueId sqrt(ValueId a) { return d_.make(Op::Sqrt, type(a), {a}); }
+  /// The largest of a colour's channels.
+  ValueId max3(ValueId a) {
+    if (type(a) == VType::Float) return a;
+    auto ch = [&](int i) { return d_.make(Op::Swizzle, VType::Float, {a}, static_cast<std::uint16_t>(i | (1 << 8))); };
+    return max(max(ch(0), ch(1)), ch(2));
+  }
   ValueId oneMinus(ValueId a) { return d_.make(Op::OneMinus, type(a), {a}); }
   ValueId exp(ValueId a) { return d_.make(Op::Exp, type(a), {a}); }
   ValueId normalize(ValueId a) { return d_.make(Op::Normalize, type(a), {a}); }
@@ -130,6 +139,21 @@ void takeDiscrete(Slab& r, const Slab& a, const Slab& b, bool bWins) {
 }
 
 }  // namespace
+
+Slab interfaceUnderLayers(Material& m, const Slab& in, ValueId& scale) {
+  Ex e(m.values);
+  Slab s = in;
+  ValueId f = e.max3(e.sat(pin(in, SlabPin::F0)));
+  ValueId root = e.sqrt(f);
+  ValueId r = e.bin(Op::Divide, e.sub(root, e.k(SUBSTRATE_COAT_SQRT_F0)),
+                    e.oneMinus(e.mul(root, e.k(SUBSTRATE_COAT_SQRT_F0))));
+  ValueId rel = e.min(f, e.mul(r, r));
+  rel = e.lerp(rel, f, e.sat(e.mul(e.sub(f, e.k(0.1)), e.k(10.0))));
+  scale = e.bin(Op::Divide, rel, e.max(f, e.k(1e-4)));
+  s.pin(SlabPin::F0) = e.mul(pin(in, SlabPin::F0), scale);
+  s.pin(SlabPin::F90) = e.mul(pin(in, SlabPin::F90), scale);
+  return s;
+}
 
 ValueId coverageOf(Material& m, const Slab& s) { return s.coverage == kNoValue ? m.values.scalar(1) : s.coverage; }
 
@@ -235,18 +259,31 @@ Slab blendVertical(Material& m, const Slab& topIn, const Slab& baseIn, ValueId d
   Slab t = base1;
   for (SlabPin p : {SlabPin::F0, SlabPin::F90, SlabPin::Roughness, SlabPin::Normal}) t.pin(p) = pin(top, p);
   t.pin(SlabPin::Anisotropy) = e.k(0);
-  // Glints (flakes under a clear coat) stay unless the top hides the base:
-  // the glint value is lerped toward the top's by k = 1 - mean(T_n^2 C_B)(1 - mean F0_T).
-  ValueId k = e.oneMinus(e.mul(e.mean(tn2cb), e.oneMinus(e.mean(pin(top, SlabPin::F0)))));
+  // The base's interface as the runtime reads it under the top (relative to
+  // it: a dielectric base of the top's IOR has none left).
+  ValueId relScale;
+  const Slab baseUnder = interfaceUnderLayers(m, base1, relScale);
+  // Glints (flakes under a clear coat) stay unless the top hides the base or
+  // the base's interface vanishes under it: the glint value is lerped toward
+  // the top's by k = 1 - mean(T_n^2 C_B)(1 - mean F0_T) mean(F0_rel / F0_B).
+  ValueId k = e.oneMinus(
+      e.mul(e.mul(e.mean(tn2cb), e.oneMinus(e.mean(pin(top, SlabPin::F0)))), e.mean(relScale)));
   t.pin(SlabPin::GlintValue) = e.lerp(pin(base1, SlabPin::GlintValue), pin(top, SlabPin::GlintValue), k);
   // Energy of the stack: the top's interface reflects F_T; what it transmits
   // meets the medium, which returns its volumetric albedo a_T(1 - T_n^2), and
   // reaches the base, whose whole albedo (specular included: its lobe is not
   // the top's) comes back as diffuse through the top twice at the diffuse mean
   // cosine 0.5 (T_n^2 each way, as the runtime's layer throughput T^(1/mu)).
+  // The base's diffuse also gets back what the top's underside reflects down,
+  // as the runtime's substrate_closure_coat_diffuse: times
+  // (1 - F_T) / ((1 - F_T) + TRAP A_B (1 - T_n^4)), 1 under a clear top.
   // The diffuse makes the single interface return exactly that.
   ValueId ft = fresnelAverage(m, top);
-  ValueId albedoBase = e.add(fresnelAverage(m, base1), diffuseEnergy(m, base1));
+  ValueId tn4 = e.mul(tn2, tn2);
+  ValueId trap = e.safeDiv(e.oneMinus(ft), e.add(e.oneMinus(ft), e.mul(e.mul(e.k(SUBSTRATE_COAT_TRAP),
+                                                                              foldedDiffuse(m, baseUnder)),
+                                                                        e.oneMinus(tn4))));
+  ValueId albedoBase = e.add(fresnelAverage(m, baseUnder), e.mul(diffuseEnergy(m, baseUnder), trap));
   ValueId stack = e.add(ft, e.mul(e.oneMinus(ft), e.add(e.mul(pin(top, SlabPin::DiffuseAlbedo), e.oneMinus(tn2)),
                                                          e.mul(e.mul(tn2cb, tn2), albedoBase))));
   setDiffuseEnergy(m, t, e.max(e.sub(stack, fresnelAverage(m, t)), e.k(0)));

@@ -47,6 +47,15 @@ Slab blendSelect(Material& m, const Slab& a, const Slab& b, ValueId value, Value
 /// kFuzzAlbedo·amount)). Vertical blending uses it under the top.
 Slab foldToSingleInterface(Material& m, const Slab& s);
 
+/// The slab's interface as the runtime reads it under layers
+/// (substrate_closure_fresnel_ends at coverage 1: the layers above are a
+/// dielectric of F0 0.04): F0 and F90 scaled by the ratio of the largest
+/// channel's F0 relative to it, ((s - 0.2) / (1 - 0.2 s))^2 with s = sqrt(F0),
+/// to that F0: never above 1, only in the dielectric range (back to 1 over F0
+/// 0.1 .. 0.2; a coloured F0 reaching 0.2 in a channel is a conductor's). `scale` receives the ratio (0: index-matched, no interface
+/// left; 1: unchanged).
+Slab interfaceUnderLayers(Material& m, const Slab& s, ValueId& scale);
+
 /// Fraction of the fuzz colour a fully fuzzy slab adds to its diffuse albedo
 /// when fuzz is folded (the mean directional albedo of a Charlie sheen lobe
 /// over roughness, rounded).

@@ -367,6 +367,69 @@ T glintFactor(const Closure<T>& c, T d, T ToH, T BoH, T NoH) {
 }
 
 // ---------------------------------------------------------------------------
+// --- closures under layers (substrate_closure_fresnel_ends, substrate_closure_coat_diffuse)
+
+template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
+template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
+
+// F0 and F90 scaled by the ratio of the largest channel's F0 relative to a dielectric of
+// F0 0.04 above, ((s - 0.2) / (1 - 0.2 s))^2, to itself: never above 1, only
+// in the dielectric range (back to 1 over F0 0.1 .. 0.2), lerped toward 1 by
+// coverageAbove.
+template <class T>
+void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90) {
+  f0 = saturate(c.f0);
+  f90 = splat3(T(1));
+  if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  const T cover = saturate(c.coverageAbove);
+  if (cover > T(0)) {
+    const T f = max3(saturate(c.f0));
+    const T s = std::sqrt(f);
+    const T r = (s - kCoatSqrtF0<T>) / (T(1) - kCoatSqrtF0<T> * s);
+    T rel = std::min(f, r * r);
+    rel = lerp(rel, f, saturate((f - T(0.1)) * T(10)));
+    const T scale = lerp(T(1), rel / std::max(f, T(1e-4)), cover);
+    f0 = f0 * scale;
+    f90 = f90 * scale;
+  }
+}
+
+// 1 / lerp(1, D, cover), D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
+// T_i = max(T_N, 0.96^(1+k)), T_m = sat(T_N / 0.96^(1+k)).
+// The first term raised by 1 + 0.0145 (mean F90 - mean F0) of the closure's
+// own (relative) interface: the covariance of its coupling with the layers'.
+template <class T>
+V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90) {
+  const T cover = saturate(c.coverageAbove);
+  if (!(cover > T(0))) return splat3(T(1));
+  T g = T(0.95238), ifc = T(0.96), invIfc = T(1.0416666667);
+  if (c.extraInterfaces == 1u) {
+    g = T(0.91991);
+    ifc = T(0.9216);
+    invIfc = T(1.0850694444);
+  } else if (c.extraInterfaces == 2u) {
+    g = T(0.89524);
+    ifc = T(0.884736);
+    invIfc = T(1.1302806713);
+  } else if (c.extraInterfaces >= 3u) {
+    g = T(0.87535);
+    ifc = T(0.84934656);
+    invIfc = T(1.1773756993);
+  }
+  const T own = saturate(dot(f90 - f0, splat3(T(1) / T(3))));
+  g = g * (T(1) + T(0.0145) * own);
+  V3<T> r;
+  for (int i = 0; i < 3; ++i) {
+    const T tn = saturate(c.topTransmittance[i]);
+    const T ti = std::max(tn, ifc);
+    const T tm = saturate(tn * invIfc);
+    const T tm2 = tm * tm;
+    const T d = g * ti * (T(1) - T(0.12) * (T(1) - ti)) + kCoatTrap<T> * saturate(c.diffuseAlbedo[i]) * (T(1) - tm2 * tm2);
+    r[i] = T(1) / lerp(T(1), d, cover);
+  }
+  return r;
+}
+
 // substrate_eval_closure.
 
 // long: it mirrors substrate_eval_closure statement for statement, so the two
@@ -396,9 +459,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   T VoH = saturate(dot(V, H));
   T VoL = clampT(dot(V, L), T(-1), T(1));
 
-  V3<T> f0 = saturate(c.f0);
-  V3<T> f90 = splat3(T(1));
-  if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  V3<T> f0, f90;
+  closureFresnelEnds(c, f0, f90);
   T roughness = saturate(c.roughness);
 
   T anisotropy = T(0);
@@ -466,7 +528,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
                       : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
                             diffuseLightCoupling(f0, f90, NoLc, roughness, hazeRoughness, hazeWeight);
-  V3<T> result = spec + diff * (splat3(T(1)) - specAlbedo);
+  // Under layers: what their underside sends back down.
+  V3<T> result = spec + diff * (splat3(T(1)) - specAlbedo) * closureCoatDiffuse(c, f0, f90);
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -488,6 +551,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
+  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&);                              \
+  template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                 \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \
   template T ggxD<T>(T, T);                                                                            \

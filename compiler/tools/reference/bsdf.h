@@ -12,6 +12,13 @@ namespace substratec::reference {
 template <class T> V3<T> closureNormal(const Closure<T>& c);                                 // substrate_closure_normal
 template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>& Tn, V3<T>& Bn);  // substrate_closure_frame
 
+// Closures under layers (the layers above read as a dielectric of F0 0.04).
+/// substrate_closure_fresnel_ends: F0 and F90 (white without the F90 feature),
+/// relative to the layers above by coverageAbove.
+template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90);
+/// substrate_closure_coat_diffuse: 1 / lerp(1, D, coverageAbove), what the diffuse gets back.
+template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
+
 // GGX.
 template <class T> V2<T> ggxAlpha(T roughness, T anisotropy);                               // substrate_ggx_alpha
 template <class T> T ggxD(T a, T NoH);                                                      // substrate_ggx_d

@@ -41,14 +41,25 @@ T interfacesTransmission(T mu, std::uint32_t extra) {
   return g;
 }
 
-// substrate_closure_above_throughput: lerp(1, T_N^(1/max(mu, 1e-4)) *
+// substrate_coat_path_length: 1.5 rsqrt(1.25 + sat(mu)^2) = 1 / mu_t, the
+// path per unit thickness along the cosine refracted into the layers above.
+template <class T>
+T coatPathLength(T mu) {
+  const T m = saturate(mu);
+  return T(1.5) / std::sqrt(T(1.25) + m * m);
+}
+
+// substrate_closure_above_throughput: lerp(1, T_N^coatPathLength(mu) *
 // (1 - (1 - mu)^5)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
 // transcendental) when nothing covers the closure.
 template <class T>
 V3<T> aboveThroughput(const Closure<T>& c, T mu) {
   T cover = saturate(c.coverageAbove);
   if (cover > T(0)) {
-    const V3<T> t = transmittanceAtCosine(c.topTransmittance, mu);
+    const T path = coatPathLength(mu);
+    V3<T> t;
+    for (int k = 0; k < 3; ++k)
+      t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
     const T i = interfacesTransmission(mu, c.extraInterfaces);
     return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
   }
@@ -67,9 +78,8 @@ T envRoughness(const Closure<T>& c) {
 // translucency compute it (both test c.secondRoughnessWeight > 0, unsaturated).
 template <class T>
 V3<T> specularAlbedo(const Closure<T>& c, T NoV) {
-  V3<T> f0 = saturate(c.f0);
-  V3<T> f90 = splat3(T(1));
-  if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  V3<T> f0, f90;
+  closureFresnelEnds(c, f0, f90);
   V3<T> specAlbedo;
   specularEnergy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
   if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
@@ -139,11 +149,13 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   T NoVraw = dot(N, V);
   if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));
   T NoV = clampT(NoVraw, K<T>::minCos, T(1));
+  V3<T> f0, f90;
+  closureFresnelEnds(c, f0, f90);
   V3<T> specAlbedo = specularAlbedo(c, NoV);
   V3<T> spec = specAlbedo * vmax(prefilteredRadiance, splat3(T(0)));
   // Specular profile: the default tint is 1.
   V3<T> irr = vmax(irradiance, splat3(T(0))) * K<T>::invPi;
-  V3<T> diff = saturate(c.diffuseAlbedo) * (splat3(T(1)) - specAlbedo) * irr;
+  V3<T> diff = saturate(c.diffuseAlbedo) * (splat3(T(1)) - specAlbedo) * closureCoatDiffuse(c, f0, f90) * irr;
   V3<T> specLight = lightThroughput(c, NoV);
   V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
   V3<T> result = spec * specLight + diff * diffuseLight;
