@@ -85,7 +85,7 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   float s = sqrt(f);
   float r = (s - SUBSTRATE_COAT_SQRT_F0) / (1.0 - SUBSTRATE_COAT_SQRT_F0 * s);
   float rel = min(f, r * r);
-  rel = lerp(rel, f, saturate((f - 0.1) * 10.0));
+  rel = lerp(rel, f, saturate((f - SUBSTRATE_COAT_DIELECTRIC_F0) * SUBSTRATE_COAT_CONDUCTOR_BLEND));
   float scale = lerp(1.0, rel / max(f, 1e-4), saturate(c.coverageAbove));
   f0f *= scale;
   f90f *= scale;
@@ -130,22 +130,22 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, mfloat3 f0, mfloat3 f9
 #else
   // No branch: at coverageAbove 0 the factor is exactly 1.
   float cover = saturate(c.coverageAbove);
-  float g = 0.95238;
-  float ifc = 0.96;
-  float invIfc = 1.0416666667;
+  float g = SUBSTRATE_COAT_G_0;
+  float ifc = SUBSTRATE_COAT_T_0;
+  float invIfc = SUBSTRATE_COAT_INV_T_0;
 #if SUBSTRATE_USE_EXTRA_INTERFACES
   if (c.extraInterfaces == 1u) {
-    g = 0.91991;
-    ifc = 0.9216;
-    invIfc = 1.0850694444;
+    g = SUBSTRATE_COAT_G_1;
+    ifc = SUBSTRATE_COAT_T_1;
+    invIfc = SUBSTRATE_COAT_INV_T_1;
   } else if (c.extraInterfaces == 2u) {
-    g = 0.89524;
-    ifc = 0.884736;
-    invIfc = 1.1302806713;
+    g = SUBSTRATE_COAT_G_2;
+    ifc = SUBSTRATE_COAT_T_2;
+    invIfc = SUBSTRATE_COAT_INV_T_2;
   } else if (c.extraInterfaces >= 3u) {
-    g = 0.87535;
-    ifc = 0.84934656;
-    invIfc = 1.1773756993;
+    g = SUBSTRATE_COAT_G_3;
+    ifc = SUBSTRATE_COAT_T_3;
+    invIfc = SUBSTRATE_COAT_INV_T_3;
   }
 #endif
   float3 tn = saturate(c.topTransmittance);
@@ -153,7 +153,7 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, mfloat3 f0, mfloat3 f9
   float3 tm = saturate(tn * invIfc);
   float3 tm2 = tm * tm;
   float own = saturate(dot(SUBSTRATE_F3(f90 - f0), SUBSTRATE_SPLAT3(1.0 / 3.0)));
-  float3 d = (g * (1.0 + 0.0145 * own)) * ti * (1.0 - 0.12 * (1.0 - ti)) +
+  float3 d = (g * (1.0 + SUBSTRATE_COAT_COVARIANCE * own)) * ti * (1.0 - SUBSTRATE_COAT_BEND * (1.0 - ti)) +
              SUBSTRATE_COAT_TRAP * saturate(c.diffuseAlbedo) * (1.0 - tm2 * tm2);
   return 1.0 / lerp(SUBSTRATE_SPLAT3(1.0), d, cover);
 #endif

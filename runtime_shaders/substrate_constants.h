@@ -48,6 +48,33 @@
 //         reflectance seen from inside (total internal reflection included).
 #define SUBSTRATE_COAT_SQRT_F0 0.2
 #define SUBSTRATE_COAT_TRAP 1.34177
+// Only a dielectric interface is made relative to the layers above: up to
+// F0 0.1 it is; from there it blends back to its own F0, reached at 0.2 (read
+// as a conductor, as the ground truth walks conductors). BLEND = 1 / (0.2 - 0.1).
+#define SUBSTRATE_COAT_DIELECTRIC_F0 0.1
+#define SUBSTRATE_COAT_CONDUCTOR_BLEND 10.0
+// substrate_closure_coat_diffuse's terms, for k = extraInterfaces 0..3:
+//   G_k: 2 int mu g(mu)^(1 + k) dmu, the cosine-weighted mean of the lighting's
+//        light-side interface term;
+//   T_k: 0.96^(1 + k), the interfaces' share of topTransmittance (1 - F0 of
+//        each), and INV_T_k = 1 / T_k;
+//   BEND: T_i^1.13 bounded above by Bernoulli's inequality, T_i (1 - 0.12 (1 - T_i));
+//   COVARIANCE: the closure's own interface coupling's covariance with the
+//        layers', per unit of mean F90 - mean F0.
+#define SUBSTRATE_COAT_G_0 0.95238
+#define SUBSTRATE_COAT_G_1 0.91991
+#define SUBSTRATE_COAT_G_2 0.89524
+#define SUBSTRATE_COAT_G_3 0.87535
+#define SUBSTRATE_COAT_T_0 0.96
+#define SUBSTRATE_COAT_T_1 0.9216
+#define SUBSTRATE_COAT_T_2 0.884736
+#define SUBSTRATE_COAT_T_3 0.84934656
+#define SUBSTRATE_COAT_INV_T_0 1.0416666667
+#define SUBSTRATE_COAT_INV_T_1 1.0850694444
+#define SUBSTRATE_COAT_INV_T_2 1.1302806713
+#define SUBSTRATE_COAT_INV_T_3 1.1773756993
+#define SUBSTRATE_COAT_BEND 0.12
+#define SUBSTRATE_COAT_COVARIANCE 0.0145
 
 // The tree walk's guard against a division by a coverage of 0 (substrate_tree.h).
 #define SUBSTRATE_TREE_EPSILON 1e-6

@@ -148,7 +148,7 @@ Slab interfaceUnderLayers(Material& m, const Slab& in, ValueId& scale) {
   ValueId r = e.bin(Op::Divide, e.sub(root, e.k(SUBSTRATE_COAT_SQRT_F0)),
                     e.oneMinus(e.mul(root, e.k(SUBSTRATE_COAT_SQRT_F0))));
   ValueId rel = e.min(f, e.mul(r, r));
-  rel = e.lerp(rel, f, e.sat(e.mul(e.sub(f, e.k(0.1)), e.k(10.0))));
+  rel = e.lerp(rel, f, e.sat(e.mul(e.sub(f, e.k(SUBSTRATE_COAT_DIELECTRIC_F0)), e.k(SUBSTRATE_COAT_CONDUCTOR_BLEND))));
   scale = e.bin(Op::Divide, rel, e.max(f, e.k(1e-4)));
   s.pin(SlabPin::F0) = e.mul(pin(in, SlabPin::F0), scale);
   s.pin(SlabPin::F90) = e.mul(pin(in, SlabPin::F90), scale);

@@ -381,17 +381,16 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90) {
   f0 = saturate(c.f0);
   f90 = splat3(T(1));
   if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  // No branch, as in the shader: at coverageAbove 0 the scale is exactly 1.
   const T cover = saturate(c.coverageAbove);
-  if (cover > T(0)) {
-    const T f = max3(saturate(c.f0));
-    const T s = std::sqrt(f);
-    const T r = (s - kCoatSqrtF0<T>) / (T(1) - kCoatSqrtF0<T> * s);
-    T rel = std::min(f, r * r);
-    rel = lerp(rel, f, saturate((f - T(0.1)) * T(10)));
-    const T scale = lerp(T(1), rel / std::max(f, T(1e-4)), cover);
-    f0 = f0 * scale;
-    f90 = f90 * scale;
-  }
+  const T f = max3(saturate(c.f0));
+  const T s = std::sqrt(f);
+  const T r = (s - kCoatSqrtF0<T>) / (T(1) - kCoatSqrtF0<T> * s);
+  T rel = std::min(f, r * r);
+  rel = lerp(rel, f, saturate((f - T(SUBSTRATE_COAT_DIELECTRIC_F0)) * T(SUBSTRATE_COAT_CONDUCTOR_BLEND)));
+  const T scale = lerp(T(1), rel / std::max(f, T(1e-4)), cover);
+  f0 = f0 * scale;
+  f90 = f90 * scale;
 }
 
 // 1 / lerp(1, D, cover), D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
@@ -400,31 +399,31 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90) {
 // own (relative) interface: the covariance of its coupling with the layers'.
 template <class T>
 V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90) {
+  // No branch, as in the shader: at coverageAbove 0 the factor is exactly 1.
   const T cover = saturate(c.coverageAbove);
-  if (!(cover > T(0))) return splat3(T(1));
-  T g = T(0.95238), ifc = T(0.96), invIfc = T(1.0416666667);
+  T g = T(SUBSTRATE_COAT_G_0), ifc = T(SUBSTRATE_COAT_T_0), invIfc = T(SUBSTRATE_COAT_INV_T_0);
   if (c.extraInterfaces == 1u) {
-    g = T(0.91991);
-    ifc = T(0.9216);
-    invIfc = T(1.0850694444);
+    g = T(SUBSTRATE_COAT_G_1);
+    ifc = T(SUBSTRATE_COAT_T_1);
+    invIfc = T(SUBSTRATE_COAT_INV_T_1);
   } else if (c.extraInterfaces == 2u) {
-    g = T(0.89524);
-    ifc = T(0.884736);
-    invIfc = T(1.1302806713);
+    g = T(SUBSTRATE_COAT_G_2);
+    ifc = T(SUBSTRATE_COAT_T_2);
+    invIfc = T(SUBSTRATE_COAT_INV_T_2);
   } else if (c.extraInterfaces >= 3u) {
-    g = T(0.87535);
-    ifc = T(0.84934656);
-    invIfc = T(1.1773756993);
+    g = T(SUBSTRATE_COAT_G_3);
+    ifc = T(SUBSTRATE_COAT_T_3);
+    invIfc = T(SUBSTRATE_COAT_INV_T_3);
   }
   const T own = saturate(dot(f90 - f0, splat3(T(1) / T(3))));
-  g = g * (T(1) + T(0.0145) * own);
+  g = g * (T(1) + T(SUBSTRATE_COAT_COVARIANCE) * own);
   V3<T> r;
   for (int i = 0; i < 3; ++i) {
     const T tn = saturate(c.topTransmittance[i]);
     const T ti = std::max(tn, ifc);
     const T tm = saturate(tn * invIfc);
     const T tm2 = tm * tm;
-    const T d = g * ti * (T(1) - T(0.12) * (T(1) - ti)) + kCoatTrap<T> * saturate(c.diffuseAlbedo[i]) * (T(1) - tm2 * tm2);
+    const T d = g * ti * (T(1) - T(SUBSTRATE_COAT_BEND) * (T(1) - ti)) + kCoatTrap<T> * saturate(c.diffuseAlbedo[i]) * (T(1) - tm2 * tm2);
     r[i] = T(1) / lerp(T(1), d, cover);
   }
   return r;
