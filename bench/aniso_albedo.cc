@@ -1,15 +1,15 @@
 // The energy of an anisotropic GGX lobe (issue 19, item 1): how much of the
-// light a white conductor (F0 = F90 = 1) with today's energy compensation
+// light a white conductor (F0 = F90 = 1) with the shipped energy compensation
 // returns, per view cosine, over roughness, |anisotropy| and view azimuth;
-// and what a compensation from the lobe's largest albedo over the view
-// azimuths, E_max(NoV, r, |A|), would return (the design measured for the
-// next step: azimuth-free, so it never gains energy at any azimuth).
+// and what the compensation from the lobe's exact largest albedo over the view
+// azimuths, W = 1 / E_max(NoV, r, |A|), returns (azimuth-free, so it gains
+// energy at no azimuth; the shipped W reads E_max from a table since issue 19).
 //
 // The single-scattering albedo E(NoV, phi) is integrated here independently
 // of the reference: Heitz 2018's visible-normal sampling of the anisotropic
 // lobe on an n x n stratified grid, weight G2 / G1(V) (height-correlated
 // Smith), alphas from substrate_ggx_alpha (r^2 (1 +- A), clamped to
-// [1e-3, 1]). Today's compensation W is the reference's mirror of the
+// [1e-3, 1]). The shipped compensation W is the reference's mirror of the
 // shader, reference::specularEnergyAniso, so the returned albedo is E W.
 // Not a test: `build/bin/aniso_albedo [n]` prints a markdown table
 // (docs/accuracy.md, "Anisotropy: what the compensation returns").
@@ -74,7 +74,7 @@ int main(int argc, char** argv) {
   std::printf("Anisotropic GGX, white conductor (F0 = F90 = 1): albedo returned, over r in {0.1 .. 1} (%zu),\n"
               "|A| in {0.1 .. 1} (%zu), %d view azimuths from the tangent to the bitangent; %d x %d points each.\n\n",
               std::size(rs), std::size(as), kPhis, n, n);
-  std::printf("| NoV | cases | today: min | today: mean | E / E_max: min | E / E_max: mean | worst today |\n");
+  std::printf("| NoV | cases | shipped: min | shipped: mean | E / E_max: min | E / E_max: mean | worst shipped |\n");
   std::printf("|---:|---:|---:|---:|---:|---:|---|\n");
   int total = 0;
   for (double mu : mus) {

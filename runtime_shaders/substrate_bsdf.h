@@ -241,16 +241,16 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float NoV, float roug
   return w;
 }
 
-// The same for a lobe of anisotropy A. The tables hold isotropic lobes only,
-// and a stretched lobe's albedo leaves that family (seen along its rough axis
-// at NoV 0.1, r 0.5, A 0.5: E = 0.918, above the isotropic E at every alpha in
-// [ay, ax]), so W from the isotropic E overshot (1.74 at r 1, A 1). With
-// t = 1 - (1 - |A|)^2: E and E - B are widened toward 1 and E, bounds for any
-// lobe, by t (measured need: 0.26 at |A| 0.2, 0.68 at 0.5, 0.97 at 1); B, which
-// a stretched lobe seen along its smooth axis raises (its facets tilt
-// sideways: V.H small), is taken as at least the isotropic B at that axis's
-// alpha times 1 + min(0.55 sat(3.3 |A|), 0.2 + 2.33 (1 - |A|)) (measured need:
-// 1.10 at |A| 0.1, 1.45 at 0.5, 1.48 at 0.7, 1.10 at 1), never above E.
+// The same for a lobe of anisotropy A. A stretched lobe's albedo leaves the
+// isotropic family (seen along its rough axis at NoV 0.1, r 0.5, A 0.5:
+// E = 0.918, above the isotropic E at every alpha in [ay, ax]; head-on at r 1,
+// |A| 1: 0.533, below every isotropic lobe's) and depends on the view's azimuth
+// (r 1, |A| 1, NoV 0.1: 0.53 along the smooth axis, 0.86 along the rough one).
+// E and B are E_max and B_max(NoV, r, |A|), the largest over the azimuths
+// (substrate_energy_aniso): W = 1 / E_max gains energy at no azimuth and is
+// exact at normal incidence, and the diffuse below gets no more than 1 - E_spec
+// of the true lobe (issue 19; docs/accuracy.md, "Anisotropy"). E - B is
+// widened toward E by t = sat(4 |A|): no table bounds it, E does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
 mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float NoV, float roughness, float anisotropy,
@@ -260,13 +260,9 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float NoV, floa
 #if SUBSTRATE_USE_ANISOTROPY
   float A = min(abs(anisotropy), 1.0);
   if (A > 0.0) {
-    float t = A * (2.0 - A);
-    e = lerp(e, 1.0, t);
-    float r = saturate(roughness);
-    float smoothAxis = sqrt(max(r * r * (1.0 - A), SUBSTRATE_MIN_ALPHA));
-    float margin = 1.0 + min(0.55 * saturate(3.3 * A), 0.2 + 2.33 * (1.0 - A));
-    float b = min(max(dfg.y, substrate_energy_dfg(NoV, smoothAxis).y * margin), e);
-    dfg = float2(lerp(dfg.x, e, t), b);
+    float2 eb = substrate_energy_aniso(NoV, roughness, A, float2(e, dfg.y));
+    e = eb.x;
+    dfg = float2(lerp(dfg.x, e, saturate(4.0 * A)), min(eb.y, e));
   }
 #endif
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);

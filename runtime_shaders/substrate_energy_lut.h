@@ -6,19 +6,27 @@
 // Three 32 x 32 tables (E, B and E_fuzz; see the data header). Lookups are
 // bilinear on [0, 1]^2 (inputs clamped); the outer half cell is extrapolated
 // linearly from the last two centres, and results are clamped to range.
+// A fourth, E_max(NoV, r, |A|) and B_max of anisotropic lobes, 15 x 16 uint4 of
+// eight halves (substrate_energy_aniso), is read only by shaders compiled with
+// SUBSTRATE_USE_ANISOTROPY: the others declare (or inline) the first three only.
 //
 // Where the values live (choose before including this file):
-//   default                the host binds the 3072 floats of
+//   default                the host binds the 4032 words of
 //                          substrate_energy_lut_data.h, in that order, as a
-//                          uniform buffer (768 float4, 12,288 bytes) at descriptor
-//                          set SUBSTRATE_LUT_SET (0), binding SUBSTRATE_LUT_BINDING (5).
+//                          uniform buffer (1008 float4, 16,128 bytes: within
+//                          Vulkan's minimum maxUniformBufferRange) at descriptor set
+//                          SUBSTRATE_LUT_SET (0), binding SUBSTRATE_LUT_BINDING (5).
 //   SUBSTRATE_LUT_INLINE   the tables are compiled into the shader as one constant
 //                          array: no binding, but ~3,000 constants in the module
 //                          (slow to compile with glslang, and some backends copy
 //                          the array for every dynamic index).
 //   SUBSTRATE_LUT_FETCH(table, index)   defined by the including shader: read
 //                          entry `index` (0..1023) of table `table`
-//                          (SUBSTRATE_LUT_E/B/FUZZ = 0/1/2) from its own storage.
+//                          (SUBSTRATE_LUT_E/B/FUZZ/ANISO = 0/1/2/3) from its own
+//                          storage, 32-bit words as floats (the anisotropic
+//                          table's words are bits: read with asuint);
+//                          SUBSTRATE_LUT_FETCH_ANISO(element) may be defined too:
+//                          uint4 `element` (0..239) of table 3.
 #ifndef SUBSTRATE_ENERGY_LUT_H
 #define SUBSTRATE_ENERGY_LUT_H 1
 
@@ -33,23 +41,37 @@
 #include "substrate_energy_lut_data.h"
 #ifndef SUBSTRATE_LUT_FETCH
 #define SUBSTRATE_LUT_FETCH(table, index) SUBSTRATE_LUT_TABLES[(table) * 1024 + (index)]
+#ifndef SUBSTRATE_LUT_FETCH_ANISO
+#define SUBSTRATE_LUT_FETCH_ANISO(element)                                                               \
+  uint4(SUBSTRATE_LUT_ANISO_TABLE[(element) * 4], SUBSTRATE_LUT_ANISO_TABLE[(element) * 4 + 1],            \
+        SUBSTRATE_LUT_ANISO_TABLE[(element) * 4 + 2], SUBSTRATE_LUT_ANISO_TABLE[(element) * 4 + 3])
+#endif
 #endif
 #else
 #define SUBSTRATE_LUT_SIZE 32
 #define SUBSTRATE_LUT_E 0
 #define SUBSTRATE_LUT_B 1
 #define SUBSTRATE_LUT_FUZZ 2
-#define SUBSTRATE_LUT_FLOATS 3072
+#define SUBSTRATE_LUT_ANISO 3
+#define SUBSTRATE_LUT_ANISO_SIZE 16
+#define SUBSTRATE_LUT_FLOATS 4032
 #ifndef SUBSTRATE_LUT_FETCH
-// A uniform buffer of 768 float4 (12,288 bytes: within every Vulkan device's
-// maxUniformBufferRange) holding the 3072 floats in order, four per element.
+// A uniform buffer of up to 1008 float4 (16,128 bytes: within every Vulkan
+// device's maxUniformBufferRange, 16,384 at least) holding the 4032 words in
+// order, four per element; a shader without anisotropy declares the first 768
+// (the E, B and E_fuzz tables) and never reads the rest.
+#if SUBSTRATE_USE_ANISOTROPY
+#define SUBSTRATE_LUT_DECLARED_FLOAT4S 1008
+#else
+#define SUBSTRATE_LUT_DECLARED_FLOAT4S 768
+#endif
 #if defined(SUBSTRATE_GLSL)
 layout(set = SUBSTRATE_LUT_SET, binding = SUBSTRATE_LUT_BINDING, std140) uniform SubstrateLutBuffer {
-  float4 substrate_lut_tables[SUBSTRATE_LUT_FLOATS / 4];
+  float4 substrate_lut_tables[SUBSTRATE_LUT_DECLARED_FLOAT4S];
 };
 #else
 struct SubstrateLutData {
-  float4 tables[SUBSTRATE_LUT_FLOATS / 4];
+  float4 tables[SUBSTRATE_LUT_DECLARED_FLOAT4S];
 };
 [[vk::binding(SUBSTRATE_LUT_BINDING, SUBSTRATE_LUT_SET)]] ConstantBuffer<SubstrateLutData> substrate_lut_buffer;
 #define substrate_lut_tables substrate_lut_buffer.tables
@@ -58,7 +80,16 @@ float substrate_lut_fetch(int k) {
   return substrate_lut_tables[k >> 2][k & 3];
 }
 #define SUBSTRATE_LUT_FETCH(table, index) substrate_lut_fetch((table) * 1024 + (index))
+#ifndef SUBSTRATE_LUT_FETCH_ANISO
+#define SUBSTRATE_LUT_FETCH_ANISO(element) asuint(substrate_lut_tables[SUBSTRATE_LUT_ANISO * 256 + (element)])
 #endif
+#endif
+#endif
+// Elsewhere (the includer's own SUBSTRATE_LUT_FETCH) a node is four entries.
+#ifndef SUBSTRATE_LUT_FETCH_ANISO
+#define SUBSTRATE_LUT_FETCH_ANISO(element)                                                                     \
+  asuint(float4(SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_ANISO, (element) * 4), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_ANISO, (element) * 4 + 1), \
+                SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_ANISO, (element) * 4 + 2), SUBSTRATE_LUT_FETCH(SUBSTRATE_LUT_ANISO, (element) * 4 + 3)))
 #endif
 
 // Bilinear coordinates into a 32 x 32 table: the four indices (x0y0, x1y0,
@@ -108,6 +139,36 @@ float2 substrate_energy_dfg(float NoV, float roughness) {
   b = clamp(b, 0.0, 1.0);
   return float2(clamp(e - b, 0.0, 1.0), b);
 }
+
+// (E_max, B_max)(NoV, r, |A|): the largest directional albedo and the largest
+// B (the (1 - VoH)^5 part), over the view's azimuth, of the GGX lobe of
+// anisotropy |A| with F = 1 (scripts/gen_energy_lut.py: upper bounds at every
+// lookup). Nodes at sqrt(NoV) = i / 15 and r = j / 15 hold both at |A| = 0.5
+// and 1 as halves; one uint4 holds two nodes neighbouring in NoV, so the
+// bilinear lookup in (sqrt(NoV), r) is two fetches (as many words as the E and
+// B lookups at the smooth axis' alpha it replaces). Across |A|: hat weights at
+// 0.5 and 1, with `iso`, the isotropic (E, B) at (NoV, r), at |A| = 0.
+// E clamped to [1e-3, 1], B to [0, 1].
+#if SUBSTRATE_USE_ANISOTROPY
+// One row of the lookup: (E at 0.5, E at 1, B at 0.5, B at 1), lerped in NoV.
+float4 substrate_energy_aniso_row(uint4 n, float f) {
+  return lerp(float4(substrate_unpack_half2(n.x), substrate_unpack_half2(n.y)),
+              float4(substrate_unpack_half2(n.z), substrate_unpack_half2(n.w)), f);
+}
+
+float2 substrate_energy_aniso(float NoV, float roughness, float absAnisotropy, float2 iso) {
+  float2 p = float2(sqrt(saturate(NoV)), saturate(roughness)) * 15.0;
+  float2 p0 = min(floor(p), SUBSTRATE_SPLAT2(14.0));
+  float2 f = p - p0;
+  int k = int(p0.y) * (SUBSTRATE_LUT_ANISO_SIZE - 1) + int(p0.x);
+  float4 v = lerp(substrate_energy_aniso_row(SUBSTRATE_LUT_FETCH_ANISO(k), f.x),
+                  substrate_energy_aniso_row(SUBSTRATE_LUT_FETCH_ANISO(k + SUBSTRATE_LUT_ANISO_SIZE - 1), f.x), f.y);
+  float a = saturate(absAnisotropy) * 2.0;
+  float2 w = float2(1.0 - abs(a - 1.0), max(a - 1.0, 0.0));
+  float2 r = float2(dot(v.xy, w), dot(v.zw, w)) + iso * max(1.0 - a, 0.0);
+  return float2(clamp(r.x, 1e-3, 1.0), saturate(r.y));
+}
+#endif
 
 // E_fuzz(NoV, r): directional albedo of the Charlie sheen lobe (colour 1,
 // amount 1); may exceed 1 at grazing view for smooth fuzz (see above).

@@ -19,6 +19,18 @@ centres):
                                clamped: it exceeds 1 at grazing view for smooth
                                fuzz (the runtime normalizes the lobe there).
 
+  SUBSTRATE_LUT_ANISO          E_max(mu, r, |A|) and B_max(mu, r, |A|): the largest
+                               directional albedo and the largest B, over the view's
+                               azimuth, of the anisotropic GGX lobe with F = 1
+                               (alphas r^2 (1 +- |A|), clamped as the runtime does),
+                               on 16 x 16 nodes in (sqrt(mu), r) at |A| = 0.5 and 1,
+                               as IEEE halves rounded up (pack_aniso: one uint4 per
+                               two nodes neighbouring in mu); the runtime compensates an
+                               anisotropic lobe with W = 1 / E_max (issue 19), which
+                               gains energy at no azimuth, and bounds its B by
+                               B_max. Raised to an envelope of its lookup as the
+                               tables above are (aniso_table).
+
 Integration is deterministic: GGX by visible-normal importance sampling
 (Heitz 2018) and the sheen by sampling its NDF, both over a Hammersley set.
 
@@ -34,11 +46,13 @@ bound for any F0, F90 in [0, 1]: compensation never adds energy and the
 diffuse below never receives more than 1 - E_spec of the true lobe.
 
 Pure Python 3 (no numpy). Writes the header (default path, or argv[1]) and prints
-nothing; two runs give identical files (about 2 minutes).
+nothing; two runs give identical files (about 3 minutes on 2 cores).
 """
 
 import math
+import multiprocessing
 import os
+import struct
 import sys
 
 N = 32                 # table resolution per axis
@@ -179,6 +193,179 @@ def fuzz_cell(mu, r, pts):
     return total / float(len(pts))
 
 
+# --- The anisotropic table (issue 19): E_max(NoV, r, |A|) ---------------------
+
+ANISO_N = 16            # nodes per axis in (sqrt(NoV), r), at i / 15 and j / 15
+ANISO_SLICES = 2        # |A| = 0.5, 1 (|A| = 0 is the E and B tables)
+ANISO_PHIS = 9          # view azimuths from the tangent to the bitangent, 0 .. pi/2
+ANISO_SAMPLES = 1024    # Hammersley points per azimuth at a node
+ANISO_CHECK_SAMPLES = 512  # and at an envelope check point
+ANISO_MARGIN = 5e-4     # absolute slack over the integrated value (integration noise)
+
+
+def ggx_alpha(r, a_abs):
+    """substrate_ggx_alpha: (ax, ay) = r^2 (1 + |A|, 1 - |A|), clamped to [1e-3, 1]."""
+    a = r * r
+    return (min(max(a * (1.0 + a_abs), GGX_MIN_ALPHA), 1.0), min(max(a * (1.0 - a_abs), GGX_MIN_ALPHA), 1.0))
+
+
+def aniso_albedo(mu, phi, ax, ay, pts):
+    """(E, B) of the anisotropic GGX lobe with F = 1 seen from azimuth phi (from
+    the axis of roughness ax): Heitz 2018's visible-normal sampling, weight
+    G2 / G1(V); B is the part weighted by (1 - VoH)^5."""
+    sv = math.sqrt(max(0.0, 1.0 - mu * mu))
+    vx, vy, vz = sv * math.cos(phi), sv * math.sin(phi), mu
+    lam_v = 0.5 * (-1.0 + math.sqrt(1.0 + (ax * ax * vx * vx + ay * ay * vy * vy) / (vz * vz)))
+    hx, hy, hz = ax * vx, ay * vy, vz
+    hl = math.sqrt(hx * hx + hy * hy + hz * hz)
+    hx, hy, hz = hx / hl, hy / hl, hz / hl
+    lensq = hx * hx + hy * hy
+    if lensq > 0.0:
+        il = 1.0 / math.sqrt(lensq)
+        t1x, t1y = -hy * il, hx * il
+    else:
+        t1x, t1y = 1.0, 0.0
+    # T2 = cross(Vh, T1), T1 = (t1x, t1y, 0)
+    t2x, t2y, t2z = -hz * t1y, hz * t1x, hx * t1y - hy * t1x
+    s = 0.5 * (1.0 + hz)
+    two_pi = 2.0 * math.pi
+    total = 0.0
+    total_b = 0.0
+    for u1, u2 in pts:
+        rr = math.sqrt(u1)
+        ph = two_pi * u2
+        a1 = rr * math.cos(ph)
+        a2 = (1.0 - s) * math.sqrt(max(0.0, 1.0 - a1 * a1)) + s * rr * math.sin(ph)
+        an = math.sqrt(max(0.0, 1.0 - a1 * a1 - a2 * a2))
+        mx = ax * (a1 * t1x + a2 * t2x + an * hx)
+        my = ay * (a1 * t1y + a2 * t2y + an * hy)
+        mz = max(0.0, a2 * t2z + an * hz)
+        ml = math.sqrt(mx * mx + my * my + mz * mz)
+        if ml <= 0.0:
+            continue
+        mx, my, mz = mx / ml, my / ml, mz / ml
+        voh = vx * mx + vy * my + vz * mz
+        lx, ly, lz = 2.0 * voh * mx - vx, 2.0 * voh * my - vy, 2.0 * voh * mz - vz
+        if lz <= 0.0:
+            continue
+        lam_l = 0.5 * (-1.0 + math.sqrt(1.0 + (ax * ax * lx * lx + ay * ay * ly * ly) / (lz * lz)))
+        w = (1.0 + lam_v) / (1.0 + lam_v + lam_l)
+        fc = 1.0 - min(max(voh, 0.0), 1.0)
+        fc2 = fc * fc
+        total += w
+        total_b += w * fc2 * fc2 * fc
+    return total / float(len(pts)), total_b / float(len(pts))
+
+
+def aniso_max(args):
+    """(E_max, B_max): the largest E and the largest B over ANISO_PHIS view
+    azimuths of the lobe at (NoV, r, |A|) (each bounded separately)."""
+    mu, r, a_abs, n = args
+    ax, ay = ggx_alpha(r, a_abs)
+    pts = hammersley(n)
+    mu = max(mu, MIN_NOV)
+    eb = [aniso_albedo(mu, k * 0.5 * math.pi / (ANISO_PHIS - 1), ax, ay, pts) for k in range(ANISO_PHIS)]
+    return max(e for e, _ in eb), max(b for _, b in eb)
+
+
+def aniso_weights(mu, r, a_abs):
+    """substrate_energy_aniso's lookup: the (node index, weight) pairs over the
+    nodes (index = (j * 16 + i) * ANISO_SLICES + slice) and the weight of the
+    isotropic tables."""
+    x = math.sqrt(min(max(mu, 0.0), 1.0)) * (ANISO_N - 1)
+    y = min(max(r, 0.0), 1.0) * (ANISO_N - 1)
+    i0 = min(int(math.floor(x)), ANISO_N - 2)
+    j0 = min(int(math.floor(y)), ANISO_N - 2)
+    fx, fy = x - i0, y - j0
+    a = min(max(a_abs, 0.0), 1.0) * ANISO_SLICES
+    out = []
+    for dj, wy in ((0, 1.0 - fy), (1, fy)):
+        for di, wx in ((0, 1.0 - fx), (1, fx)):
+            for sl in range(ANISO_SLICES):
+                w = max(0.0, 1.0 - abs(a - (sl + 1))) * wx * wy
+                if w > 0.0:
+                    out.append((((j0 + dj) * ANISO_N + i0 + di) * ANISO_SLICES + sl, w))
+    return out, max(0.0, 1.0 - a)
+
+
+def iso_lookup(tab, mu, r, lo):
+    """A bilinear lookup of a generated 32 x 32 table (lookup_weights), clamped
+    to [lo, 1] (substrate_energy_dfg: E to [1e-3, 1], B to [0, 1])."""
+    px = min(max(mu, 0.0), 1.0) * N - 0.5
+    py = min(max(r, 0.0), 1.0) * N - 0.5
+    return min(max(sum(tab[i] * w for i, w in lookup_weights(px, py)), lo), 1.0)
+
+
+def half_up(v):
+    """The smallest IEEE half >= v (v >= 0), as its 16 bits."""
+    h = struct.unpack("<H", struct.pack("<e", v))[0]
+    if struct.unpack("<e", struct.pack("<H", h))[0] < v:
+        h += 1
+    return h
+
+
+def pack_aniso(e_nodes, b_nodes):
+    """One uint4 per pair of nodes neighbouring in NoV, (i, j) and (i + 1, j),
+    i < 15, at [(j * 15 + i) * 4]: (E(i), B(i), E(i + 1), B(i + 1)), each word
+    the value at |A| 0.5 | the value at 1 << 16 as halves rounded up (a bound
+    stays a bound). The lookup reads one word group per roughness row."""
+    def word(nodes, i, j):
+        n = (j * ANISO_N + i) * ANISO_SLICES
+        return half_up(nodes[n]) | half_up(nodes[n + 1]) << 16
+    out = []
+    for j in range(ANISO_N):
+        for i in range(ANISO_N - 1):
+            out += [word(e_nodes, i, j), word(b_nodes, i, j), word(e_nodes, i + 1, j), word(b_nodes, i + 1, j)]
+    return out
+
+
+def raise_aniso(nodes, checks, values, iso_tab, lo):
+    """Raises `nodes` until the lookup (aniso_weights, the isotropic table
+    `iso_tab` at |A| = 0) is at least value + ANISO_MARGIN at every check."""
+    for _ in range(200):
+        worst = 0.0
+        for (mu, r, a_abs, _n), value in zip(checks, values):
+            ws, w_iso = aniso_weights(mu, r, a_abs)
+            have = w_iso * iso_lookup(iso_tab, mu, r, lo) + sum(nodes[k] * w for k, w in ws)
+            d = value + ANISO_MARGIN - have
+            if d > 1e-9:
+                worst = max(worst, d)
+                s2 = sum(w * w for _, w in ws)
+                for k, w in ws:
+                    nodes[k] += d * w / s2
+        if worst <= 1e-9:
+            return
+    raise RuntimeError("anisotropic envelope did not converge")
+
+
+def aniso_table(e_tab, b_tab, pool):
+    """The E_max and B_max nodes, each raised until the lookup bounds it (plus
+    ANISO_MARGIN) at every check point: the nodes themselves, the midpoints
+    between nodes in sqrt(NoV) and r, at |A| = 1/16 .. 1 in steps of 1/8 and
+    1/16 below 1/4 (where the isotropic tables take part), NoV >= 1e-4; then
+    packed as halves rounded up (pack_aniso)."""
+    nodes_args = []
+    for j in range(ANISO_N):
+        for i in range(ANISO_N):
+            for sl in range(ANISO_SLICES):
+                nodes_args.append(((i / (ANISO_N - 1.0)) ** 2, j / (ANISO_N - 1.0), (sl + 1.0) / ANISO_SLICES,
+                                   ANISO_SAMPLES))
+    nodes = pool.map(aniso_max, nodes_args, chunksize=16)
+    e_nodes = [e for e, _ in nodes]
+    b_nodes = [b for _, b in nodes]
+    us = [k / (2.0 * (ANISO_N - 1)) for k in range(2 * ANISO_N - 1)]
+    check_a = [1 / 16.0, 1 / 8.0, 3 / 16.0, 1 / 4.0, 3 / 8.0, 1 / 2.0, 5 / 8.0, 3 / 4.0, 7 / 8.0, 1.0]
+    checks = []
+    for y in us:
+        for x in us:
+            for a_abs in check_a:
+                checks.append((max(x * x, MIN_NOV), y, a_abs, ANISO_CHECK_SAMPLES))
+    values = pool.map(aniso_max, checks, chunksize=32)
+    raise_aniso(e_nodes, checks, [e for e, _ in values], e_tab, 1e-3)
+    raise_aniso(b_nodes, checks, [b for _, b in values], b_tab, 0.0)
+    return pack_aniso(e_nodes, b_nodes)
+
+
 def fmt(v):
     return "%.5e" % v
 
@@ -192,6 +379,17 @@ def emit_table(out, name, index, values, comment):
         out.append("  " + line + ("" if last else ",") + "  // r = %.5f" % ((j + 0.5) / N))
 
 
+def emit_aniso_table(out, values):
+    out.append(ANISO_TOP)
+    out.append("  // [(j * 15 + i) * 4 + c]: nodes (sqrt(NoV) = i / 15 and (i + 1) / 15, r = j / 15); c = 0, 1:")
+    out.append("  // E_max, B_max at node i, c = 2, 3 at node i + 1; each word: |A| 0.5 | |A| 1 << 16 (halves)")
+    row = (ANISO_N - 1) * 4
+    for j in range(ANISO_N):
+        line = ", ".join("0x%08xu" % v for v in values[j * row:(j + 1) * row])
+        out.append("  " + line + ("" if j + 1 == ANISO_N else ",") + "  // r = %.5f" % (j / (ANISO_N - 1.0)))
+    out.append(ANISO_BOTTOM)
+
+
 HEADER_TOP = """\
 // substratec runtime shaders: the directional-albedo tables (GENERATED by
 // scripts/gen_energy_lut.py -- do not edit; rerun the script instead).
@@ -199,7 +397,12 @@ HEADER_TOP = """\
 // One array of 3 x 32 x 32 floats, SUBSTRATE_LUT_TABLES[t * 1024 + j * 32 + i]:
 // t the table (SUBSTRATE_LUT_E, SUBSTRATE_LUT_B, SUBSTRATE_LUT_FUZZ), i the NoV
 // cell and j the perceptual-roughness cell; NoV = (i + 0.5) / 32 and
-// r = (j + 0.5) / 32 at cell centres.
+// r = (j + 0.5) / 32 at cell centres. Then, for shaders with anisotropy and for
+// hosts (SUBSTRATE_USE_ANISOTROPY undefined or 1), SUBSTRATE_LUT_ANISO_TABLE:
+// 15 x 16 uint4 of two IEEE halves per uint (low bits first), one per pair
+// of nodes neighbouring in NoV, [(j * 15 + i) * 4 + c]: nodes at
+// NoV = (i / 15)^2 and ((i + 1) / 15)^2, r = j / 15. The host uploads the two
+// arrays' bits in that order (SUBSTRATE_LUT_FLOATS 32-bit words in all).
 //
 //   SUBSTRATE_LUT_E     E(NoV, r): albedo of the single-scattering GGX lobe with
 //                       F = 1 (height-correlated Smith G2, alpha = max(r^2, 1e-3)).
@@ -214,6 +417,20 @@ HEADER_TOP = """\
 //                       Not clamped: the model exceeds 1 at grazing view for small
 //                       roughness (up to ~3.2 at NoV = 1/64, r = 1/64); the BSDF
 //                       divides the lobe by max(1, E_fuzz).
+//   SUBSTRATE_LUT_ANISO E_max(NoV, r, |A|) and B_max(NoV, r, |A|): the largest
+//                       albedo and the largest B, over the view's azimuth, of
+//                       the anisotropic GGX lobe with F = 1 (alphas
+//                       r^2 (1 +- |A|) clamped to [1e-3, 1]), for the energy
+//                       terms of anisotropic lobes (substrate_energy_aniso):
+//                       bounds at every azimuth. Components 0, 1: E_max and B_max
+//                       at node i, 2, 3 at node i + 1; each word holds |A| = 0.5
+//                       in its low and |A| = 1 in its high half.
+//                       %d azimuths per point, %d points per azimuth at the nodes;
+//                       raised until the lookup (bilinear in sqrt(NoV) and r, by
+//                       hat weights over |A| with the E and B tables at |A| = 0)
+//                       is at least the value + %g at the nodes, the midpoints
+//                       between them and 10 values of |A| (%d points per
+//                       azimuth), then rounded up to halves.
 //
 // Integration: %d (GGX, visible-normal sampling, Heitz 2018) and %d (sheen, NDF
 // sampling) Hammersley points per cell.
@@ -225,7 +442,7 @@ HEADER_TOP = """\
 // centre) with a margin of %g (E_fuzz: %g of the value more); nodes
 // the lookup left short were raised (docs/stability.md, "Energy: the white furnace").
 //
-// Shaders read these values from a storage buffer by default (see
+// Shaders read these values from a uniform buffer by default (see
 // substrate_energy_lut.h); this file is what the host uploads, and what a shader
 // compiles in as a constant array with SUBSTRATE_LUT_INLINE. It needs
 // SUBSTRATE_CONST and SUBSTRATE_ARRAY_BEGIN/END: the shader preludes define them,
@@ -237,13 +454,24 @@ HEADER_TOP = """\
 #define SUBSTRATE_LUT_E 0
 #define SUBSTRATE_LUT_B 1
 #define SUBSTRATE_LUT_FUZZ 2
-#define SUBSTRATE_LUT_FLOATS 3072
+#define SUBSTRATE_LUT_ANISO 3
+#define SUBSTRATE_LUT_ANISO_SIZE 16
+#define SUBSTRATE_LUT_FLOATS 4032
 
 SUBSTRATE_CONST float SUBSTRATE_LUT_TABLES[3072] = SUBSTRATE_ARRAY_BEGIN(float, 3072)"""
 
 HEADER_BOTTOM = """\
+#endif
+"""
+
+ANISO_TOP = """\
 SUBSTRATE_ARRAY_END;
 
+#if !defined(SUBSTRATE_USE_ANISOTROPY) || SUBSTRATE_USE_ANISOTROPY
+SUBSTRATE_CONST uint SUBSTRATE_LUT_ANISO_TABLE[960] = SUBSTRATE_ARRAY_BEGIN(uint, 960)"""
+
+ANISO_BOTTOM = """\
+SUBSTRATE_ARRAY_END;
 #endif
 """
 
@@ -329,12 +557,15 @@ def main():
     # E is stored as the sum of the two bounds, not clamped to 1: the lookup
     # takes E - B back from it (substrate_energy_dfg).
     e_tab = [x + b for x, b in zip(x_tab, b_tab)]
+    with multiprocessing.Pool() as pool:
+        a_tab = aniso_table(e_tab, b_tab, pool)
     steps = N * ENVELOPE_STEPS + 1
-    out = [HEADER_TOP % (GGX_SAMPLES, FUZZ_SAMPLES, steps, steps, len(ENVELOPE_EXTRA_NOV), ENVELOPE_MARGIN,
-                         ENVELOPE_FUZZ_RELATIVE_MARGIN)]
+    out = [HEADER_TOP % (ANISO_PHIS, ANISO_SAMPLES, ANISO_MARGIN, ANISO_CHECK_SAMPLES, GGX_SAMPLES, FUZZ_SAMPLES,
+                         steps, steps, len(ENVELOPE_EXTRA_NOV), ENVELOPE_MARGIN, ENVELOPE_FUZZ_RELATIVE_MARGIN)]
     emit_table(out, "SUBSTRATE_LUT_E", 0, e_tab, "E(NoV, r), F = 1")
     emit_table(out, "SUBSTRATE_LUT_B", 1, b_tab, "B(NoV, r), the (1 - VoH)^5 part of E")
     emit_table(out, "SUBSTRATE_LUT_FUZZ", 2, f_tab, "E_fuzz(NoV, r), Charlie sheen")
+    emit_aniso_table(out, a_tab)
     out.append(HEADER_BOTTOM)
     text = "\n".join(out)
     with open(path, "w", newline="\n") as fh:

@@ -131,6 +131,37 @@ TEST(Accuracy, ACoatGivesBackWhatItsUndersideReflects) {
   EXPECT_EQ(rows, 12);
 }
 
+TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
+  // Issue 19, item 1: a coloured conductor of roughness 0.6 stretched to
+  // |A| 0.8 (bench/materials/stretched_conductor.json) against the walk, whose
+  // microsurface scatters multiply. Its energy compensation reads the lobe's
+  // largest albedo over the view's azimuth (substrate_energy_aniso); before, it
+  // was widened toward none and the control read -23.1 / -21.1 / -12.4 / -8.1 %
+  // (NoV 1 / 0.6 / 0.2 / 0.1), a white furnace of 0.73 head-on; now -2.1 / -1.8 /
+  // -2.4 / -2.4 % (the table's slices at |A| 0.5 and 1, raised to bound
+  // |A| 0.8 between them, give back a little). Reciprocity is
+  // not bounded here: Turquin's W depends on the view alone (1.16-1.20 for this
+  // lobe, 1.05-1.11 for the isotropic one).
+  const CompileResult r = compileSlab(
+      R"({"kind": "slab", "diffuse_albedo": 0, "f0": [1.0, 0.78, 0.34], "roughness": 0.6, "anisotropy": 0.8})");
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+    EXPECT_LE(std::fabs(*row.relError), 0.04);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.97);
+      EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
 TEST(Accuracy, SameSamplesSameBitsWhateverTheThreads) {
   const CompileResult r =
       compileSlab(R"({"kind": "slab", "diffuse_albedo": [0.6, 0.3, 0.2], "f0": 0.04, "roughness": 0.3})");

@@ -104,9 +104,8 @@ V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH) {
 
 // substrate_specular_energy_aniso: e = clamp(E - B + B, 1e-3, 1) from the dfg
 // pair (the shader sums the pair back); an anisotropic lobe, with
-// A = min(|anisotropy|, 1) and t = A (2 - A): e -> lerp(e, 1, t),
-// E - B -> lerp(E - B, e, t), B -> min(max(B, B(NoV, sqrt(max(r^2 (1 - A), 1e-3))) m), e),
-// m = 1 + min(0.55 sat(3.3 A), 0.2 + 2.33 (1 - A));
+// A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
+// E - B -> lerp(E - B, e, sat(4 A)), B -> min(B_max, e);
 // W = 1 + F0 (1 - e) / e, E_spec = sat((F0 x + F90 y) W).
 template <class T>
 V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo) {
@@ -114,13 +113,9 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness,
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
   T A = std::min(std::fabs(anisotropy), T(1));
   if (A > T(0)) {
-    T t = A * (T(2) - A);
-    e = lerp(e, T(1), t);
-    T r = saturate(roughness);
-    T smoothAxis = std::sqrt(std::max(r * r * (T(1) - A), kMinAlpha<T>));
-    T margin = T(1) + std::min(T(0.55) * saturate(T(3.3) * A), T(0.2) + T(2.33) * (T(1) - A));
-    T b = std::max(dfg[1], energyDfg(NoV, smoothAxis)[1] * margin);
-    dfg = {lerp(dfg[0], e, t), std::min(b, e)};
+    const V2<T> eb = energyAniso(NoV, roughness, A, V2<T>{e, dfg[1]});
+    e = eb[0];
+    dfg = {lerp(dfg[0], e, saturate(T(4) * A)), std::min(eb[1], e)};
   }
   V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
   albedo = saturate((f0 * dfg[0] + f90 * dfg[1]) * w);

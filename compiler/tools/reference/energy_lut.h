@@ -1,5 +1,5 @@
 // Mirrors runtime_shaders/substrate_energy_lut.h: bilinear lookups into the
-// directional-albedo tables (E, B, E_fuzz; 32 x 32 each, validate/runtime_files.h's
+// directional-albedo tables (E, B, E_fuzz; 32 x 32 each; and E_max of anisotropic lobes, validate/runtime_files.h's
 // energyLutTables(), the floats the host uploads), with the shader's edge
 // extrapolation and output clamps.
 #pragma once
@@ -22,6 +22,12 @@ T energyAlbedo(T NoV, T roughness);
 /// upper bounds of E - B and of B separately, so E is not clamped first).
 template <class T>
 V2<T> energyDfg(T NoV, T roughness);
+
+/// substrate_energy_aniso: (E_max, B_max)(NoV, r, |A|) of an anisotropic lobe,
+/// the largest albedo and B over the view's azimuth (the fourth table, halves),
+/// with `iso` (the isotropic E, B) at |A| = 0; E clamped to [1e-3, 1], B to [0, 1].
+template <class T>
+V2<T> energyAniso(T NoV, T roughness, T absAnisotropy, const V2<T>& iso);
 
 /// substrate_fuzz_albedo: E_fuzz(NoV, r), >= 0.
 template <class T>
