@@ -1,5 +1,5 @@
 // Mirrors runtime_shaders/substrate_energy_lut.h: the tables are the same
-// 4096 floats (validate/runtime_files.h, energyLutTables(): E, then B, then
+// 4032 words (validate/runtime_files.h, energyLutTables(): E, then B, then
 // E_fuzz, each row-major with index = roughness cell * 32 + NoV cell, then the
 // anisotropic E_max and B_max, 15 x 16 words of four, as halves), read
 // through the shader's substrate_lut_coords / substrate_lut_blend and clamps.
