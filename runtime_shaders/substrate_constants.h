@@ -53,18 +53,33 @@
 // as a conductor, as the ground truth walks conductors). BLEND = 1 / (0.2 - 0.1).
 #define SUBSTRATE_COAT_DIELECTRIC_F0 0.1
 #define SUBSTRATE_COAT_CONDUCTOR_BLEND 10.0
+// The Fresnel curve of every interface between its F0 and its F90 (issue 19,
+// step 4; substrate_fresnel_weight): chi(c) = t + D(t), t = (1 - c)^5,
+// D(t) = (1 - t) s (A + B s), s = sqrt(t): the exact dielectric Fresnel of
+// IOR 1.5, the interface the layers above are read as, normalized to [0, 1],
+// within 9.7e-4 (a least-squares fit, scripts/fit_fresnel_albedo.py).
+//   ROUGH_K, ROUGH_END: the share of a negative D(mean t) that the albedo
+//   bound of a lobe gives up, K below roughness END and 0 from there
+//   (substrate_fresnel_pull, substrate_fresnel_b; fitted as a bound on the
+//   integral: the largest share needed is 0.425, at r 0.225).
+#define SUBSTRATE_FRESNEL_CURVE_A 0.18317
+#define SUBSTRATE_FRESNEL_CURVE_B -0.39315
+#define SUBSTRATE_FRESNEL_ROUGH_K 0.43
+#define SUBSTRATE_FRESNEL_ROUGH_END 0.45
 // substrate_closure_coat_diffuse's terms, for k = extraInterfaces 0..3:
 //   G_k: 2 int mu g(mu)^(1 + k) dmu, the cosine-weighted mean of the lighting's
-//        light-side interface term;
+//        light-side interface term g (substrate_interface_transmission:
+//        1 - chi(mu) since issue 19 step 4; with Schlick's 1 - (1 - mu)^5
+//        they were 0.95238 / 0.91991 / 0.89524 / 0.87535);
 //   T_k: 0.96^(1 + k), the interfaces' share of topTransmittance (1 - F0 of
 //        each), and INV_T_k = 1 / T_k;
 //   BEND: T_i^1.13 bounded above by Bernoulli's inequality, T_i (1 - 0.12 (1 - T_i));
 //   COVARIANCE: the closure's own interface coupling's covariance with the
 //        layers', per unit of mean F90 - mean F0.
-#define SUBSTRATE_COAT_G_0 0.95238
-#define SUBSTRATE_COAT_G_1 0.91991
-#define SUBSTRATE_COAT_G_2 0.89524
-#define SUBSTRATE_COAT_G_3 0.87535
+#define SUBSTRATE_COAT_G_0 0.94642
+#define SUBSTRATE_COAT_G_1 0.90734
+#define SUBSTRATE_COAT_G_2 0.87632
+#define SUBSTRATE_COAT_G_3 0.85053
 #define SUBSTRATE_COAT_T_0 0.96
 #define SUBSTRATE_COAT_T_1 0.9216
 #define SUBSTRATE_COAT_T_2 0.884736

@@ -9,20 +9,20 @@
 // SUBSTRATE_DIFFUSE_MEAN_COS: substrate_constants.h.
 
 // The angular part of what an interface transmits, normalized to 1 at normal
-// incidence (where T_N already holds its 1 - F0): 1 - (1 - mu)^5, Schlick's
-// Fresnel with F90 = 1 being F0 + (1 - F0)(1 - mu)^5, so that
-// (1 - F0) * this = 1 - F(mu) exactly. Without it a coat reflects F(mu) at a
-// grazing view and still lets 1 - F0 reach the base: a white base under a
-// clear coat returned 1.21 of the light at NoV 0.1 (docs/stability.md).
-// Conservative for rough coats (their E_spec is below F at grazing).
+// incidence (where T_N already holds its 1 - F0): 1 - chi(mu), chi the
+// Fresnel curve every interface follows (substrate_fresnel_weight, the exact
+// one of IOR 1.5; Schlick's (1 - mu)^5 before issue 19 step 4), so that
+// (1 - F0) * this = 1 - F(mu) exactly, what a smooth top of that F0 (and
+// F90 1) does not reflect. Without it a coat reflects F(mu) at a grazing view
+// and still lets 1 - F0 reach the base: a white base under a clear coat
+// returned 1.21 of the light at NoV 0.1 (docs/stability.md). Conservative for
+// rough coats (their E_spec is below F at grazing).
 float substrate_interface_transmission(float mu) {
-  float x = 1.0 - saturate(mu);
-  float x2 = x * x;
-  return 1.0 - x2 * x2 * x;
+  return 1.0 - substrate_fresnel_weight(mu);
 }
 
 // The angular part of the 1 + `extra` interfaces above a closure (extra =
-// SubstrateClosure.extraInterfaces, 0..3): (1 - (1 - mu)^5)^(1 + extra), by
+// SubstrateClosure.extraInterfaces, 0..3): (1 - chi(mu))^(1 + extra), by
 // multiplies. A stack of clear coats lets through no more than each of its
 // interfaces in turn: with one term for the whole stack every further
 // interface reflected its F(mu) and still passed everything on (issue 16:
@@ -57,13 +57,13 @@ float substrate_coat_path_length(float mu) {
   return 1.5 * rsqrt(1.25 + m * m);
 }
 
-// lerp(1, T_N^(1/mu_t) * (1 - (1 - mu)^5)^(1 + extraInterfaces),
+// lerp(1, T_N^(1/mu_t) * (1 - chi(mu))^(1 + extraInterfaces),
 // coverageAbove): the transmittance of the layers above along a direction at
 // cosine mu (their media along the refracted path 1 / mu_t =
 // substrate_coat_path_length(mu), T_N clamped to [1e-30, 1] as
 // substrate_transmittance_at_cosine does, and their interfaces), blended by their coverage. No
 // transcendental when nothing covers the closure (top layers). The remap
-// (exp, log) and the interface term (1 - (1 - mu)^5 cancels at grazing) are
+// (exp, log) and the interface term (1 - chi(mu) cancels at grazing) are
 // float; the throughput, in [0, 1], is mfloat.
 mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
 #if SUBSTRATE_USE_LAYERS

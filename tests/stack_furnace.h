@@ -24,10 +24,19 @@
 
 #include <fmt/format.h>
 
+#include "reference/bsdf.h"
 #include "reference/reference.h"
 #include "util/random.h"
 
 namespace substratec::stackfurnace {
+
+/// The lighting's angular term for one interface above a closure
+/// (substrate_interface_transmission): the layers above read as a dielectric
+/// of IOR 1.5, F0 0.04, they let through 1 - F(mu) of it, (1 - F(mu)) / 0.96
+/// of what T_N holds, with F on the Fresnel curve every interface follows
+/// (reference::fresnelWeight: exact Fresnel within 1e-3,
+/// ReferenceFresnel.TheCurveIsExactFresnelOfIor1_5).
+inline double interfaceTerm(double mu) { return 1 - reference::fresnelWeight(mu); }
 
 constexpr double kTolerance = 1.001;                 // docs/stability.md: the furnace bound
 constexpr double kNoV[] = {1.0, 0.5, 0.1, 1e-3};     // the furnace's cosines (stability: 1, 0.5, 0.1) and grazing

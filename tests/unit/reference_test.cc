@@ -16,10 +16,12 @@
 #include <string>
 #include <vector>
 
+#include "../stack_furnace.h"
 #include "diag/diagnostics.h"
 #include "pipeline/pipeline.h"
 #include "reference/bsdf.h"
 #include "reference/energy_lut.h"
+#include "reference/random_walk.h"
 #include "reference/reference.h"
 #include "test_util.h"
 #include "validate/runtime_files.h"
@@ -387,11 +389,12 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
   EXPECT_NE(mid.features & kFeatureCoverageAbove, 0u);
   EXPECT_EQ(base.extraInterfaces, 1u);
   EXPECT_EQ(mid.extraInterfaces, 0u);
-  // The lighting: (1 - (1 - mu)^5)^(1 + extraInterfaces) along the view and the
-  // light (cover is 1 under the full inner coat, so the ratio is the term itself).
+  // The lighting: the interface term g(mu) (stackfurnace::interfaceTerm) to
+  // the power 1 + extraInterfaces along the view and the light (cover is 1
+  // under the full inner coat, so the ratio is the term itself).
   ASSERT_NEAR(cover, 1.0, 1e-12);
   for (double mu : {1.0, 0.5, 0.1, 1e-3}) {
-    const double g = 1 - std::pow(1 - mu, 5);
+    const double g = stackfurnace::interfaceTerm(mu);
     Closure<double> one = base;
     one.extraInterfaces = 0;
     for (std::uint32_t k : {0u, 1u, 2u, 3u}) {
@@ -400,8 +403,8 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
       const auto a = viewThroughput<double>(c, mu), b = viewThroughput<double>(one, mu);
       const auto l = lightThroughput<double>(c, mu), lb = lightThroughput<double>(one, mu);
       for (int ch = 0; ch < 3; ++ch) {
-        EXPECT_NEAR(a[ch], b[ch] * std::pow(g, k), 1e-12) << "mu " << mu << ", k " << k;
-        EXPECT_NEAR(l[ch], lb[ch] * std::pow(g, k), 1e-12) << "mu " << mu << ", k " << k;
+        EXPECT_NEAR(a[ch], b[ch] * std::pow(g, k), 1e-9) << "mu " << mu << ", k " << k;
+        EXPECT_NEAR(l[ch], lb[ch] * std::pow(g, k), 1e-9) << "mu " << mu << ", k " << k;
       }
     }
   }
@@ -656,14 +659,41 @@ TEST(ReferenceEnergy, TableLookupIsExactAtCellCentresAndContinuous) {
   EXPECT_NEAR(energyAlbedo(1.0, 31.5 / 32), std::clamp(e31 + 0.5 * (e31 - e30), 1e-3, 1.0), 1e-7);
 }
 
+TEST(ReferenceFresnel, TheCurveIsExactFresnelOfIor1_5) {
+  // Every interface follows one Fresnel curve between its ends (issue 19,
+  // step 4): F = F0 + (F90 - F0) chi(c), chi exact Fresnel of IOR 1.5
+  // normalized, (F(c) - 0.04) / 0.96, to 1e-3 (a fit: substrate_fresnel_weight),
+  // against the ground truth's own dielectric Fresnel. Schlick's (1 - c)^5,
+  // the curve before, is 22.8 % below exact at c = 0.6 and 6.2 % above at 0.1.
+  double worst = 0, previous = 1;
+  int cosines = 0;
+  for (int i = 0; i <= 10000; ++i) {
+    const double c = i / 10000.0;
+    const double chi = fresnelWeight(c);
+    worst = std::max(worst, std::fabs(chi - (fresnelDielectric(c, 1.5) - 0.04) / 0.96));
+    EXPECT_LE(chi, previous + 1e-12) << c;  // falls from grazing to normal incidence
+    previous = chi;
+    ++cosines;
+  }
+  EXPECT_EQ(cosines, 10001);
+  EXPECT_LT(worst, 1e-3);
+  EXPECT_NEAR(fresnelWeight(0.0), 1.0, 1e-12);
+  EXPECT_NEAR(fresnelWeight(1.0), 0.0, 1e-12);
+  const V3<double> f0{0.04, 0.04, 0.04}, one{1, 1, 1};
+  EXPECT_NEAR(fresnel(f0, one, 0.6)[0], fresnelDielectric(0.6, 1.5), 1e-3);
+  EXPECT_NEAR(fresnelDielectric(0.6, 1.5), 0.0645, 5e-4);
+  EXPECT_NEAR(fresnel(f0, one, 0.1)[0], fresnelDielectric(0.1, 1.5), 1e-3);
+  std::printf("[ reference ] Fresnel curve: within %.1e of exact Fresnel of IOR 1.5 over %d cosines\n", worst, cosines);
+}
+
 TEST(ReferenceEnergy, TheDiffuseLightCouplingKeepsTheViewsAlbedo) {
   // substrate_diffuse_light_coupling: (1 - E~(NoL)) / (1 - Ē~), E~ Karis' fit of
-  // the interface's albedo and Ē~ its cosine-weighted mean (a polynomial,
-  // lower bounds), has a mean over the hemisphere of at most 1 and within
-  // 2e-3 of it, so a Lambertian under the interface still returns albedo
+  // the interface's albedo (refitted for the Fresnel curve chi) and Ē~ its
+  // cosine-weighted mean (a polynomial, lower bounds), has a mean over the
+  // hemisphere of at most 1 and within 2.5e-3 of it, so a Lambertian under the interface still returns albedo
   // (1 - E_spec(NoV)) along every view. Measured: printed below.
   // First the means themselves, at 1,001 roughnesses: below the midpoint rule
-  // (4,096 points) and within 6e-4 of it.
+  // (4,096 points) and within 8e-4 of it.
   double meanGap = 0;
   for (int i = 0; i <= 1000; ++i) {
     const double r = i / 1000.0;
@@ -679,7 +709,7 @@ TEST(ReferenceEnergy, TheDiffuseLightCouplingKeepsTheViewsAlbedo) {
     EXPECT_LE(m[1], Y) << r;
     meanGap = std::max({meanGap, X - m[0], Y - m[1]});
   }
-  EXPECT_LT(meanGap, 6e-4);
+  EXPECT_LT(meanGap, 8e-4);
   double worst = 0, highest = 0;
   int cases = 0;
   for (double f0 : {0.0, 0.02, 0.04, 0.1, 0.3, 0.6, 0.9, 1.0})
@@ -698,13 +728,13 @@ TEST(ReferenceEnergy, TheDiffuseLightCouplingKeepsTheViewsAlbedo) {
           highest = std::max(highest, mean);
           // Nearly everything reflected (the denominator's floor, 1e-3) or an
           // inverted edge (F90 < F0, capped at 1): only below.
-          // The means sit at most 5.6e-4 each below the truth (3e-4 lowered, the
-          // fit's 2.6e-4), so the denominator 1 - Ē~ is at most 1.12e-3 too
-          // large: the mean is within 1e-3 + 1.12e-3 / (1 - Ē~) of 1.
+          // The means sit at most 7.6e-4 each below the truth (4e-4 lowered, the
+          // fit's 3.6e-4), so the denominator 1 - Ē~ is at most 1.52e-3 too
+          // large: the mean is within 1e-3 + 1.52e-3 / (1 - Ē~) of 1.
           const V2<double> m = interfaceAlbedoMeans(r);
           const double denominator = 1 - f0 * m[0] - f90 * m[1];
           if (denominator < 0.01 || f90 < f0) continue;
-          EXPECT_NEAR(mean, 1.0, 1e-3 + 1.12e-3 / denominator);
+          EXPECT_NEAR(mean, 1.0, 1e-3 + 1.52e-3 / denominator);
           if (f0 <= 0.1) worst = std::max(worst, std::fabs(mean - 1));
           ++cases;
         }
@@ -712,14 +742,17 @@ TEST(ReferenceEnergy, TheDiffuseLightCouplingKeepsTheViewsAlbedo) {
   std::printf("[ reference ] diffuse light coupling: mean over the hemisphere within %.2e of 1 for F0 <= 0.1 (%d cases), "
               "at most %.6f; its means at most %.1e below the quadrature\n",
               worst, cases, highest, meanGap);
-  // A smooth F0 0.04 interface, against Schlick's F(mu) = F0 + (1 - F0)(1 - mu)^5
-  // (mean F0 + (1 - F0) / 21): light at normal incidence feeds the diffuse
-  // 1.05 times, at NoL 0.05 a quarter (Karis' fit is within 0.02 of it there).
+  // A smooth F0 0.04 interface, against exact Fresnel of IOR 1.5 (the ground
+  // truth's fresnelDielectric; its cosine-weighted mean 0.0918 by quadrature):
+  // light at normal incidence feeds the diffuse 1.06 times, at NoL 0.05 a
+  // quarter (the fit is within 0.02 of it there).
   const V3<double> F0{0.04, 0.04, 0.04}, one{1, 1, 1};
-  auto schlick = [](double mu) { return 0.04 + 0.96 * std::pow(1 - mu, 5); };
-  const double fAvg = 0.04 + 0.96 / 21;
-  EXPECT_NEAR(diffuseLightCoupling(F0, one, 1.0, 0.0, 0.0, 0.0), (1 - schlick(1.0)) / (1 - fAvg), 0.005);
-  EXPECT_NEAR(diffuseLightCoupling(F0, one, 0.05, 0.0, 0.0, 0.0), (1 - schlick(0.05)) / (1 - fAvg), 0.02);
+  auto exact = [](double mu) { return fresnelDielectric(mu, 1.5); };
+  double fAvg = 0;
+  for (int k = 0; k < 100000; ++k) fAvg += 2 * (k + 0.5) / 100000 * exact((k + 0.5) / 100000) / 100000;
+  EXPECT_NEAR(fAvg, 0.0918, 5e-4);
+  EXPECT_NEAR(diffuseLightCoupling(F0, one, 1.0, 0.0, 0.0, 0.0), (1 - exact(1.0)) / (1 - fAvg), 0.01);
+  EXPECT_NEAR(diffuseLightCoupling(F0, one, 0.05, 0.0, 0.0, 0.0), (1 - exact(0.05)) / (1 - fAvg), 0.02);
   // A white smooth mirror passes nothing on, at any light angle.
   EXPECT_NEAR(diffuseLightCoupling(one, one, 0.5, 0.0, 0.0, 0.0), 0.0, 1e-12);
 }
@@ -733,12 +766,13 @@ TEST(ReferenceSplitSum, AgreesWithIntegrationUnderAUniformEnvironment) {
   // (substrate_lighting.h: a Lambertian albedo a reflects a E / pi).
   // Measured (8192 points per strategy), roughness 0.3..0.7, NoV 0.3..1, worst
   // relative difference, top closures: Lambert 0.17 %, EON 0.76 %, haze 0.15 %,
-  // fuzz 7.7 % (the split sum scales the layers under the fuzz along the view
+  // fuzz 8.1 % (the split sum scales the layers under the fuzz along the view
   // only; the direct light, which the integration sums, along the light too
   // since issue 16 — 0.54 % before — and a single cosine cannot stand for every
   // light: the split sum is high, never above the white furnace's 1);
-  // Chan 2024, whose albedo is not
-  // `albedo`, 5.1 %. Under layers:
+  // Chan 2024, whose albedo is not `albedo`, 6.2 % (7.7 % and 5.2 % before
+  // issue 19 step 4: the albedo the split sum takes for the exact Fresnel
+  // curve is an upper bound, up to 0.015 above the lobe's). Under layers:
   // ThroughLayersItsCosinesAreApproximations.
   struct Case {
     const char* name;
@@ -749,8 +783,8 @@ TEST(ReferenceSplitSum, AgreesWithIntegrationUnderAUniformEnvironment) {
   const Case cases[] = {{"lambert", kDiffuseLambert, 0, 0.02},
                         {"eon", kDiffuseEon, 0, 0.02},
                         {"haze", kDiffuseLambert, kFeatureHaze, 0.02},
-                        {"fuzz", kDiffuseLambert, kFeatureFuzz, 0.08},
-                        {"chan2024", kDiffuseChan2024, 0, 0.06}};
+                        {"fuzz", kDiffuseLambert, kFeatureFuzz, 0.085},
+                        {"chan2024", kDiffuseChan2024, 0, 0.065}};
   const V3<double> one{1, 1, 1}, pi{M_PI, M_PI, M_PI};
   for (const Case& k : cases) {
     double worst = 0;
@@ -829,7 +863,7 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
     EXPECT_LT(worst, coat.hi) << coat.name;  // ... of a bounded size
   }
   // The diffuse alone: the mean-cosine approximation against its exact value.
-  // e3 = integral over mu in (0, 1] of mu exp(-tau / mu_t) (1 - (1 - mu)^5): the
+  // e3 = integral over mu in (0, 1] of mu exp(-tau / mu_t) g(mu): the
   // medium's E3(tau) along the cosine refracted into the layers (IOR 1.5,
   // mu_t = sqrt(1 - (1 - mu^2) / 2.25)) with the interface term, midpoint rule.
   auto refracted = [](double mu) { return std::sqrt(1 - (1 - mu * mu) / 2.25); };
@@ -837,14 +871,14 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
   const double tau = -std::log(0.5);
   for (int i = 0; i < 100000; ++i) {
     const double mu = (i + 0.5) / 100000;
-    e3 += mu * std::exp(-tau / refracted(mu)) * (1 - std::pow(1 - mu, 5)) / 100000;
+    e3 += mu * std::exp(-tau / refracted(mu)) * stackfurnace::interfaceTerm(mu) / 100000;
   }
   // What the diffuse gets back from the coat's underside (substrate_closure_coat_diffuse):
   // 1 / lerp(1, D, 0.6), D = G_0 T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4) with
   // T_i = 0.96 (the interface's share), T_m = 0.5 / 0.96 (the medium's), A = 0.7; the
   // closure's own interface (F0 0, F90 0) adds no covariance term.
   const double ti = 0.96, tm = 0.5 / 0.96;
-  const double back = 1 / (0.4 + 0.6 * (0.95238 * ti * (1 - 0.12 * (1 - ti)) + 1.34177 * 0.7 * (1 - std::pow(tm, 4))));
+  const double back = 1 / (0.4 + 0.6 * (0.94642 * ti * (1 - 0.12 * (1 - ti)) + 1.34177 * 0.7 * (1 - std::pow(tm, 4))));
   Closure<double> c;
   c.diffuseAlbedo = {0.7, 0.7, 0.7};
   c.f0 = {0, 0, 0};
@@ -857,7 +891,7 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
   const V3<double> ref = envIntegrated(c, V, [&](const V3<double>&) { return one; }, kDiffuseLambert, 8192, 6);
   EXPECT_NEAR(ref[0], 0.7 * (0.4 + 0.6 * 2 * e3) * back, 2e-3);
   EXPECT_NEAR(envSplitSum(c, V, one, pi, kDiffuseLambert)[0],
-              0.7 * (0.4 + 0.6 * std::pow(0.5, 1 / refracted(0.5)) * (1 - std::pow(0.5, 5))) * back, 1e-9);
+              0.7 * (0.4 + 0.6 * std::pow(0.5, 1 / refracted(0.5)) * stackfurnace::interfaceTerm(0.5)) * back, 1e-9);
 }
 
 // ---------------------------------------------------------------------------

@@ -96,29 +96,65 @@ T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL, T BoL, T NoL) {
   return T(0.5) / std::max(gv + gl, T(1e-30));
 }
 
-// substrate_fresnel: F0 + (F90 - F0) pow5(1 - VoH).
+// substrate_fresnel_delta: D(t) = (1 - t) s (A + B s), s = sqrt(t).
+template <class T>
+T fresnelDelta(T t) {
+  const T s = std::sqrt(t);
+  return (T(1) - t) * s * (T(SUBSTRATE_FRESNEL_CURVE_A) + T(SUBSTRATE_FRESNEL_CURVE_B) * s);
+}
+
+// substrate_fresnel_weight: chi(c) = t + D(t), t = pow5(1 - c) (c clamped).
+template <class T>
+T fresnelWeight(T c) {
+  const T t = pow5(T(1) - c);
+  return t + fresnelDelta(t);
+}
+
+// substrate_fresnel: F0 + (F90 - F0) chi(VoH).
 template <class T>
 V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH) {
-  return f0 + (f90 - f0) * pow5(T(1) - VoH);
+  return f0 + (f90 - f0) * fresnelWeight(VoH);
+}
+
+// substrate_fresnel_b: t = min(B / e, 1), d = D(t): e (t + d - pull min(d, 0)).
+template <class T>
+T fresnelB(const V2<T>& dfg, T e, T pull) {
+  const T t = std::min(dfg[1] / e, T(1));
+  const T d = fresnelDelta(t);
+  return e * (t + d - pull * std::min(d, T(0)));
+}
+
+// substrate_fresnel_pull: 0.43 below roughness 0.45, else 0.
+template <class T>
+T fresnelPull(T roughness) {
+  return roughness < T(SUBSTRATE_FRESNEL_ROUGH_END) ? T(SUBSTRATE_FRESNEL_ROUGH_K) : T(0);
+}
+
+// substrate_fresnel_albedo: F0 e + max(F90 - F0, 0) b.
+template <class T>
+V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b) {
+  return f0 * e + vmax(f90 - f0, splat3(T(0))) * b;
 }
 
 // substrate_specular_energy_aniso: e = clamp(E - B + B, 1e-3, 1) from the dfg
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
-// E - B -> lerp(E - B, e, sat(4 A)), B -> min(B_max, e);
-// W = 1 + F0 (1 - e) / e, E_spec = sat((F0 x + F90 y) W).
+// B -> min(B_max, e), pull 1 (else fresnelPull(r));
+// W = 1 + F0 (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull)) W).
 template <class T>
 V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
+  T pull = fresnelPull(roughness);
   T A = std::min(std::fabs(anisotropy), T(1));
   if (A > T(0)) {
     const V2<T> eb = energyAniso(NoV, roughness, A, V2<T>{e, dfg[1]});
     e = eb[0];
-    dfg = {lerp(dfg[0], e, saturate(T(4) * A)), std::min(eb[1], e)};
+    dfg[1] = std::min(eb[1], e);
+    pull = T(1);
   }
   V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
-  albedo = saturate((f0 * dfg[0] + f90 * dfg[1]) * w);
+  albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull)) * w);
   return w;
 }
 
@@ -128,24 +164,24 @@ V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T
   return specularEnergyAniso(f0, f90, NoV, roughness, T(0), albedo);
 }
 
-// substrate_interface_albedo_fit: c = r (-1, -0.0275, -0.572, 0.022) + (1, 0.0425, 1.04, -0.04),
-// a = min(c.x^2, 2^(-9.28 mu)) c.x + c.y, (A, B) = (-1.04 a + c.z, 1.04 a + c.w).
+// substrate_interface_albedo_fit: c = r (-1, -0.00645, -0.572, 0.022) + (1, 0.03195, 1.04, -0.04),
+// a = min(c.x^2, 2^(-7.925 mu)) c.x + c.y, (A, B) = (-1.0091 a + c.z, 1.0091 a + c.w).
 template <class T>
 V2<T> interfaceAlbedoFit(T mu, T roughness) {
   const T r = saturate(roughness);
-  const T c0 = T(1) - r, c1 = T(0.0425) - T(0.0275) * r, c2 = T(1.04) - T(0.572) * r, c3 = T(-0.04) + T(0.022) * r;
-  const T a = std::min(c0 * c0, std::exp2(T(-9.28) * mu)) * c0 + c1;
-  return {T(-1.04) * a + c2, T(1.04) * a + c3};
+  const T c0 = T(1) - r, c1 = T(0.03195) - T(0.00645) * r, c2 = T(1.04) - T(0.572) * r, c3 = T(-0.04) + T(0.022) * r;
+  const T a = std::min(c0 * c0, std::exp2(T(-7.925) * mu)) * c0 + c1;
+  return {T(-1.0091) * a + c2, T(1.0091) * a + c3};
 }
 
 // substrate_interface_albedo_means: x = quartic(r) (the shader's coefficients),
-// (x - 3e-4, 1 - 0.55 r - x - 3e-4).
+// (x - 4e-4, 1 - 0.55 r - x - 4e-4).
 template <class T>
 V2<T> interfaceAlbedoMeans(T roughness) {
   const T r = saturate(roughness);
-  const T x = T(0.946226516) +
-              r * (T(-0.496317088) + r * (T(0.014998938) + r * (T(0.037845306) + r * T(-0.050608685))));
-  return {x - T(3e-4), T(1) - T(0.55) * r - x - T(3e-4)};
+  const T x = T(0.942790291) +
+              r * (T(-0.503803993) + r * (T(0.019770635) + r * (T(0.050697408) + r * T(-0.067537130))));
+  return {x - T(4e-4), T(1) - T(0.55) * r - x - T(4e-4)};
 }
 
 // substrate_diffuse_light_coupling: min(max(1 - f0 A - f90 B, 0) / max(1 - f0 X - f90 Y, 1e-3), cap)
@@ -553,6 +589,11 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T ggxDAniso<T>(const V2<T>&, T, T, T);                                                      \
   template T ggxVis<T>(T, T, T);                                                                       \
   template T ggxVisAniso<T>(const V2<T>&, T, T, T, T, T, T);                                           \
+  template T fresnelDelta<T>(T);                                                                       \
+  template T fresnelWeight<T>(T);                                                                      \
+  template T fresnelB<T>(const V2<T>&, T, T);                                                          \
+  template T fresnelPull<T>(T);                                                                        \
+  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T);                                            \
   template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, V3<T>&);                          \
   template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, T, T, V3<T>&);                  \

@@ -25,6 +25,12 @@ template <class T> T ggxD(T a, T NoH);                                          
 template <class T> T ggxDAniso(const V2<T>& alpha, T ToH, T BoH, T NoH);                    // substrate_ggx_d_aniso
 template <class T> T ggxVis(T a, T NoV, T NoL);                                             // substrate_ggx_vis
 template <class T> T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL, T BoL, T NoL);
+template <class T> T fresnelDelta(T t);                                                    // substrate_fresnel_delta
+template <class T> T fresnelWeight(T c);                                                    // substrate_fresnel_weight
+template <class T> T fresnelB(const V2<T>& dfg, T e, T pull);                              // substrate_fresnel_b
+template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull
+template <class T>
+V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
 template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH);                 // substrate_fresnel
 /// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`.
 template <class T> V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo);

@@ -21,15 +21,13 @@ namespace {
 template <class T> constexpr T kDiffuseMeanCos = T(SUBSTRATE_DIFFUSE_MEAN_COS);
 template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
 
-// substrate_interface_transmission: 1 - (1 - sat(mu))^5.
+// substrate_interface_transmission: 1 - chi(mu) (fresnelWeight).
 template <class T>
 T interfaceTransmission(T mu) {
-  T x = T(1) - saturate(mu);
-  T x2 = x * x;
-  return T(1) - x2 * x2 * x;
+  return T(1) - fresnelWeight(mu);
 }
 
-// substrate_interfaces_transmission: (1 - (1 - sat(mu))^5)^(1 + extra) by
+// substrate_interfaces_transmission: (1 - chi(mu))^(1 + extra) by
 // multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
 template <class T>
 T interfacesTransmission(T mu, std::uint32_t extra) {
