@@ -51,8 +51,23 @@ void substrate_closure_frame(SubstrateClosure c, float3 N, out float3 T, out flo
   B = cross(N, T);
 }
 
+// The share of the curve chi in an interface's Fresnel, from its largest
+// channel's F0: 1 up to 0.1 (a dielectric), 0 from 0.2 (a conductor, which
+// keeps Schlick's curve t = (1 - c)^5: the ground truth's conductor, by
+// Gulbrandsen 2014, is fitted to it, and chi is up to 0.037 from it), linear
+// between, as substrate_closure_fresnel_ends reads conductors. The curve is
+// then t + share D(t). (The layers above are read as a dielectric: a
+// conductor-like top over layers lets through 1 - chi where it reflects up
+// to (1 - F0) 0.037 more at grazing; the random stacks of
+// Furnace.RandomStacksOfTwoToEightSlabsNeverGainEnergy stay within 1.001.)
+float substrate_fresnel_share(float f0max) {
+  return 1.0 - saturate((f0max - SUBSTRATE_COAT_DIELECTRIC_F0) * SUBSTRATE_COAT_CONDUCTOR_BLEND);
+}
+
 // The Fresnel ends of a closure: its reflectance at normal incidence, and at
-// grazing incidence (white unless it has the F90 feature).
+// grazing incidence (white unless it has the F90 feature), and the share of
+// the dielectric curve between them (substrate_fresnel_share, from the
+// largest channel of the relative F0).
 //
 // Under layers (coverageAbove > 0) the interface is relative to the layers
 // above, read as a dielectric of F0 0.04 (SUBSTRATE_COAT_SQRT_F0): a slab's F0
@@ -71,7 +86,7 @@ void substrate_closure_frame(SubstrateClosure c, float3 N, out float3 T, out flo
 // (substrate_closure_coat_diffuse) the clear coat control read +4.5 .. +7.3 %
 // over the truth and a white Lambertian under a clear coat of the same IOR
 // returned up to 1.003 of the light head-on.
-void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mfloat3 f90) {
+void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mfloat3 f90, out float share) {
   float3 f0f = saturate(c.f0);
   float3 f90f = SUBSTRATE_SPLAT3(1.0);
 #if SUBSTRATE_USE_F90
@@ -79,10 +94,10 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
     f90f = saturate(c.f90);
   }
 #endif
+  float f = substrate_max3(f0f);
 #if SUBSTRATE_USE_LAYERS
   // No branch: at coverageAbove 0 the scale is exactly 1. In float: one
   // conversion per end in half precision.
-  float f = substrate_max3(f0f);
   float s = sqrt(f);
   float r = (s - SUBSTRATE_COAT_SQRT_F0) / (1.0 - SUBSTRATE_COAT_SQRT_F0 * s);
   float rel = min(f, r * r);
@@ -90,7 +105,9 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   float scale = lerp(1.0, rel / max(f, 1e-4), saturate(c.coverageAbove));
   f0f *= scale;
   f90f *= scale;
+  f *= scale;
 #endif
+  share = substrate_fresnel_share(f);
   f0 = SUBSTRATE_M3(f0f);
   f90 = SUBSTRATE_M3(f90f);
 }
@@ -249,10 +266,13 @@ float substrate_fresnel_weight(float c) {
   return t + substrate_fresnel_delta(t);
 }
 
-// The Fresnel of an interface with an F90: F0 + (F90 - F0) chi(VoH) (the
+// The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH),
+// w = t + share D(t) (chi for a dielectric, Schlick's t for a conductor; the
 // weight from the half vector in float, the blend of the colours in mfloat).
-mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float VoH) {
-  return f0 + (f90 - f0) * SUBSTRATE_M(substrate_fresnel_weight(VoH));
+mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float share, float VoH) {
+  float t = substrate_pow5(1.0 - VoH);
+  float w = t + share * substrate_fresnel_delta(t);
+  return f0 + (f90 - f0) * SUBSTRATE_M(w);
 }
 
 // An upper bound of the part of a lobe's albedo weighted by the Fresnel curve
@@ -266,11 +286,12 @@ mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float VoH) {
 // scripts/fit_fresnel_albedo.py) it is at most 0.016 above the lobe's in the
 // albedo of an F0 0.04 interface (Schlick's missed by up to 0.036 either
 // way); a stretched lobe, whose B_max and E_max (substrate_energy_aniso) the
-// fit does not cover, takes pull = 1: e (t + max(D(t), 0)).
-float substrate_fresnel_b(float2 dfg, float e, float pull) {
+// fit does not cover, takes pull = 1: e (t + max(D(t), 0)). `share` is the
+// curve's (substrate_fresnel_share): e (t + share (D - pull min(D, 0))).
+float substrate_fresnel_b(float2 dfg, float e, float pull, float share) {
   float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
   float d = substrate_fresnel_delta(t);
-  return e * (t + d - pull * min(d, 0.0));
+  return e * (t + share * (d - pull * min(d, 0.0)));
 }
 
 // k(r) of substrate_fresnel_b: 0.43 below roughness 0.45, 0 from there (the
@@ -295,11 +316,12 @@ mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
 // substrate_fresnel_albedo). Returns W; E_spec in `albedo`. Both are safe for energy: W E <= 1
 // and E_spec is never below the compensated lobe's true albedo. The table
 // lookup and E are float; W (<= 1000) and E_spec are colours (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float NoV, float roughness, out mfloat3 albedo) {
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float NoV, float roughness,
+                                  out mfloat3 albedo) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness))) * w);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share)) * w);
   return w;
 }
 
@@ -316,8 +338,8 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float NoV, float roug
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float NoV, float roughness, float anisotropy,
-                                        out mfloat3 albedo) {
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float NoV, float roughness,
+                                        float anisotropy, out mfloat3 albedo) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float pull = substrate_fresnel_pull(roughness);
@@ -331,7 +353,7 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float NoV, floa
   }
 #endif
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, substrate_fresnel_b(dfg, e, pull)) * w);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, substrate_fresnel_b(dfg, e, pull, share)) * w);
   return w;
 }
 
@@ -652,7 +674,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 
   mfloat3 f0;
   mfloat3 f90;
-  substrate_closure_fresnel_ends(c, f0, f90);
+  float share;
+  substrate_closure_fresnel_ends(c, f0, f90, share);
   float roughness = saturate(c.roughness);
 
   float anisotropy = 0.0;
@@ -664,7 +687,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
   mfloat3 specAlbedo;
-  mfloat3 w1 = substrate_specular_energy_aniso(f0, f90, NoV, roughness, anisotropy, specAlbedo);
+  mfloat3 w1 = substrate_specular_energy_aniso(f0, f90, share, NoV, roughness, anisotropy, specAlbedo);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -676,7 +699,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   mfloat3 w2 = w1;
   if (hazeWeight > 0.0) {
     mfloat3 specAlbedo2;
-    w2 = substrate_specular_energy_aniso(f0, f90, NoV, hazeRoughness, anisotropy, specAlbedo2);
+    w2 = substrate_specular_energy_aniso(f0, f90, share, NoV, hazeRoughness, anisotropy, specAlbedo2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
   }
 
@@ -716,7 +739,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
       substrate_ggx_d_vis(alpha2, anisotropy != 0.0, ToH, BoH, NoH, ToV, BoV, NoV, ToL, BoL, NoLc, d2, vis2);
       lobe = lerp(lobe, SUBSTRATE_F3(w2) * (d2 * vis2 * NoLc), hazeWeight);
     }
-    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, VoH)) * lobe;
+    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, share, VoH)) * lobe;
 #if SUBSTRATE_USE_GLINT
     if ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u) {
       spec *= substrate_glint_factor(c, d1, ToH, BoH, NoH);

@@ -127,16 +127,16 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
 
 // What a closure's interface reflects at cosine NoV (its directional albedo,
 // E_spec = (F0 (E - B) + F90 B) W): the primary lobe's, lerped toward the haze
-// lobe's by the haze weight, from the closure's Fresnel ends f0, f90
-// (substrate_closure_fresnel_ends). The environment and the translucency both
+// lobe's by the haze weight, from the closure's Fresnel ends f0, f90 and the
+// curve's share (substrate_closure_fresnel_ends). The environment and the translucency both
 // remove it from what reaches the diffuse or passes through.
-mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float NoV) {
+mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float share, float NoV) {
   mfloat3 specAlbedo;
-  substrate_specular_energy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
+  substrate_specular_energy(f0, f90, share, NoV, saturate(c.roughness), specAlbedo);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
     mfloat3 specAlbedo2;
-    substrate_specular_energy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
+    substrate_specular_energy(f0, f90, share, NoV, saturate(c.secondRoughness), specAlbedo2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
   }
 #endif
@@ -147,8 +147,9 @@ mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfl
 mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
   mfloat3 f0;
   mfloat3 f90;
-  substrate_closure_fresnel_ends(c, f0, f90);
-  return substrate_closure_specular_albedo_of(c, f0, f90, NoV);
+  float share;
+  substrate_closure_fresnel_ends(c, f0, f90, share);
+  return substrate_closure_specular_albedo_of(c, f0, f90, share, NoV);
 }
 
 // ---------------------------------------------------------------------------
@@ -232,8 +233,9 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
   mfloat3 f0;
   mfloat3 f90;
-  substrate_closure_fresnel_ends(c, f0, f90);
-  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, NoV);
+  float share;
+  substrate_closure_fresnel_ends(c, f0, f90, share);
+  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, share, NoV);
   // Radiance (HDR) is float; the weights that multiply it are mfloat.
   float3 spec = SUBSTRATE_F3(specAlbedo) * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE

@@ -136,6 +136,36 @@ TEST(Accuracy, ACoatGivesBackWhatItsUndersideReflects) {
   EXPECT_EQ(rows, 12);
 }
 
+TEST(Accuracy, ADarkBaseUnderASmoothInterfaceFollowsExactFresnel) {
+  // Issue 19, item 3 (bench/materials/dark_under_smooth_interface.json): a
+  // Lambertian of albedo 0.2 under a nearly smooth interface of F0 0.04, whose
+  // reflection is much of the albedo. With Schlick's curve it read -1.2 / +0.3
+  // / -6.7 / -5.1 / +3.5 / +4.5 % (NoV 1 .. 0.1) and reciprocity 1.13 (the
+  // light side's fit and the view side's Schlick parted); with the exact curve
+  // of IOR 1.5 (the ground truth's dielectric) -1.4 / +1.3 / -2.4 / -0.4 / +0.6
+  // / -0.4 % and 1.03.
+  const CompileResult r =
+      compileSlab(R"({"kind": "slab", "diffuse_albedo": 0.2, "f0": 0.04, "roughness": 0.05, "sss_mfp": 0})");
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 512;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+    EXPECT_LE(std::fabs(*row.relError), 0.035);
+    EXPECT_LE(row.reciprocityMaxRatio, 1.05);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.97);
+      EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
 TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   // Issue 19, item 1: a coloured conductor of roughness 0.6 stretched to
   // |A| 0.8 (bench/materials/stretched_conductor.json) against the walk, whose

@@ -530,7 +530,7 @@ TEST(Furnace, TheEnergyTablesNeverUnderestimate) {
     for (double r : {0.0, 0.03, 0.06, 0.1, 0.13, 0.2, 0.33, 0.5, 0.66, 0.8, 0.93, 0.99, 1.0}) {
       const V2<double> table = energyDfg(NoV, r);
       const double e = std::clamp(table[0] + table[1], 1e-3, 1.0);
-      const V2<double> dfg{e, fresnelB(table, e, fresnelPull(r))};
+      const V2<double> dfg{e, fresnelB(table, e, fresnelPull(r), 1.0)};
       Closure<double> c = whiteClosure(1, 0, r);
       const double x = albedoOf({"table", c, kDiffuseLambert, NoV, 0.3}, kSamples) * e;
       c.features = kFeatureF90;

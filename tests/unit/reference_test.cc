@@ -680,9 +680,9 @@ TEST(ReferenceFresnel, TheCurveIsExactFresnelOfIor1_5) {
   EXPECT_NEAR(fresnelWeight(0.0), 1.0, 1e-12);
   EXPECT_NEAR(fresnelWeight(1.0), 0.0, 1e-12);
   const V3<double> f0{0.04, 0.04, 0.04}, one{1, 1, 1};
-  EXPECT_NEAR(fresnel(f0, one, 0.6)[0], fresnelDielectric(0.6, 1.5), 1e-3);
+  EXPECT_NEAR(fresnel(f0, one, 1.0, 0.6)[0], fresnelDielectric(0.6, 1.5), 1e-3);
   EXPECT_NEAR(fresnelDielectric(0.6, 1.5), 0.0645, 5e-4);
-  EXPECT_NEAR(fresnel(f0, one, 0.1)[0], fresnelDielectric(0.1, 1.5), 1e-3);
+  EXPECT_NEAR(fresnel(f0, one, 1.0, 0.1)[0], fresnelDielectric(0.1, 1.5), 1e-3);
   std::printf("[ reference ] Fresnel curve: within %.1e of exact Fresnel of IOR 1.5 over %d cosines\n", worst, cosines);
 }
 

@@ -110,18 +110,25 @@ T fresnelWeight(T c) {
   return t + fresnelDelta(t);
 }
 
-// substrate_fresnel: F0 + (F90 - F0) chi(VoH).
+// substrate_fresnel_share: 1 - sat((f0max - 0.1) 10).
 template <class T>
-V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH) {
-  return f0 + (f90 - f0) * fresnelWeight(VoH);
+T fresnelShare(T f0max) {
+  return T(1) - saturate((f0max - T(SUBSTRATE_COAT_DIELECTRIC_F0)) * T(SUBSTRATE_COAT_CONDUCTOR_BLEND));
 }
 
-// substrate_fresnel_b: t = min(B / e, 1), d = D(t): e (t + d - pull min(d, 0)).
+// substrate_fresnel: F0 + (F90 - F0) (t + share D(t)), t = pow5(1 - VoH).
 template <class T>
-T fresnelB(const V2<T>& dfg, T e, T pull) {
+V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH) {
+  const T t = pow5(T(1) - VoH);
+  return f0 + (f90 - f0) * (t + share * fresnelDelta(t));
+}
+
+// substrate_fresnel_b: t = min(B / e, 1), d = D(t): e (t + share (d - pull min(d, 0))).
+template <class T>
+T fresnelB(const V2<T>& dfg, T e, T pull, T share) {
   const T t = std::min(dfg[1] / e, T(1));
   const T d = fresnelDelta(t);
-  return e * (t + d - pull * std::min(d, T(0)));
+  return e * (t + share * (d - pull * std::min(d, T(0))));
 }
 
 // substrate_fresnel_pull: 0.43 below roughness 0.45, else 0.
@@ -140,9 +147,10 @@ V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b) {
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
 // B -> min(B_max, e), pull 1 (else fresnelPull(r));
-// W = 1 + F0 (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull)) W).
+// W = 1 + F0 (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W).
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo) {
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, T anisotropy,
+                          V3<T>& albedo) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
   T pull = fresnelPull(roughness);
@@ -154,14 +162,14 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness,
     pull = T(1);
   }
   V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
-  albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull)) * w);
+  albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull, share)) * w);
   return w;
 }
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo) {
-  return specularEnergyAniso(f0, f90, NoV, roughness, T(0), albedo);
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, V3<T>& albedo) {
+  return specularEnergyAniso(f0, f90, share, NoV, roughness, T(0), albedo);
 }
 
 // substrate_interface_albedo_fit: c = r (-1, -0.00645, -0.572, 0.022) + (1, 0.03195, 1.04, -0.04),
@@ -408,7 +416,7 @@ template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
 // in the dielectric range (back to 1 over F0 0.1 .. 0.2), lerped toward 1 by
 // coverageAbove.
 template <class T>
-void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90) {
+void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share) {
   f0 = saturate(c.f0);
   f90 = splat3(T(1));
   if (c.features & kFeatureF90) f90 = saturate(c.f90);
@@ -422,6 +430,7 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90) {
   const T scale = lerp(T(1), rel / std::max(f, T(1e-4)), cover);
   f0 = f0 * scale;
   f90 = f90 * scale;
+  share = fresnelShare(f * scale);
 }
 
 // 1 / lerp(1, D, cover), D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
@@ -490,7 +499,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   T VoL = clampT(dot(V, L), T(-1), T(1));
 
   V3<T> f0, f90;
-  closureFresnelEnds(c, f0, f90);
+  T share;
+  closureFresnelEnds(c, f0, f90, share);
   T roughness = saturate(c.roughness);
 
   T anisotropy = T(0);
@@ -499,7 +509,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   // Energy terms (needed by the diffuse even when NoL <= 0; anisotropic lobes
   // widen them, substrate_specular_energy_aniso).
   V3<T> specAlbedo;
-  V3<T> w1 = specularEnergyAniso(f0, f90, NoV, roughness, anisotropy, specAlbedo);
+  V3<T> w1 = specularEnergyAniso(f0, f90, share, NoV, roughness, anisotropy, specAlbedo);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -509,7 +519,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   V3<T> w2 = w1;
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
-    w2 = specularEnergyAniso(f0, f90, NoV, hazeRoughness, anisotropy, specAlbedo2);
+    w2 = specularEnergyAniso(f0, f90, share, NoV, hazeRoughness, anisotropy, specAlbedo2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
   }
 
@@ -547,7 +557,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
       ggxTerms(hazeRoughness, d2, vis2);
       lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
     }
-    spec = fresnel(f0, f90, VoH) * lobe;
+    spec = fresnel(f0, f90, share, VoH) * lobe;
     if (c.features & kFeatureGlint) spec = spec * glintFactor(c, d1, ToH, BoH, NoH);
     // Specular profile: SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint is 1.
   }
@@ -581,7 +591,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
-  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&);                              \
+  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                 \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \
@@ -591,12 +601,13 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T ggxVisAniso<T>(const V2<T>&, T, T, T, T, T, T);                                           \
   template T fresnelDelta<T>(T);                                                                       \
   template T fresnelWeight<T>(T);                                                                      \
-  template T fresnelB<T>(const V2<T>&, T, T);                                                          \
+  template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
+  template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \
   template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
-  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T);                                            \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, V3<T>&);                          \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, T, T, V3<T>&);                  \
+  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, T, V3<T>&);                       \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, T, T, T, V3<T>&);               \
   template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
   template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \

@@ -14,8 +14,8 @@ template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>&
 
 // Closures under layers (the layers above read as a dielectric of F0 0.04).
 /// substrate_closure_fresnel_ends: F0 and F90 (white without the F90 feature),
-/// relative to the layers above by coverageAbove.
-template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90);
+/// relative to the layers above by coverageAbove, and the share of the dielectric curve (fresnelShare).
+template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share);
 /// substrate_closure_coat_diffuse: 1 / lerp(1, D, coverageAbove), what the diffuse gets back.
 template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
 
@@ -27,16 +27,19 @@ template <class T> T ggxVis(T a, T NoV, T NoL);                                 
 template <class T> T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL, T BoL, T NoL);
 template <class T> T fresnelDelta(T t);                                                    // substrate_fresnel_delta
 template <class T> T fresnelWeight(T c);                                                    // substrate_fresnel_weight
-template <class T> T fresnelB(const V2<T>& dfg, T e, T pull);                              // substrate_fresnel_b
+template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
+template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
 template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull
 template <class T>
 V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
-template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T VoH);                 // substrate_fresnel
+template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH);        // substrate_fresnel
 /// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`.
-template <class T> V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, V3<T>& albedo);
+template <class T>
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, V3<T>& albedo);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T NoV, T roughness, T anisotropy, V3<T>& albedo);
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, T anisotropy,
+                          V3<T>& albedo);
 /// substrate_interface_albedo_fit: Karis' (A, B), E~ = F0 A + F90 B.
 template <class T> V2<T> interfaceAlbedoFit(T mu, T roughness);
 /// substrate_interface_albedo_means: (X, Y), the fit's hemispherical means (lower bounds).

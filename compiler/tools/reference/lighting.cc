@@ -77,12 +77,13 @@ T envRoughness(const Closure<T>& c) {
 template <class T>
 V3<T> specularAlbedo(const Closure<T>& c, T NoV) {
   V3<T> f0, f90;
-  closureFresnelEnds(c, f0, f90);
+  T share;
+  closureFresnelEnds(c, f0, f90, share);
   V3<T> specAlbedo;
-  specularEnergy(f0, f90, NoV, saturate(c.roughness), specAlbedo);
+  specularEnergy(f0, f90, share, NoV, saturate(c.roughness), specAlbedo);
   if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
     V3<T> specAlbedo2;
-    specularEnergy(f0, f90, NoV, saturate(c.secondRoughness), specAlbedo2);
+    specularEnergy(f0, f90, share, NoV, saturate(c.secondRoughness), specAlbedo2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
   }
   return specAlbedo;
@@ -148,7 +149,8 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));
   T NoV = clampT(NoVraw, K<T>::minCos, T(1));
   V3<T> f0, f90;
-  closureFresnelEnds(c, f0, f90);
+  T share;
+  closureFresnelEnds(c, f0, f90, share);
   V3<T> specAlbedo = specularAlbedo(c, NoV);
   V3<T> spec = specAlbedo * vmax(prefilteredRadiance, splat3(T(0)));
   // Specular profile: the default tint is 1.
