@@ -316,15 +316,17 @@ mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
 // compensated lobe's directional albedo E_spec = (F0 E + (F90 - F0) B_chi) W,
 // from the tables at (NoV, r) (upper bounds of E - B and B; E = their sum
 // clamped to [1e-3, 1]; B_chi bounded from them, substrate_fresnel_b and
-// substrate_fresnel_albedo). Returns W; E_spec in `albedo`. Both are safe for energy: W E <= 1
-// and E_spec is never below the compensated lobe's true albedo. The table
-// lookup and E are float; W (<= 1000) and E_spec are colours (mfloat).
+// substrate_fresnel_albedo). Returns W; E_spec in `albedo`. Both are safe for
+// energy: W E <= 1 and E_spec is never below the compensated lobe's true
+// albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
+// (mfloat).
 mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float NoV, float roughness,
                                   out mfloat3 albedo) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share)) * w);
+  float b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b) * w);
   return w;
 }
 
