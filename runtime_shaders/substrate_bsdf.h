@@ -142,7 +142,8 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
 // (0 for the usual index-matched base, whose interface is gone). Without it a
 // base of F0 0.805 under an F0-0 layer returned 1.0013 and a closure under a
 // half coverage 1.0025 (furnace_test.cc); with it the largest is 1.0008.
-float3 substrate_closure_coat_diffuse(SubstrateClosure c, mfloat3 f0, mfloat3 f90) {
+// `ends`: the means of the closure's F0 and F90 (substrate_diffuse_interface).
+float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
 #if !SUBSTRATE_USE_LAYERS
   return SUBSTRATE_SPLAT3(1.0);
 #else
@@ -170,7 +171,7 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, mfloat3 f0, mfloat3 f9
   float3 ti = max(tn, SUBSTRATE_SPLAT3(ifc));
   float3 tm = saturate(tn * invIfc);
   float3 tm2 = tm * tm;
-  float own = saturate(dot(SUBSTRATE_F3(f90 - f0), SUBSTRATE_SPLAT3(1.0 / 3.0)));
+  float own = saturate(ends.y - ends.x);
   float3 d = (g * (1.0 + SUBSTRATE_COAT_COVARIANCE * own)) * ti * (1.0 - SUBSTRATE_COAT_BEND * (1.0 - ti)) +
              SUBSTRATE_COAT_TRAP * saturate(c.diffuseAlbedo) * (1.0 - tm2 * tm2);
   return 1.0 / lerp(SUBSTRATE_SPLAT3(1.0), d, cover);
@@ -294,6 +295,15 @@ float substrate_fresnel_b(float2 dfg, float e, float pull, float share) {
   return e * (t + share * (d - pull * min(d, 0.0)));
 }
 
+// The same at `share` and at share 1 (a closure's dielectric part,
+// substrate_dielectric_albedo), from one evaluation of the curve.
+float2 substrate_fresnel_b_pair(float2 dfg, float e, float pull, float share) {
+  float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
+  float d = substrate_fresnel_delta(t);
+  float x = d - pull * min(d, 0.0);
+  return e * float2(t + share * x, t + x);
+}
+
 // k(r) of substrate_fresnel_b: 0.43 below roughness 0.45, 0 from there (the
 // share the fit needs is at most 0.425, at r 0.225, and 0 from r 0.45 on).
 float substrate_fresnel_pull(float roughness) {
@@ -312,6 +322,50 @@ mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
   return SUBSTRATE_M3(f0f * e + max(SUBSTRATE_F3(f90) - f0f, SUBSTRATE_SPLAT3(0.0)) * b);
 }
 
+// The compensated albedo of a closure's dielectric part (substrate_closure_dielectric_part),
+// a grey interface of F0 d.x and F90 d.y on the whole curve (b: substrate_fresnel_b
+// with share 1): (d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e). Scalar.
+float substrate_dielectric_albedo(float2 d, float e, float b) {
+  return saturate((d.x * e + max(d.y - d.x, 0.0) * b) * (1.0 + d.x * ((1.0 - e) / e)));
+}
+
+// The Fresnel ends (F0, F90) of the interface a closure's diffuse lies under:
+// its dielectric part (SUBSTRATE_MIX_START). A closure whose largest F0 is a
+// dielectric's (up to 0.18) is all dielectric: its largest channels (E_d >=
+// E_spec up to F0 0.1, where both follow the curve chi; from there E_d keeps
+// chi where E_spec blends toward Schlick's: +0.9 % albedo at NoV 0.1 for F0
+// 0.17 over a diffuse of 0.8, toward the truth). From F0 0.25 it is read as a metalness
+// mix whose dielectric part is SUBSTRATE_MIX_DIELECTRIC_F0 with F90 1, both
+// relative to the layers above by coverageAbove as substrate_closure_fresnel_ends
+// makes a dielectric (index-matched under them at 0.04); linear between.
+// Without SUBSTRATE_USE_METALNESS_MIX: (1, 1), the whole interface.
+float2 substrate_closure_dielectric_part(SubstrateClosure c, mfloat3 f0, mfloat3 f90) {
+#if SUBSTRATE_USE_METALNESS_MIX
+  float cover = 0.0;
+#if SUBSTRATE_USE_LAYERS
+  cover = saturate(c.coverageAbove);
+#endif
+  float f = substrate_max3(SUBSTRATE_F3(f0));
+  float2 mixed = float2(lerp(SUBSTRATE_MIX_DIELECTRIC_F0, SUBSTRATE_MIX_DIELECTRIC_F0_UNDER, cover),
+                        lerp(1.0, SUBSTRATE_MIX_DIELECTRIC_F0_UNDER / SUBSTRATE_MIX_DIELECTRIC_F0, cover));
+  return lerp(float2(f, substrate_max3(SUBSTRATE_F3(f90))), mixed,
+              saturate((f - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND));
+#else
+  return SUBSTRATE_SPLAT2(1.0);
+#endif
+}
+
+// The channel means of F0 and F90 of the interface the diffuse lies under, for
+// its light-side coupling and the layers' covariance term: F0 at most the
+// dielectric part's (substrate_closure_dielectric_part) per channel. Float.
+float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
+  float3 f = SUBSTRATE_F3(f0);
+#if SUBSTRATE_USE_METALNESS_MIX
+  f = min(f, SUBSTRATE_SPLAT3(fd.x));
+#endif
+  return float2(dot(f, SUBSTRATE_SPLAT3(1.0 / 3.0)), dot(SUBSTRATE_F3(f90), SUBSTRATE_SPLAT3(1.0 / 3.0)));
+}
+
 // Turquin 2019 multiple-scattering compensation W = 1 + F0 (1 - E) / E and the
 // compensated lobe's directional albedo E_spec = (F0 E + (F90 - F0) B_chi) W,
 // from the tables at (NoV, r) (upper bounds of E - B and B; E = their sum
@@ -320,13 +374,14 @@ mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
 // energy: W E <= 1 and E_spec is never below the compensated lobe's true
 // albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
 // (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float NoV, float roughness,
-                                  out mfloat3 albedo) {
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, float NoV, float roughness,
+                                  out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  float b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b) * w);
+  float2 b = substrate_fresnel_b_pair(dfg, e, substrate_fresnel_pull(roughness), share);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
+  dielectric = substrate_dielectric_albedo(fd, e, b.y);
   return w;
 }
 
@@ -343,8 +398,8 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float No
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float NoV, float roughness,
-                                        float anisotropy, out mfloat3 albedo) {
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, float NoV, float roughness,
+                                        float anisotropy, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float pull = substrate_fresnel_pull(roughness);
@@ -358,8 +413,32 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, fl
   }
 #endif
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, substrate_fresnel_b(dfg, e, pull, share)) * w);
+  float2 b = substrate_fresnel_b_pair(dfg, e, pull, share);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
+  dielectric = substrate_dielectric_albedo(fd, e, b.y);
   return w;
+}
+
+// What the interface lets through to the diffuse along the view, per
+// channel: 1 - E_spec, unless the closure is a metalness mix (issue 19,
+// item 5; SUBSTRATE_MIX_DIELECTRIC_F0): its diffuse lies under the
+// dielectric part, which reflects E_d (substrate_dielectric_albedo), not
+// the mixed F0's E_spec, so it gets 1 - min(E_spec, E_d); never more than
+// the energy the interface leaves, (1 - E_spec) / albedo, so that the
+// closure's albedo, albedo (...) + E_spec, stays at most 1 (a slab of
+// diffuse 1 and F0 0.5 is not a mix: it keeps 1 - E_spec). A metalness mix
+// of base colour b, metallic m and dielectric F0 fd has diffuse b (1 - m)
+// and 1 - E_spec = (1 - m)(1 - E_d) + m (1 - E_b), so the bound holds it
+// where b is 1. Float (albedo may be 0; one conversion back).
+mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float dielectric) {
+#if SUBSTRATE_USE_METALNESS_MIX
+  float3 e = SUBSTRATE_F3(specAlbedo);
+  float3 t = min(SUBSTRATE_SPLAT3(1.0) - min(e, SUBSTRATE_SPLAT3(dielectric)),
+                 (SUBSTRATE_SPLAT3(1.0) - e) / max(SUBSTRATE_F3(albedo), SUBSTRATE_SPLAT3(1e-3)));
+  return SUBSTRATE_M3(t);
+#else
+  return SUBSTRATE_MSPLAT3(1.0) - specAlbedo;
+#endif
 }
 
 // Karis' analytic fit ("Physically Based Shading on Mobile", 2014; UE's
@@ -413,7 +492,7 @@ float2 substrate_interface_albedo_means(float roughness) {
 // channels, from the means of F0 and F90 (any scalar interface keeps the mean
 // of 1; one division instead of three). Float; converted once (<= 1000). No
 // table: the fit and the means' polynomial cost about as much as one fetch.
-mfloat substrate_diffuse_light_coupling(mfloat3 f0, mfloat3 f90, float NoL, float roughness, float hazeRoughness,
+mfloat substrate_diffuse_light_coupling(float2 ends, float NoL, float roughness, float hazeRoughness,
                                         float hazeWeight) {
   float mu = max(NoL, SUBSTRATE_MIN_COS);
   float2 ab = substrate_interface_albedo_fit(mu, roughness);
@@ -422,8 +501,8 @@ mfloat substrate_diffuse_light_coupling(mfloat3 f0, mfloat3 f90, float NoL, floa
     ab = lerp(ab, substrate_interface_albedo_fit(mu, hazeRoughness), hazeWeight);
     m = lerp(m, substrate_interface_albedo_means(hazeRoughness), hazeWeight);
   }
-  float F0 = dot(SUBSTRATE_F3(f0), SUBSTRATE_SPLAT3(1.0 / 3.0));
-  float F90 = dot(SUBSTRATE_F3(f90), SUBSTRATE_SPLAT3(1.0 / 3.0));
+  float F0 = ends.x;  // the means of F0 and F90 (substrate_diffuse_interface)
+  float F90 = ends.y;
   float numerator = max(1.0 - F0 * ab.x - F90 * ab.y, 0.0);
   float denominator = max(1.0 - F0 * m.x - F90 * m.y, 1e-3);
   float cap = F90 < F0 ? 1.0 : 1000.0;
@@ -691,8 +770,10 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 #endif
 
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
+  float2 fd = substrate_closure_dielectric_part(c, f0, f90);
   mfloat3 specAlbedo;
-  mfloat3 w1 = substrate_specular_energy_aniso(f0, f90, share, NoV, roughness, anisotropy, specAlbedo);
+  float dielectric;
+  mfloat3 w1 = substrate_specular_energy_aniso(f0, f90, share, fd, NoV, roughness, anisotropy, specAlbedo, dielectric);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -704,8 +785,10 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   mfloat3 w2 = w1;
   if (hazeWeight > 0.0) {
     mfloat3 specAlbedo2;
-    w2 = substrate_specular_energy_aniso(f0, f90, share, NoV, hazeRoughness, anisotropy, specAlbedo2);
+    float dielectric2;
+    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
+    dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }
 
   float3 spec = SUBSTRATE_SPLAT3(0.0);
@@ -758,19 +841,22 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   }
 
   // Diffuse, below the specular interface: what the interface lets in along
-  // the view, 1 - E_spec(NoV), and along the light, the coupling (not for the
-  // wrap lobe, which reaches below the horizon: it keeps the view's term).
+  // the view, 1 - E_spec(NoV) (substrate_diffuse_transmission: the dielectric
+  // part's of a metalness mix), and along the light, the coupling, of the
+  // dielectric part too (F0 at most fd; not for the wrap lobe, which reaches
+  // below the horizon: it keeps the view's term).
   mfloat3 albedo = SUBSTRATE_M3(saturate(c.diffuseAlbedo));
+  float2 ends = substrate_diffuse_interface(f0, f90, fd);
   mfloat3 diffuse;
   if (isWrap) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
     diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
-              substrate_diffuse_light_coupling(f0, f90, NoLc, roughness, hazeRoughness, hazeWeight);
+              substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
   }
   // Under layers: what their underside sends back down (float: a factor up to 1.1).
-  float3 result = spec + SUBSTRATE_F3(diffuse * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo)) *
-                             substrate_closure_coat_diffuse(c, f0, f90);
+  float3 result = spec + SUBSTRATE_F3(diffuse * substrate_diffuse_transmission(albedo, specAlbedo, dielectric)) *
+                             substrate_closure_coat_diffuse(c, ends);
 
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {

@@ -95,6 +95,13 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_LAYERS
 #define SUBSTRATE_USE_LAYERS 1
 #endif
+// 1: a closure's diffuse lies under its dielectric part, and a conductor-like
+// F0 is read as a metalness mix (substrate_closure_dielectric_part): the
+// compiler sets it for materials with a metalness_to_diffuse_f0 slab; 0
+// compiles the diffuse under the whole interface (1 - E_spec), as before.
+#ifndef SUBSTRATE_USE_METALNESS_MIX
+#define SUBSTRATE_USE_METALNESS_MIX 1
+#endif
 // 1: every closure the shader lights has a unit N (the generated material
 // function guarantees it for a unit g.N: its normals go through
 // substrate_tangent_to_world, which normalizes, or are g.N itself), so

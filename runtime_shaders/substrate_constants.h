@@ -53,6 +53,22 @@
 // as a conductor, as the ground truth walks conductors). BLEND = 1 / (0.2 - 0.1).
 #define SUBSTRATE_COAT_DIELECTRIC_F0 0.1
 #define SUBSTRATE_COAT_CONDUCTOR_BLEND 10.0
+// The diffuse of a slab lies under its dielectric part (issue 19, item 5;
+// substrate_closure_dielectric_part). No dielectric reflects more than
+// diamond's F0 0.172 (IOR 2.42): a slab whose F0 reaches MIX_START + 1 / MIX_BLEND
+// (0.25) in a channel is read as a metalness mix, a conductor beside a
+// dielectric, as metalness_to_diffuse_f0 writes it, and its diffuse is
+// attenuated by the specular albedo of the dielectric part, of F0
+// MIX_DIELECTRIC_F0 (the helper's 0.08 specular at its default 0.5, and
+// glTF's), not by the mixed F0's; up to MIX_START (0.18) the slab is all
+// dielectric; linear between. Under the layers above (coverageAbove 1) the
+// dielectric part is relative to them, as substrate_closure_fresnel_ends
+// makes a dielectric: ((sqrt(0.04) - 0.2) / (1 - 0.2 sqrt(0.04)))^2 = 0,
+// index-matched.
+#define SUBSTRATE_MIX_START 0.18
+#define SUBSTRATE_MIX_BLEND 14.285714
+#define SUBSTRATE_MIX_DIELECTRIC_F0 0.04
+#define SUBSTRATE_MIX_DIELECTRIC_F0_UNDER 0.0
 // The Fresnel curve of every interface between its F0 and its F90 (issue 19,
 // step 4; substrate_fresnel_weight): chi(c) = t + D(t), t = (1 - c)^5,
 // D(t) = (1 - t) s (A + B s), s = sqrt(t): the exact dielectric Fresnel of

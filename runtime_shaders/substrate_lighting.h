@@ -129,15 +129,20 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
 // E_spec = (F0 (E - B) + F90 B) W): the primary lobe's, lerped toward the haze
 // lobe's by the haze weight, from the closure's Fresnel ends f0, f90 and the
 // curve's share (substrate_closure_fresnel_ends). The environment and the translucency both
-// remove it from what reaches the diffuse or passes through.
-mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float share, float NoV) {
+// remove it from what reaches the diffuse or passes through. `dielectric`: the
+// same for the closure's dielectric part of ends fd (substrate_closure_dielectric_part,
+// for substrate_diffuse_transmission).
+mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float share, float2 fd,
+                                             float NoV, out float dielectric) {
   mfloat3 specAlbedo;
-  substrate_specular_energy(f0, f90, share, NoV, saturate(c.roughness), specAlbedo);
+  substrate_specular_energy(f0, f90, share, fd, NoV, saturate(c.roughness), specAlbedo, dielectric);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
     mfloat3 specAlbedo2;
-    substrate_specular_energy(f0, f90, share, NoV, saturate(c.secondRoughness), specAlbedo2);
+    float dielectric2;
+    substrate_specular_energy(f0, f90, share, fd, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
+    dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }
 #endif
   return specAlbedo;
@@ -149,7 +154,8 @@ mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
   mfloat3 f90;
   float share;
   substrate_closure_fresnel_ends(c, f0, f90, share);
-  return substrate_closure_specular_albedo_of(c, f0, f90, share, NoV);
+  float dielectric;
+  return substrate_closure_specular_albedo_of(c, f0, f90, share, SUBSTRATE_SPLAT2(1.0), NoV, dielectric);
 }
 
 // ---------------------------------------------------------------------------
@@ -217,7 +223,7 @@ float substrate_env_mip(float roughness, float mipCount) {
 //                        (W/m^2; a Lambertian albedo a reflects a E / pi).
 // Specular: E_spec = (F0 (E - B) + F90 B) W from the same tables as the direct
 // lighting (haze: lerped by weight), tinted by the specular profile at
-// (NoV, NoV); diffuse: albedo (1 - E_spec) E / pi (every diffuse model, wrap
+// (NoV, NoV); diffuse: albedo T E / pi, T = substrate_diffuse_transmission (every diffuse model, wrap
 // included, uses albedo as its hemispherical albedo); fuzz: amount colour
 // min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1))
 // at NoV (the direct light's light-side term, E_fuzz(NoL), is not applied here:
@@ -235,7 +241,9 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   mfloat3 f90;
   float share;
   substrate_closure_fresnel_ends(c, f0, f90, share);
-  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, share, NoV);
+  float2 fd = substrate_closure_dielectric_part(c, f0, f90);
+  float dielectric;
+  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, share, fd, NoV, dielectric);
   // Radiance (HDR) is float; the weights that multiply it are mfloat.
   float3 spec = SUBSTRATE_F3(specAlbedo) * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE
@@ -244,8 +252,10 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   }
 #endif
   float3 irr = max(irradiance, SUBSTRATE_SPLAT3(0.0)) * SUBSTRATE_INV_PI;
-  float3 diffuse = SUBSTRATE_F3(SUBSTRATE_M3(saturate(c.diffuseAlbedo)) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo)) *
-                   substrate_closure_coat_diffuse(c, f0, f90) * irr;
+  mfloat3 albedo = SUBSTRATE_M3(saturate(c.diffuseAlbedo));
+  float2 ends = substrate_diffuse_interface(f0, f90, fd);
+  float3 diffuse = SUBSTRATE_F3(albedo * substrate_diffuse_transmission(albedo, specAlbedo, dielectric)) *
+                   substrate_closure_coat_diffuse(c, ends) * irr;
   mfloat3 specLight = substrate_closure_light_throughput(c, NoV);
   mfloat3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
   float3 result = spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight);

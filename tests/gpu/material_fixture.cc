@@ -105,6 +105,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.extraInterfaces = c.extraInterfaces;
   o.features = c.features;
   o.isTop = c.isTop;
+  o.metalnessMix = c.metalnessMix;
   return o;
 }
 
@@ -179,7 +180,8 @@ Shaded<T> lightClosures(const std::vector<reference::Closure<double>>& closures,
 template Shaded<float> lightClosures<float>(const std::vector<reference::Closure<double>>&, const Sample&, int);
 template Shaded<double> lightClosures<double>(const std::vector<reference::Closure<double>>&, const Sample&, int);
 
-reference::Closure<double> closureFromResults(const std::vector<float>& results, int stride, int i, int k) {
+reference::Closure<double> closureFromResults(const std::vector<float>& results, int stride, int i, int k,
+                                              bool metalnessMix) {
   const float* p = &results[static_cast<std::size_t>(i) * stride + kResultHeaderFloats + kClosureFloats * k];
   auto v3 = [&](int at) { return std::array<double, 3>{p[at], p[at + 1], p[at + 2]}; };
   reference::Closure<double> c;
@@ -210,6 +212,7 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.features = static_cast<uint32_t>(p[kClosureFeatures]);
   c.isTop = p[kClosureIsTop] != 0.0f;
   c.extraInterfaces = static_cast<uint32_t>(p[kClosureExtraInterfaces]);
+  c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }
 

@@ -166,6 +166,46 @@ TEST(Accuracy, ADarkBaseUnderASmoothInterfaceFollowsExactFresnel) {
   EXPECT_EQ(rows, 6);
 }
 
+TEST(Accuracy, AMetalnessSlabReturnsTheMixItStandsFor) {
+  // Issue 19, item 5 (bench/materials/metalness_mix.json): one slab from
+  // metalness_to_diffuse_f0 (base colour (0.8, 0.5, 0.2), metallic 0.6,
+  // specular 0.5) stands for a conductor of F0 = base colour beside a
+  // dielectric of F0 0.04 over a diffuse of the base colour, which is how the
+  // truth walks it. Its diffuse attenuated by the specular albedo of the mixed
+  // F0 (0.5 in red) read -13.8 / -14.4 / -12.6 / -11.0 % (NoV 1 / 0.6 / 0.2 /
+  // 0.1) and a white furnace of 0.76; attenuated by the dielectric part's
+  // (substrate_closure_dielectric_part) -1.2 / -2.7 / -3.7 / -2.8 % and 0.97.
+  Diagnostics d("metalness.json");
+  CompileOptions co;
+  co.budgetOverride = 1024;
+  co.maxClosuresOverride = 8;
+  auto compiled = compileText("metalness.json", test::material(R"(
+      "paint": {"kind": "metalness_to_diffuse_f0", "base_color": [0.8, 0.5, 0.2], "metallic": 0.6, "specular": 0.5},
+      "root": {"kind": "slab", "diffuse_albedo": "paint.diffuse_albedo", "f0": "paint.f0", "roughness": 0.4,
+               "sss_mfp": 0})"),
+                              co, d);
+  ASSERT_TRUE(compiled) << d.formatAll();
+  const CompileResult& r = *compiled;
+  ASSERT_TRUE(r.material.slabs.at(0).metalness) << "the slab must carry its metalness provenance";
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 256;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+    EXPECT_LE(std::fabs(*row.relError), 0.05);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.97);
+      EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
 TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   // Issue 19, item 1: a coloured conductor of roughness 0.6 stretched to
   // |A| 0.8 (bench/materials/stretched_conductor.json) against the walk, whose

@@ -470,6 +470,7 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.extraInterfaces = c.extraInterfaces;
   o.features = c.features;
   o.isTop = c.isTop;
+  o.metalnessMix = c.metalnessMix;
   return o;
 }
 

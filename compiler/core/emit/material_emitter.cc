@@ -576,6 +576,7 @@ std::string Emitter::run() {
   line("// What this material uses: the runtime compiles nothing else.");
   out_ += useDefines(all);
   out_ += extraInterfacesDefine(L_);
+  line(fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}", m_.metalnessMix ? 1 : 0));
   line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", diffuseModelNumber(opt_.diffuseModel)));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));
   line(fmt::format("#define {}_WORD_COUNT {}", upper, L_.words()));

@@ -134,6 +134,9 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
   // Extra interfaces are in closure headers only: a lone closure is on top.
   s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
   s += fmt::format("#define SUBSTRATE_USE_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);  // so are layers
+  // The stream does not say which closures are metalness mixes: every
+  // conductor-like F0 is read as one (the runtime's default).
+  s += "#define SUBSTRATE_USE_METALNESS_MIX 1\n";
   s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", diffuseModelNumber(scene.diffuseModel));
   s += fmt::format("#define SUBSTRATE_MAX_CLOSURES {}\n", k.maxClosures);
   s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", k.maxWords);

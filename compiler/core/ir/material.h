@@ -138,6 +138,11 @@ struct Material {
   int root = -1;
   std::vector<Basis> bases;
   std::vector<CullNote> culled;
+  /// A slab's pins come from a metalness_to_diffuse_f0 node (Slab::metalness,
+  /// set by build_tree, kept through simplification): the runtime reads
+  /// conductor-like F0 as a metalness mix whose diffuse lies under its
+  /// dielectric part (SUBSTRATE_USE_METALNESS_MIX; blend's diffuse energy the same).
+  bool metalnessMix = false;
   /// Readable names for DAG nodes that are named value nodes (or their
   /// outputs) in the source: generated code uses them as variable names.
   std::unordered_map<ValueId, std::string> valueNames;

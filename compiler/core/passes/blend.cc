@@ -74,18 +74,36 @@ ValueId foldedDiffuse(Material& m, const Slab& s) {
                 e.mul(pin(s, SlabPin::FuzzAmount), e.k(kFuzzAlbedo)));
 }
 
-/// The part of the directional albedo that is not specular: (1 - F)·folded diffuse.
-ValueId diffuseEnergy(Material& m, const Slab& s) {
+/// The same for the interface the diffuse lies under, the slab's dielectric
+/// part, as the runtime reads it (substrate_closure_dielectric_part): from
+/// F0 0.25 a metalness mix whose diffuse lies under a dielectric of F0
+/// SUBSTRATE_MIX_DIELECTRIC_F0 and F90 1; up to 0.18 its own; linear between.
+/// Only in a material the runtime reads so (Material::metalnessMix).
+ValueId dielectricFresnelAverage(Material& m, const Slab& s) {
+  if (!m.metalnessMix) return fresnelAverage(m, s);
   Ex e(m.values);
-  return e.mul(e.oneMinus(fresnelAverage(m, s)), foldedDiffuse(m, s));
+  ValueId fmax = e.max3(e.sat(pin(s, SlabPin::F0)));
+  ValueId t = e.sat(e.mul(e.sub(fmax, e.k(SUBSTRATE_MIX_START)), e.k(SUBSTRATE_MIX_BLEND)));
+  ValueId f0 = e.min(pin(s, SlabPin::F0), e.lerp(fmax, e.k(SUBSTRATE_MIX_DIELECTRIC_F0), t));
+  ValueId f90 = e.lerp(pin(s, SlabPin::F90), e.k(1.0), t);
+  return e.add(f0, e.mul(e.sub(f90, f0), e.k(1.0 / 21.0)));
 }
 
-/// Sets r's diffuse albedo so that (1 - F_r)·folded diffuse equals `target`:
+/// The part of the directional albedo that is not specular: (1 - F_d)·folded
+/// diffuse, within what the interface leaves, 1 - F (substrate_diffuse_transmission).
+ValueId diffuseEnergy(Material& m, const Slab& s) {
+  Ex e(m.values);
+  return e.min(e.mul(e.oneMinus(dielectricFresnelAverage(m, s)), foldedDiffuse(m, s)),
+               e.oneMinus(fresnelAverage(m, s)));
+}
+
+/// Sets r's diffuse albedo so that (1 - F_d,r)·folded diffuse equals `target`:
 /// the blended slab returns exactly the blended energy (a plain lerp of the
 /// diffuse would not, since (1-F)·d is bilinear in the blended parameters).
+/// Where the target exceeds 1 - F_r the runtime keeps the bound.
 void setDiffuseEnergy(Material& m, Slab& r, ValueId target) {
   Ex e(m.values);
-  ValueId folded = e.safeDiv(target, e.oneMinus(fresnelAverage(m, r)));
+  ValueId folded = e.safeDiv(target, e.oneMinus(dielectricFresnelAverage(m, r)));
   ValueId fuzz = e.mul(pin(r, SlabPin::FuzzAmount), e.k(kFuzzAlbedo));
   ValueId d = e.safeDiv(e.sub(folded, e.mul(fuzz, pin(r, SlabPin::FuzzColor))), e.oneMinus(fuzz));
   r.pin(SlabPin::DiffuseAlbedo) = e.sat(d);

@@ -60,6 +60,7 @@ class TreeBuilder {
         if (src.slabPins[p].tag == PinRef::Node) checkConstantRange(slab.pins[p], info, src.pointer);
       }
       slab.metalness = metalnessSource(src, slab);
+      if (slab.metalness) m_.metalnessMix = true;
       slab.specularProfileInput = src.specularProfileInput;
       slab.sssType = src.sssType;
       slab.sssTypeExplicit = src.sssTypeExplicit;

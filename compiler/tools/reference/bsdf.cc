@@ -143,14 +143,21 @@ V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b) {
   return f0 * e + vmax(f90 - f0, splat3(T(0))) * b;
 }
 
+// substrate_dielectric_albedo: sat((d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e)).
+template <class T>
+T dielectricAlbedo(const V2<T>& d, T e, T b) {
+  return saturate((d[0] * e + std::max(d[1] - d[0], T(0)) * b) * (T(1) + d[0] * ((T(1) - e) / e)));
+}
+
 // substrate_specular_energy_aniso: e = clamp(E - B + B, 1e-3, 1) from the dfg
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
 // B -> min(B_max, e), pull 1 (else fresnelPull(r));
-// W = 1 + F0 (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W).
+// W = 1 + F0 (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
+// the dielectric part's (ends fd) dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)).
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, T anisotropy,
-                          V3<T>& albedo) {
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness, T anisotropy,
+                          V3<T>& albedo, T& dielectric) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
   T pull = fresnelPull(roughness);
@@ -163,13 +170,22 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T r
   }
   V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
   albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull, share)) * w);
+  dielectric = dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, T(1)));
   return w;
 }
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, V3<T>& albedo) {
-  return specularEnergyAniso(f0, f90, share, NoV, roughness, T(0), albedo);
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness, V3<T>& albedo,
+                     T& dielectric) {
+  return specularEnergyAniso(f0, f90, share, fd, NoV, roughness, T(0), albedo, dielectric);
+}
+
+// substrate_diffuse_transmission: min(1 - min(E_spec, E_d), (1 - E_spec) / max(albedo, 1e-3)).
+template <class T>
+V3<T> diffuseTransmission(const V3<T>& albedo, const V3<T>& specAlbedo, T dielectric) {
+  const V3<T> one = splat3(T(1));
+  return vmin(one - vmin(specAlbedo, splat3(dielectric)), (one - specAlbedo) / vmax(albedo, splat3(T(1e-3))));
 }
 
 // substrate_interface_albedo_fit: c = r (-1, -0.00645, -0.572, 0.022) + (1, 0.03195, 1.04, -0.04),
@@ -433,10 +449,25 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share) {
   share = fresnelShare(f * scale);
 }
 
+// substrate_closure_dielectric_part: lerp((max F0, max F90), (MIX_DIELECTRIC_F0, 1) relative
+// to the layers above by coverageAbove, sat((max F0 - MIX_START) MIX_BLEND)).
+template <class T>
+V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90) {
+  // Without SUBSTRATE_USE_METALNESS_MIX: (1, 1), so E_d = 1 and the transmission is 1 - E_spec.
+  if (!c.metalnessMix) return {T(1), T(1)};
+  const T cover = saturate(c.coverageAbove);
+  const T f = max3(f0);
+  const V2<T> mixed{lerp(T(SUBSTRATE_MIX_DIELECTRIC_F0), T(SUBSTRATE_MIX_DIELECTRIC_F0_UNDER), cover),
+                    lerp(T(1), T(SUBSTRATE_MIX_DIELECTRIC_F0_UNDER / SUBSTRATE_MIX_DIELECTRIC_F0), cover)};
+  const T t = saturate((f - T(SUBSTRATE_MIX_START)) * T(SUBSTRATE_MIX_BLEND));
+  return {lerp(f, mixed[0], t), lerp(max3(f90), mixed[1], t)};
+}
+
 // 1 / lerp(1, D, cover), D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
 // T_i = max(T_N, 0.96^(1+k)), T_m = sat(T_N / 0.96^(1+k)).
-// The first term raised by 1 + 0.0145 (mean F90 - mean F0) of the closure's
-// own (relative) interface: the covariance of its coupling with the layers'.
+// The first term raised by 1 + 0.0145 sat(mean F90 - mean F0) of the closure's
+// own (relative) interface: the covariance of its coupling with the layers' (the
+// shader takes the two means, substrate_diffuse_interface).
 template <class T>
 V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90) {
   // No branch, as in the shader: at coverageAbove 0 the factor is exactly 1.
@@ -508,8 +539,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
   // Energy terms (needed by the diffuse even when NoL <= 0; anisotropic lobes
   // widen them, substrate_specular_energy_aniso).
+  const V2<T> fd = closureDielectricPart(c, f0, f90);
   V3<T> specAlbedo;
-  V3<T> w1 = specularEnergyAniso(f0, f90, share, NoV, roughness, anisotropy, specAlbedo);
+  T dielectric;
+  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, NoV, roughness, anisotropy, specAlbedo, dielectric);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -519,8 +552,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   V3<T> w2 = w1;
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
-    w2 = specularEnergyAniso(f0, f90, share, NoV, hazeRoughness, anisotropy, specAlbedo2);
+    T dielectric2;
+    w2 = specularEnergyAniso(f0, f90, share, fd, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
+    dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }
 
   V3<T> spec = zero;
@@ -564,12 +599,14 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
   // Diffuse, below the specular interface.
   V3<T> albedo = saturate(c.diffuseAlbedo);
+  // The diffuse's interface: the dielectric part's (F0 at most fd).
+  const V3<T> f0d = vmin(f0, splat3(fd[0]));
   // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
                       : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
-                            diffuseLightCoupling(f0, f90, NoLc, roughness, hazeRoughness, hazeWeight);
+                            diffuseLightCoupling(f0d, f90, NoLc, roughness, hazeRoughness, hazeWeight);
   // Under layers: what their underside sends back down.
-  V3<T> result = spec + diff * (splat3(T(1)) - specAlbedo) * closureCoatDiffuse(c, f0, f90);
+  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90);
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -606,8 +643,11 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T fresnelPull<T>(T);                                                                        \
   template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, T, T, V3<T>&);                       \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, T, T, T, V3<T>&);               \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, T, T, V3<T>&, T&);    \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, T, T, T, V3<T>&, T&); \
+  template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
+  template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \
+  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);              \
   template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
   template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \

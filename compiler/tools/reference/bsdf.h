@@ -18,6 +18,8 @@ template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>&
 template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share);
 /// substrate_closure_coat_diffuse: 1 / lerp(1, D, coverageAbove), what the diffuse gets back.
 template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
+/// substrate_closure_dielectric_part: the Fresnel ends (F0, F90) of the interface the diffuse lies under.
+template <class T> V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
 
 // GGX.
 template <class T> V2<T> ggxAlpha(T roughness, T anisotropy);                               // substrate_ggx_alpha
@@ -33,19 +35,27 @@ template <class T> T fresnelPull(T roughness);                                  
 template <class T>
 V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
 template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH);        // substrate_fresnel
-/// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`.
+/// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`, and in
+/// `dielectric` the albedo of the closure's dielectric part (ends fd, closureDielectricPart).
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, V3<T>& albedo);
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness,
+                     V3<T>& albedo, T& dielectric);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, T NoV, T roughness, T anisotropy,
-                          V3<T>& albedo);
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness,
+                          T anisotropy, V3<T>& albedo, T& dielectric);
+/// substrate_dielectric_albedo: the compensated albedo of a grey interface of ends d.
+template <class T> T dielectricAlbedo(const V2<T>& d, T e, T b);
+/// substrate_diffuse_transmission: what the interface lets through to the diffuse along the view,
+/// 1 - E_spec, or 1 - E_d of the dielectric part where that is larger, within the energy 1 - E_spec.
+template <class T> V3<T> diffuseTransmission(const V3<T>& albedo, const V3<T>& specAlbedo, T dielectric);
 /// substrate_interface_albedo_fit: Karis' (A, B), E~ = F0 A + F90 B.
 template <class T> V2<T> interfaceAlbedoFit(T mu, T roughness);
 /// substrate_interface_albedo_means: (X, Y), the fit's hemispherical means (lower bounds).
 template <class T> V2<T> interfaceAlbedoMeans(T roughness);
 /// substrate_diffuse_light_coupling: (1 - E~(NoL)) / max(1 - Ē~, 1e-3), haze-blended,
-/// one scalar from the channels' mean F0 and F90.
+/// one scalar from the channels' mean F0 and F90 (the shader takes those means,
+/// substrate_diffuse_interface; the same arithmetic).
 template <class T>
 T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T hazeRoughness, T hazeWeight);
 

@@ -93,6 +93,12 @@ std::array<T, n> vmax(const std::array<T, n>& a, const std::array<T, n>& b) {
   return r;
 }
 template <class T, std::size_t n>
+std::array<T, n> vmin(const std::array<T, n>& a, const std::array<T, n>& b) {
+  std::array<T, n> r;
+  for (std::size_t i = 0; i < n; ++i) r[i] = std::min(a[i], b[i]);
+  return r;
+}
+template <class T, std::size_t n>
 std::array<T, n> vabs(const std::array<T, n>& a) {
   std::array<T, n> r;
   for (std::size_t i = 0; i < n; ++i) r[i] = std::fabs(a[i]);

@@ -73,18 +73,22 @@ T envRoughness(const Closure<T>& c) {
 }
 
 // E_spec at NoV (haze lerped in when its weight is > 0), as the split sum and
-// translucency compute it (both test c.secondRoughnessWeight > 0, unsaturated).
+// translucency compute it (both test c.secondRoughnessWeight > 0, unsaturated),
+// and the dielectric part's in `dielectric` (substrate_closure_specular_albedo_of).
 template <class T>
-V3<T> specularAlbedo(const Closure<T>& c, T NoV) {
+V3<T> specularAlbedo(const Closure<T>& c, T NoV, T& dielectric) {
   V3<T> f0, f90;
   T share;
   closureFresnelEnds(c, f0, f90, share);
+  const V2<T> fd = closureDielectricPart(c, f0, f90);
   V3<T> specAlbedo;
-  specularEnergy(f0, f90, share, NoV, saturate(c.roughness), specAlbedo);
+  specularEnergy(f0, f90, share, fd, NoV, saturate(c.roughness), specAlbedo, dielectric);
   if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
     V3<T> specAlbedo2;
-    specularEnergy(f0, f90, share, NoV, saturate(c.secondRoughness), specAlbedo2);
+    T dielectric2;
+    specularEnergy(f0, f90, share, fd, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
+    dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }
   return specAlbedo;
 }
@@ -138,7 +142,7 @@ T envMip(T roughness, T mipCount) {
 }
 
 // substrate_env_split_sum: specular E_spec * prefiltered through the layers above
-// at NoV; diffuse albedo (1 - E_spec) irradiance / pi and fuzz through them at
+// at NoV; diffuse albedo T irradiance / pi (T: diffuseTransmission) and fuzz through them at
 // SUBSTRATE_DIFFUSE_MEAN_COS (every diffuse model, wrap included, uses albedo as
 // its hemispherical albedo). The view-side throughput is the caller's.
 template <class T>
@@ -151,11 +155,14 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   V3<T> f0, f90;
   T share;
   closureFresnelEnds(c, f0, f90, share);
-  V3<T> specAlbedo = specularAlbedo(c, NoV);
+  T dielectric;
+  V3<T> specAlbedo = specularAlbedo(c, NoV, dielectric);
   V3<T> spec = specAlbedo * vmax(prefilteredRadiance, splat3(T(0)));
   // Specular profile: the default tint is 1.
   V3<T> irr = vmax(irradiance, splat3(T(0))) * K<T>::invPi;
-  V3<T> diff = saturate(c.diffuseAlbedo) * (splat3(T(1)) - specAlbedo) * closureCoatDiffuse(c, f0, f90) * irr;
+  const V3<T> albedo = saturate(c.diffuseAlbedo);
+  const V3<T> f0d = vmin(f0, splat3(closureDielectricPart(c, f0, f90)[0]));
+  V3<T> diff = albedo * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90) * irr;
   V3<T> specLight = lightThroughput(c, NoV);
   V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
   V3<T> result = spec * specLight + diff * diffuseLight;
@@ -173,7 +180,8 @@ template <class T>
 void translucency(const Closure<T>& c, T NoV, T& coverage, V3<T>& transmittanceOut) {
   coverage = saturate(c.weight);
   T mu = clampT(NoV, K<T>::minCos, T(1));
-  V3<T> specAlbedo = specularAlbedo(c, mu);
+  T dielectric;
+  V3<T> specAlbedo = specularAlbedo(c, mu, dielectric);
   transmittanceOut = aboveThroughput(c, mu) * (splat3(T(1)) - specAlbedo);
   if (c.features & kFeatureFuzz)
     transmittanceOut = transmittanceOut * (T(1) - saturate(c.fuzzAmount) * std::min(fuzzAlbedo(mu, c.fuzzRoughness), T(1)));

@@ -78,6 +78,10 @@ struct Closure {
   std::uint32_t extraInterfaces = 0;  // interfaces above beyond the first, 0..3
   std::uint32_t features = 0;
   bool isTop = true;
+  /// SUBSTRATE_USE_METALNESS_MIX of the shader that lights it (Material::metalnessMix;
+  /// the deferred scene lighting always has it): false reads the diffuse under the whole
+  /// interface (closureDielectricPart (1, 1)).
+  bool metalnessMix = true;
 };
 
 /// One shading point, as SubstrateGeometry (world space; converted to T inside).

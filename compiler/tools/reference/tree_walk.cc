@@ -297,6 +297,7 @@ class Walk {
       c.isTop = false;
     }
     c.features = bits;
+    c.metalnessMix = m_.metalnessMix;  // the material's SUBSTRATE_USE_METALNESS_MIX
     return c;
   }
 
