@@ -106,6 +106,18 @@
 #define SUBSTRATE_COAT_INV_T_3 1.1773756993
 #define SUBSTRATE_COAT_BEND 0.12
 #define SUBSTRATE_COAT_COVARIANCE 0.0145
+// substrate_closure_coat_specular (issue 19, step 6): the share R of a
+// closure's lobe that the layers' top sends back down by total internal
+// reflection, R = P1 a^2 / (a^2 + P2 d^2) + P3 a^2, a the GGX alpha and
+// d = mu_i - CRITICAL_COS, mu_i = sqrt(1 - (1 - NoV^2) INV_ETA2) the view's
+// cosine inside the layers (IOR 1.5) and CRITICAL_COS = sqrt(1 - INV_ETA2)
+// the smallest it can be: least squares on the integral over 33 views and
+// 21 roughnesses, rms 0.020, within 0.065 (scripts/fit_coat_tir.py).
+#define SUBSTRATE_COAT_TIR_P1 0.5006
+#define SUBSTRATE_COAT_TIR_P2 1.34
+#define SUBSTRATE_COAT_TIR_P3 0.1584
+#define SUBSTRATE_COAT_INV_ETA2 0.4444444444
+#define SUBSTRATE_COAT_CRITICAL_COS 0.7453559925
 
 // The tree walk's guard against a division by a coverage of 0 (substrate_tree.h).
 #define SUBSTRATE_TREE_EPSILON 1e-6
