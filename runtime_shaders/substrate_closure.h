@@ -95,6 +95,13 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_LAYERS
 #define SUBSTRATE_USE_LAYERS 1
 #endif
+// 1: some closure under a layer may be a conductor (F0 above 0.1), whose
+// lobe the layers' top partly sends back down (substrate_closure_coat_specular):
+// the compiler clears it when every closure under a layer has a constant
+// dielectric F0, for which the factor is exactly 1.
+#ifndef SUBSTRATE_USE_COAT_CONDUCTOR
+#define SUBSTRATE_USE_COAT_CONDUCTOR 1
+#endif
 // 1: a closure's diffuse lies under its dielectric part, and a conductor-like
 // F0 is read as a metalness mix (substrate_closure_dielectric_part): the
 // compiler sets it for materials with a metalness_to_diffuse_f0 slab; 0

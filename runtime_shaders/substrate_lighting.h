@@ -222,8 +222,9 @@ float substrate_env_mip(float roughness, float mipCount) {
 //   irradiance:          E = integral of L cos over the hemisphere around N
 //                        (W/m^2; a Lambertian albedo a reflects a E / pi).
 // Specular: E_spec = (F0 (E - B) + F90 B) W from the same tables as the direct
-// lighting (haze: lerped by weight), tinted by the specular profile at
-// (NoV, NoV); diffuse: albedo T E / pi, T = substrate_diffuse_transmission (every diffuse model, wrap
+// lighting (haze: lerped by weight), under layers times what their top sends
+// back down (substrate_closure_coat_specular at NoV = NoL), tinted by the
+// specular profile at (NoV, NoV); diffuse: albedo T E / pi, T = substrate_diffuse_transmission (every diffuse model, wrap
 // included, uses albedo as its hemispherical albedo); fuzz: amount colour
 // min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1))
 // at NoV (the direct light's light-side term, E_fuzz(NoL), is not applied here:
@@ -244,8 +245,12 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   float2 fd = substrate_closure_dielectric_part(c, f0, f90);
   float dielectric;
   mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, share, fd, NoV, dielectric);
-  // Radiance (HDR) is float; the weights that multiply it are mfloat.
-  float3 spec = SUBSTRATE_F3(specAlbedo) * max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
+  // Radiance (HDR) is float; the weights that multiply it are mfloat. Under
+  // layers: what their top sends back down (the light from the mirror
+  // direction, at NoV).
+  float3 spec = SUBSTRATE_F3(specAlbedo) *
+                substrate_closure_coat_specular(c, f0, f90, fd, share, NoV, NoV, substrate_env_roughness(c)) *
+                max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE
   if ((c.features & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u && c.specularProfile > 0u) {
     spec *= SUBSTRATE_SPECULAR_PROFILE_SAMPLE(c.specularProfile - 1u, float2(NoV, NoV));

@@ -51,6 +51,27 @@ std::string extraInterfacesDefine(const StorageLayout& layout) {
                      layered ? 1 : 0);
 }
 
+/// SUBSTRATE_USE_COAT_CONDUCTOR: 1 when some closure under a layer may read
+/// as a conductor (its F0 not a constant whose largest channel is at most
+/// SUBSTRATE_COAT_DIELECTRIC_F0, the share of the dielectric curve below 1):
+/// substrate_closure_coat_specular returns exactly 1 for the others, so a
+/// material whose closures under layers are all dielectrics compiles none of it.
+std::string coatConductorDefine(const Material& m, const StorageLayout& layout) {
+  bool any = false;
+  for (const ClosureLayout& c : layout.closures) {
+    if (c.isTop || c.slab < 0) continue;
+    const ValueId f0 = m.slabs[c.slab].pin(SlabPin::F0);
+    if (f0 == kNoValue || !m.values.isConst(f0)) {
+      any = true;
+      continue;
+    }
+    const auto& k = m.values.node(f0).c;
+    const int channels = m.values.node(f0).type == VType::Float ? 1 : 3;
+    for (int i = 0; i < channels; ++i) any = any || !(k[i] <= SUBSTRATE_COAT_DIELECTRIC_F0);
+  }
+  return fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", any ? 1 : 0);
+}
+
 bool translucentBlend(const Material& m) {
   return m.settings.blendMode == BlendMode::TranslucentGrey || m.settings.blendMode == BlendMode::TranslucentColored ||
          m.settings.blendMode == BlendMode::ColoredTransmittanceOnly;
@@ -576,6 +597,7 @@ std::string Emitter::run() {
   line("// What this material uses: the runtime compiles nothing else.");
   out_ += useDefines(all);
   out_ += extraInterfacesDefine(L_);
+  out_ += coatConductorDefine(m_, L_);
   line(fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}", m_.metalnessMix ? 1 : 0));
   line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", diffuseModelNumber(opt_.diffuseModel)));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));

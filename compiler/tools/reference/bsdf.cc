@@ -500,6 +500,40 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90)
   return r;
 }
 
+// substrate_closure_coat_specular: (1 - R') / (1 - e' (1 - (1 - R') g')) per channel, with
+// t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2, 1e-3),
+// d = max(mu_i - mu_c, 0) along the view and along the light), g' = lerp(1, 1 - chi(max(NoV, NoL)), t),
+// e' = e sat(T_N / 0.96)^2 and e the closure's hemispherical albedo, F_avg + A diffuseTransmission(A, F_avg,
+// d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the same of the dielectric part fd).
+template <class T>
+V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, const V2<T>& fd, T share, T NoV,
+                          T NoL, T roughness) {
+  // No branch, as in the shader: at coverageAbove 0 (or share 1) the factor is exactly 1.
+  const T t = saturate(c.coverageAbove) * (T(1) - share);
+  const T r = saturate(roughness);
+  const T a = std::max(r * r, kMinAlpha<T>);
+  const T a2 = a * a;
+  auto inner = [](T mu) {
+    return std::max(std::sqrt(T(1) - (T(1) - mu * mu) * T(SUBSTRATE_COAT_INV_ETA2)) - T(SUBSTRATE_COAT_CRITICAL_COS), T(0));
+  };
+  const T v = saturate(NoV);
+  const T l = saturate(NoL);
+  const T trapped = t * (T(SUBSTRATE_COAT_TIR_P1) * a2 / (a2 + T(SUBSTRATE_COAT_TIR_P2) * inner(v) * inner(l)) +
+                         T(SUBSTRATE_COAT_TIR_P3) * a2);
+  const T escape = (T(1) - trapped) * lerp(T(1), T(1) - fresnelWeight(std::max(v, l)), t);
+  const V3<T> albedo = saturate(c.diffuseAlbedo);
+  const V3<T> fAvg = f0 + (f90 - f0) * T(1.0 / 21.0);
+  const T dAvg = fd[0] + (fd[1] - fd[0]) * T(1.0 / 21.0);
+  const V3<T> e = saturate(fAvg + albedo * diffuseTransmission(albedo, fAvg, dAvg));
+  V3<T> k;
+  for (int i = 0; i < 3; ++i) {
+    const T tn = saturate(c.topTransmittance[i]);
+    const T tm = saturate(tn * T(SUBSTRATE_COAT_INV_T_0));
+    k[i] = (T(1) - trapped) / (T(1) - e[i] * (tm * tm) * (T(1) - escape));
+  }
+  return k;
+}
+
 // substrate_eval_closure.
 
 // long: it mirrors substrate_eval_closure statement for statement, so the two
@@ -592,21 +626,24 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
       ggxTerms(hazeRoughness, d2, vis2);
       lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
     }
-    spec = fresnel(f0, f90, share, VoH) * lobe;
+    // Under layers: what the layers' top sends back down instead of out (a conductor's lobe).
+    spec = fresnel(f0, f90, share, VoH) * lobe *
+           closureCoatSpecular(c, f0, f90, fd, share, NoV, NoLc, lerp(roughness, hazeRoughness, hazeWeight));
     if (c.features & kFeatureGlint) spec = spec * glintFactor(c, d1, ToH, BoH, NoH);
     // Specular profile: SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint is 1.
   }
 
   // Diffuse, below the specular interface.
   V3<T> albedo = saturate(c.diffuseAlbedo);
-  // The diffuse's interface: the dielectric part's (F0 at most fd).
+  // The diffuse's interface: the dielectric part's (F0 and F90 at most fd's).
   const V3<T> f0d = vmin(f0, splat3(fd[0]));
+  const V3<T> f90d = vmin(f90, splat3(fd[1]));
   // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
                       : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
-                            diffuseLightCoupling(f0d, f90, NoLc, roughness, hazeRoughness, hazeWeight);
+                            diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // Under layers: what their underside sends back down.
-  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90);
+  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d);
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -630,6 +667,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
   template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                 \
+  template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \
   template T ggxD<T>(T, T);                                                                            \

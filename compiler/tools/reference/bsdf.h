@@ -18,6 +18,11 @@ template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>&
 template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share);
 /// substrate_closure_coat_diffuse: 1 / lerp(1, D, coverageAbove), what the diffuse gets back.
 template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
+/// substrate_closure_coat_specular: what a conductor's lobe under layers keeps, given back what their top
+/// sends down (the trapped share R) and the closure reflects again (its hemispherical albedo).
+template <class T>
+V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, const V2<T>& fd, T share, T NoV,
+                          T NoL, T roughness);
 /// substrate_closure_dielectric_part: the Fresnel ends (F0, F90) of the interface the diffuse lies under.
 template <class T> V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
 

@@ -157,12 +157,17 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   closureFresnelEnds(c, f0, f90, share);
   T dielectric;
   V3<T> specAlbedo = specularAlbedo(c, NoV, dielectric);
-  V3<T> spec = specAlbedo * vmax(prefilteredRadiance, splat3(T(0)));
+  const V2<T> fd = closureDielectricPart(c, f0, f90);
+  // Under layers: what their top sends back down instead of out (substrate_closure_coat_specular;
+  // the light comes from the mirror direction, at NoV).
+  V3<T> spec = specAlbedo * closureCoatSpecular(c, f0, f90, fd, share, NoV, NoV, envRoughness(c)) *
+               vmax(prefilteredRadiance, splat3(T(0)));
   // Specular profile: the default tint is 1.
   V3<T> irr = vmax(irradiance, splat3(T(0))) * K<T>::invPi;
   const V3<T> albedo = saturate(c.diffuseAlbedo);
-  const V3<T> f0d = vmin(f0, splat3(closureDielectricPart(c, f0, f90)[0]));
-  V3<T> diff = albedo * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90) * irr;
+  const V3<T> f0d = vmin(f0, splat3(fd[0]));
+  const V3<T> f90d = vmin(f90, splat3(fd[1]));
+  V3<T> diff = albedo * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d) * irr;
   V3<T> specLight = lightThroughput(c, NoV);
   V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
   V3<T> result = spec * specLight + diff * diffuseLight;
