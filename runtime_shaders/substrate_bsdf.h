@@ -359,10 +359,8 @@ float2 substrate_closure_dielectric_part(SubstrateClosure c, mfloat3 f0, mfloat3
 // its light-side coupling and the layers' covariance term: F0 and F90 at most
 // the dielectric part's (substrate_closure_dielectric_part) per channel. (F90
 // too since issue 19 step 6: a mix's dielectric part under a coat is
-// index-matched, F0 = F90 = 0, and an interface of F0 0 and F90 1 there
-// coupled the diffuse and raised the covariance term for nothing: a white
-// furnace of a mix under a clear coat read 1.002 once its conductor's lobe
-// stopped losing what the coat traps.) Float.
+// index-matched, F0 = F90 = 0, where F90 1 gave its diffuse a coupling and a
+// covariance term of an interface that is not there.) Float.
 float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
   float3 f = SUBSTRATE_F3(f0);
   float3 g = SUBSTRATE_F3(f90);
@@ -470,7 +468,7 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // and NoL, and the closure reflects e of the rest, times the media's round
 // trip T_m^2, T_m = sat(T_N / 0.96): e is its hemispherical albedo (the mean
 // Fresnel F0 + (F90 - F0) / 21 and the diffuse below it,
-// substrate_diffuse_transmission: one value for every direction, so the
+// substrate_diffuse_transmission_of: one value for every direction, so the
 // factor stays reciprocal). With R' = t R and g' = lerp(1, g, t),
 // t = coverageAbove (1 - share):
 //   k = (1 - R') / (1 - e T_m^2 (1 - (1 - R') g')).
@@ -480,12 +478,13 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // throughput lets in, as without the factor; the media's scattering is the
 // layers' own albedo and is not given back. (g = 0.96 (1 - chi), the
 // interface's own transmission, gives back the 4 % it reflects head-on too,
-// but a white metalness slab of diffuse 1 under a coat then returned 1.0019:
-// its lobe integrates 0.3 % above the E_spec its diffuse is given.) Without it a rough
-// conductor under a clear coat returned all its lobe reflects: +21 / +33 /
-// +19 / +11 % at NoV 1 / 0.6 / 0.2 / 0.1 over the truth
-// (bench/materials/conductor_under_clear_coat.json), +3.0 / +2.4 / +3.6 /
-// +3.4 % with it. Only for conductors: at share 1 (F0 up to 0.1) the factor
+// but car_paint's slab forced to F0 0.616 and diffuse 1 under its coat then
+// returned 1.0019 of a white furnace: its lobe integrates 0.3 % above the
+// E_spec its diffuse is given.) Without the factor a rough conductor under a
+// clear coat returned all its lobe reflects: +21 / +33 / +19 / +11 % at NoV
+// 1 / 0.6 / 0.2 / 0.1 over the truth
+// (bench/materials/conductor_under_clear_coat.json), +1.5 / +1.3 / +3.2 /
+// +3.2 % with it. Only for conductors: at share 1 (F0 up to 0.1) the factor
 // is exactly 1 (a dielectric's trapped light returns through its diffuse,
 // substrate_closure_coat_diffuse), and the compiler clears
 // SUBSTRATE_USE_COAT_CONDUCTOR when every closure under a layer has such a
@@ -504,7 +503,8 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float l = saturate(NoL);
   float dv = max(sqrt(1.0 - (1.0 - v * v) * SUBSTRATE_COAT_INV_ETA2) - SUBSTRATE_COAT_CRITICAL_COS, 0.0);
   float dl = max(sqrt(1.0 - (1.0 - l * l) * SUBSTRATE_COAT_INV_ETA2) - SUBSTRATE_COAT_CRITICAL_COS, 0.0);
-  float trapped = t * (SUBSTRATE_COAT_TIR_P1 * a2 / (a2 + SUBSTRATE_COAT_TIR_P2 * dv * dl) + SUBSTRATE_COAT_TIR_P3 * a2);
+  float trapped =
+      t * (SUBSTRATE_COAT_TIR_P1 * a2 / (a2 + SUBSTRATE_COAT_TIR_P2 * dv * dl) + SUBSTRATE_COAT_TIR_P3 * a2);
   // The closure's hemispherical albedo: its interface's mean Fresnel and what
   // that lets through to its diffuse (the dielectric part's, for a mix).
   float3 f0f = SUBSTRATE_F3(f0);
@@ -906,7 +906,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     }
     // Under layers: what their top sends back down instead of out.
     spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, share, VoH)) * lobe *
-           substrate_closure_coat_specular(c, f0, f90, fd, share, NoV, NoLc, lerp(roughness, hazeRoughness, hazeWeight));
+           substrate_closure_coat_specular(c, f0, f90, fd, share, NoV, NoLc,
+                                           lerp(roughness, hazeRoughness, hazeWeight));
 #if SUBSTRATE_USE_GLINT
     if ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u) {
       spec *= substrate_glint_factor(c, d1, ToH, BoH, NoH);

@@ -224,8 +224,9 @@ float substrate_env_mip(float roughness, float mipCount) {
 // Specular: E_spec = (F0 (E - B) + F90 B) W from the same tables as the direct
 // lighting (haze: lerped by weight), under layers times what their top sends
 // back down (substrate_closure_coat_specular at NoV = NoL), tinted by the
-// specular profile at (NoV, NoV); diffuse: albedo T E / pi, T = substrate_diffuse_transmission (every diffuse model, wrap
-// included, uses albedo as its hemispherical albedo); fuzz: amount colour
+// specular profile at (NoV, NoV); diffuse: albedo T E / pi,
+// T = substrate_diffuse_transmission (every diffuse model, wrap included,
+// uses albedo as its hemispherical albedo); fuzz: amount colour
 // min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1))
 // at NoV (the direct light's light-side term, E_fuzz(NoL), is not applied here:
 // the environment has no single light direction).

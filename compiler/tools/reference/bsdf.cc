@@ -514,7 +514,8 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   const T a = std::max(r * r, kMinAlpha<T>);
   const T a2 = a * a;
   auto inner = [](T mu) {
-    return std::max(std::sqrt(T(1) - (T(1) - mu * mu) * T(SUBSTRATE_COAT_INV_ETA2)) - T(SUBSTRATE_COAT_CRITICAL_COS), T(0));
+    const T inside = std::sqrt(T(1) - (T(1) - mu * mu) * T(SUBSTRATE_COAT_INV_ETA2));
+    return std::max(inside - T(SUBSTRATE_COAT_CRITICAL_COS), T(0));
   };
   const T v = saturate(NoV);
   const T l = saturate(NoL);
