@@ -289,15 +289,9 @@ mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float share, float VoH) {
 // way); a stretched lobe, whose B_max and E_max (substrate_energy_aniso) the
 // fit does not cover, takes pull = 1: e (t + max(D(t), 0)). `share` is the
 // curve's (substrate_fresnel_share): e (t + share (D - pull min(D, 0))).
-float substrate_fresnel_b(float2 dfg, float e, float pull, float share) {
-  float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
-  float d = substrate_fresnel_delta(t);
-  return e * (t + share * (d - pull * min(d, 0.0)));
-}
-
-// The same at `share` and at share 1 (a closure's dielectric part,
+// Returns it at `share` (x) and at share 1 (y: a closure's dielectric part,
 // substrate_dielectric_albedo), from one evaluation of the curve.
-float2 substrate_fresnel_b_pair(float2 dfg, float e, float pull, float share) {
+float2 substrate_fresnel_b(float2 dfg, float e, float pull, float share) {
   float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
   float d = substrate_fresnel_delta(t);
   float x = d - pull * min(d, 0.0);
@@ -324,7 +318,7 @@ mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
 
 // The compensated albedo of a closure's dielectric part (substrate_closure_dielectric_part),
 // a grey interface of F0 d.x and F90 d.y on the whole curve (b: substrate_fresnel_b
-// with share 1): (d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e). Scalar.
+// at share 1): (d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e). Scalar.
 float substrate_dielectric_albedo(float2 d, float e, float b) {
   return saturate((d.x * e + max(d.y - d.x, 0.0) * b) * (1.0 + d.x * ((1.0 - e) / e)));
 }
@@ -384,7 +378,7 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 f
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  float2 b = substrate_fresnel_b_pair(dfg, e, substrate_fresnel_pull(roughness), share);
+  float2 b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
   albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
   dielectric = substrate_dielectric_albedo(fd, e, b.y);
   return w;
@@ -418,7 +412,7 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, fl
   }
 #endif
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
-  float2 b = substrate_fresnel_b_pair(dfg, e, pull, share);
+  float2 b = substrate_fresnel_b(dfg, e, pull, share);
   albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
   dielectric = substrate_dielectric_albedo(fd, e, b.y);
   return w;
@@ -489,6 +483,13 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // substrate_closure_coat_diffuse), and the compiler clears
 // SUBSTRATE_USE_COAT_CONDUCTOR when every closure under a layer has such a
 // constant F0. Float.
+// How far a cosine mu in [0, 1], once refracted into the layers above (IOR
+// 1.5), lies above their critical cosine: sqrt(1 - (1 - mu^2) / 1.5^2) -
+// 0.74536, in [0, 0.2546] (substrate_closure_coat_specular's d).
+float substrate_coat_critical_margin(float mu) {
+  return max(sqrt(1.0 - (1.0 - mu * mu) * SUBSTRATE_COAT_INV_ETA2) - SUBSTRATE_COAT_CRITICAL_COS, 0.0);
+}
+
 float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float2 fd, float share, float NoV,
                                        float NoL, float roughness) {
 #if !SUBSTRATE_USE_LAYERS || !SUBSTRATE_USE_COAT_CONDUCTOR
@@ -501,8 +502,8 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float a2 = a * a;
   float v = saturate(NoV);
   float l = saturate(NoL);
-  float dv = max(sqrt(1.0 - (1.0 - v * v) * SUBSTRATE_COAT_INV_ETA2) - SUBSTRATE_COAT_CRITICAL_COS, 0.0);
-  float dl = max(sqrt(1.0 - (1.0 - l * l) * SUBSTRATE_COAT_INV_ETA2) - SUBSTRATE_COAT_CRITICAL_COS, 0.0);
+  float dv = substrate_coat_critical_margin(v);
+  float dl = substrate_coat_critical_margin(l);
   float trapped =
       t * (SUBSTRATE_COAT_TIR_P1 * a2 / (a2 + SUBSTRATE_COAT_TIR_P2 * dv * dl) + SUBSTRATE_COAT_TIR_P3 * a2);
   // The closure's hemispherical albedo: its interface's mean Fresnel and what
