@@ -617,14 +617,37 @@ mfloat3 substrate_diffuse_chan2018(mfloat3 albedo, float roughness, float NoV, f
   return albedo * SUBSTRATE_M(lobe * saturate(NoL) / (1.0 + excess));
 }
 
+// What Chan 2024's lobe loses of a white albedo at cosine mu, over r:
+// 1 - E(mu, r) = r h, h = 1 - 0.38 r - Scale (1/2 + mu/3 + (Bias - 0.025) K1(mu)),
+// because (NoH + Bias) / (NoH + 0.025) = 1 + (Bias - 0.025) / (NoH + 0.025) and
+// int VoH^2 cos / pi = 1/2 + mu/3 exactly; K1 = int VoH^2 / (NoH + 0.025) cos / pi
+// is a rational fit (SUBSTRATE_CHAN24_K1_*, scripts/fit_chan2024_energy.py).
+float substrate_chan2024_loss(float mu, float r, float scale, float bias) {
+  float k1 = (SUBSTRATE_CHAN24_K1_P0 +
+              mu * (SUBSTRATE_CHAN24_K1_P1 + mu * (SUBSTRATE_CHAN24_K1_P2 + mu * SUBSTRATE_CHAN24_K1_P3))) /
+             (mu + SUBSTRATE_CHAN24_K1_C);
+  return 1.0 - 0.38 * r - scale * (0.5 + mu * (1.0 / 3.0) + (bias - 0.025) * k1);
+}
+
 // Chan 2024, "Multiscattering Diffuse and Specular BRDFs" (as UE ships it, with
 // a Lambertian smooth limit): Scale = max(0.55 - 0.2 r, 1.25 - 1.6 r),
 // Bias = sat(4 a), FRough = Scale (NoH + Bias) / (NoH + 0.025) VoH^2,
 // f = albedo / pi (lerp(1, FRough, r) + 0.38 a). Its directional albedo
 // exceeds `albedo` by up to 2.4 % at grazing views (NoV < 0.04) for r > 0.43:
 // the lobe is divided by 1 + 0.026 sat(1 - NoV / 0.04) sat(10 (r - 0.42)), a
-// bound of that excess (docs/stability.md).
-mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
+// bound of that excess (docs/stability.md). Elsewhere it returns only 0.94-1
+// of `albedo` (issue 19, step 7): what it loses comes back as a reciprocal
+// multiple-scattering lobe (Kulla & Conty 2017's form, as EON's),
+// albedo / pi r max(h_V, 0) max(h_L, 0) / H, H = int h 2 mu dmu =
+// 1 - 0.38 r - Scale (13/18 + (Bias - 0.025) M), whose directional albedo is
+// r h_V = 1 - E: with it the white albedo is 0.9994-1.0001 for NoV >= 0.05.
+// `msShare` scales that lobe: 1 - coverageAbove (substrate_eval_closure). Under
+// layers the diffuse is normalized by substrate_closure_coat_diffuse for a
+// cosine-distributed lobe, and Chan's rough lobe, which favours light near the
+// normal where the layers pass more, already gains there: with the lobe, a
+// white base of r 0.5 under an F0-0 coat returned 1.0036 at NoV 1.
+mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH,
+                                   float msShare) {
   float r = saturate(roughness);
   float a = r * r;
   float scale = max(0.55 - 0.2 * r, 1.25 - 1.6 * r);
@@ -633,7 +656,10 @@ mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, f
   float fRough = scale * (n + bias) / (n + 0.025) * VoH * VoH;
   float f = lerp(1.0, fRough, r) + 0.38 * a;
   float excess = 0.026 * saturate(1.0 - 25.0 * NoV) * saturate(10.0 * (r - 0.42));
-  return albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * f * saturate(NoL) / (1.0 + excess));
+  float lossAvg = 1.0 - 0.38 * r - scale * (13.0 / 18.0 + (bias - 0.025) * SUBSTRATE_CHAN24_K1_MEAN);
+  float ms = msShare * r * max(substrate_chan2024_loss(saturate(NoV), r, scale, bias), 0.0) *
+             max(substrate_chan2024_loss(saturate(NoL), r, scale, bias), 0.0) / max(lossAvg, 1e-4);
+  return albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * (f / (1.0 + excess) + ms) * saturate(NoL));
 }
 
 // E_FON(mu, r): the directional albedo of the Fujii Oren-Nayar lobe, the
@@ -670,12 +696,13 @@ mfloat3 substrate_diffuse_eon(mfloat3 albedo, float roughness, float NoV, float 
   return (rho * SUBSTRATE_M(fss) + rhoMs * SUBSTRATE_M(ms)) * SUBSTRATE_M(SUBSTRATE_INV_PI * mi);
 }
 
-// The diffuse model selected by SUBSTRATE_DIFFUSE_MODEL.
-mfloat3 substrate_diffuse(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL) {
+// The diffuse model selected by SUBSTRATE_DIFFUSE_MODEL (`msShare`: Chan 2024's).
+mfloat3 substrate_diffuse(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL,
+                          float msShare) {
 #if SUBSTRATE_DIFFUSE_MODEL == 1
   return substrate_diffuse_chan2018(albedo, roughness, NoV, NoL, NoH, VoH);
 #elif SUBSTRATE_DIFFUSE_MODEL == 2
-  return substrate_diffuse_chan2024(albedo, roughness, NoV, NoL, NoH, VoH);
+  return substrate_diffuse_chan2024(albedo, roughness, NoV, NoL, NoH, VoH, msShare);
 #elif SUBSTRATE_DIFFUSE_MODEL == 3
   return substrate_diffuse_eon(albedo, roughness, NoV, NoL, VoL);
 #else
@@ -932,7 +959,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (isWrap) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
-    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
+    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL, 1.0 - saturate(c.coverageAbove)) *
               substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
   }
   // Under layers: what their underside sends back down (float: a factor up to 1.1).

@@ -119,6 +119,19 @@
 #define SUBSTRATE_COAT_INV_ETA2 0.4444444444
 #define SUBSTRATE_COAT_CRITICAL_COS 0.7453559925
 
+// substrate_diffuse_chan2024's multiple-scattering lobe (issue 19, step 7):
+// K1(mu) = int VoH^2 / (NoH + 0.025) cos / pi over the light hemisphere ~
+// (P0 + P1 mu + P2 mu^2 + P3 mu^3) / (mu + C), minimax within 5.4e-4 over mu in
+// [0, 1] then shifted up by that, so it never lies below K1 (the lobe never
+// returns more than Chan 2024 loses); M = int K1 2 mu dmu of the fit
+// (scripts/fit_chan2024_energy.py).
+#define SUBSTRATE_CHAN24_K1_P0 0.301627
+#define SUBSTRATE_CHAN24_K1_P1 0.817761
+#define SUBSTRATE_CHAN24_K1_P2 -0.105938
+#define SUBSTRATE_CHAN24_K1_P3 0.068682
+#define SUBSTRATE_CHAN24_K1_C 0.220
+#define SUBSTRATE_CHAN24_K1_MEAN 0.942430
+
 // The tree walk's guard against a division by a coverage of 0 (substrate_tree.h).
 #define SUBSTRATE_TREE_EPSILON 1e-6
 

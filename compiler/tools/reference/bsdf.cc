@@ -253,10 +253,22 @@ V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T V
   return albedo * (lobe * saturate(NoL) / (T(1) + excess));
 }
 
-// substrate_diffuse_chan2024 (UE's, Lambertian smooth limit), divided by
-// 1 + 0.026 sat(1 - 25 NoV) sat(10 (r - 0.42)), the bound of its albedo excess.
+// substrate_chan2024_loss: h(mu, r), with 1 - E(mu, r) = r h for Chan 2024's
+// white albedo E; K1 the rational fit SUBSTRATE_CHAN24_K1_*.
 template <class T>
-V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH) {
+T chan2024Loss(T mu, T r, T scale, T bias) {
+  T k1 = (T(SUBSTRATE_CHAN24_K1_P0) +
+          mu * (T(SUBSTRATE_CHAN24_K1_P1) + mu * (T(SUBSTRATE_CHAN24_K1_P2) + mu * T(SUBSTRATE_CHAN24_K1_P3)))) /
+         (mu + T(SUBSTRATE_CHAN24_K1_C));
+  return T(1) - T(0.38) * r - scale * (T(0.5) + mu / T(3) + (bias - T(0.025)) * k1);
+}
+
+// substrate_diffuse_chan2024 (UE's, Lambertian smooth limit), divided by
+// 1 + 0.026 sat(1 - 25 NoV) sat(10 (r - 0.42)), the bound of its albedo excess,
+// plus msShare times the multiple-scattering lobe r max(h_V, 0) max(h_L, 0) / H
+// (issue 19, step 7).
+template <class T>
+V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T msShare) {
   T r = saturate(roughness);
   T a = r * r;
   T scale = std::max(T(0.55) - T(0.2) * r, T(1.25) - T(1.6) * r);
@@ -265,7 +277,10 @@ V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T V
   T fRough = scale * (n + bias) / (n + T(0.025)) * VoH * VoH;
   T f = lerp(T(1), fRough, r) + T(0.38) * a;
   T excess = T(0.026) * saturate(T(1) - T(25) * NoV) * saturate(T(10) * (r - T(0.42)));
-  return albedo * (K<T>::invPi * f * saturate(NoL) / (T(1) + excess));
+  T lossAvg = T(1) - T(0.38) * r - scale * (T(13) / T(18) + (bias - T(0.025)) * T(SUBSTRATE_CHAN24_K1_MEAN));
+  T ms = msShare * r * std::max(chan2024Loss(saturate(NoV), r, scale, bias), T(0)) *
+         std::max(chan2024Loss(saturate(NoL), r, scale, bias), T(0)) / std::max(lossAvg, T(1e-4));
+  return albedo * (K<T>::invPi * (f / (T(1) + excess) + ms) * saturate(NoL));
 }
 
 // substrate_eon_albedo: Portsmouth et al. 2025's quartic fit of E_FON.
@@ -297,10 +312,10 @@ V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL) {
 }
 
 template <class T>
-V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL) {
+V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL, T msShare) {
   switch (model) {
     case kDiffuseChan2018: return diffuseChan2018(albedo, roughness, NoV, NoL, NoH, VoH);
-    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoV, NoL, NoH, VoH);
+    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoV, NoL, NoH, VoH, msShare);
     case kDiffuseEon: return diffuseEon(albedo, roughness, NoV, NoL, VoL);
     default: return diffuseLambert(albedo, NoL);
   }
@@ -641,7 +656,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   const V3<T> f90d = vmin(f90, splat3(fd[1]));
   // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
-                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
+                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL, T(1) - saturate(c.coverageAbove)) *
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // Under layers: what their underside sends back down.
   V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d);
@@ -692,10 +707,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
-  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \
+  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T, T);                                      \
   template T eonAlbedo<T>(T, T);                                                                       \
   template V3<T> diffuseEon<T>(const V3<T>&, T, T, T, T);                                              \
-  template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
+  template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T, T);                                      \
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
   template T charlieD<T>(T, T);                                                                        \

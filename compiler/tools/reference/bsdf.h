@@ -67,11 +67,13 @@ T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T 
 // Diffuse models (BRDF * NoL).
 template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);
 template <class T> V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
-template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
+template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T msShare);
 template <class T> T eonAlbedo(T mu, T r);
 template <class T> V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL);
-/// substrate_diffuse with SUBSTRATE_DIFFUSE_MODEL = model (anything else than 1..3: Lambert).
-template <class T> V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL);
+/// substrate_diffuse with SUBSTRATE_DIFFUSE_MODEL = model (anything else than 1..3: Lambert); msShare
+/// scales Chan 2024's multiple-scattering lobe (1 - coverageAbove in evalClosure).
+template <class T>
+V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL, T msShare = T(1));
 
 // SSS wrap.
 template <class T> V3<T> sssWrapAmount(const V3<T>& mfp);
