@@ -179,4 +179,18 @@ float substrate_fuzz_albedo(float NoV, float fuzzRoughness) {
   return max(SUBSTRATE_LUT_BILINEAR(SUBSTRATE_LUT_FUZZ, i, f), 0.0);
 }
 
+// What a slab's fuzz lets through to the layers under it, seen at cosine NoV:
+// 1 - amount min(E_fuzz(NoV), 1), the factor the slab's own lobes take along
+// the view (substrate_eval_closure). The generated material multiplies the
+// weight of every closure under a fuzzy slab (the top of a vertical) by it
+// (issue 19, step 7): without it a coat with fuzz 0.2 over a white base
+// returned up to 1.067 of the light, its fuzz reflecting and the base still
+// lit whole. Along the view only (the weight is counted once): the light the
+// fuzz reflects before reaching the layers is not taken (their reciprocity
+// ratio up to 1 / (1 - amount E_fuzz), 1.10 at fuzz 0.2). Not through the
+// layers' transmittance, which the trapped light between them never crosses.
+float substrate_fuzz_transmission(float amount, float fuzzRoughness, float NoV) {
+  return 1.0 - saturate(amount) * min(substrate_fuzz_albedo(saturate(NoV), fuzzRoughness), 1.0);
+}
+
 #endif

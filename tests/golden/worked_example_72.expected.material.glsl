@@ -24,6 +24,7 @@
 #include "substrate_common.h"
 #include "substrate_values.h"
 #include "substrate_tree.h"
+#include "substrate_energy_lut.h"
 
 // Material inputs: descriptor set 1, binding 0 (std140); textures from binding 1.
 layout(set = 1, binding = 0, std140) uniform worked_example_72_Inputs {
@@ -70,6 +71,7 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   // slab 'coat' (Id=1, BSDF 0), in the top layer of vertical 'root'
   float C_coat = 1.0;
   float3 T_coat = substrate_transmittance(n_coat_medium_mfp, worked_example_72_inputs.i_coat_thickness);
+  float FT_coat = substrate_fuzz_transmission(worked_example_72_inputs.i_dust, 0.7, dot(substrate_tangent_to_world(float3(0.0, 0.0, 1.0), g.N, g.T), g.V));
   // slab 'fabric_a' (Id=3, BSDF 1)
   float C_fabric_a = 1.0;
   float3 T_fabric_a = float3(0.0, 0.0, 0.0);
@@ -114,7 +116,7 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   closures[1].fuzzAmount = worked_example_72_inputs.i_fuzz;
   closures[1].fuzzColor = worked_example_72_inputs.i_color_a;
   closures[1].fuzzRoughness = 0.5;
-  closures[1].weight = (1.0 - n_mask_r_r);
+  closures[1].weight = (1.0 - n_mask_r_r) * FT_coat;
   closures[1].topTransmittance = ta_fabric_a;
   closures[1].coverageAbove = ca_fabric_a;
   closures[1].isTop = false;
@@ -136,7 +138,7 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   closures[2].fuzzAmount = worked_example_72_inputs.i_fuzz;
   closures[2].fuzzColor = worked_example_72_inputs.i_color_b;
   closures[2].fuzzRoughness = 0.5;
-  closures[2].weight = n_mask_r_r;
+  closures[2].weight = n_mask_r_r * FT_coat;
   closures[2].topTransmittance = ta_fabric_b;
   closures[2].coverageAbove = ca_fabric_b;
   closures[2].isTop = false;

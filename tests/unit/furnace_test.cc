@@ -377,6 +377,41 @@ TEST(Furnace, StacksOfWhiteTransparentSlabsAtEveryDepth) {
   ASSERT_EQ(measured, 7 * 4);
 }
 
+TEST(Furnace, AFuzzyCoatTakesWhatItsFuzzReflectsFromTheLayersUnderIt) {
+  // A transparent coat with fuzz over a white Lambertian base. The fuzz
+  // reflects a share of the view's light; the base under it must not be lit
+  // whole as well (issue 19 step 7: 1.017 ... 1.067 of the light before, at
+  // fuzz 0.2, roughness 0.7, coat F0 0).
+  using namespace stackfurnace;
+  int measured = 0;
+  double worst = 0;
+  for (double f0 : {0.0, 0.04})
+    for (double amount : {0.2, 0.6, 1.0})
+      for (double fuzzRoughness : {0.2, 0.5, 0.9}) {
+        const std::string text = fmt::format(
+            R"({{"format": "substrate-material/1", "name": "fuzzy_coat", "output": "root", "nodes": {{
+              "coat": {{"kind": "slab", "diffuse_albedo": 0, "f0": {}, "roughness": 0.1, "sss_mfp": 1e6,
+                        "fuzz_amount": {}, "fuzz_color": 1, "fuzz_roughness": {}}},
+              "base": {{"kind": "slab", "diffuse_albedo": 1, "f0": 0, "roughness": 0.5}},
+              "root": {{"kind": "vertical", "top": "coat", "base": "base", "thickness": 0}}}}}})",
+            f0, amount, fuzzRoughness);
+        Diagnostics d("fuzzy_coat.json");
+        auto r = compileText("fuzzy_coat.json", text, CompileOptions{}, d);
+        ASSERT_TRUE(r.has_value()) << d.formatAll();
+        ASSERT_EQ(r->after.closures.size(), 2u);
+        for (double mu : kNoV) {
+          reference::Geometry g;
+          g.V = stackfurnace::viewAt(mu);
+          const double a = furnace(reference::evaluateMaterial<double>(*r, g, {}, {}).closures, g.V, 11);
+          ++measured;
+          worst = std::max(worst, a);
+          EXPECT_LE(a, kTolerance) << "F0 " << f0 << ", fuzz " << amount << " r " << fuzzRoughness << ", NoV " << mu;
+        }
+      }
+  std::printf("[ furnace  ] a fuzzy coat over a white base: largest %.5f over %d\n", worst, measured);
+  ASSERT_EQ(measured, 2 * 3 * 3 * 4);
+}
+
 TEST(Furnace, AWhiteRoughConductorReturnsNearlyAllOfIt) {
   // F0 = 1, no diffuse, isotropic: Turquin's compensation brings the lobe to
   // ~1 at every roughness (single scattering alone falls to 0.33 at r = 1).

@@ -139,6 +139,7 @@ class Emitter {
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
   bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
   bool underOperatorTop(int node) const;  // in (or is) an operator that is the top of a vertical
+  bool fuzzAboveAny() const;              // a slab with fuzz is the top of a vertical (fuzzyLayer)
 
   void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
   /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
@@ -293,6 +294,12 @@ bool Emitter::underOperatorTop(int node) const {
   return false;
 }
 
+bool Emitter::fuzzAboveAny() const {
+  for (int n : t_.preorder)
+    if (m_.nodes[n].op == TreeOp::Vertical && fuzzyLayer(m_, m_.nodes[n].left)) return true;
+  return false;
+}
+
 bool Emitter::knownOpaque(int node) const {
   const Slab& s = m_.slabs[m_.nodes[node].slab];
   const int v = verticalOfTop(node);
@@ -403,6 +410,11 @@ void Emitter::emitTree() {
                      v >= 0 ? fmt::format(", in the top layer of vertical '{}'", m_.nodes[v].id) : ""));
     line(fmt::format("float C_{} = {};", node.id, c));
     line(fmt::format("float3 T_{} = {};", node.id, t));
+    if (v >= 0 && fuzzyLayer(m_, n) && m_.nodes[v].left == n)  // what its fuzz lets through to the layers under it
+      line(fmt::format("float FT_{} = substrate_fuzz_transmission({}, {}, dot(substrate_tangent_to_world({}, g.N, g.T), "
+                       "g.V));",
+                       node.id, expr(s.pin(SlabPin::FuzzAmount)), expr(s.pin(SlabPin::FuzzRoughness)),
+                       expr(s.pin(SlabPin::Normal))));
     if (underOperatorTop(n))  // what it lets through, its interface included (TI: see emitClosures)
       line(fmt::format("float3 TI_{0} = T_{0} * (1.0 - {1});", node.id, expr(s.pin(SlabPin::F0))));
   }
@@ -475,6 +487,7 @@ std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string
         break;
       case TreeOp::Vertical:
         if (op.right == x) layers.emplace_back(p, op.left);
+        if (op.right == x && fuzzyLayer(m_, op.left)) f = fmt::format("FT_{}", m_.nodes[op.left].id);
         break;
       default: break;
     }
@@ -606,6 +619,8 @@ std::string Emitter::run() {
   line("#include \"substrate_common.h\"");
   line("#include \"substrate_values.h\"");
   line("#include \"substrate_tree.h\"");
+  // A fuzzy layer's transmission reads the fuzz albedo table (substrate_fuzz_transmission).
+  if (fuzzAboveAny()) line("#include \"substrate_energy_lut.h\"");
   line("");
   emitResources();
   line("");

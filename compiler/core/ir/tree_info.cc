@@ -88,6 +88,7 @@ void analyzePreorder(const Material& m, TreeInfo& t) {
         l.layer = it.node;            // the top is this vertical's layer (the base stays in the enclosing one)
         r.layerDepth += 1;            // the base is under one more layer
         r.coverAbove = it.coverAbove && t.unitCoverage[node.left];
+        r.unit = it.unit && !fuzzyLayer(m, node.left);  // the base is weighted by what the fuzz lets through
         r.above += node.left >= 0 ? t.interfaces[node.left] : 0;
         break;
       case TreeOp::Horizontal:

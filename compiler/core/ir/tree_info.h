@@ -18,7 +18,8 @@ struct TreeInfo {
   std::vector<bool> isTop;       // slabs: nothing layered above (layerDepth == 0)
   std::vector<bool> isBottom;    // slabs: nothing layered below (never a vertical top)
   std::vector<bool> unitWeight;  // slabs: the mix/coverage weights on the path to the
-                                 // root are statically 1 (transmittance not included)
+                                 // root are statically 1 (transmittance not included), and no
+                                 // fuzzy layer lies above (fuzzyLayer)
   std::vector<bool> unitCoverageAbove;  // slabs: every layer above has coverage statically 1
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
   std::vector<int> interfaces;   // any node: the most interfaces a path down through the subtree
@@ -38,6 +39,14 @@ struct TreeInfo {
 };
 
 TreeInfo analyzeTree(const Material& m);
+
+/// Node `node` is a slab with fuzz: as the top of a vertical, its fuzz reflects
+/// a share of the view's light that no longer reaches the layers under it,
+/// whose closures' weight takes what it lets through (substrate_fuzz_transmission,
+/// issue 19 step 7): their weight is not statically 1.
+inline bool fuzzyLayer(const Material& m, int node) {
+  return node >= 0 && m.nodes[node].op == TreeOp::Slab && (m.slabs[m.nodes[node].slab].features & kFeatFuzz);
+}
 
 /// The most interfaces beyond the first one above a closure that its stored
 /// extra-interface count holds (2 bits: docs/storage.md); the lighting applies

@@ -116,13 +116,17 @@ namespace {
 
 /// The product of mix and coverage weights on the path of slab node `node`
 /// to the root is a constant (every factor is): it is never 0 or 1 at run
-/// time unless it is so statically.
+/// time unless it is so statically. Not under a fuzzy layer, whose factor
+/// follows the view (tree_info.h, fuzzyLayer).
 bool constantWeight(const Material& m, const TreeInfo& t, int node) {
   const Slab& s = m.slabs[m.nodes[node].slab];
   if (s.coverage != kNoValue && !m.values.isConst(s.coverage)) return false;
-  for (int p = t.parent[node]; p >= 0; p = t.parent[p]) {
+  for (int x = node, p = t.parent[node]; p >= 0; x = p, p = t.parent[p]) {
     const TreeNode& op = m.nodes[p];
     switch (op.op) {
+      case TreeOp::Vertical:
+        if (op.right == x && fuzzyLayer(m, op.left)) return false;
+        break;
       case TreeOp::Horizontal:
       case TreeOp::CoverageWeight:
         if (!m.values.isConst(op.a)) return false;

@@ -16,6 +16,7 @@
 
 #include "ir/value_eval.h"
 #include "reference/common.h"
+#include "reference/energy_lut.h"
 #include "reference/reference.h"
 
 namespace substratec::reference {
@@ -151,7 +152,7 @@ class Walk {
  public:
   Walk(const CompileResult& r, const std::vector<std::array<double, 4>>& values, const Geometry& g)
       : m_(r.material), t_(r.tree), L_(r.after), vals_(values),
-        gN_(cast<T>(g.N)), gT_(cast<T>(g.T)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
+        gN_(cast<T>(g.N)), gT_(cast<T>(g.T)), gV_(cast<T>(g.V)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
 
   MaterialResult<T> run() {
     const std::size_t n = m_.nodes.size();
@@ -314,11 +315,20 @@ class Walk {
         case TreeOp::Select: weight = weight * (op.right == x ? T(1) - step(op) : step(op)); break;
         case TreeOp::Vertical:
           if (op.right == x) tops.push_back(op.left);
+          if (op.right == x && fuzzyLayer(m_, op.left)) weight = weight * fuzzThrough(m_.slabs[m_.nodes[op.left].slab]);
           break;
         default: break;
       }
     }
     return weight;
+  }
+
+  /// The emitter's FT_: substrate_fuzz_transmission of a fuzzy layer's fuzz
+  /// seen along the view at its own normal.
+  T fuzzThrough(const Slab& s) const {
+    const V3<T> N = tangentToWorld(vec3(s.pin(SlabPin::Normal)), gN_, gT_);
+    const T e = std::min(fuzzAlbedo(saturate(dot(N, gV_)), scalar(s.pin(SlabPin::FuzzRoughness))), T(1));
+    return T(1) - saturate(scalar(s.pin(SlabPin::FuzzAmount))) * e;
   }
 
   /// The layers above, from the root down (substrate_layer_above); a slab on
@@ -392,7 +402,7 @@ class Walk {
   const TreeInfo& t_;
   const StorageLayout& L_;
   const std::vector<std::array<double, 4>>& vals_;
-  V3<T> gN_, gT_;
+  V3<T> gN_, gT_, gV_;
   V4<T> uvDerivatives_;
   std::vector<T> C_;
   std::vector<V3<T>> Tr_;
