@@ -112,6 +112,18 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   f90 = SUBSTRATE_M3(f90f);
 }
 
+// The diffuse model's lobe factor of G_k (SUBSTRATE_COAT_LOBE_*): Chan 2024's
+// or EON's, 1 for the others.
+float substrate_coat_lobe(float chan2024, float eon) {
+#if SUBSTRATE_DIFFUSE_MODEL == 2
+  return chan2024;
+#elif SUBSTRATE_DIFFUSE_MODEL == 3
+  return eon;
+#else
+  return 1.0;
+#endif
+}
+
 // What the diffuse of a closure under layers gets back from them, per
 // channel: 1 / lerp(1, D, coverageAbove), with
 //   D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4).
@@ -142,6 +154,10 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
 // (0 for the usual index-matched base, whose interface is gone). Without it a
 // base of F0 0.805 under an F0-0 layer returned 1.0013 and a closure under a
 // half coverage 1.0025 (furnace_test.cc); with it the largest is 1.0008.
+// G_k is for a cosine-distributed lobe: a rough one that favours light near the
+// normal takes more of the light-side term, so it is raised by the diffuse
+// model's bound of that (substrate_coat_lobe: Chan 2024 1.0062 at k = 0, EON
+// 1.0037; issue 19 step 7).
 // `ends`: the means of the closure's F0 and F90 (substrate_diffuse_interface).
 float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
 #if !SUBSTRATE_USE_LAYERS
@@ -149,20 +165,20 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
 #else
   // No branch: at coverageAbove 0 the factor is exactly 1.
   float cover = saturate(c.coverageAbove);
-  float g = SUBSTRATE_COAT_G_0;
+  float g = SUBSTRATE_COAT_G_0 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
   float ifc = SUBSTRATE_COAT_T_0;
   float invIfc = SUBSTRATE_COAT_INV_T_0;
 #if SUBSTRATE_USE_EXTRA_INTERFACES
   if (c.extraInterfaces == 1u) {
-    g = SUBSTRATE_COAT_G_1;
+    g = SUBSTRATE_COAT_G_1 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
     ifc = SUBSTRATE_COAT_T_1;
     invIfc = SUBSTRATE_COAT_INV_T_1;
   } else if (c.extraInterfaces == 2u) {
-    g = SUBSTRATE_COAT_G_2;
+    g = SUBSTRATE_COAT_G_2 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
     ifc = SUBSTRATE_COAT_T_2;
     invIfc = SUBSTRATE_COAT_INV_T_2;
   } else if (c.extraInterfaces >= 3u) {
-    g = SUBSTRATE_COAT_G_3;
+    g = SUBSTRATE_COAT_G_3 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
     ifc = SUBSTRATE_COAT_T_3;
     invIfc = SUBSTRATE_COAT_INV_T_3;
   }
@@ -640,14 +656,10 @@ float substrate_chan2024_loss(float mu, float r, float scale, float bias) {
 // multiple-scattering lobe (Kulla & Conty 2017's form, as EON's),
 // albedo / pi r max(h_V, 0) max(h_L, 0) / H, H = int h 2 mu dmu =
 // 1 - 0.38 r - Scale (13/18 + (Bias - 0.025) M), whose directional albedo is
-// r h_V = 1 - E: with it the white albedo is 0.9994-1.0001 for NoV >= 0.05.
-// `msShare` scales that lobe: 1 - coverageAbove (substrate_eval_closure). Under
-// layers the diffuse is normalized by substrate_closure_coat_diffuse for a
-// cosine-distributed lobe, and Chan's rough lobe, which favours light near the
-// normal where the layers pass more, already gains there: with the lobe, a
-// white base of r 0.5 under an F0-0 coat returned 1.0036 at NoV 1.
-mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH,
-                                   float msShare) {
+// r h_V = 1 - E: with it the white albedo is 0.9993-1.0000 for NoV >= 0.05.
+// Under layers, substrate_closure_coat_diffuse bounds the lobe's shape
+// (SUBSTRATE_COAT_LOBE_CHAN2024_*).
+mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH) {
   float r = saturate(roughness);
   float a = r * r;
   float scale = max(0.55 - 0.2 * r, 1.25 - 1.6 * r);
@@ -657,7 +669,7 @@ mfloat3 substrate_diffuse_chan2024(mfloat3 albedo, float roughness, float NoV, f
   float f = lerp(1.0, fRough, r) + 0.38 * a;
   float excess = 0.026 * saturate(1.0 - 25.0 * NoV) * saturate(10.0 * (r - 0.42));
   float lossAvg = 1.0 - 0.38 * r - scale * (13.0 / 18.0 + (bias - 0.025) * SUBSTRATE_CHAN24_K1_MEAN);
-  float ms = msShare * r * max(substrate_chan2024_loss(saturate(NoV), r, scale, bias), 0.0) *
+  float ms = r * max(substrate_chan2024_loss(saturate(NoV), r, scale, bias), 0.0) *
              max(substrate_chan2024_loss(saturate(NoL), r, scale, bias), 0.0) / max(lossAvg, 1e-4);
   return albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * (f / (1.0 + excess) + ms) * saturate(NoL));
 }
@@ -696,13 +708,12 @@ mfloat3 substrate_diffuse_eon(mfloat3 albedo, float roughness, float NoV, float 
   return (rho * SUBSTRATE_M(fss) + rhoMs * SUBSTRATE_M(ms)) * SUBSTRATE_M(SUBSTRATE_INV_PI * mi);
 }
 
-// The diffuse model selected by SUBSTRATE_DIFFUSE_MODEL (`msShare`: Chan 2024's).
-mfloat3 substrate_diffuse(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL,
-                          float msShare) {
+// The diffuse model selected by SUBSTRATE_DIFFUSE_MODEL.
+mfloat3 substrate_diffuse(mfloat3 albedo, float roughness, float NoV, float NoL, float NoH, float VoH, float VoL) {
 #if SUBSTRATE_DIFFUSE_MODEL == 1
   return substrate_diffuse_chan2018(albedo, roughness, NoV, NoL, NoH, VoH);
 #elif SUBSTRATE_DIFFUSE_MODEL == 2
-  return substrate_diffuse_chan2024(albedo, roughness, NoV, NoL, NoH, VoH, msShare);
+  return substrate_diffuse_chan2024(albedo, roughness, NoV, NoL, NoH, VoH);
 #elif SUBSTRATE_DIFFUSE_MODEL == 3
   return substrate_diffuse_eon(albedo, roughness, NoV, NoL, VoL);
 #else
@@ -959,7 +970,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (isWrap) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
-    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL, 1.0 - saturate(c.coverageAbove)) *
+    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
               substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
   }
   // Under layers: what their underside sends back down (float: a factor up to 1.1).

@@ -96,6 +96,21 @@
 #define SUBSTRATE_COAT_G_1 0.90734
 #define SUBSTRATE_COAT_G_2 0.87632
 #define SUBSTRATE_COAT_G_3 0.85053
+//   LOBE_<model>_k: G_k assumes a cosine-distributed diffuse lobe; a rough
+//        lobe that favours light near the normal, where g is largest, takes
+//        more of it, by up to this factor (the largest over 11 roughnesses and
+//        7 views of (1 - chi(NoV))^(1 + k) int f g^(1 + k) cos / (G_k int f cos);
+//        Chan 2024 with its multiple-scattering lobe at r 1, NoV 1: a white base
+//        under an F0-0 coat returned 1.0057 without it, EON 1.0033; issue 19,
+//        step 7; scripts/fit_chan2024_energy.py). Lambert: 1.
+#define SUBSTRATE_COAT_LOBE_CHAN2024_0 1.0062
+#define SUBSTRATE_COAT_LOBE_CHAN2024_1 1.0100
+#define SUBSTRATE_COAT_LOBE_CHAN2024_2 1.0129
+#define SUBSTRATE_COAT_LOBE_CHAN2024_3 1.0152
+#define SUBSTRATE_COAT_LOBE_EON_0 1.0037
+#define SUBSTRATE_COAT_LOBE_EON_1 1.0056
+#define SUBSTRATE_COAT_LOBE_EON_2 1.0071
+#define SUBSTRATE_COAT_LOBE_EON_3 1.0084
 #define SUBSTRATE_COAT_T_0 0.96
 #define SUBSTRATE_COAT_T_1 0.9216
 #define SUBSTRATE_COAT_T_2 0.884736

@@ -33,6 +33,15 @@ energy is returned as a reciprocal multiple-scattering lobe (Kulla & Conty
 whose directional albedo is exactly r h(mu_o) = 1 - E(mu_o) where h >= 0
 (h < 0 only below NoV 0.04 at r > 0.42, where E already exceeds 1 and the
 runtime divides it by a bound of that excess).
+
+Then the lobe factors SUBSTRATE_COAT_LOBE_* of substrate_closure_coat_diffuse:
+under layers the diffuse is normalized with G_k = 2 int mu g_k dmu, the
+cosine-weighted mean of the light-side interface term g_k = (1 - chi)^(1 + k)
+(chi the runtime's Fresnel curve, SUBSTRATE_FRESNEL_CURVE_*). A lobe f that
+favours light near the normal takes more of it; the factor is the largest
+over 11 roughnesses and 7 views of g_k(NoV) int f g_k cos / (G_k int f cos),
+for Chan 2024 with its lobe (the constants just fitted) and for EON (its
+roughness 0.4 r, albedo 1), rounded up.
 """
 
 import math
@@ -169,6 +178,75 @@ def main():
     print(f"  after:  lowest {lo_after[0]:.4f} at {lo_after[1]}, highest {hi_after[0]:.4f} at {hi_after[1]}")
     print(f"  after, NoV >= 0.05: lowest {lo_view[0]:.4f} at {lo_view[1]} (below, the bound of the excess divides)")
     print(f"  H(r) lowest {min(big_h(j / 100.0, m) for j in range(101)):.4f}")
+    print_lobe_factors(p, c, m)
+
+
+CURVE_A, CURVE_B = 0.18317, -0.39315  # SUBSTRATE_FRESNEL_CURVE_A, _B
+
+
+def interface_term(mu, k):
+    """g_k = (1 - chi(mu))^(1 + k), chi the runtime's Fresnel curve."""
+    t = (1.0 - mu) ** 5
+    s = math.sqrt(t)
+    return (1.0 - (t + (1.0 - t) * s * (CURVE_A + CURVE_B * s))) ** (1 + k)
+
+
+def chan_lobe(r, mo, mi, phi, p, c, m):
+    """Chan 2024 (times pi, albedo 1), the bound of its excess and its lobe."""
+    so, si = math.sqrt(max(0.0, 1 - mo * mo)), math.sqrt(max(0.0, 1 - mi * mi))
+    hx, hy, hz = so + si * math.cos(phi), si * math.sin(phi), mo + mi
+    inv = 1.0 / math.sqrt(hx * hx + hy * hy + hz * hz)
+    noh, voh = hz * inv, (so * hx + mo * hz) * inv
+    s, b = scale_bias(r)
+    f = 1.0 - r + r * s * (noh + b) / (noh + 0.025) * voh * voh + 0.38 * r * r
+    f /= 1.0 + 0.026 * min(1.0, max(0.0, 1.0 - 25.0 * mo)) * min(1.0, max(0.0, 10.0 * (r - 0.42)))
+    if r > 0:
+        f += r * max(h_of(mo, r, p, c), 0.0) * max(h_of(mi, r, p, c), 0.0) / max(big_h(r, m), 1e-4)
+    return f
+
+
+def eon_albedo(mu, r):
+    x = 1.0 - mu
+    return (1 + r * x * (0.0571085289 + x * (0.491881867 + x * (-0.332181442 + x * 0.0714429953)))) / (
+        1 + 0.287793409 * r)
+
+
+def eon_lobe(r, mo, mi, phi):
+    """EON (times pi) at albedo 1 with the runtime's roughness 0.4 r."""
+    r *= 0.4
+    so, si = math.sqrt(max(0.0, 1 - mo * mo)), math.sqrt(max(0.0, 1 - mi * mi))
+    s = so * si * math.cos(phi)
+    s_over_t = s / max(mo, mi, 1e-6) if s > 0 else s
+    af = 1.0 / (1.0 + 0.287793409 * r)
+    e_avg = af * (1.0 + 0.0724882125 * r)
+    ms = max(1e-7, 1 - eon_albedo(mo, r)) * max(1e-7, 1 - eon_albedo(mi, r)) / max(1e-7, 1 - e_avg)
+    return af * (1.0 + r * s_over_t) + ms  # rho = 1, rho_ms = 1
+
+
+def lobe_factor(lobe, k, n=64):
+    """The largest g_k(NoV) int f g_k cos / (G_k int f cos) over the grid."""
+    g_mean = sum(2 * ((i + 0.5) / 4000) * interface_term((i + 0.5) / 4000, k) for i in range(4000)) / 4000
+    worst = 0.0
+    for j in range(11):
+        r = j / 10.0
+        for mo in (1.0, 0.95, 0.9, 0.8, 0.6, 0.4, 0.2):
+            num = den = 0.0
+            for i in range(n):
+                mi = math.sqrt((i + 0.5) / n)
+                g = interface_term(mi, k)
+                for q in range(n):
+                    f = lobe(r, mo, mi, (q + 0.5) / n * math.pi)
+                    num += f * g
+                    den += f
+            worst = max(worst, interface_term(mo, k) * num / (den * g_mean))
+    return worst
+
+
+def print_lobe_factors(p, c, m):
+    for name, lobe in (("CHAN2024", lambda r, mo, mi, phi: chan_lobe(r, mo, mi, phi, p, c, m)), ("EON", eon_lobe)):
+        factors = [lobe_factor(lobe, k) for k in range(4)]
+        print(f"SUBSTRATE_COAT_LOBE_{name}_0..3: " + ", ".join(f"{math.ceil(v * 1e4) / 1e4:.4f} ({v:.5f})"
+                                                          for v in factors))
 
 
 if __name__ == "__main__":

@@ -265,10 +265,10 @@ T chan2024Loss(T mu, T r, T scale, T bias) {
 
 // substrate_diffuse_chan2024 (UE's, Lambertian smooth limit), divided by
 // 1 + 0.026 sat(1 - 25 NoV) sat(10 (r - 0.42)), the bound of its albedo excess,
-// plus msShare times the multiple-scattering lobe r max(h_V, 0) max(h_L, 0) / H
-// (issue 19, step 7).
+// plus the multiple-scattering lobe r max(h_V, 0) max(h_L, 0) / H (issue 19,
+// step 7).
 template <class T>
-V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T msShare) {
+V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH) {
   T r = saturate(roughness);
   T a = r * r;
   T scale = std::max(T(0.55) - T(0.2) * r, T(1.25) - T(1.6) * r);
@@ -278,7 +278,7 @@ V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T V
   T f = lerp(T(1), fRough, r) + T(0.38) * a;
   T excess = T(0.026) * saturate(T(1) - T(25) * NoV) * saturate(T(10) * (r - T(0.42)));
   T lossAvg = T(1) - T(0.38) * r - scale * (T(13) / T(18) + (bias - T(0.025)) * T(SUBSTRATE_CHAN24_K1_MEAN));
-  T ms = msShare * r * std::max(chan2024Loss(saturate(NoV), r, scale, bias), T(0)) *
+  T ms = r * std::max(chan2024Loss(saturate(NoV), r, scale, bias), T(0)) *
          std::max(chan2024Loss(saturate(NoL), r, scale, bias), T(0)) / std::max(lossAvg, T(1e-4));
   return albedo * (K<T>::invPi * (f / (T(1) + excess) + ms) * saturate(NoL));
 }
@@ -312,10 +312,10 @@ V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL) {
 }
 
 template <class T>
-V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL, T msShare) {
+V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL) {
   switch (model) {
     case kDiffuseChan2018: return diffuseChan2018(albedo, roughness, NoV, NoL, NoH, VoH);
-    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoV, NoL, NoH, VoH, msShare);
+    case kDiffuseChan2024: return diffuseChan2024(albedo, roughness, NoV, NoL, NoH, VoH);
     case kDiffuseEon: return diffuseEon(albedo, roughness, NoV, NoL, VoL);
     default: return diffuseLambert(albedo, NoL);
   }
@@ -484,20 +484,25 @@ V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f
 // own (relative) interface: the covariance of its coupling with the layers' (the
 // shader takes the two means, substrate_diffuse_interface).
 template <class T>
-V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90) {
+V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, int diffuseModel) {
   // No branch, as in the shader: at coverageAbove 0 the factor is exactly 1.
   const T cover = saturate(c.coverageAbove);
-  T g = T(SUBSTRATE_COAT_G_0), ifc = T(SUBSTRATE_COAT_T_0), invIfc = T(SUBSTRATE_COAT_INV_T_0);
+  // substrate_coat_lobe: the diffuse model's bound of its lobe's share of G_k.
+  auto lobe = [diffuseModel](double chan2024, double eon) {
+    return T(diffuseModel == kDiffuseChan2024 ? chan2024 : diffuseModel == kDiffuseEon ? eon : 1.0);
+  };
+  T g = T(SUBSTRATE_COAT_G_0) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
+  T ifc = T(SUBSTRATE_COAT_T_0), invIfc = T(SUBSTRATE_COAT_INV_T_0);
   if (c.extraInterfaces == 1u) {
-    g = T(SUBSTRATE_COAT_G_1);
+    g = T(SUBSTRATE_COAT_G_1) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
     ifc = T(SUBSTRATE_COAT_T_1);
     invIfc = T(SUBSTRATE_COAT_INV_T_1);
   } else if (c.extraInterfaces == 2u) {
-    g = T(SUBSTRATE_COAT_G_2);
+    g = T(SUBSTRATE_COAT_G_2) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
     ifc = T(SUBSTRATE_COAT_T_2);
     invIfc = T(SUBSTRATE_COAT_INV_T_2);
   } else if (c.extraInterfaces >= 3u) {
-    g = T(SUBSTRATE_COAT_G_3);
+    g = T(SUBSTRATE_COAT_G_3) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
     ifc = T(SUBSTRATE_COAT_T_3);
     invIfc = T(SUBSTRATE_COAT_INV_T_3);
   }
@@ -656,10 +661,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   const V3<T> f90d = vmin(f90, splat3(fd[1]));
   // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
-                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL, T(1) - saturate(c.coverageAbove)) *
+                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // Under layers: what their underside sends back down.
-  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d);
+  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d, diffuseModel);
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -682,7 +687,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
   template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
-  template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                 \
+  template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);                 \
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \
@@ -707,10 +712,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
-  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T, T);                                      \
+  template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \
   template T eonAlbedo<T>(T, T);                                                                       \
   template V3<T> diffuseEon<T>(const V3<T>&, T, T, T, T);                                              \
-  template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T, T);                                      \
+  template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
   template T charlieD<T>(T, T);                                                                        \

@@ -17,7 +17,7 @@ template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>&
 /// relative to the layers above by coverageAbove, and the share of the dielectric curve (fresnelShare).
 template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share);
 /// substrate_closure_coat_diffuse: 1 / lerp(1, D, coverageAbove), what the diffuse gets back.
-template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
+template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, int diffuseModel);
 /// substrate_closure_coat_specular: what a conductor's lobe under layers keeps, given back what their top
 /// sends down (the trapped share R) and the closure reflects again (its hemispherical albedo).
 template <class T>
@@ -67,13 +67,11 @@ T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T 
 // Diffuse models (BRDF * NoL).
 template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);
 template <class T> V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
-template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T msShare);
+template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
 template <class T> T eonAlbedo(T mu, T r);
 template <class T> V3<T> diffuseEon(const V3<T>& albedo, T roughness, T NoV, T NoL, T VoL);
-/// substrate_diffuse with SUBSTRATE_DIFFUSE_MODEL = model (anything else than 1..3: Lambert); msShare
-/// scales Chan 2024's multiple-scattering lobe (1 - coverageAbove in evalClosure).
-template <class T>
-V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL, T msShare = T(1));
+/// substrate_diffuse with SUBSTRATE_DIFFUSE_MODEL = model (anything else than 1..3: Lambert).
+template <class T> V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH, T VoL);
 
 // SSS wrap.
 template <class T> V3<T> sssWrapAmount(const V3<T>& mfp);
