@@ -121,13 +121,17 @@ def big_h(r, m):
     return 1.0 - 0.38 * r - s * (13.0 / 18.0 + (b - 0.025) * m)
 
 
+def excess_bound(mu, r):
+    """The runtime's divisor for the grazing excess, 1 + 0.026 sat(1 - 25 mu) sat(10 (r - 0.42))."""
+    return 1.0 + 0.026 * min(1.0, max(0.0, 1.0 - 25.0 * mu)) * min(1.0, max(0.0, 10.0 * (r - 0.42)))
+
+
 def chan_albedo(mu, r, k0, k1):
     """E(mu, r) from the two integrals, divided by the runtime's bound of the
     excess (1 + 0.026 sat(1 - 25 mu) sat(10 (r - 0.42)))."""
     s, b = scale_bias(r)
     e = 1.0 - r + r * s * (k0 + (b - 0.025) * k1) + 0.38 * r * r
-    excess = 0.026 * min(1.0, max(0.0, 1.0 - 25.0 * mu)) * min(1.0, max(0.0, 10.0 * (r - 0.42)))
-    return e / (1.0 + excess)
+    return e / excess_bound(mu, r)
 
 
 def main():
@@ -199,7 +203,7 @@ def chan_lobe(r, mo, mi, phi, p, c, m):
     noh, voh = hz * inv, (so * hx + mo * hz) * inv
     s, b = scale_bias(r)
     f = 1.0 - r + r * s * (noh + b) / (noh + 0.025) * voh * voh + 0.38 * r * r
-    f /= 1.0 + 0.026 * min(1.0, max(0.0, 1.0 - 25.0 * mo)) * min(1.0, max(0.0, 10.0 * (r - 0.42)))
+    f /= excess_bound(mo, r)
     if r > 0:
         f += r * max(h_of(mo, r, p, c), 0.0) * max(h_of(mi, r, p, c), 0.0) / max(big_h(r, m), 1e-4)
     return f

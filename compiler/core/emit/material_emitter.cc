@@ -411,8 +411,8 @@ void Emitter::emitTree() {
     line(fmt::format("float C_{} = {};", node.id, c));
     line(fmt::format("float3 T_{} = {};", node.id, t));
     if (v >= 0 && fuzzyLayer(m_, n) && m_.nodes[v].left == n)  // what its fuzz lets through to the layers under it
-      line(fmt::format("float FT_{} = substrate_fuzz_transmission({}, {}, dot(substrate_tangent_to_world({}, g.N, g.T), "
-                       "g.V));",
+      line(fmt::format("float FT_{} = substrate_fuzz_transmission({}, {}, "
+                       "dot(substrate_tangent_to_world({}, g.N, g.T), g.V));",
                        node.id, expr(s.pin(SlabPin::FuzzAmount)), expr(s.pin(SlabPin::FuzzRoughness)),
                        expr(s.pin(SlabPin::Normal))));
     if (underOperatorTop(n))  // what it lets through, its interface included (TI: see emitClosures)
@@ -486,8 +486,9 @@ std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string
                           : fmt::format("step({}, {})", expr(op.a), expr(op.b));
         break;
       case TreeOp::Vertical:
-        if (op.right == x) layers.emplace_back(p, op.left);
-        if (op.right == x && fuzzyLayer(m_, op.left)) f = fmt::format("FT_{}", m_.nodes[op.left].id);
+        if (op.right != x) break;
+        layers.emplace_back(p, op.left);
+        if (fuzzyLayer(m_, op.left)) f = fmt::format("FT_{}", m_.nodes[op.left].id);  // what its fuzz lets through
         break;
       default: break;
     }

@@ -664,7 +664,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
                       : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // Under layers: what their underside sends back down.
-  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d, diffuseModel);
+  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) *
+                            closureCoatDiffuse(c, f0d, f90d, diffuseModel);
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -687,7 +688,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
   template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
-  template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);                 \
+  template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \

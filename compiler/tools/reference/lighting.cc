@@ -147,7 +147,7 @@ T envMip(T roughness, T mipCount) {
 // its hemispherical albedo). The view-side throughput is the caller's.
 template <class T>
 V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredRadiance, const V3<T>& irradiance,
-                  int diffuseModel /* the split sum uses albedo for every model, and its coat factor */) {
+                  int diffuseModel /* the diffuse is albedo for every model; its coat factor is the model's */) {
   V3<T> N = closureNormal(c);
   T NoVraw = dot(N, V);
   if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));
@@ -167,7 +167,8 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   const V3<T> albedo = saturate(c.diffuseAlbedo);
   const V3<T> f0d = vmin(f0, splat3(fd[0]));
   const V3<T> f90d = vmin(f90, splat3(fd[1]));
-  V3<T> diff = albedo * diffuseTransmission(albedo, specAlbedo, dielectric) * closureCoatDiffuse(c, f0d, f90d, diffuseModel) * irr;
+  V3<T> diff = albedo * diffuseTransmission(albedo, specAlbedo, dielectric) *
+               closureCoatDiffuse(c, f0d, f90d, diffuseModel) * irr;
   V3<T> specLight = lightThroughput(c, NoV);
   V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
   V3<T> result = spec * specLight + diff * diffuseLight;

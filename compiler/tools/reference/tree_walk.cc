@@ -314,8 +314,9 @@ class Walk {
         case TreeOp::CoverageWeight: weight = weight * scalar(op.a); break;
         case TreeOp::Select: weight = weight * (op.right == x ? T(1) - step(op) : step(op)); break;
         case TreeOp::Vertical:
-          if (op.right == x) tops.push_back(op.left);
-          if (op.right == x && fuzzyLayer(m_, op.left)) weight = weight * fuzzThrough(m_.slabs[m_.nodes[op.left].slab]);
+          if (op.right != x) break;
+          tops.push_back(op.left);
+          if (fuzzyLayer(m_, op.left)) weight = weight * fuzzThrough(m_.slabs[m_.nodes[op.left].slab]);
           break;
         default: break;
       }
