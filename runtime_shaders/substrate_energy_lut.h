@@ -185,7 +185,11 @@ float substrate_fuzz_albedo(float NoV, float fuzzRoughness) {
 // weight of every closure under a fuzzy slab (the top of a vertical) by it
 // (issue 19, step 7): without it a coat with fuzz 0.2 over a white base
 // returned up to 1.067 of the light, its fuzz reflecting and the base still
-// lit whole. Along the view only (the weight is counted once): the light the
+// lit whole. When the top is an operator (a mix of coats, a coverage weight,
+// a vertical), its slabs' factors go through the same operators as their
+// transmittance, 1 for a slab without fuzz, and the closures under it take
+// lerp(1, that, the layer's coverage) (step 8: a mix of a fuzzy and a clear
+// coat returned up to 1.13). Along the view only (the weight is counted once): the light the
 // fuzz reflects before reaching the layers is not taken (their reciprocity
 // ratio up to 1 / (1 - amount E_fuzz), 1.10 at fuzz 0.2). Not through the
 // layers' transmittance, which the trapped light between them never crosses.

@@ -412,6 +412,55 @@ TEST(Furnace, AFuzzyCoatTakesWhatItsFuzzReflectsFromTheLayersUnderIt) {
   ASSERT_EQ(measured, 2 * 3 * 3 * 4);
 }
 
+TEST(Furnace, FuzzInAnOperatorOnTopTakesItsShareFromTheLayersUnderIt) {
+  // The fuzzy coat is one part of the top layer: mixed with a clear coat,
+  // under a coverage weight, selected, or the top of a vertical that is itself
+  // the top. The base under it takes what the layer's fuzz lets through, by
+  // the same operators as its transmittance (issue 19 step 8: 1.074 ... 1.132
+  // of the light before, when only a fuzzy slab directly on top counted).
+  using namespace stackfurnace;
+  const char* tops[] = {
+      R"("top": {{"kind": "horizontal", "background": "clear", "foreground": "fuzzy", "mix": 0.7}})",
+      R"("top": {{"kind": "coverage_weight", "a": "fuzzy", "weight": 0.6}})",
+      R"("top": {{"kind": "select", "a": "clear", "b": "fuzzy", "value": "$v", "threshold": 0.5}})",
+      R"("top": {{"kind": "vertical", "top": "fuzzy", "base": "clear", "thickness": 0}})",
+  };
+  int measured = 0;
+  double worst = 0;
+  for (const char* top : tops)
+    for (double f0 : {0.0, 0.04})
+      for (double amount : {0.5, 1.0})
+        for (double fuzzRoughness : {0.3, 0.8}) {
+          const std::string text = fmt::format(
+              fmt::runtime(std::string(R"({{"format": "substrate-material/1", "name": "fuzzy_top", "output": "root",
+              "inputs": {{"v": {{"type": "float", "default": 0.8}}}}, "nodes": {{
+                "fuzzy": {{"kind": "slab", "diffuse_albedo": 0, "f0": {0}, "roughness": 0.1, "sss_mfp": 1e6,
+                           "fuzz_amount": {1}, "fuzz_color": 1, "fuzz_roughness": {2}}},
+                "clear": {{"kind": "slab", "diffuse_albedo": 0, "f0": {0}, "roughness": 0.1, "sss_mfp": 1e6}},
+                )") + top + R"(,
+                "base": {{"kind": "slab", "diffuse_albedo": 1, "f0": 0, "roughness": 0.5}},
+                "root": {{"kind": "vertical", "top": "top", "base": "base", "thickness": 0}}}}}})"),
+              f0, amount, fuzzRoughness);
+          Diagnostics d("fuzzy_top.json");
+          CompileOptions o;
+          o.budgetOverride = 4096;  // every closure kept
+          auto r = compileText("fuzzy_top.json", text, o, d);
+          ASSERT_TRUE(r.has_value()) << d.formatAll();
+          ASSERT_GE(r->after.closures.size(), 2u) << top;
+          for (double mu : kNoV) {
+            reference::Geometry g;
+            g.V = stackfurnace::viewAt(mu);
+            const double a = furnace(reference::evaluateMaterial<double>(*r, g, {}, {}).closures, g.V, 11);
+            ++measured;
+            worst = std::max(worst, a);
+            EXPECT_LE(a, kTolerance) << top << "\nF0 " << f0 << ", fuzz " << amount << " r " << fuzzRoughness
+                                     << ", NoV " << mu;
+          }
+        }
+  std::printf("[ furnace  ] fuzz in an operator on top of a white base: largest %.5f over %d\n", worst, measured);
+  ASSERT_EQ(measured, 4 * 2 * 2 * 2 * 4);
+}
+
 TEST(Furnace, AWhiteRoughConductorReturnsNearlyAllOfIt) {
   // F0 = 1, no diffuse, isotropic: Turquin's compensation brings the lobe to
   // ~1 at every roughness (single scattering alone falls to 0.33 at r = 1).

@@ -133,13 +133,15 @@ class Emitter {
   void collectNeeded();
   void emitResources();
   void emitTree();
+  std::string operatorCall(const TreeNode& node, const std::string& prefix, const std::string& c,
+                           const std::string& t);  // substrate_op_* of a binary operator (emitTree)
   void emitClosures();
   std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
   bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
   bool underOperatorTop(int node) const;  // in (or is) an operator that is the top of a vertical
-  bool fuzzAboveAny() const;              // a slab with fuzz is the top of a vertical (fuzzyLayer)
+  bool fuzzAboveAny() const;              // the top layer of a vertical holds fuzz (fuzzyLayer)
 
   void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
   /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
@@ -410,7 +412,7 @@ void Emitter::emitTree() {
                      v >= 0 ? fmt::format(", in the top layer of vertical '{}'", m_.nodes[v].id) : ""));
     line(fmt::format("float C_{} = {};", node.id, c));
     line(fmt::format("float3 T_{} = {};", node.id, t));
-    if (v >= 0 && fuzzyLayer(m_, n) && m_.nodes[v].left == n)  // what its fuzz lets through to the layers under it
+    if (t_.layerVertical[n] >= 0 && fuzzyLayer(m_, n))  // what its fuzz lets through to the layers under it
       line(fmt::format("float FT_{} = substrate_fuzz_transmission({}, {}, "
                        "dot(substrate_tangent_to_world({}, g.N, g.T), g.V));",
                        node.id, expr(s.pin(SlabPin::FuzzAmount)), expr(s.pin(SlabPin::FuzzRoughness)),
@@ -421,49 +423,47 @@ void Emitter::emitTree() {
   // Operators bottom-up: by distance from leaves, then tree id.
   for (int n : t_.bottomUpOperators) {
     const TreeNode& node = m_.nodes[n];
-    const std::string id = node.id, l = nodeName(node.left), r = node.right >= 0 ? nodeName(node.right) : "";
+    const std::string id = node.id, l = nodeName(node.left);
+    const bool weight = node.op == TreeOp::CoverageWeight;  // unary: C = weight * C_a, the rest passes through
     line(fmt::format("// {} '{}' (Id={}, DistanceFromLeaves={})", treeOpName(node.op), id, t_.reportId[n],
                      t_.distanceFromLeaves[n]));
     line(fmt::format("float C_{0}; float3 T_{0};", id));
-    switch (node.op) {
-      case TreeOp::Horizontal:
-        line(fmt::format("substrate_op_horizontal(C_{0}, T_{0}, C_{1}, T_{1}, {2}, C_{3}, T_{3});", l, r, expr(node.a), id));
-        break;
-      case TreeOp::Select:
-        line(fmt::format("substrate_op_horizontal(C_{0}, T_{0}, C_{1}, T_{1}, 1.0 - step({2}, {3}), C_{4}, T_{4});", l, r,
-                         expr(node.a), expr(node.b), id));
-        break;
-      case TreeOp::Vertical:
-        line(fmt::format("substrate_op_vertical(C_{0}, T_{0}, C_{1}, T_{1}, C_{2}, T_{2});", l, r, id));
-        break;
-      case TreeOp::Add: line(fmt::format("substrate_op_add(C_{0}, T_{0}, C_{1}, T_{1}, C_{2}, T_{2});", l, r, id)); break;
-      case TreeOp::CoverageWeight:
-        line(fmt::format("C_{0} = {1} * C_{2}; T_{0} = T_{2};", id, expr(node.a), l));
-        break;
-      case TreeOp::Slab: break;
+    line(weight ? fmt::format("C_{0} = {1} * C_{2}; T_{0} = T_{2};", id, expr(node.a), l)
+                : operatorCall(node, "T_", "C_" + id, "T_" + id));
+    if (t_.layerVertical[n] >= 0 && fuzzyLayer(m_, n)) {
+      // The same operator on what the children's fuzz lets through (1 for a
+      // child without fuzz), for the closures under the layer (walkUp).
+      line(fmt::format("float FT_{};", id));
+      line(weight ? fmt::format("FT_{} = FT_{};", id, l)
+                  : fmt::format("{{ float c; float3 f; {} FT_{} = f.x; }}", operatorCall(node, "FT_", "c", "f"), id));
     }
     if (!underOperatorTop(n)) continue;
     // The same operator on what the children let through with their interfaces.
     line(fmt::format("float3 TI_{};", id));
-    switch (node.op) {
-      case TreeOp::Horizontal:
-        line(fmt::format("{{ float c; substrate_op_horizontal(C_{0}, TI_{0}, C_{1}, TI_{1}, {2}, c, TI_{3}); }}", l, r,
-                         expr(node.a), id));
-        break;
-      case TreeOp::Select:
-        line(fmt::format("{{ float c; substrate_op_horizontal(C_{0}, TI_{0}, C_{1}, TI_{1}, 1.0 - step({2}, {3}), c, "
-                         "TI_{4}); }}",
-                         l, r, expr(node.a), expr(node.b), id));
-        break;
-      case TreeOp::Vertical:
-        line(fmt::format("{{ float c; substrate_op_vertical(C_{0}, TI_{0}, C_{1}, TI_{1}, c, TI_{2}); }}", l, r, id));
-        break;
-      case TreeOp::Add:
-        line(fmt::format("{{ float c; substrate_op_add(C_{0}, TI_{0}, C_{1}, TI_{1}, c, TI_{2}); }}", l, r, id));
-        break;
-      case TreeOp::CoverageWeight: line(fmt::format("TI_{} = TI_{};", id, l)); break;
-      case TreeOp::Slab: break;
-    }
+    line(weight ? fmt::format("TI_{} = TI_{};", id, l)
+                : fmt::format("{{ float c; {} }}", operatorCall(node, "TI_", "c", "TI_" + id)));
+  }
+}
+
+/// The call of binary operator `node`'s substrate_op_* on its children's
+/// coverages C_ and their values named `prefix` (T_, TI_: float3; FT_: a float
+/// splat to float3, 1 for a child without fuzz), into `c` and `t`.
+std::string Emitter::operatorCall(const TreeNode& node, const std::string& prefix, const std::string& c,
+                                  const std::string& t) {
+  auto value = [&](int x) {
+    if (prefix != "FT_") return prefix + nodeName(x);
+    return fmt::format("SUBSTRATE_SPLAT3({})", fuzzyLayer(m_, x) ? "FT_" + nodeName(x) : std::string("1.0"));
+  };
+  const std::string l = nodeName(node.left), r = nodeName(node.right), tl = value(node.left), tr = value(node.right);
+  switch (node.op) {
+    case TreeOp::Horizontal:
+      return fmt::format("substrate_op_horizontal(C_{}, {}, C_{}, {}, {}, {}, {});", l, tl, r, tr, expr(node.a), c, t);
+    case TreeOp::Select:
+      return fmt::format("substrate_op_horizontal(C_{}, {}, C_{}, {}, 1.0 - step({}, {}), {}, {});", l, tl, r, tr,
+                         expr(node.a), expr(node.b), c, t);
+    case TreeOp::Vertical: return fmt::format("substrate_op_vertical(C_{}, {}, C_{}, {}, {}, {});", l, tl, r, tr, c, t);
+    case TreeOp::Add: return fmt::format("substrate_op_add(C_{}, {}, C_{}, {}, {}, {});", l, tl, r, tr, c, t);
+    default: return "";  // slabs and coverage weights: the caller's
   }
 }
 
@@ -488,7 +488,10 @@ std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string
       case TreeOp::Vertical:
         if (op.right != x) break;
         layers.emplace_back(p, op.left);
-        if (fuzzyLayer(m_, op.left)) f = fmt::format("FT_{}", m_.nodes[op.left].id);  // what its fuzz lets through
+        // What its fuzz lets through: FT where the layer covers, 1 elsewhere.
+        if (fuzzyLayer(m_, op.left))
+          f = t_.unitCoverage[op.left] ? fmt::format("FT_{}", m_.nodes[op.left].id)
+                                       : fmt::format("lerp(1.0, FT_{0}, C_{0})", m_.nodes[op.left].id);
         break;
       default: break;
     }

@@ -19,7 +19,7 @@ struct TreeInfo {
   std::vector<bool> isBottom;    // slabs: nothing layered below (never a vertical top)
   std::vector<bool> unitWeight;  // slabs: the mix/coverage weights on the path to the
                                  // root are statically 1 (transmittance not included), and no
-                                 // fuzzy layer lies above (fuzzyLayer)
+                                 // layer above holds fuzz (fuzzyLayer)
   std::vector<bool> unitCoverageAbove;  // slabs: every layer above has coverage statically 1
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
   std::vector<int> interfaces;   // any node: the most interfaces a path down through the subtree
@@ -40,12 +40,26 @@ struct TreeInfo {
 
 TreeInfo analyzeTree(const Material& m);
 
-/// Node `node` is a slab with fuzz: as the top of a vertical, its fuzz reflects
-/// a share of the view's light that no longer reaches the layers under it,
-/// whose closures' weight takes what it lets through (substrate_fuzz_transmission,
-/// issue 19 step 7): their weight is not statically 1.
+/// The subtree at `node` holds a slab with fuzz: as (or in) the top layer of a
+/// vertical, that fuzz reflects a share of the view's light that no longer
+/// reaches the layers under it, whose closures' weight takes what the layer
+/// lets through (substrate_fuzz_transmission, combined through the layer's
+/// operators as its transmittance is; issue 19 steps 7 and 8): their weight is
+/// not statically 1. An explicit walk, bounded by the node count.
 inline bool fuzzyLayer(const Material& m, int node) {
-  return node >= 0 && m.nodes[node].op == TreeOp::Slab && (m.slabs[m.nodes[node].slab].features & kFeatFuzz);
+  std::vector<int> stack;
+  if (node >= 0) stack.push_back(node);
+  for (std::size_t visits = 0; !stack.empty() && visits < m.nodes.size(); ++visits) {
+    const TreeNode& n = m.nodes[stack.back()];
+    stack.pop_back();
+    if (n.op == TreeOp::Slab) {
+      if (m.slabs[n.slab].features & kFeatFuzz) return true;
+      continue;
+    }
+    if (n.left >= 0) stack.push_back(n.left);
+    if (n.right >= 0) stack.push_back(n.right);
+  }
+  return false;
 }
 
 /// The most interfaces beyond the first one above a closure that its stored

@@ -159,6 +159,7 @@ class Walk {
     C_.assign(n, T(1));
     Tr_.assign(n, splat3(T(1)));
     TI_.assign(n, splat3(T(1)));
+    FT_.assign(n, splat3(T(1)));
     slabs();
     operators();
     MaterialResult<T> out;
@@ -213,6 +214,7 @@ class Walk {
       else
         Tr_[n] = transmittance(mfpOf(s), v >= 0 ? scalar(m_.nodes[v].a) : static_cast<T>(d));
       TI_[n] = Tr_[n] * (splat3(T(1)) - vec3(s.pin(SlabPin::F0)));
+      if (s.features & kFeatFuzz) FT_[n] = splat3(fuzzThrough(s));
     }
   }
 
@@ -245,6 +247,16 @@ class Walk {
         case TreeOp::Vertical: opVertical(C_[l], TI_[l], C_[r], TI_[r], c, TI_[n]); break;
         case TreeOp::Add: opAdd(C_[l], TI_[l], C_[r], TI_[r], c, TI_[n]); break;
         case TreeOp::CoverageWeight: TI_[n] = TI_[l]; break;
+        case TreeOp::Slab: break;
+      }
+      // The emitter's FT_: the same operator on what the children's fuzz lets
+      // through (1 without fuzz; used when the node is in a vertical's top).
+      switch (node.op) {
+        case TreeOp::Horizontal: opHorizontal(C_[l], FT_[l], C_[r], FT_[r], scalar(node.a), c, FT_[n]); break;
+        case TreeOp::Select: opHorizontal(C_[l], FT_[l], C_[r], FT_[r], T(1) - step(node), c, FT_[n]); break;
+        case TreeOp::Vertical: opVertical(C_[l], FT_[l], C_[r], FT_[r], c, FT_[n]); break;
+        case TreeOp::Add: opAdd(C_[l], FT_[l], C_[r], FT_[r], c, FT_[n]); break;
+        case TreeOp::CoverageWeight: FT_[n] = FT_[l]; break;
         case TreeOp::Slab: break;
       }
     }
@@ -316,7 +328,10 @@ class Walk {
         case TreeOp::Vertical:
           if (op.right != x) break;
           tops.push_back(op.left);
-          if (fuzzyLayer(m_, op.left)) weight = weight * fuzzThrough(m_.slabs[m_.nodes[op.left].slab]);
+          // What the layer's fuzz lets through where it covers (the emitter's walkUp).
+          if (fuzzyLayer(m_, op.left))
+            weight = weight * (t_.unitCoverage[op.left] ? FT_[op.left][0]
+                                                        : T(1) - C_[op.left] * (T(1) - FT_[op.left][0]));
           break;
         default: break;
       }
@@ -324,8 +339,8 @@ class Walk {
     return weight;
   }
 
-  /// The emitter's FT_: substrate_fuzz_transmission of a fuzzy layer's fuzz
-  /// seen along the view at its own normal.
+  /// The emitter's FT_ of a slab with fuzz: substrate_fuzz_transmission of its
+  /// fuzz seen along the view at its own normal.
   T fuzzThrough(const Slab& s) const {
     const V3<T> N = tangentToWorld(vec3(s.pin(SlabPin::Normal)), gN_, gT_);
     const T e = std::min(fuzzAlbedo(saturate(dot(N, gV_)), scalar(s.pin(SlabPin::FuzzRoughness))), T(1));
@@ -408,6 +423,7 @@ class Walk {
   std::vector<T> C_;
   std::vector<V3<T>> Tr_;
   std::vector<V3<T>> TI_;  // what each node lets through with its interfaces (emitter's TI_)
+  std::vector<V3<T>> FT_;  // what each node's fuzz lets through along the view (emitter's FT_; splat)
   std::map<int, int> profileIndex_;
 };
 
