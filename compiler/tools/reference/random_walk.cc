@@ -434,6 +434,28 @@ bool sheenSample(const Interface& I, const V& wo, double q, SplitMix64& rng, Bsd
   return true;
 }
 
+/// What the fuzz of a pass-through (index-matched) interface lets through a
+/// crossing in direction w (either way): fuzzPass at the cosine of the
+/// direction above, |w_z|; 1 without fuzz. The pass-through itself is a delta.
+double passThrough(const Interface& I, const V& w) { return fuzzPass(I, std::fabs(w[2])); }
+
+/// Light travelling up (w) meets the fuzz of a pass-through from below: its
+/// sheen reflects it back down with probability q (the mirror image of the
+/// reflection from above), the rest crosses with weight (1 - q) / (1 - q).
+/// True when reflected (w, beta updated).
+bool sheenFromBelow(const Interface& I, V& w, V& beta, SplitMix64& rng) {
+  const double q = I.fuzzAmount > 0 ? fuzzCatch(I, std::fabs(w[2])) : 0;
+  if (!(q > 0 && rng.uniform() < q)) return false;
+  BsdfSample bs;
+  if (!sheenSample(I, V{-w[0], -w[1], w[2]}, q, rng, bs)) {
+    beta = V{0, 0, 0};  // a sample below the horizon: the path carries nothing
+    return true;
+  }
+  beta = beta * bs.weight;
+  w = V{bs.wi[0], bs.wi[1], -bs.wi[2]};
+  return true;
+}
+
 bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
   if (!(I.fuzzAmount > 0)) return coreSample(I, wo, rng, mode, flags, s);
   const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
@@ -761,6 +783,7 @@ int traceLightChain(const Resolved& s, int last, const V& wi, SplitMix64& rng, s
     if (I.kind == Interface::Kind::Pass) {
       // A delta transmission: f / pdf = 1 / |cos|, and f |cos| / pdf = 1 (k >= 1).
       c = neg(from);
+      wgt = wgt * passThrough(I, c);
       if (k == 0) wgt = wgt / std::fabs(c[2]);
     } else {
       BsdfSample bs;
@@ -820,8 +843,9 @@ struct EvalWalk {
   }
   /// Enters through the top interface (its reflection is counted apart); false: no entry.
   bool enter(const V& wo) {
-    if (exitDelta) {
+    if (exitDelta) {  // the top's sheen reflection is counted apart (ifcF)
       w = neg(wo);
+      beta = beta * passThrough(s.ifc[0], w);
     } else {
       BsdfSample bs;
       if (!ifcSample(s.ifc[0], wo, rng, Mode::Importance, kTransmission, bs)) return false;
@@ -861,12 +885,14 @@ struct EvalWalk {
   bool up() {
     const Interface& I = s.ifc[k];
     if (k == 0) {
-      // Leaving is counted at the last vertex: only reflection continues.
-      if (exitDelta) return false;
+      // Leaving is counted at the last vertex: only reflection continues
+      // (on a pass-through, its fuzz's).
+      if (exitDelta) return sheenFromBelow(I, w, beta, rng) && !isZero(beta);
       BsdfSample bs;
       return bounce(I, neg(w), kReflection, rng, beta, w, bs);
     }
     if (I.kind == Interface::Kind::Pass) {
+      if (sheenFromBelow(I, w, beta, rng)) return !isZero(beta);
       --k;
       t = s.med[k].tau;
       return true;
@@ -898,7 +924,7 @@ struct EvalWalk {
       return true;
     }
     const Interface& I = s.ifc[k + 1];
-    if (I.kind == Interface::Kind::Pass) {
+    if (I.kind == Interface::Kind::Pass && !(I.fuzzAmount > 0)) {
       ++k;
       t = 0;
       return true;
@@ -909,7 +935,23 @@ struct EvalWalk {
       if (!isZero(fv)) connectB(fv * std::fabs(lw[2]), ifcPdf(I, neg(w), lw, kAll), std::exp(-trUp / std::fabs(lw[2])));
     }
     BsdfSample bs;
-    if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
+    if (I.kind == Interface::Kind::Pass) {
+      // The fuzz on a pass-through from above: its sheen reflects with
+      // probability q (NEE above: ifcF is the sheen's), else a delta crossing
+      // of weight (1 - q) / (1 - q).
+      const double q = fuzzCatch(I, std::fabs(w[2]));
+      if (!(q > 0 && rng.uniform() < q)) {
+        ++k;
+        t = 0;
+        return true;
+      }
+      if (!sheenSample(I, neg(w), q, rng, bs)) return false;
+      bs.pdf = ifcPdf(I, neg(w), bs.wi, kAll);
+      beta = beta * bs.weight;
+      w = bs.wi;
+    } else if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) {
+      return false;
+    }
     if (bs.reflect) {
       if (k == 0) exitA(w, bs.pdf, std::exp(-trUp / std::fabs(w[2])));
     } else {
@@ -985,7 +1027,17 @@ struct AlbedoWalk {
   bool enter(const V& wo) {
     w = neg(wo);
     const Interface& I = s.ifc[0];
-    if (I.kind == Interface::Kind::Pass) return true;
+    if (I.kind == Interface::Kind::Pass) {
+      // The fuzz on top reflects by its sheen with probability q (what it
+      // catches) and lets the rest through (weight 1 - q over 1 - q).
+      const double q = I.fuzzAmount > 0 ? fuzzCatch(I, wo[2]) : 0;
+      if (q > 0 && rng.uniform() < q) {
+        BsdfSample r;
+        if (sheenSample(I, wo, q, rng, r)) sum = sum + r.weight;
+        return false;
+      }
+      return true;
+    }
     BsdfSample r, tr;
     ifcSplit(I, wo, rng, r, tr);
     sum = sum + r.weight;
@@ -1012,6 +1064,7 @@ struct AlbedoWalk {
       if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
       crossed = !bs.reflect;
     }
+    if (crossed && I.kind == Interface::Kind::Pass && sheenFromBelow(I, w, beta, rng)) return !isZero(beta);
     if (crossed) {
       if (k == 0) {
         sum = sum + beta;
@@ -1036,6 +1089,17 @@ struct AlbedoWalk {
       BsdfSample bs;
       if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
       crossed = !bs.reflect;
+    } else if (I.fuzzAmount > 0) {
+      // The fuzz on a pass-through from above: its sheen reflects with
+      // probability q, else a delta crossing of weight (1 - q) / (1 - q).
+      const double q = fuzzCatch(I, std::fabs(w[2]));
+      if (q > 0 && rng.uniform() < q) {
+        BsdfSample bs;
+        if (!sheenSample(I, neg(w), q, rng, bs)) return false;
+        beta = beta * bs.weight;
+        w = bs.wi;
+        crossed = false;
+      }
     }
     if (crossed) {
       ++k;

@@ -60,8 +60,14 @@
 //       (it reflects at most what it takes from the crossing light), the LTC /
 //       table sheen of the runtime as a layer, not a volumetric fibre walk;
 //       light from below that it would send back down is absorbed. Not
-//       reciprocal (the runtime's normalization by E_fuzz(mu_o) is not). Fuzz
-//       on an index-matched (F0 0) interface is not walked (a pass-through).
+//       reciprocal (the runtime's normalization by E_fuzz(mu_o) is not). On a
+//       pass-through (an index-matched interface: F0 0 on top, the IOR of the
+//       layer above under it) the fuzz is walked the same way — a velvet's
+//       sheen over its diffuse, a fabric's fuzz under a coat of its IOR (before
+//       issue 19 step 8 it was skipped) — except that what it catches from
+//       below is sent back down by the mirror image of its sheen (tinted by its
+//       colour), not absorbed: with nothing in the way, the two sides are
+//       alike.
 //   * Medium of a layer that is not the bottom: thickness d (the vertical's
 //     thickness), extinction sigma_t = 1 / MFP per channel (MFP clamped to
 //     >= 1e-30), so optical thickness tau = d / MFP; single-scattering albedo
@@ -140,7 +146,7 @@
 //   long walks: the albedo of an SSS slab (F0 0.04, roughness 0.5) at A = 0.5
 //   / 0.8 / 0.95 was short by 0 / 6 / 22 % at maxDepth 64 (single scattering).
 //
-// NOT MODELLED: fuzz on an index-matched interface, glints, emissive, SSS type (wrap /
+// NOT MODELLED: glints, emissive, SSS type (wrap /
 //   diffusion: only the medium counts), F90 of rough (microsurface) dielectric
 //   lobes, thin-surface transmission (the bottom is semi-infinite or opaque),
 //   normal maps (ground_truth.cc's frame). Specular profiles enter as their
