@@ -395,8 +395,10 @@ void coreSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, 
 // each crossing (mu that of the direction above). An energy-conserving "mean
 // sheen layer" (what the sheen reflects at most, amount * min(E, 1), is what
 // it takes from the crossing light) — the LTC / table sheen of the runtime as
-// a layer, not a volumetric fibre walk. Light from below that the fuzz would
-// reflect back down is absorbed.
+// a layer, not a volumetric fibre walk. resolve() puts it on a pass-through of
+// its own over its interface (pushInterface), where light from below that it
+// catches goes back down (sheenFromBelow); the wrappers below (ifcF, ifcPdf,
+// ifcSample, ifcSplit) then only ever see fuzz on a pass-through.
 
 double fuzzCatch(const Interface& I, double mu) {
   return I.fuzzAmount * std::min(fuzzAlbedo(std::clamp(mu, 0.0, 1.0), I.fuzzRough), 1.0);
@@ -593,6 +595,24 @@ void finishInterface(Interface& I, const WalkLayer& L, int rc, bool single) {
   I.fuzzColor = vclamp(L.fuzzColor, 0.0, 1.0);
 }
 
+/// Pushes interface I: a real interface with fuzz goes in as two, a
+/// pass-through carrying the fuzz over the bare interface with no medium
+/// between them, so that what the fuzz catches from below goes back down by
+/// the pass-through's rules (sheenFromBelow) instead of being absorbed, and
+/// light bounces between the fuzz and the interface as between two layers.
+void pushInterface(Resolved& r, Interface I) {
+  if (I.kind != Interface::Kind::Pass && I.fuzzAmount > 0) {
+    Interface fuzz;
+    fuzz.fuzzAmount = I.fuzzAmount;
+    fuzz.fuzzRough = I.fuzzRough;
+    fuzz.fuzzColor = I.fuzzColor;
+    r.ifc.push_back(fuzz);
+    r.med.push_back(Medium{});  // tau 0: the interface lies right under its fuzz
+    I.fuzzAmount = 0;
+  }
+  r.ifc.push_back(I);
+}
+
 /// The stack with the IORs and optical thicknesses of channel `rc`; per-channel
 /// weights (albedos, conductor Fresnel) for all channels.
 Resolved resolve(const std::vector<WalkLayer>& stack, const std::vector<V>& albedos, int rc, const WalkOptions& o) {
@@ -605,7 +625,7 @@ Resolved resolve(const std::vector<WalkLayer>& stack, const std::vector<V>& albe
     if (L.conductor) {
       I.kind = Interface::Kind::Conductor;
       finishInterface(I, L, rc, o.singleScatteringInterfaces);
-      r.ifc.push_back(I);
+      pushInterface(r, I);
       r.med.push_back(Medium{});
       r.bottom = Bottom::Conductor;
       break;
@@ -617,7 +637,7 @@ Resolved resolve(const std::vector<WalkLayer>& stack, const std::vector<V>& albe
     finishInterface(I, L, rc, o.singleScatteringInterfaces);
     Medium M;
     M.g = std::clamp(L.phaseAnisotropy, -kMaxG, kMaxG);
-    r.ifc.push_back(I);
+    pushInterface(r, I);
     const V& albedo = albedos[i];
     if (L.opaqueBase) {
       r.lambert = albedo;

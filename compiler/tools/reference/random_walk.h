@@ -58,16 +58,16 @@
 //       straight with weight 1 - amount * min(E_fuzz(mu), 1) at each crossing
 //       (mu of the direction above). An energy-conserving "mean sheen layer"
 //       (it reflects at most what it takes from the crossing light), the LTC /
-//       table sheen of the runtime as a layer, not a volumetric fibre walk;
-//       light from below that it would send back down is absorbed. Not
-//       reciprocal (the runtime's normalization by E_fuzz(mu_o) is not). On a
-//       pass-through (an index-matched interface: F0 0 on top, the IOR of the
-//       layer above under it) the fuzz is walked the same way — a velvet's
-//       sheen over its diffuse, a fabric's fuzz under a coat of its IOR (before
-//       issue 19 step 8 it was skipped) — except that what it catches from
-//       below is sent back down by the mirror image of its sheen (tinted by its
-//       colour), not absorbed: with nothing in the way, the two sides are
-//       alike.
+//       table sheen of the runtime as a layer, not a volumetric fibre walk. It
+//       is walked as a pass-through of its own (no medium between it and the
+//       interface under it), so light bounces between the two as between two
+//       layers, and what it catches from below goes back down by the mirror
+//       image of its sheen (tinted by its colour); a velvet (fuzz on an F0-0
+//       interface) and a fabric under a coat of its own IOR (index-matched)
+//       keep their fuzz. Issue 19 step 8: before, the fuzz of a pass-through
+//       was skipped and what a fuzz caught from below was absorbed (a white
+//       fuzzy coat over a white base returned 0.94). Not reciprocal (the
+//       runtime's normalization by E_fuzz(mu_o) is not).
 //   * Medium of a layer that is not the bottom: thickness d (the vertical's
 //     thickness), extinction sigma_t = 1 / MFP per channel (MFP clamped to
 //     >= 1e-30), so optical thickness tau = d / MFP; single-scattering albedo
