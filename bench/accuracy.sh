@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates, measured in one run on this machine:
-#   docs/accuracy/layering.md: `substratec accuracy --json` of every example and
-#     of the one-effect controls in bench/materials/ (the shipping model against
+#   docs/accuracy/layering.md: `substratec accuracy --json` of every example, of
+#     the one-effect controls in bench/materials/ and of every material of the
+#     MaterialX corpus in tests/import/corpus/materialx (the shipping model against
 #     the Monte Carlo truth: directional albedo at NoV 1 / 0.6 / 0.2 / 0.1 with
 #     standard errors, BRDF error, reciprocity, white furnace, what the truth
 #     excludes);
@@ -40,6 +41,27 @@ for f in "$ROOT"/bench/materials/*.json; do
   "$BIN" accuracy "$f" --json --diffuse lambert --samples "$SAMPLES" --eval-samples "$EVAL_SAMPLES" \
     > "$TMP/controls/$stem.json"
 done
+# The MaterialX corpus (tests/import/corpus/materialx): every material of every
+# file, by name (the names `import` gives them); a file that does not import, or
+# a material `accuracy` cannot measure, is listed with its first error.
+mkdir -p "$TMP/corpus" "$TMP/imported"
+: > "$TMP/corpus_unread.txt"
+while IFS= read -r f; do
+  stem="$(basename "$f" .mtlx)"
+  if ! "$BIN" import "$f" -o "$TMP/imported/$stem" > /dev/null 2> "$TMP/imported/$stem.err"; then
+    echo "$(grep -m1 'error' "$TMP/imported/$stem.err" | sed "s|$ROOT/||g")" >> "$TMP/corpus_unread.txt"
+    continue
+  fi
+  for j in "$TMP/imported/$stem"/*.json; do
+    name="$(python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["name"])' "$j")"
+    out="$TMP/corpus/$stem--$name.json"
+    if ! "$BIN" accuracy "$f" --material "$name" --json --samples "$SAMPLES" --eval-samples "$EVAL_SAMPLES" \
+      > "$out" 2> "$out.err"; then
+      echo "$name: $(grep -m1 'error' "$out.err" | sed "s|$ROOT/||g")" >> "$TMP/corpus_unread.txt"
+      rm -f "$out"
+    fi
+  done
+done < <(find "$ROOT/tests/import/corpus/materialx" -name '*.mtlx' | sort)
 python3 "$ROOT/bench/accuracy_tables.py" "$TMP" "$OUT" "$REV" "$(cut -d' ' -f1-3 /proc/loadavg)" \
   "$SAMPLES" "$EVAL_SAMPLES" "$PIXELS" "$RUNS" "$SWEEP_SAMPLES" "$SWEEP_EVAL_SAMPLES"
 cp "$TMP"/sweeps/*.svg "$OUT/"
