@@ -544,8 +544,9 @@ TEST(RandomWalkFurnace, WhiteFuzzReturnsAllTheLight) {
   // lobe reflects (the lobe's integral, up to 5 % below the table at grazing
   // views and low fuzz roughness). Issue 19 step 8: before, the fuzz on a
   // real interface absorbed what it caught from below (the fuzzy coat
-  // control's truth returned 0.96 / 0.94 at NoV 1 / 0.2). 4000 walks, maxDepth
-  // 1024: measured 0.970 .. 1.007; held to [0.965, 1.01].
+  // control's truth returned 0.96 / 0.94 at NoV 1 / 0.2). 16000 walks, maxDepth
+  // 1024: measured 0.983 .. 1.003 (standard errors ~0.004: the sheen's sampling
+  // weights vary); held to [0.965, 1.005] widened by 4 standard errors.
   int cases = 0;
   double lo = 2, hi = 0;
   for (double fuzzRoughness : {0.3, 0.8}) {
@@ -576,9 +577,10 @@ TEST(RandomWalkFurnace, WhiteFuzzReturnsAllTheLight) {
         {fuzzy(dielectric)}, {fuzzy(white)}, {fuzzy(coat), dielectric}, {fuzzy(coat), white}, {fuzzy(velvet)}};
     for (const auto& stack : stacks)
       for (double mu : {1.0, 0.5, 0.2}) {
-        const double a = layeredAlbedo(stack, dir(mu, 0.3), opts(4000, 70 + cases, 1024))[0];
-        EXPECT_GE(a, 0.965) << stack.size() << " layers, fuzz roughness " << fuzzRoughness << ", mu " << mu;
-        EXPECT_LE(a, 1.01) << stack.size() << " layers, fuzz roughness " << fuzzRoughness << ", mu " << mu;
+        const Estimate e = layeredAlbedoEstimate(stack, dir(mu, 0.3), opts(16000, 70 + cases, 1024));
+        const double a = e.value[0], band = 4 * e.standardError[0];
+        EXPECT_GE(a, 0.965 - band) << stack.size() << " layers, fuzz roughness " << fuzzRoughness << ", mu " << mu;
+        EXPECT_LE(a, 1.005 + band) << stack.size() << " layers, fuzz roughness " << fuzzRoughness << ", mu " << mu;
         lo = std::min(lo, a);
         hi = std::max(hi, a);
         ++cases;
