@@ -298,7 +298,7 @@ bool Emitter::underOperatorTop(int node) const {
 
 bool Emitter::fuzzAboveAny() const {
   for (int n : t_.preorder)
-    if (m_.nodes[n].op == TreeOp::Vertical && fuzzyLayer(m_, m_.nodes[n].left)) return true;
+    if (m_.nodes[n].op == TreeOp::Vertical && fuzzyLayer(t_, m_.nodes[n].left)) return true;
   return false;
 }
 
@@ -412,7 +412,7 @@ void Emitter::emitTree() {
                      v >= 0 ? fmt::format(", in the top layer of vertical '{}'", m_.nodes[v].id) : ""));
     line(fmt::format("float C_{} = {};", node.id, c));
     line(fmt::format("float3 T_{} = {};", node.id, t));
-    if (t_.layerVertical[n] >= 0 && fuzzyLayer(m_, n))  // what its fuzz lets through to the layers under it
+    if (t_.layerVertical[n] >= 0 && fuzzyLayer(t_, n))  // what its fuzz lets through to the layers under it
       line(fmt::format("float FT_{} = substrate_fuzz_transmission({}, {}, "
                        "dot(substrate_tangent_to_world({}, g.N, g.T), g.V));",
                        node.id, expr(s.pin(SlabPin::FuzzAmount)), expr(s.pin(SlabPin::FuzzRoughness)),
@@ -430,7 +430,7 @@ void Emitter::emitTree() {
     line(fmt::format("float C_{0}; float3 T_{0};", id));
     line(weight ? fmt::format("C_{0} = {1} * C_{2}; T_{0} = T_{2};", id, expr(node.a), l)
                 : operatorCall(node, "T_", "C_" + id, "T_" + id));
-    if (t_.layerVertical[n] >= 0 && fuzzyLayer(m_, n)) {
+    if (t_.layerVertical[n] >= 0 && fuzzyLayer(t_, n)) {
       // The same operator on what the children's fuzz lets through (1 for a
       // child without fuzz), for the closures under the layer (walkUp).
       line(fmt::format("float FT_{};", id));
@@ -452,7 +452,7 @@ std::string Emitter::operatorCall(const TreeNode& node, const std::string& prefi
                                   const std::string& t) {
   auto value = [&](int x) {
     if (prefix != "FT_") return prefix + nodeName(x);
-    return fmt::format("SUBSTRATE_SPLAT3({})", fuzzyLayer(m_, x) ? "FT_" + nodeName(x) : std::string("1.0"));
+    return fmt::format("SUBSTRATE_SPLAT3({})", fuzzyLayer(t_, x) ? "FT_" + nodeName(x) : std::string("1.0"));
   };
   const std::string l = nodeName(node.left), r = nodeName(node.right), tl = value(node.left), tr = value(node.right);
   switch (node.op) {
@@ -489,7 +489,7 @@ std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string
         if (op.right != x) break;
         layers.emplace_back(p, op.left);
         // What its fuzz lets through: FT where the layer covers, 1 elsewhere.
-        if (fuzzyLayer(m_, op.left))
+        if (fuzzyLayer(t_, op.left))
           f = t_.unitCoverage[op.left] ? fmt::format("FT_{}", m_.nodes[op.left].id)
                                        : fmt::format("lerp(1.0, FT_{0}, C_{0})", m_.nodes[op.left].id);
         break;

@@ -6,9 +6,9 @@ namespace substratec {
 
 namespace {
 
-/// Static coverage and interface counts (children before parents): the
+/// Static coverage, interface counts and fuzz (children before parents): the
 /// coverage of a subtree is 1 for a slab and stays 1 through operators whose
-/// rule keeps it there.
+/// rule keeps it there; a subtree holds fuzz where one of its slabs does.
 void analyzeCoverage(const Material& m, TreeInfo& t) {
   std::vector<int> order;
   std::vector<int> st{m.root};
@@ -36,6 +36,8 @@ void analyzeCoverage(const Material& m, TreeInfo& t) {
       case TreeOp::Vertical: one = c(node.left) || c(node.right); break; // sat(a+1), Ct + 1*(1-Ct)
     }
     t.unitCoverage[*it] = one;
+    auto f = [&](int j) { return j >= 0 && t.holdsFuzz[j]; };
+    t.holdsFuzz[*it] = node.op == TreeOp::Slab ? (m.slabs[node.slab].features & kFeatFuzz) != 0 : f(node.left) || f(node.right);
     auto k = [&](int j) { return j >= 0 ? t.interfaces[j] : 0; };
     t.interfaces[*it] = node.op == TreeOp::Slab       ? 1
                         : node.op == TreeOp::Vertical ? k(node.left) + k(node.right)
@@ -88,7 +90,7 @@ void analyzePreorder(const Material& m, TreeInfo& t) {
         l.layer = it.node;            // the top is this vertical's layer (the base stays in the enclosing one)
         r.layerDepth += 1;            // the base is under one more layer
         r.coverAbove = it.coverAbove && t.unitCoverage[node.left];
-        r.unit = it.unit && !fuzzyLayer(m, node.left);  // the base is weighted by what the fuzz lets through
+        r.unit = it.unit && !fuzzyLayer(t, node.left);  // the base is weighted by what the fuzz lets through
         r.above += node.left >= 0 ? t.interfaces[node.left] : 0;
         break;
       case TreeOp::Horizontal:
@@ -135,6 +137,7 @@ TreeInfo analyzeTree(const Material& m) {
   t.unitWeight.assign(n, false);
   t.unitCoverageAbove.assign(n, false);
   t.unitCoverage.assign(n, false);
+  t.holdsFuzz.assign(n, false);
   t.interfaces.assign(n, 0);
   t.interfacesAbove.assign(n, 0);
   t.bsdfId.assign(m.slabs.size(), -1);

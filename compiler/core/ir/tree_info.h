@@ -22,6 +22,7 @@ struct TreeInfo {
                                  // layer above holds fuzz (fuzzyLayer)
   std::vector<bool> unitCoverageAbove;  // slabs: every layer above has coverage statically 1
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
+  std::vector<bool> holdsFuzz;          // any node: the subtree holds a slab with fuzz (fuzzyLayer)
   std::vector<int> interfaces;   // any node: the most interfaces a path down through the subtree
                                  // crosses (slab 1, vertical top + base, other operators the larger side)
   std::vector<int> interfacesAbove;  // slabs: the interfaces of the tops of the verticals whose base
@@ -40,27 +41,13 @@ struct TreeInfo {
 
 TreeInfo analyzeTree(const Material& m);
 
-/// The subtree at `node` holds a slab with fuzz: as (or in) the top layer of a
-/// vertical, that fuzz reflects a share of the view's light that no longer
-/// reaches the layers under it, whose closures' weight takes what the layer
-/// lets through (substrate_fuzz_transmission, combined through the layer's
-/// operators as its transmittance is; issue 19 steps 7 and 8): their weight is
-/// not statically 1. An explicit walk, bounded by the node count.
-inline bool fuzzyLayer(const Material& m, int node) {
-  std::vector<int> stack;
-  if (node >= 0) stack.push_back(node);
-  for (std::size_t visits = 0; !stack.empty() && visits < m.nodes.size(); ++visits) {
-    const TreeNode& n = m.nodes[stack.back()];
-    stack.pop_back();
-    if (n.op == TreeOp::Slab) {
-      if (m.slabs[n.slab].features & kFeatFuzz) return true;
-      continue;
-    }
-    if (n.left >= 0) stack.push_back(n.left);
-    if (n.right >= 0) stack.push_back(n.right);
-  }
-  return false;
-}
+/// The subtree at `node` holds a slab with fuzz (TreeInfo::holdsFuzz, false
+/// for -1): as (or in) the top layer of a vertical, that fuzz reflects a share
+/// of the view's light that no longer reaches the layers under it, whose
+/// closures' weight takes what the layer lets through
+/// (substrate_fuzz_transmission, combined through the layer's operators as its
+/// transmittance is; issue 19 steps 7 and 8): their weight is not statically 1.
+inline bool fuzzyLayer(const TreeInfo& t, int node) { return node >= 0 && t.holdsFuzz[node]; }
 
 /// The most interfaces beyond the first one above a closure that its stored
 /// extra-interface count holds (2 bits: docs/storage.md); the lighting applies

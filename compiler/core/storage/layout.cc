@@ -125,7 +125,7 @@ bool constantWeight(const Material& m, const TreeInfo& t, int node) {
     const TreeNode& op = m.nodes[p];
     switch (op.op) {
       case TreeOp::Vertical:
-        if (op.right == x && fuzzyLayer(m, op.left)) return false;
+        if (op.right == x && fuzzyLayer(t, op.left)) return false;
         break;
       case TreeOp::Horizontal:
       case TreeOp::CoverageWeight:

@@ -318,7 +318,7 @@ double corePdf(const Interface& I, const V& wo, const V& wi, int flags) {
 /// weight of a kept exit stays f / p_all — the restricted estimator is then
 /// the integral of f over the wanted side only, unbiased (the single-scattering
 /// lobes instead renormalize their Fresnel choice among the allowed lobes).
-bool coreSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
+bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
   if (I.kind == Interface::Kind::Pass) return false;
   const int l = (I.haze > 0 && (I.haze >= 1 || rng.uniform() < I.haze)) ? 1 : 0;
   const Lobe& L = I.lobe[l];
@@ -348,7 +348,7 @@ bool coreSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int
 /// E[r.weight] + E[t.weight] is the interface's whole albedo, with no Bernoulli
 /// choice between them); on a microsurface walk the exit fills one of them.
 /// A zero weight: that side is absent.
-void coreSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
+void ifcSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
   r = BsdfSample{};
   t = BsdfSample{};
   const int l = (I.haze > 0 && (I.haze >= 1 || rng.uniform() < I.haze)) ? 1 : 0;
@@ -396,14 +396,14 @@ void coreSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, 
 // sheen layer" (what the sheen reflects at most, amount * min(E, 1), is what
 // it takes from the crossing light) — the LTC / table sheen of the runtime as
 // a layer, not a volumetric fibre walk. resolve() puts it on a pass-through of
-// its own over its interface (pushInterface), where light from below that it
-// catches goes back down (sheenFromBelow); the wrappers below (ifcF, ifcPdf,
-// ifcSample, ifcSplit) then only ever see fuzz on a pass-through.
+// its own over its interface (pushInterface), so only pass-throughs carry
+// fuzz: a real interface is its core (ifcF, ifcPdf, ifcSample, ifcSplit), a
+// pass-through's f and density are its sheen's, and the walks take its delta
+// crossing apart (passThrough, sheenFromAbove, sheenFromBelow).
 
 double fuzzCatch(const Interface& I, double mu) {
-  return I.fuzzAmount * std::min(fuzzAlbedo(std::clamp(mu, 0.0, 1.0), I.fuzzRough), 1.0);
+  return I.fuzzAmount > 0 ? I.fuzzAmount * std::min(fuzzAlbedo(std::clamp(mu, 0.0, 1.0), I.fuzzRough), 1.0) : 0.0;
 }
-double fuzzPass(const Interface& I, double mu) { return I.fuzzAmount > 0 ? 1 - fuzzCatch(I, mu) : 1.0; }
 /// The sheen's f |cos wi| (wo, wi above).
 V sheenFcos(const Interface& I, const V& wo, const V& wi) {
   const V h = unitOr(wo + wi, V{0, 0, 1});
@@ -411,20 +411,20 @@ V sheenFcos(const Interface& I, const V& wo, const V& wi) {
   return I.fuzzColor * (I.fuzzAmount * charlieSheen(I.fuzzRough, wo[2], wi[2], h[2]) / std::max(1.0, e));
 }
 
+/// f(wo, wi) of I (no cosine): a real interface's lobes, or the sheen of a
+/// pass-through's fuzz (wo, wi above).
 V ifcF(const Interface& I, const V& wo, const V& wi, Mode mode, SplitMix64& rng) {
-  V f = coreF(I, wo, wi, mode, rng);
-  if (!(I.fuzzAmount > 0) || wi[2] == 0) return f;
-  if (wo[2] > 0) f = f * fuzzPass(I, wo[2]);
-  if (wi[2] > 0) f = f * fuzzPass(I, wi[2]);
-  if (wo[2] > 0 && wi[2] > 0) f = f + sheenFcos(I, wo, wi) / wi[2];
-  return f;
+  if (I.kind != Interface::Kind::Pass) return coreF(I, wo, wi, mode, rng);
+  if (!(I.fuzzAmount > 0) || !(wo[2] > 0) || !(wi[2] > 0)) return V{0, 0, 0};
+  return sheenFcos(I, wo, wi) / wi[2];
 }
 
+/// The density of ifcF's lobes: a pass-through's sheen is cosine-sampled with
+/// probability fuzzCatch (sheenFromAbove).
 double ifcPdf(const Interface& I, const V& wo, const V& wi, int flags) {
-  const double p = corePdf(I, wo, wi, flags);
-  if (!(I.fuzzAmount > 0) || !(wo[2] > 0)) return p;
-  const double q = fuzzCatch(I, wo[2]);
-  return (1 - q) * p + ((flags & kReflection) && wi[2] > 0 ? q * wi[2] * kInvPi : 0);
+  if (I.kind != Interface::Kind::Pass) return corePdf(I, wo, wi, flags);
+  if (!(wo[2] > 0) || !(flags & kReflection) || !(wi[2] > 0)) return 0;
+  return fuzzCatch(I, wo[2]) * wi[2] * kInvPi;
 }
 
 /// The sheen picked with probability q (wo above): a cosine-sampled reflection.
@@ -437,16 +437,31 @@ bool sheenSample(const Interface& I, const V& wo, double q, SplitMix64& rng, Bsd
 }
 
 /// What the fuzz of a pass-through (index-matched) interface lets through a
-/// crossing in direction w (either way): fuzzPass at the cosine of the
-/// direction above, |w_z|; 1 without fuzz. The pass-through itself is a delta.
-double passThrough(const Interface& I, const V& w) { return fuzzPass(I, std::fabs(w[2])); }
+/// crossing in direction w (either way): 1 - fuzzCatch at the cosine of the
+/// direction above, |w_z|. The pass-through itself is a delta.
+double passThrough(const Interface& I, const V& w) { return 1 - fuzzCatch(I, std::fabs(w[2])); }
+
+/// Light travelling down (w) meets the fuzz of a pass-through from above: its
+/// sheen reflects it back up with probability q (what it catches; bs the
+/// sample, its density ifcPdf's), the rest crosses with weight (1 - q) / (1 -
+/// q). `reflected` says which; false: the sheen's sample failed, the walk ends.
+bool sheenFromAbove(const Interface& I, V& w, V& beta, SplitMix64& rng, BsdfSample& bs, bool& reflected) {
+  const double q = fuzzCatch(I, std::fabs(w[2]));
+  reflected = q > 0 && rng.uniform() < q;
+  if (!reflected) return true;
+  if (!sheenSample(I, neg(w), q, rng, bs)) return false;
+  bs.pdf = ifcPdf(I, neg(w), bs.wi, kAll);
+  beta = beta * bs.weight;
+  w = bs.wi;
+  return true;
+}
 
 /// Light travelling up (w) meets the fuzz of a pass-through from below: its
 /// sheen reflects it back down with probability q (the mirror image of the
 /// reflection from above), the rest crosses with weight (1 - q) / (1 - q).
 /// True when reflected (w, beta updated).
 bool sheenFromBelow(const Interface& I, V& w, V& beta, SplitMix64& rng) {
-  const double q = I.fuzzAmount > 0 ? fuzzCatch(I, std::fabs(w[2])) : 0;
+  const double q = fuzzCatch(I, std::fabs(w[2]));
   if (!(q > 0 && rng.uniform() < q)) return false;
   BsdfSample bs;
   if (!sheenSample(I, V{-w[0], -w[1], w[2]}, q, rng, bs)) {
@@ -456,35 +471,6 @@ bool sheenFromBelow(const Interface& I, V& w, V& beta, SplitMix64& rng) {
   beta = beta * bs.weight;
   w = V{bs.wi[0], bs.wi[1], -bs.wi[2]};
   return true;
-}
-
-bool ifcSample(const Interface& I, const V& wo, SplitMix64& rng, Mode mode, int flags, BsdfSample& s) {
-  if (!(I.fuzzAmount > 0)) return coreSample(I, wo, rng, mode, flags, s);
-  const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
-  if (q > 0 && rng.uniform() < q) {
-    if (!(flags & kReflection) || !sheenSample(I, wo, q, rng, s)) return false;
-  } else {
-    if (!coreSample(I, wo, rng, mode, flags, s)) return false;
-    if (wo[2] > 0) s.weight = s.weight * (fuzzPass(I, wo[2]) / (1 - q));
-    if (s.wi[2] > 0) s.weight = s.weight * fuzzPass(I, s.wi[2]);
-  }
-  s.pdf = ifcPdf(I, wo, s.wi, flags);
-  return s.pdf > 0 && std::isfinite(s.weight[0] + s.weight[1] + s.weight[2]);
-}
-
-void ifcSplit(const Interface& I, const V& wo, SplitMix64& rng, BsdfSample& r, BsdfSample& t) {
-  if (!(I.fuzzAmount > 0)) return coreSplit(I, wo, rng, r, t);
-  const double q = wo[2] > 0 ? fuzzCatch(I, wo[2]) : 0;
-  if (q > 0 && rng.uniform() < q) {
-    t = BsdfSample{};
-    if (!sheenSample(I, wo, q, rng, r)) r = BsdfSample{};
-    return;
-  }
-  coreSplit(I, wo, rng, r, t);
-  for (BsdfSample* x : {&r, &t}) {
-    if (wo[2] > 0) x->weight = x->weight * (fuzzPass(I, wo[2]) / (1 - q));
-    if (x->wi[2] > 0) x->weight = x->weight * fuzzPass(I, x->wi[2]);
-  }
 }
 
 // ---------------------------------------------------------------------------
@@ -955,24 +941,15 @@ struct EvalWalk {
       if (!isZero(fv)) connectB(fv * std::fabs(lw[2]), ifcPdf(I, neg(w), lw, kAll), std::exp(-trUp / std::fabs(lw[2])));
     }
     BsdfSample bs;
-    if (I.kind == Interface::Kind::Pass) {
-      // The fuzz on a pass-through from above: its sheen reflects with
-      // probability q (NEE above: ifcF is the sheen's), else a delta crossing
-      // of weight (1 - q) / (1 - q).
-      const double q = fuzzCatch(I, std::fabs(w[2]));
-      if (!(q > 0 && rng.uniform() < q)) {
-        ++k;
-        t = 0;
-        return true;
-      }
-      if (!sheenSample(I, neg(w), q, rng, bs)) return false;
-      bs.pdf = ifcPdf(I, neg(w), bs.wi, kAll);
-      beta = beta * bs.weight;
-      w = bs.wi;
+    bool reflected = false;
+    if (I.kind == Interface::Kind::Pass) {  // its fuzz (NEE above: ifcF is the sheen's)
+      if (!sheenFromAbove(I, w, beta, rng, bs, reflected)) return false;
     } else if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) {
       return false;
+    } else {
+      reflected = bs.reflect;
     }
-    if (bs.reflect) {
+    if (reflected) {
       if (k == 0) exitA(w, bs.pdf, std::exp(-trUp / std::fabs(w[2])));
     } else {
       ++k;
@@ -1050,7 +1027,7 @@ struct AlbedoWalk {
     if (I.kind == Interface::Kind::Pass) {
       // The fuzz on top reflects by its sheen with probability q (what it
       // catches) and lets the rest through (weight 1 - q over 1 - q).
-      const double q = I.fuzzAmount > 0 ? fuzzCatch(I, wo[2]) : 0;
+      const double q = fuzzCatch(I, wo[2]);
       if (q > 0 && rng.uniform() < q) {
         BsdfSample r;
         if (sheenSample(I, wo, q, rng, r)) sum = sum + r.weight;
@@ -1109,17 +1086,11 @@ struct AlbedoWalk {
       BsdfSample bs;
       if (!bounce(I, neg(w), kAll, rng, beta, w, bs)) return false;
       crossed = !bs.reflect;
-    } else if (I.fuzzAmount > 0) {
-      // The fuzz on a pass-through from above: its sheen reflects with
-      // probability q, else a delta crossing of weight (1 - q) / (1 - q).
-      const double q = fuzzCatch(I, std::fabs(w[2]));
-      if (q > 0 && rng.uniform() < q) {
-        BsdfSample bs;
-        if (!sheenSample(I, neg(w), q, rng, bs)) return false;
-        beta = beta * bs.weight;
-        w = bs.wi;
-        crossed = false;
-      }
+    } else {
+      BsdfSample bs;
+      bool reflected = false;
+      if (!sheenFromAbove(I, w, beta, rng, bs, reflected)) return false;
+      crossed = !reflected;
     }
     if (crossed) {
       ++k;

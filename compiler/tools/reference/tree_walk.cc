@@ -329,7 +329,7 @@ class Walk {
           if (op.right != x) break;
           tops.push_back(op.left);
           // What the layer's fuzz lets through where it covers (the emitter's walkUp).
-          if (fuzzyLayer(m_, op.left))
+          if (fuzzyLayer(t_, op.left))
             weight = weight * (t_.unitCoverage[op.left] ? FT_[op.left][0]
                                                         : T(1) - C_[op.left] * (T(1) - FT_[op.left][0]));
           break;
