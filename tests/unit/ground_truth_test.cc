@@ -298,6 +298,28 @@ TEST(RandomWalkGroundTruth, FurnaceMaterialIsWhiteForBothSides) {
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(e.value[k], 1.0, 0.02) << k;
 }
 
+TEST(RandomWalkGroundTruth, FurnaceMetalnessSlabIsWhiteAtGrazingToo) {
+  // A metal whose F90 is 0 (MaterialX's Standard Surface with specular 0, as
+  // standard_surface_copper imports) absorbs at grazing angles: the furnace
+  // whitens its F90 as it does a conductor's, so its analytic side is judged
+  // white as the truth's is (Gulbrandsen's metal of F0 1 reflects everything).
+  const std::string nodes = R"(
+    "h": {"kind": "metalness_to_diffuse_f0", "base_color": [0.9, 0.5, 0.3], "metallic": 1.0, "specular": 0.0},
+    "root": {"kind": "slab", "diffuse_albedo": "h.diffuse_albedo", "f0": "h.f0", "f90": 0.0, "roughness": 0.3})";
+  CompileResult w = furnaceMaterial(compileUnsimplified("metal_f90_0.json", test::material(nodes)));
+  int checked = 0;
+  for (double mu : {1.0, 0.5, 0.2}) {
+    Geometry g;
+    g.V = dir(mu, 0.0);
+    MaterialResult<double> a = evaluateMaterial<double>(w, g, InputValues{}, {});
+    for (const auto& c : a.closures) {
+      for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(c.f90[k], 1.0) << mu;
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 3);
+}
+
 
 }  // namespace
 }  // namespace substratec

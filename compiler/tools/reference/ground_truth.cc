@@ -352,7 +352,8 @@ std::vector<std::string> groundTruthExcluded(const CompileResult& r) {
 
 namespace {
 
-/// One slab of the furnace: albedos at 1, conductors white, coats clear.
+/// One slab of the furnace: albedos at 1, conductors white (F0 and F90: a
+/// conductor's F90 below 1 absorbs at grazing angles), coats clear.
 void whitenSlab(const CompileResult& r, const LayerReader& reader, int index, Material& m) {
   ValueDag& dag = m.values;
   Slab& s = m.slabs[index];
@@ -368,6 +369,7 @@ void whitenSlab(const CompileResult& r, const LayerReader& reader, int index, Ma
     ms.f0 = dag.makeN(Op::MetalnessToDiffuseF0, VType::Vec3, args, 3, 1);
     s.pin(SlabPin::DiffuseAlbedo) = ms.diffuse;
     s.pin(SlabPin::F0) = ms.f0;
+    s.pin(SlabPin::F90) = one3;  // its conductor part is white; its dielectric part gives the rest to the diffuse
   } else if (L.conductor) {
     s.pin(SlabPin::F0) = one3;
     s.pin(SlabPin::F90) = one3;
