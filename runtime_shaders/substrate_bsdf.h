@@ -124,6 +124,17 @@ float substrate_coat_lobe(float chan2024, float eon) {
 #endif
 }
 
+// The share of the way from G_k to 1 that a rough top moves the mean of the
+// layers' interface term (substrate_coat_transmission, issue 19 step 9):
+// h(f) = sat(f (0.2533 + f (-1.2067 + 1.9925 f))), f = c.coatFloor. The
+// cosine-weighted mean of the term to the power 1 + k is at most G_k + (1 -
+// G_k) h(f) for k = 0..3 (h is fitted above the largest of the four shares,
+// within 0.017 of it; scripts/fit_coat_transmission.py), so the diffuse's
+// normalization never gains energy; h(0) = 0: a smooth top keeps G_k.
+float substrate_coat_mean_share(float coatFloor) {
+  return saturate(coatFloor * (SUBSTRATE_COAT_MEAN_A + coatFloor * (SUBSTRATE_COAT_MEAN_B + SUBSTRATE_COAT_MEAN_C * coatFloor)));
+}
+
 // What the diffuse of a closure under layers gets back from them, per
 // channel: 1 / lerp(1, D, coverageAbove), with
 //   D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4).
@@ -154,6 +165,8 @@ float substrate_coat_lobe(float chan2024, float eon) {
 // (0 for the usual index-matched base, whose interface is gone). Without it a
 // base of F0 0.805 under an F0-0 layer returned 1.0013 and a closure under a
 // half coverage 1.0025 (furnace_test.cc); with it the largest is 1.0008.
+// Under a rough top the term is larger at grazing angles, and G_k becomes
+// G_k + (1 - G_k) h(r) (substrate_coat_mean_share, a bound from above).
 // G_k is for a cosine-distributed lobe: a rough one that favours light near the
 // normal takes more of the light-side term, so it is raised by the diffuse
 // model's bound of that (substrate_coat_lobe: Chan 2024 1.0062 at k = 0, EON
@@ -165,24 +178,29 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
 #else
   // No branch: at coverageAbove 0 the factor is exactly 1.
   float cover = saturate(c.coverageAbove);
-  float g = SUBSTRATE_COAT_G_0 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
+  float gk = SUBSTRATE_COAT_G_0;
+  float lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
   float ifc = SUBSTRATE_COAT_T_0;
   float invIfc = SUBSTRATE_COAT_INV_T_0;
 #if SUBSTRATE_USE_EXTRA_INTERFACES
   if (c.extraInterfaces == 1u) {
-    g = SUBSTRATE_COAT_G_1 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
+    gk = SUBSTRATE_COAT_G_1;
+    lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
     ifc = SUBSTRATE_COAT_T_1;
     invIfc = SUBSTRATE_COAT_INV_T_1;
   } else if (c.extraInterfaces == 2u) {
-    g = SUBSTRATE_COAT_G_2 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
+    gk = SUBSTRATE_COAT_G_2;
+    lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
     ifc = SUBSTRATE_COAT_T_2;
     invIfc = SUBSTRATE_COAT_INV_T_2;
   } else if (c.extraInterfaces >= 3u) {
-    g = SUBSTRATE_COAT_G_3 * substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
+    gk = SUBSTRATE_COAT_G_3;
+    lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
     ifc = SUBSTRATE_COAT_T_3;
     invIfc = SUBSTRATE_COAT_INV_T_3;
   }
 #endif
+  float g = (gk + (1.0 - gk) * substrate_coat_mean_share(c.coatFloor)) * lobe;
   float3 tn = saturate(c.topTransmittance);
   float3 ti = max(tn, SUBSTRATE_SPLAT3(ifc));
   float3 tm = saturate(tn * invIfc);
@@ -281,6 +299,27 @@ float substrate_fresnel_delta(float t) {
 float substrate_fresnel_weight(float c) {
   float t = substrate_pow5(1.0 - c);
   return t + substrate_fresnel_delta(t);
+}
+
+// The angular part of what the layers' interface lets through along a
+// direction at cosine mu (issue 19, step 9). The layers above are read as one
+// interface of IOR 1.5, whose smooth transmission 1 - chi(mu) falls to 0 at
+// grazing angles; a rough top reflects far less there, and what it does not
+// reflect reaches the layers under it. What an interface of F0 0 and F90 1
+// and roughness r lets through, 1 - b (b the chi-weighted part of the tables'
+// albedo, substrate_fresnel_b at share 1), is the least any top of F0 0 ..
+// 0.04 lets through per unit of T_N (which holds its 1 - F0): 1 - b + F0 (1 -
+// e) / (1 - F0) >= 1 - b. Without a lookup: max(1 - chi(mu), 1 - (1 - f)
+// (1 - mu)^2), f = c.coatFloor (substrate_coat_floor of the top layer's
+// roughness): the largest f of that form that keeps the term within max(1 -
+// chi(mu), 1 - b) at every mu (scripts/fit_coat_transmission.py; it takes 46 %
+// of the light that 1 - b adds at r 0.2, 85 % at r 1). At r 0.6 the term is
+// 0.85 at mu 0.1 (a smooth top: 0.45); up to r 0.1 it is the smooth one.
+// Without it a white Lambertian under a clear coat of roughness 1 returned
+// 0.46 of the light at NoV 0.1, a white conductor 0.46.
+float substrate_coat_transmission(float mu, float coatFloor) {
+  float m = 1.0 - saturate(mu);
+  return max(1.0 - substrate_fresnel_weight(mu), 1.0 - (1.0 - coatFloor) * (m * m));
 }
 
 // The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH),
@@ -474,8 +513,9 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // a the GGX alpha of the (haze-lerped) roughness, d = mu_i - 0.74536 along the
 // view and along the light (their product keeps it reciprocal;
 // SUBSTRATE_COAT_TIR_*, a fit to the integral, scripts/fit_coat_tir.py). Each
-// pass leaves the interface by (1 - R) g, g = 1 - chi at the larger of NoV
-// and NoL, and the closure reflects e of the rest, times the media's round
+// pass leaves the interface by (1 - R) g, g the layers' interface term at the
+// larger of NoV and NoL (substrate_coat_transmission, as the throughputs take
+// it), and the closure reflects e of the rest, times the media's round
 // trip T_m^2, T_m = sat(T_N / 0.96): e is its hemispherical albedo (the mean
 // Fresnel F0 + (F90 - F0) / 21 and the diffuse below it,
 // substrate_diffuse_transmission_of: one value for every direction, so the
@@ -529,7 +569,7 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float dAvg = fd.x + (fd.y - fd.x) * (1.0 / 21.0);
   float3 albedo = saturate(c.diffuseAlbedo);
   float3 e = saturate(fAvg + albedo * substrate_diffuse_transmission_of(albedo, fAvg, dAvg));
-  float escape = (1.0 - trapped) * lerp(1.0, 1.0 - substrate_fresnel_weight(max(v, l)), t);
+  float escape = (1.0 - trapped) * lerp(1.0, substrate_coat_transmission(max(v, l), c.coatFloor), t);
   float3 tm = saturate(c.topTransmittance * SUBSTRATE_COAT_INV_T_0);
   return (1.0 - trapped) / (SUBSTRATE_SPLAT3(1.0) - e * (tm * tm) * (1.0 - escape));
 #endif

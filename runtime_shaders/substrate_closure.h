@@ -39,6 +39,9 @@ struct SubstrateClosure {
   float3 topTransmittance;    // transmittance of the layers above along the normal (1 on top)
   float coverageAbove;        // coverage of the layers above (0 on top)
   uint extraInterfaces;       // interfaces above beyond the first, 0..3 (closure header bits 14-15)
+  float coatFloor;            // what the layers' rough top lets through at grazing angles, substrate_coat_floor
+                              // of the top-layer roughness (not stored per closure); 0 under a smooth top,
+                              // under more than one interface and under a mix of tops
   uint features;              // SUBSTRATE_FEATURE_* bits
   bool isTop;                 // nothing layered above
 };
@@ -149,8 +152,26 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.topTransmittance = SUBSTRATE_SPLAT3(1.0);
   c.coverageAbove = 0.0;
   c.extraInterfaces = 0u;
+  c.coatFloor = 0.0;
   c.features = 0u;
   c.isTop = true;
+}
+
+// What the rough top of the layers above a closure lets through at grazing
+// angles, per unit of their T_N (issue 19, step 9; substrate_coat_transmission
+// in substrate_bsdf.h): f(r) = 1.094 x / (x + 0.175), x = max(r - 0.1, 0), r
+// the pixel's top-layer roughness (the top-layer word's, so that the forward
+// and the deferred lighting agree). 0 up to r 0.1, 0.91 at r 1. Computed once
+// per pixel: the material function and the unpacker store it in
+// SubstrateClosure.coatFloor of each closure under one interface (extra
+// interfaces 0) when one closure is on top and its lobe is one isotropic GGX
+// lobe, so that r is that interface's own roughness; else 0 (the smooth term:
+// an inner interface may be smoother than the top, a mix of tops has no one
+// roughness, and a stretched or hazy top reflects more at grazing angles than
+// one lobe of roughness r: anisotropy -1 read 1.19 of a white furnace).
+float substrate_coat_floor(float topRoughness) {
+  float x = max(topRoughness - SUBSTRATE_COAT_ROUGH_START, 0.0);
+  return SUBSTRATE_COAT_ROUGH_SCALE * x / (x + SUBSTRATE_COAT_ROUGH_HALF);
 }
 
 #endif

@@ -92,6 +92,16 @@
 //   BEND: T_i^1.13 bounded above by Bernoulli's inequality, T_i (1 - 0.12 (1 - T_i));
 //   COVARIANCE: the closure's own interface coupling's covariance with the
 //        layers', per unit of mean F90 - mean F0.
+// substrate_coat_floor (issue 19, step 9): what a rough top lets through at
+// grazing angles, f = SCALE x / (x + HALF), x = max(r - START, 0);
+// substrate_coat_mean_share: h(f) = sat(f (A + f (B + C f))).
+// scripts/fit_coat_transmission.py.
+#define SUBSTRATE_COAT_ROUGH_SCALE 1.094
+#define SUBSTRATE_COAT_ROUGH_START 0.1
+#define SUBSTRATE_COAT_ROUGH_HALF 0.175
+#define SUBSTRATE_COAT_MEAN_A 0.2533
+#define SUBSTRATE_COAT_MEAN_B -1.2067
+#define SUBSTRATE_COAT_MEAN_C 1.9925
 #define SUBSTRATE_COAT_G_0 0.94642
 #define SUBSTRATE_COAT_G_1 0.90734
 #define SUBSTRATE_COAT_G_2 0.87632

@@ -8,30 +8,31 @@
 
 // SUBSTRATE_DIFFUSE_MEAN_COS: substrate_constants.h.
 
-// The angular part of what an interface transmits, normalized to 1 at normal
-// incidence (where T_N already holds its 1 - F0): 1 - chi(mu), chi the
-// Fresnel curve every interface follows (substrate_fresnel_weight, the exact
-// one of IOR 1.5; Schlick's (1 - mu)^5 before issue 19 step 4), so that
-// (1 - F0) * this = 1 - F(mu) exactly, what a smooth top of that F0 (and
-// F90 1) does not reflect. Without it a coat reflects F(mu) at a grazing view
-// and still lets 1 - F0 reach the base: a white base under a clear coat
-// returned 1.21 of the light at NoV 0.1 (docs/stability.md). Conservative for
-// rough coats (their E_spec is below F at grazing).
-float substrate_interface_transmission(float mu) {
-  return 1.0 - substrate_fresnel_weight(mu);
+// The angular part of what the layers' interface transmits, normalized to 1
+// at normal incidence (where T_N already holds its 1 - F0): at least 1 -
+// chi(mu), chi the Fresnel curve every interface follows
+// (substrate_fresnel_weight, the exact one of IOR 1.5; Schlick's (1 - mu)^5
+// before issue 19 step 4), so that (1 - F0) * this is at least 1 - F(mu),
+// what a smooth top of that F0 (and F90 1) does not reflect; more at grazing
+// angles under a rough top (substrate_coat_transmission, issue 19 step 9).
+// Without it a coat reflects F(mu) at a grazing view and still lets 1 - F0
+// reach the base: a white base under a clear coat returned 1.21 of the light
+// at NoV 0.1 (docs/stability.md).
+float substrate_interface_transmission(float mu, float coatFloor) {
+  return substrate_coat_transmission(mu, coatFloor);
 }
 
 // The angular part of the 1 + `extra` interfaces above a closure (extra =
-// SubstrateClosure.extraInterfaces, 0..3): (1 - chi(mu))^(1 + extra), by
-// multiplies. A stack of clear coats lets through no more than each of its
-// interfaces in turn: with one term for the whole stack every further
-// interface reflected its F(mu) and still passed everything on (issue 16:
-// six white transparent slabs returned 1.38 of the light at NoV 0.1).
+// SubstrateClosure.extraInterfaces, 0..3): the interface term to the power
+// 1 + extra, by multiplies. A stack of clear coats lets through no more than
+// each of its interfaces in turn: with one term for the whole stack every
+// further interface reflected its F(mu) and still passed everything on (issue
+// 16: six white transparent slabs returned 1.38 of the light at NoV 0.1).
 // Interfaces beyond 1 + 3 are folded into topTransmittance by the material
 // (substrate_extra_interfaces, substrate_tree.h). Compiled only when some
 // closure of the material (or scene) has extra interfaces.
-float substrate_interfaces_transmission(float mu, uint extra) {
-  float g = substrate_interface_transmission(mu);
+float substrate_interfaces_transmission(float mu, uint extra, float coatFloor) {
+  float g = substrate_interface_transmission(mu, coatFloor);
 #if SUBSTRATE_USE_EXTRA_INTERFACES
   float g2 = g * g;
   if (extra == 1u) {
@@ -57,8 +58,9 @@ float substrate_coat_path_length(float mu) {
   return 1.5 * rsqrt(1.25 + m * m);
 }
 
-// lerp(1, T_N^(1/mu_t) * (1 - chi(mu))^(1 + extraInterfaces),
-// coverageAbove): the transmittance of the layers above along a direction at
+// lerp(1, T_N^(1/mu_t) * g(mu)^(1 + extraInterfaces), coverageAbove), g the
+// layers' interface term under their top (substrate_interface_transmission):
+// the transmittance of the layers above along a direction at
 // cosine mu (their media along the refracted path 1 / mu_t =
 // substrate_coat_path_length(mu), T_N clamped to [1e-30, 1] as
 // substrate_transmittance_at_cosine does, and their interfaces), blended by their coverage. No
@@ -71,7 +73,7 @@ mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
   if (cover > 0.0) {
     float3 t = clamp(c.topTransmittance, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE), SUBSTRATE_SPLAT3(1.0));
     float3 through = exp(log(t) * substrate_coat_path_length(mu)) *
-                     substrate_interfaces_transmission(mu, c.extraInterfaces);
+                     substrate_interfaces_transmission(mu, c.extraInterfaces, c.coatFloor);
     return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
   }
 #endif

@@ -135,6 +135,8 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
     basisAniso[b] = false;
   }
   bool topShare = true;
+  uint tops = 0u;
+  bool topPlainLobe = true;  // the top closure's lobe is one isotropic GGX lobe
   for (int i = 0; i < SUBSTRATE_MAX_CLOSURES; ++i) {
     closureBasis[i] = 0u;
     if (uint(i) < count) {
@@ -157,6 +159,10 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       if (isTop && basis != 0u) {
         topShare = false;
       }
+      if (isTop) {
+        tops += 1u;
+        topPlainLobe = (feats & (SUBSTRATE_FEATURE_ANISOTROPY | SUBSTRATE_FEATURE_HAZE)) == 0u;
+      }
       if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
         basisAniso[basis] = true;
       }
@@ -167,6 +173,9 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
   float3 topN;
   float topRoughness;
   substrate_dq_top_layer(topLayer, topN, topRoughness);
+  // The top-layer roughness is the top's own when one closure is on top; a
+  // closure under that one interface alone reads its floor (substrate_coat_floor).
+  float coatFloor = tops == 1u && topPlainLobe ? substrate_coat_floor(topRoughness) : 0.0;
   float3 basisN[SUBSTRATE_MAX_BASES];
   float3 basisT[SUBSTRATE_MAX_BASES];
   for (int b = 0; b < SUBSTRATE_MAX_BASES; ++b) {
@@ -192,6 +201,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
     if (uint(j) < count) {
       closures[j].N = basisN[closureBasis[j]];
       closures[j].T = basisT[closureBasis[j]];
+      closures[j].coatFloor = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatFloor;
     }
   }
   return count;

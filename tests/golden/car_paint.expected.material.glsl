@@ -85,6 +85,8 @@ void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_P
   closures[1].coverageAbove = ca_base;
   closures[1].isTop = false;
   closures[1].features = 20u;
+  float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
+  closures[1].coatFloor = coatFloor;
 
   coverage = C_root;
   transmittance = T_root;
@@ -105,7 +107,7 @@ void car_paint_pack(SubstrateClosure closures[CAR_PAINT_CLOSURE_COUNT], float di
   words[8] = 0u;
   words[9] = 0u;
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_multi(3u, 2u, 1u);

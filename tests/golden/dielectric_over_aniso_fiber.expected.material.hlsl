@@ -75,6 +75,8 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   closures[1].coverageAbove = ca_fiber;
   closures[1].isTop = false;
   closures[1].features = 2u;
+  float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
+  closures[1].coatFloor = coatFloor;
 
   coverage = C_root;
   transmittance = T_root;
@@ -91,7 +93,7 @@ void dielectric_over_aniso_fiber_pack(SubstrateClosure closures[DIELECTRIC_OVER_
   words[4] = 0u;
   words[5] = 0u;
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_multi(2u, 2u, 1u);

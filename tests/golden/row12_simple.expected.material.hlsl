@@ -59,7 +59,7 @@ void row12_simple_pack(SubstrateClosure closures[ROW12_SIMPLE_CLOSURE_COUNT], fl
   words[0] = 0u;
   words[1] = 0u;
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_single(0u, 0u, 0u);

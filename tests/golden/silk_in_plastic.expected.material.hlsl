@@ -121,6 +121,9 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   closures[2].coverageAbove = ca_weft;
   closures[2].isTop = false;
   closures[2].features = 74u;
+  float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
+  closures[1].coatFloor = coatFloor;
+  closures[2].coatFloor = coatFloor;
 
   coverage = C_root;
   transmittance = T_root;
@@ -162,7 +165,7 @@ void silk_in_plastic_pack(SubstrateClosure closures[SILK_IN_PLASTIC_CLOSURE_COUN
     return;
   }
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_multi(2u, 3u, 2u);

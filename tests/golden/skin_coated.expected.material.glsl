@@ -91,6 +91,8 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
   closures[1].coverageAbove = ca_skin;
   closures[1].isTop = false;
   closures[1].features = 128u;
+  float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
+  closures[1].coatFloor = coatFloor;
 
   coverage = C_root;
   transmittance = T_root;
@@ -126,7 +128,7 @@ void skin_coated_pack(SubstrateClosure closures[SKIN_COATED_CLOSURE_COUNT], floa
     return;
   }
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_multi(2u, 2u, 1u);

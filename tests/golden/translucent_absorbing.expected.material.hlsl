@@ -84,7 +84,7 @@ void translucent_absorbing_pack(SubstrateClosure closures[TRANSLUCENT_ABSORBING_
     return;
   }
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_single(1u, 64u, 0u);

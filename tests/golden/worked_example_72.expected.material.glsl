@@ -188,7 +188,7 @@ void worked_example_72_pack(SubstrateClosure closures[WORKED_EXAMPLE_72_CLOSURE_
     return;
   }
   float3 topN = substrate_safe_normalize(closures[0].weight * closures[0].N, closures[0].N);
-  float topRoughness = saturate((closures[0].weight * closures[0].roughness) / max(closures[0].weight, 1e-6));
+  float topRoughness = saturate(closures[0].roughness);
   topLayer = substrate_q_top_layer(topN, topRoughness, dither);
   // header (16 bits at 0)
   { uint q = substrate_material_header_multi(2u, 3u, 3u);

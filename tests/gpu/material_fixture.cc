@@ -103,6 +103,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.topTransmittance = arrayOf<T>(c.topTransmittance);
   o.coverageAbove = static_cast<T>(c.coverageAbove);
   o.extraInterfaces = c.extraInterfaces;
+  o.coatFloor = static_cast<T>(c.coatFloor);
   o.features = c.features;
   o.isTop = c.isTop;
   o.metalnessMix = c.metalnessMix;
@@ -212,6 +213,7 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.features = static_cast<uint32_t>(p[kClosureFeatures]);
   c.isTop = p[kClosureIsTop] != 0.0f;
   c.extraInterfaces = static_cast<uint32_t>(p[kClosureExtraInterfaces]);
+  c.coatFloor = p[kClosureCoatFloor];
   c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }

@@ -250,6 +250,7 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
         check("features", at + kClosureFeatures, c64.features, c64.features);
         check("isTop", at + kClosureIsTop, c64.isTop ? 1 : 0, c64.isTop ? 1 : 0);
         check("extraInterfaces", at + kClosureExtraInterfaces, c64.extraInterfaces, c64.extraInterfaces);
+        check("coatFloor", at + kClosureCoatFloor, c64.coatFloor, c32.coatFloor);
       }
       check("coverage", kResultCoverage, ref.material.coverage, r32.material.coverage);
       for (int c = 0; c < 3; ++c) {

@@ -246,6 +246,45 @@ TEST(Accuracy, AConductorUnderACoatLosesWhatTheCoatTraps) {
   EXPECT_EQ(rows, 6);
 }
 
+TEST(Accuracy, ARoughClearCoatLetsTheGrazingLightThrough) {
+  // Issue 19, step 9 (bench/materials/rough_clear_coat_over_lambert.json): a
+  // Lambertian of albedo 0.9 under a clear coat of roughness 0.6. The layers'
+  // angular term was a smooth interface's, 1 - chi(mu), which falls to 0 at
+  // grazing angles where the rough coat reflects little: -1.1 / -2.9 / -24.6 /
+  // -44.3 % (NoV 1 / 0.6 / 0.2 / 0.1), a white furnace of 0.55 at NoV 0.1. With
+  // the rough top's floor (substrate_coat_transmission): -1.2 / -3.0 / -7.0 /
+  // -7.3 %, furnace 0.93 .. 0.99, reciprocity 1.00 as before.
+  Diagnostics d("rough_coat.json");
+  CompileOptions co;
+  co.budgetOverride = 1024;
+  co.maxClosuresOverride = 8;
+  auto compiled = compileText("rough_coat.json", test::material(R"(
+      "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.6, "sss_mfp": 1000},
+      "base": {"kind": "slab", "diffuse_albedo": 0.9, "f0": 0.04, "roughness": 0.5},
+      "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.0001})"),
+                              co, d);
+  ASSERT_TRUE(compiled) << d.formatAll();
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 256;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(*compiled, o), accuracy::truthOf(*compiled, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+    EXPECT_LE(std::fabs(*row.relError), 0.08);
+    EXPECT_GT(row.reciprocityPairs, 0);
+    EXPECT_LE(row.reciprocityMaxRatio, 1.02);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.92);
+      EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
 TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   // Issue 19, item 1: a coloured conductor of roughness 0.6 stretched to
   // |A| 0.8 (bench/materials/stretched_conductor.json) against the walk, whose

@@ -389,12 +389,19 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
   EXPECT_NE(mid.features & kFeatureCoverageAbove, 0u);
   EXPECT_EQ(base.extraInterfaces, 1u);
   EXPECT_EQ(mid.extraInterfaces, 0u);
-  // The lighting: the interface term g(mu) (stackfurnace::interfaceTerm) to
-  // the power 1 + extraInterfaces along the view and the light (cover is 1
-  // under the full inner coat, so the ratio is the term itself).
+  // The lighting: the interface term g(mu) under the layers' top (issue 19
+  // step 9: its rough floor reaches a closure under one interface only) to the power 1 + extraInterfaces
+  // along the view and the light (cover is 1 under the full inner coat, so the
+  // ratio is the term itself).
   ASSERT_NEAR(cover, 1.0, 1e-12);
+  // The top coat's roughness reaches the inner coat, under it alone; the base
+  // lies under two interfaces and keeps the smooth term (the inner coat may be
+  // the smoother one).
+  EXPECT_GT(mid.coatFloor, 0.0);
+  EXPECT_DOUBLE_EQ(mid.coatFloor, coatFloor(topRoughness(m.closures)));
+  EXPECT_DOUBLE_EQ(base.coatFloor, 0.0);
   for (double mu : {1.0, 0.5, 0.1, 1e-3}) {
-    const double g = stackfurnace::interfaceTerm(mu);
+    const double g = coatTransmission(mu, base.coatFloor);  // the layers' term under their top
     Closure<double> one = base;
     one.extraInterfaces = 0;
     for (std::uint32_t k : {0u, 1u, 2u, 3u}) {
@@ -468,6 +475,7 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.topTransmittance = v(c.topTransmittance);
   o.coverageAbove = static_cast<To>(c.coverageAbove);
   o.extraInterfaces = c.extraInterfaces;
+  o.coatFloor = static_cast<To>(c.coatFloor);
   o.features = c.features;
   o.isTop = c.isTop;
   o.metalnessMix = c.metalnessMix;

@@ -303,16 +303,13 @@ std::string emitPackFunction(const Material& m, const StorageLayout& L, const Sy
     s += "    return;\n  }\n";
   }
   // Top-layer word: the top closures' normal and roughness, coverage-weighted.
-  std::string nsum, rsum, wsum;
+  std::string nsum;
   for (std::size_t i = 0; i < L.closures.size(); ++i) {
     if (!L.closures[i].isTop) continue;
-    const std::string c = fmt::format("closures[{}]", i);
-    nsum += (nsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.N", c);
-    rsum += (rsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.roughness", c);
-    wsum += (wsum.empty() ? "" : " + ") + fmt::format("{}.weight", c);
+    nsum += (nsum.empty() ? "" : " + ") + fmt::format("closures[{0}].weight * closures[{0}].N", i);
   }
   s += fmt::format("  float3 topN = substrate_safe_normalize({}, closures[0].N);\n", nsum);
-  s += fmt::format("  float topRoughness = saturate(({}) / max({}, 1e-6));\n", rsum, wsum);
+  s += fmt::format("  float topRoughness = {};\n", topRoughnessExpr(L, "closures"));
   s += "  topLayer = substrate_q_top_layer(topN, topRoughness, dither);\n";
   std::vector<int> identity(L.closures.size());
   for (std::size_t i = 0; i < identity.size(); ++i) identity[i] = static_cast<int>(i);

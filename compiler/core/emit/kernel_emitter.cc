@@ -66,7 +66,8 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   put(kClosureFeatures, "float(" + c + ".features)");
   put(kClosureIsTop, c + ".isTop ? 1.0 : 0.0");
   put(kClosureExtraInterfaces, "float(" + c + ".extraInterfaces)");
-  for (int at = kClosureExtraInterfaces + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
+  put(kClosureCoatFloor, c + ".coatFloor");
+  for (int at = kClosureCoatFloor + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
   return s;
 }
 

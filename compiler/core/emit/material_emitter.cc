@@ -136,6 +136,7 @@ class Emitter {
   std::string operatorCall(const TreeNode& node, const std::string& prefix, const std::string& c,
                            const std::string& t);  // substrate_op_* of a binary operator (emitTree)
   void emitClosures();
+  void emitCoatFloor();
   std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
@@ -601,6 +602,26 @@ void Emitter::emitClosures() {
   }
 }
 
+/// What the layers' top lets through at grazing angles (substrate_coat_floor of
+/// the pixel's top-layer roughness, as the deferred unpacker derives it from the
+/// top-layer word, so that the forward pass lights as the deferred one does),
+/// for every closure under one interface when one closure, one isotropic lobe,
+/// is on top; the others keep 0 (substrate_closure_init).
+void Emitter::emitCoatFloor() {
+  const auto top = std::find_if(L_.closures.begin(), L_.closures.end(), [](const ClosureLayout& c) { return c.isTop; });
+  const auto tops = std::count_if(L_.closures.begin(), L_.closures.end(), [](const ClosureLayout& c) { return c.isTop; });
+  if (tops != 1) return;  // a mix of tops has no one roughness
+  if (m_.slabs[top->slab].features & (kFeatAnisotropy | kFeatHaze)) return;  // not one isotropic lobe
+  bool any = false;
+  for (std::size_t i = 0; i < L_.closures.size(); ++i) {
+    if (L_.closures[i].isTop || L_.closures[i].extraInterfaces > 0) continue;  // under that one interface only
+    if (!any) line(fmt::format("float coatFloor = substrate_coat_floor({});  // of the top-layer roughness",
+                               topRoughnessExpr(L_, "closures")));
+    any = true;
+    line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
+  }
+}
+
 std::string Emitter::run() {
   const std::string upper = materialUpper(m_);
   collectNeeded();
@@ -638,6 +659,7 @@ std::string Emitter::run() {
   emitValues();
   emitTree();
   emitClosures();
+  emitCoatFloor();
   line("");
   line(fmt::format("coverage = C_{};", m_.nodes[m_.root].id));
   line(fmt::format("transmittance = T_{};", m_.nodes[m_.root].id));
@@ -649,6 +671,20 @@ std::string Emitter::run() {
 }
 
 }  // namespace
+
+std::string topRoughnessExpr(const StorageLayout& layout, const std::string& arr) {
+  std::vector<std::size_t> tops;
+  for (std::size_t i = 0; i < layout.closures.size(); ++i)
+    if (layout.closures[i].isTop) tops.push_back(i);
+  if (tops.size() == 1) return fmt::format("saturate({}[{}].roughness)", arr, tops[0]);  // its weight cancels
+  std::string rsum, wsum;
+  for (std::size_t i : tops) {
+    const std::string c = fmt::format("{}[{}]", arr, i);
+    rsum += (rsum.empty() ? "" : " + ") + fmt::format("{0}.weight * {0}.roughness", c);
+    wsum += (wsum.empty() ? "" : " + ") + fmt::format("{}.weight", c);
+  }
+  return fmt::format("saturate(({}) / max({}, 1e-6))", rsum, wsum);
+}
 
 std::string emitMaterial(const Material& m, const TreeInfo& t, const StorageLayout& layout, const Syntax& syn,
                          const EmitOptions& options) {

@@ -55,6 +55,13 @@ std::string useDefines(std::uint16_t features);
 /// (not ClosureLayout::isTop), so the lighting compiles the layers' part.
 std::string extraInterfacesDefine(const StorageLayout& layout);
 
+/// The pixel's top-layer roughness as the top-layer word stores it (docs/storage.md)
+/// and the lighting reads it for the layers above a closure
+/// (SubstrateClosure.coatFloor): the top closures' roughness, weighted by
+/// their weights, saturated (one top closure: its roughness). `arr` names the
+/// closures' array.
+std::string topRoughnessExpr(const StorageLayout& layout, const std::string& arr);
+
 /// Shared by the entry, kernel and scene emitters.
 /// A material blended over the background through its transmittance (dual-source).
 bool translucentBlend(const Material& m);

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "gpu/sample_run.h"
+#include "reference/bsdf.h"
 #include "storage/pack.h"
 #include "validate/runtime_files.h"
 
@@ -149,9 +150,13 @@ GbufferPixel packPixel(const CompileResult& r, const reference::Geometry& g, con
   p.words = packMaterial(layout, values, bases, g.dither);
   // The top-layer word holds basis 0's normal when it is elided (any normal otherwise).
   const bool elided = layout.closures.size() == 1 || layout.basis0NormalElided;
-  p.topLayer = packTopLayer({elided ? bases[0].normal : ref.closures[0].N, values[0].roughness}, g.dither);
+  // Its roughness: the top closures' (the emitted pack's topRoughness); a pixel
+  // stored as one closure keeps that closure's.
+  const double topR = layout.closures.size() == 1 ? values[0].roughness : reference::topRoughness(ref.closures);
+  p.topLayer = packTopLayer({elided ? bases[0].normal : ref.closures[0].N, topR}, g.dither);
   const UnpackedMaterial back = unpackMaterial(p.words.data(), p.words.size(), p.topLayer);
   for (const ClosureValues& c : back.closures) p.closures.push_back(closureOf(c, back.bases.at(c.basis)));
+  reference::setCoatFloor(p.closures, back.topLayer.roughness);  // substrate_unpack_material: the word's roughness
   return p;
 }
 

@@ -439,6 +439,40 @@ T glintFactor(const Closure<T>& c, T d, T ToH, T BoH, T NoH) {
 // ---------------------------------------------------------------------------
 // --- closures under layers (substrate_closure_fresnel_ends, substrate_closure_coat_diffuse)
 
+// substrate_coat_floor: SCALE x / (x + HALF), x = max(r - START, 0).
+template <class T>
+T coatFloor(T topRoughness) {
+  const T x = std::max(topRoughness - T(SUBSTRATE_COAT_ROUGH_START), T(0));
+  return T(SUBSTRATE_COAT_ROUGH_SCALE) * x / (x + T(SUBSTRATE_COAT_ROUGH_HALF));
+}
+
+template <class T>
+void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
+  int tops = 0;
+  bool plain = true;
+  for (const Closure<T>& c : closures)
+    if (c.isTop) {
+      ++tops;
+      plain = (c.features & (kFeatureAnisotropy | kFeatureHaze)) == 0;
+    }
+  const T f = tops == 1 && plain ? coatFloor(topR) : T(0);
+  for (Closure<T>& c : closures) c.coatFloor = !c.isTop && c.extraInterfaces == 0 ? f : T(0);
+}
+
+// substrate_coat_mean_share: sat(f (A + f (B + C f))).
+template <class T>
+T coatMeanShare(T coatFloor) {
+  return saturate(coatFloor *
+                  (T(SUBSTRATE_COAT_MEAN_A) + coatFloor * (T(SUBSTRATE_COAT_MEAN_B) + T(SUBSTRATE_COAT_MEAN_C) * coatFloor)));
+}
+
+// substrate_coat_transmission: max(1 - chi(mu), 1 - (1 - f) (1 - sat(mu))^2).
+template <class T>
+T coatTransmission(T mu, T coatFloor) {
+  const T m = T(1) - saturate(mu);
+  return std::max(T(1) - fresnelWeight(mu), T(1) - (T(1) - coatFloor) * (m * m));
+}
+
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
 template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
 
@@ -478,7 +512,8 @@ V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f
   return {lerp(f, mixed[0], t), lerp(max3(f90), mixed[1], t)};
 }
 
-// 1 / lerp(1, D, cover), D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
+// 1 / lerp(1, D, cover), D = G_k(f) T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
+// G_k(f) = G_k + (1 - G_k) coatMeanShare(coatFloor),
 // T_i = max(T_N, 0.96^(1+k)), T_m = sat(T_N / 0.96^(1+k)).
 // The first term raised by 1 + 0.0145 sat(mean F90 - mean F0) of the closure's
 // own (relative) interface: the covariance of its coupling with the layers' (the
@@ -491,21 +526,25 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
   auto lobe = [diffuseModel](double chan2024, double eon) {
     return T(diffuseModel == kDiffuseChan2024 ? chan2024 : diffuseModel == kDiffuseEon ? eon : 1.0);
   };
-  T g = T(SUBSTRATE_COAT_G_0) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
+  T gk = T(SUBSTRATE_COAT_G_0), lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
   T ifc = T(SUBSTRATE_COAT_T_0), invIfc = T(SUBSTRATE_COAT_INV_T_0);
   if (c.extraInterfaces == 1u) {
-    g = T(SUBSTRATE_COAT_G_1) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
+    gk = T(SUBSTRATE_COAT_G_1);
+    lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
     ifc = T(SUBSTRATE_COAT_T_1);
     invIfc = T(SUBSTRATE_COAT_INV_T_1);
   } else if (c.extraInterfaces == 2u) {
-    g = T(SUBSTRATE_COAT_G_2) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
+    gk = T(SUBSTRATE_COAT_G_2);
+    lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
     ifc = T(SUBSTRATE_COAT_T_2);
     invIfc = T(SUBSTRATE_COAT_INV_T_2);
   } else if (c.extraInterfaces >= 3u) {
-    g = T(SUBSTRATE_COAT_G_3) * lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
+    gk = T(SUBSTRATE_COAT_G_3);
+    lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
     ifc = T(SUBSTRATE_COAT_T_3);
     invIfc = T(SUBSTRATE_COAT_INV_T_3);
   }
+  T g = (gk + (T(1) - gk) * coatMeanShare(c.coatFloor)) * lb;
   const T own = saturate(dot(f90 - f0, splat3(T(1) / T(3))));
   g = g * (T(1) + T(SUBSTRATE_COAT_COVARIANCE) * own);
   V3<T> r;
@@ -522,7 +561,8 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
 
 // substrate_closure_coat_specular: (1 - R') / (1 - e' (1 - (1 - R') g')) per channel, with
 // t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2, 1e-3),
-// d = max(mu_i - mu_c, 0) along the view and along the light), g' = lerp(1, 1 - chi(max(NoV, NoL)), t),
+// d = max(mu_i - mu_c, 0) along the view and along the light), g' = lerp(1,
+// coatTransmission(max(NoV, NoL), coatFloor), t),
 // e' = e sat(T_N / 0.96)^2 and e the closure's hemispherical albedo, F_avg + A diffuseTransmission(A, F_avg,
 // d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the same of the dielectric part fd).
 template <class T>
@@ -541,7 +581,7 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   const T l = saturate(NoL);
   const T trapped = t * (T(SUBSTRATE_COAT_TIR_P1) * a2 / (a2 + T(SUBSTRATE_COAT_TIR_P2) * inner(v) * inner(l)) +
                          T(SUBSTRATE_COAT_TIR_P3) * a2);
-  const T escape = (T(1) - trapped) * lerp(T(1), T(1) - fresnelWeight(std::max(v, l)), t);
+  const T escape = (T(1) - trapped) * lerp(T(1), coatTransmission(std::max(v, l), c.coatFloor), t);
   const V3<T> albedo = saturate(c.diffuseAlbedo);
   const V3<T> fAvg = f0 + (f90 - f0) * T(1.0 / 21.0);
   const T dAvg = fd[0] + (fd[1] - fd[0]) * T(1.0 / 21.0);
@@ -698,6 +738,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T ggxVisAniso<T>(const V2<T>&, T, T, T, T, T, T);                                           \
   template T fresnelDelta<T>(T);                                                                       \
   template T fresnelWeight<T>(T);                                                                      \
+  template T coatTransmission<T>(T, T);                                                                \
+  template T coatFloor<T>(T);                                                                          \
+  template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                         \
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \

@@ -34,6 +34,8 @@ template <class T> T ggxVis(T a, T NoV, T NoL);                                 
 template <class T> T ggxVisAniso(const V2<T>& alpha, T ToV, T BoV, T NoV, T ToL, T BoL, T NoL);
 template <class T> T fresnelDelta(T t);                                                    // substrate_fresnel_delta
 template <class T> T fresnelWeight(T c);                                                    // substrate_fresnel_weight
+template <class T> T coatTransmission(T mu, T coatFloor);                                   // substrate_coat_transmission
+template <class T> T coatFloor(T topRoughness);                                             // substrate_coat_floor
 template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
 template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull

@@ -21,17 +21,17 @@ namespace {
 template <class T> constexpr T kDiffuseMeanCos = T(SUBSTRATE_DIFFUSE_MEAN_COS);
 template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
 
-// substrate_interface_transmission: 1 - chi(mu) (fresnelWeight).
+// substrate_interface_transmission: coatTransmission(mu, coatFloor).
 template <class T>
-T interfaceTransmission(T mu) {
-  return T(1) - fresnelWeight(mu);
+T interfaceTransmission(T mu, T coatFloor) {
+  return coatTransmission(mu, coatFloor);
 }
 
-// substrate_interfaces_transmission: (1 - chi(mu))^(1 + extra) by
-// multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
+// substrate_interfaces_transmission: the interface term to the power 1 + extra
+// by multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
 template <class T>
-T interfacesTransmission(T mu, std::uint32_t extra) {
-  T g = interfaceTransmission(mu);
+T interfacesTransmission(T mu, std::uint32_t extra, T coatFloor) {
+  T g = interfaceTransmission(mu, coatFloor);
   const T g2 = g * g;
   if (extra == 1u) g = g2;
   else if (extra == 2u) g = g2 * g;
@@ -48,7 +48,7 @@ T coatPathLength(T mu) {
 }
 
 // substrate_closure_above_throughput: lerp(1, T_N^coatPathLength(mu) *
-// (1 - (1 - mu)^5)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
+// coatTransmission(mu, coatFloor)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
 // transcendental) when nothing covers the closure.
 template <class T>
 V3<T> aboveThroughput(const Closure<T>& c, T mu) {
@@ -58,7 +58,7 @@ V3<T> aboveThroughput(const Closure<T>& c, T mu) {
     V3<T> t;
     for (int k = 0; k < 3; ++k)
       t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
-    const T i = interfacesTransmission(mu, c.extraInterfaces);
+    const T i = interfacesTransmission(mu, c.extraInterfaces, c.coatFloor);
     return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
   }
   return splat3(T(1));

@@ -19,6 +19,7 @@
 // (throughputs, split sum, translucency), integrate.cc (envIntegrated),
 // common.h (substrate_common.h's primitives and small vector algebra).
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -76,6 +77,7 @@ struct Closure {
   V3<T> topTransmittance{T(1), T(1), T(1)};
   T coverageAbove = T(0);
   std::uint32_t extraInterfaces = 0;  // interfaces above beyond the first, 0..3
+  T coatFloor = T(0);  // what the layers' top lets through at grazing angles: coatFloor(topRoughness)
   std::uint32_t features = 0;
   bool isTop = true;
   /// SUBSTRATE_USE_METALNESS_MIX of the shader that lights it (Material::metalnessMix;
@@ -101,6 +103,34 @@ using TextureFn = std::function<std::array<double, 4>(int inputIndex, double u, 
 struct InputValues {
   std::vector<std::array<double, 4>> values;
 };
+
+/// The pixel's top-layer roughness as the top-layer word stores it (the
+/// emitter's topRoughnessExpr): the top closures' roughness weighted by their
+/// weights (one top closure: its roughness), saturated; every closure under
+/// layers reads coatFloor of it.
+template <class T>
+T topRoughness(const std::vector<Closure<T>>& closures) {
+  T r = T(0), w = T(0);
+  int tops = 0;
+  for (const Closure<T>& c : closures)
+    if (c.isTop) {
+      r = r + c.weight * c.roughness;
+      w = w + c.weight;
+      ++tops;
+    }
+  if (tops == 1)
+    for (const Closure<T>& c : closures)
+      if (c.isTop) return std::clamp(c.roughness, T(0), T(1));
+  return std::clamp(r / std::max(w, T(1e-6)), T(0), T(1));
+}
+
+/// SubstrateClosure.coatFloor of every closure, as the material function and
+/// the unpacker set it (substrate_coat_floor): coatFloor(topR), topR the
+/// pixel's top-layer roughness, for the closures under one interface when one
+/// closure is on top and its lobe is one isotropic GGX lobe (no anisotropy or
+/// haze feature), else 0.
+template <class T>
+void setCoatFloor(std::vector<Closure<T>>& closures, T topR);
 
 template <class T>
 struct MaterialResult {

@@ -15,6 +15,7 @@
 #include <map>
 
 #include "ir/value_eval.h"
+#include "reference/bsdf.h"
 #include "reference/common.h"
 #include "reference/energy_lut.h"
 #include "reference/reference.h"
@@ -172,6 +173,8 @@ class Walk {
     }
     assignProfiles();
     for (const ClosureLayout& cl : L_.closures) out.closures.push_back(closure(cl));
+    // What the layers' top lets through at grazing angles (the emitter's emitCoatFloor).
+    setCoatFloor(out.closures, topRoughness(out.closures));
     return out;
   }
 
