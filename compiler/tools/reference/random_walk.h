@@ -191,8 +191,10 @@ struct WalkOptions {
   /// true: it is the albedo seen through the slab's own interface in air — the
   /// analytic model's meaning (albedo (1 - E_spec) leaves, no darkening by the
   /// interface's internal reflection): each layer's A is first replaced by
-  /// A' = A / (1 - R21 + R21 A), R21 = internalReflectance(eta of its F0), the
-  /// closed form of a Lambertian under a smooth interface, then inverted as above.
+  /// A' = A / (1 - R21 + R21 A), R21 the cosine-weighted internal reflectance of
+  /// the slab's own interface in air (internalReflectance(eta of its F0) when
+  /// smooth; a rough one's is estimated once on its microsurface), the closed
+  /// form of a Lambertian under that interface, then inverted as above.
   bool albedoSeenThroughInterface = false;
   /// The IOR convention. false (the default, the model above): each slab's F0
   /// gives the relative IOR of its own interface, so layers' IORs multiply (a
