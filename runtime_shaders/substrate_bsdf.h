@@ -132,7 +132,11 @@ float substrate_coat_lobe(float chan2024, float eon) {
 // within 0.017 of it; scripts/fit_coat_transmission.py), so the diffuse's
 // normalization never gains energy; h(0) = 0: a smooth top keeps G_k.
 float substrate_coat_mean_share(float coatFloor) {
+#if SUBSTRATE_USE_COAT_FLOOR
   return saturate(coatFloor * (SUBSTRATE_COAT_MEAN_A + coatFloor * (SUBSTRATE_COAT_MEAN_B + SUBSTRATE_COAT_MEAN_C * coatFloor)));
+#else
+  return 0.0;
+#endif
 }
 
 // What the diffuse of a closure under layers gets back from them, per
@@ -166,7 +170,7 @@ float substrate_coat_mean_share(float coatFloor) {
 // base of F0 0.805 under an F0-0 layer returned 1.0013 and a closure under a
 // half coverage 1.0025 (furnace_test.cc); with it the largest is 1.0008.
 // Under a rough top the term is larger at grazing angles, and G_k becomes
-// G_k + (1 - G_k) h(r) (substrate_coat_mean_share, a bound from above).
+// G_k + (1 - G_k) h(f) (substrate_coat_mean_share, a bound from above).
 // G_k is for a cosine-distributed lobe: a rough one that favours light near the
 // normal takes more of the light-side term, so it is raised by the diffuse
 // model's bound of that (substrate_coat_lobe: Chan 2024 1.0062 at k = 0, EON
@@ -283,7 +287,7 @@ void substrate_ggx_d_vis(float2 alpha, bool aniso, float ToH, float BoH, float N
 // at every cosine, where Schlick's is 22.8 % below it at c = 0.6 and 6.2 % above
 // it at 0.1 (F0 0.04). chi(1) = 0 and chi(0) = 1. One curve for every
 // interface, so that the layers above (read as IOR 1.5) let through exactly
-// what a top of any F0 does not reflect (substrate_interface_transmission).
+// what a top of any F0 does not reflect (substrate_coat_transmission).
 // Other F0 keep this IOR's curve: at c = 0.6 an F0 of 0.02 reads 0.045 where
 // its own IOR reflects 0.039 (Schlick's 0.030), an F0 of 0.1 0.123 against
 // 0.137 (0.109); a conductor's normalized curve lies near Schlick's (the
@@ -302,10 +306,16 @@ float substrate_fresnel_weight(float c) {
 }
 
 // The angular part of what the layers' interface lets through along a
-// direction at cosine mu (issue 19, step 9). The layers above are read as one
-// interface of IOR 1.5, whose smooth transmission 1 - chi(mu) falls to 0 at
-// grazing angles; a rough top reflects far less there, and what it does not
-// reflect reaches the layers under it. What an interface of F0 0 and F90 1
+// direction at cosine mu, normalized to 1 at normal incidence (where T_N
+// already holds its 1 - F0). The layers above are read as one interface of
+// IOR 1.5: at least 1 - chi(mu), chi the Fresnel curve every interface
+// follows (Schlick's (1 - mu)^5 before issue 19 step 4), so that (1 - F0)
+// times the term is at least 1 - F(mu), what a smooth top of that F0 (and F90
+// 1) does not reflect. Without it a coat reflected F(mu) at a grazing view and
+// still let 1 - F0 reach the base: a white base under a clear coat returned
+// 1.21 of the light at NoV 0.1 (docs/stability.md). The smooth transmission
+// falls to 0 at grazing angles; a rough top reflects far less there, and what
+// it does not reflect reaches the layers under it (issue 19, step 9). What an interface of F0 0 and F90 1
 // and roughness r lets through, 1 - b (b the chi-weighted part of the tables'
 // albedo, substrate_fresnel_b at share 1), is the least any top of F0 0 ..
 // 0.04 lets through per unit of T_N (which holds its 1 - F0): 1 - b + F0 (1 -
@@ -318,8 +328,12 @@ float substrate_fresnel_weight(float c) {
 // Without it a white Lambertian under a clear coat of roughness 1 returned
 // 0.46 of the light at NoV 0.1, a white conductor 0.46.
 float substrate_coat_transmission(float mu, float coatFloor) {
+#if SUBSTRATE_USE_COAT_FLOOR
   float m = 1.0 - saturate(mu);
   return max(1.0 - substrate_fresnel_weight(mu), 1.0 - (1.0 - coatFloor) * (m * m));
+#else
+  return 1.0 - substrate_fresnel_weight(mu);  // the floor is 0: the smooth term, exactly
+#endif
 }
 
 // The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH),

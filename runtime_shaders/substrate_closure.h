@@ -105,6 +105,14 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_COAT_CONDUCTOR
 #define SUBSTRATE_USE_COAT_CONDUCTOR 1
 #endif
+// 1: some closure may lie under a rough top's floor (SubstrateClosure.coatFloor,
+// substrate_coat_floor): the compiler clears it when no closure of the
+// material gets one (several closures on top, a stretched or hazy top, or
+// every closure under layers under more than one interface), where the floor
+// is 0 and the layers' interface term is the smooth one exactly.
+#ifndef SUBSTRATE_USE_COAT_FLOOR
+#define SUBSTRATE_USE_COAT_FLOOR 1
+#endif
 // 1: a closure's diffuse lies under its dielectric part, and a conductor-like
 // F0 is read as a metalness mix (substrate_closure_dielectric_part): the
 // compiler sets it for materials with a metalness_to_diffuse_f0 slab; 0

@@ -84,7 +84,7 @@
 #define SUBSTRATE_FRESNEL_ROUGH_END 0.45
 // substrate_closure_coat_diffuse's terms, for k = extraInterfaces 0..3:
 //   G_k: 2 int mu g(mu)^(1 + k) dmu, the cosine-weighted mean of the lighting's
-//        light-side interface term g (substrate_interface_transmission:
+//        light-side interface term g (substrate_coat_transmission:
 //        1 - chi(mu) since issue 19 step 4; with Schlick's 1 - (1 - mu)^5
 //        they were 0.95238 / 0.91991 / 0.89524 / 0.87535);
 //   T_k: 0.96^(1 + k), the interfaces' share of topTransmittance (1 - F0 of

@@ -8,20 +8,6 @@
 
 // SUBSTRATE_DIFFUSE_MEAN_COS: substrate_constants.h.
 
-// The angular part of what the layers' interface transmits, normalized to 1
-// at normal incidence (where T_N already holds its 1 - F0): at least 1 -
-// chi(mu), chi the Fresnel curve every interface follows
-// (substrate_fresnel_weight, the exact one of IOR 1.5; Schlick's (1 - mu)^5
-// before issue 19 step 4), so that (1 - F0) * this is at least 1 - F(mu),
-// what a smooth top of that F0 (and F90 1) does not reflect; more at grazing
-// angles under a rough top (substrate_coat_transmission, issue 19 step 9).
-// Without it a coat reflects F(mu) at a grazing view and still lets 1 - F0
-// reach the base: a white base under a clear coat returned 1.21 of the light
-// at NoV 0.1 (docs/stability.md).
-float substrate_interface_transmission(float mu, float coatFloor) {
-  return substrate_coat_transmission(mu, coatFloor);
-}
-
 // The angular part of the 1 + `extra` interfaces above a closure (extra =
 // SubstrateClosure.extraInterfaces, 0..3): the interface term to the power
 // 1 + extra, by multiplies. A stack of clear coats lets through no more than
@@ -32,7 +18,7 @@ float substrate_interface_transmission(float mu, float coatFloor) {
 // (substrate_extra_interfaces, substrate_tree.h). Compiled only when some
 // closure of the material (or scene) has extra interfaces.
 float substrate_interfaces_transmission(float mu, uint extra, float coatFloor) {
-  float g = substrate_interface_transmission(mu, coatFloor);
+  float g = substrate_coat_transmission(mu, coatFloor);
 #if SUBSTRATE_USE_EXTRA_INTERFACES
   float g2 = g * g;
   if (extra == 1u) {
@@ -59,7 +45,7 @@ float substrate_coat_path_length(float mu) {
 }
 
 // lerp(1, T_N^(1/mu_t) * g(mu)^(1 + extraInterfaces), coverageAbove), g the
-// layers' interface term under their top (substrate_interface_transmission):
+// layers' interface term under their top (substrate_coat_transmission):
 // the transmittance of the layers above along a direction at
 // cosine mu (their media along the refracted path 1 / mu_t =
 // substrate_coat_path_length(mu), T_N clamped to [1e-30, 1] as

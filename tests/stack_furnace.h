@@ -31,7 +31,7 @@
 namespace substratec::stackfurnace {
 
 /// The lighting's angular term for one interface above a closure
-/// (substrate_interface_transmission): the layers above read as a dielectric
+/// (substrate_coat_transmission): the layers above read as a dielectric
 /// of IOR 1.5, F0 0.04, they let through 1 - F(mu) of it, (1 - F(mu)) / 0.96
 /// of what T_N holds, with F on the Fresnel curve every interface follows
 /// (reference::fresnelWeight: exact Fresnel within 1e-3,

@@ -350,7 +350,7 @@ double materialAlbedo(const CompileResult& r, double mu) {
 
 TEST(LayeringEnergy, AClearCoatDoesNotBrightenAWhiteBaseAtGrazingViews) {
   // The coat reflects F(mu), which grows toward grazing; what reaches the base
-  // must shrink with it (substrate_interface_transmission). Without it: 1.10
+  // must shrink with it (substrate_coat_transmission). Without it: 1.10
   // at NoV 0.2 and 1.21 at 0.1.
   const CompileResult r = compile(R"({"format": "substrate-material/1", "name": "white_coat",
     "nodes": {"coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": 10},

@@ -835,7 +835,7 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
   //     reaches steeper, clearer directions than the mirror one, and the
   //     interfaces' 1 - (1 - mu)^5 falls fast toward grazing); 12.1 % before the
   //     media were crossed along the refracted cosine (issue 19, step 2), 6.6 %
-  //     before the interface term (substrate_interface_transmission) existed;
+  //     before the interface term (substrate_coat_transmission) existed;
   //   absorbing coat (T_N = 0.5):          7.1 % (the diffuse sees the mean of
   //     T_N^(1 / mu_t) where split sum takes T_N^(1 / mu_t(0.5))); 22.0 % when the
   //     media were crossed along mu itself (2 E3(-ln T_N) against T_N^2).

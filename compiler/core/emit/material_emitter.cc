@@ -72,6 +72,33 @@ std::string coatConductorDefine(const Material& m, const StorageLayout& layout) 
   return fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", any ? 1 : 0);
 }
 
+/// The closures that read the layers' rough top (SubstrateClosure.coatFloor):
+/// when one closure, one isotropic lobe, is on top, those under that one
+/// interface (extraInterfaces 0); else none. None either when every closure is
+/// on top, or when the top's roughness is a constant up to
+/// SUBSTRATE_COAT_ROUGH_START, whose floor is 0 (a clear coat of roughness 0.05).
+std::vector<std::size_t> coatFloorClosures(const Material& m, const StorageLayout& layout) {
+  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
+  const auto top = std::find_if(layout.closures.begin(), layout.closures.end(), isTop);
+  if (std::count_if(layout.closures.begin(), layout.closures.end(), isTop) != 1) return {};  // no one roughness
+  const Slab& slab = m.slabs[top->slab];
+  if (slab.features & (kFeatAnisotropy | kFeatHaze)) return {};  // not one isotropic lobe
+  const ValueId r = slab.pin(SlabPin::Roughness);
+  if (r != kNoValue && m.values.isConst(r) && m.values.node(r).c[0] <= SUBSTRATE_COAT_ROUGH_START) return {};
+  std::vector<std::size_t> out;
+  for (std::size_t i = 0; i < layout.closures.size(); ++i)
+    if (!layout.closures[i].isTop && layout.closures[i].extraInterfaces == 0) out.push_back(i);
+  return out;
+}
+
+/// SUBSTRATE_USE_COAT_FLOOR: 1 when some closure reads the rough top's floor
+/// (coatFloorClosures); the others' floor is 0, for which the layers'
+/// interface term is the smooth one exactly, so a material with none compiles
+/// none of it.
+std::string coatFloorDefine(const Material& m, const StorageLayout& layout) {
+  return fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n", coatFloorClosures(m, layout).empty() ? 0 : 1);
+}
+
 bool translucentBlend(const Material& m) {
   return m.settings.blendMode == BlendMode::TranslucentGrey || m.settings.blendMode == BlendMode::TranslucentColored ||
          m.settings.blendMode == BlendMode::ColoredTransmittanceOnly;
@@ -608,18 +635,11 @@ void Emitter::emitClosures() {
 /// for every closure under one interface when one closure, one isotropic lobe,
 /// is on top; the others keep 0 (substrate_closure_init).
 void Emitter::emitCoatFloor() {
-  const auto top = std::find_if(L_.closures.begin(), L_.closures.end(), [](const ClosureLayout& c) { return c.isTop; });
-  const auto tops = std::count_if(L_.closures.begin(), L_.closures.end(), [](const ClosureLayout& c) { return c.isTop; });
-  if (tops != 1) return;  // a mix of tops has no one roughness
-  if (m_.slabs[top->slab].features & (kFeatAnisotropy | kFeatHaze)) return;  // not one isotropic lobe
-  bool any = false;
-  for (std::size_t i = 0; i < L_.closures.size(); ++i) {
-    if (L_.closures[i].isTop || L_.closures[i].extraInterfaces > 0) continue;  // under that one interface only
-    if (!any) line(fmt::format("float coatFloor = substrate_coat_floor({});  // of the top-layer roughness",
-                               topRoughnessExpr(L_, "closures")));
-    any = true;
-    line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
-  }
+  const std::vector<std::size_t> under = coatFloorClosures(m_, L_);
+  if (under.empty()) return;
+  line(fmt::format("float coatFloor = substrate_coat_floor({});  // of the top-layer roughness",
+                   topRoughnessExpr(L_, "closures")));
+  for (std::size_t i : under) line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
 }
 
 std::string Emitter::run() {
@@ -636,6 +656,7 @@ std::string Emitter::run() {
   out_ += useDefines(all);
   out_ += extraInterfacesDefine(L_);
   out_ += coatConductorDefine(m_, L_);
+  out_ += coatFloorDefine(m_, L_);
   line(fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}", m_.metalnessMix ? 1 : 0));
   line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", diffuseModelNumber(opt_.diffuseModel)));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));

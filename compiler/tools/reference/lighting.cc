@@ -21,17 +21,11 @@ namespace {
 template <class T> constexpr T kDiffuseMeanCos = T(SUBSTRATE_DIFFUSE_MEAN_COS);
 template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
 
-// substrate_interface_transmission: coatTransmission(mu, coatFloor).
-template <class T>
-T interfaceTransmission(T mu, T coatFloor) {
-  return coatTransmission(mu, coatFloor);
-}
-
 // substrate_interfaces_transmission: the interface term to the power 1 + extra
 // by multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
 template <class T>
 T interfacesTransmission(T mu, std::uint32_t extra, T coatFloor) {
-  T g = interfaceTransmission(mu, coatFloor);
+  T g = coatTransmission(mu, coatFloor);
   const T g2 = g * g;
   if (extra == 1u) g = g2;
   else if (extra == 2u) g = g2 * g;
