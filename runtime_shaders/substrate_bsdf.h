@@ -64,8 +64,25 @@ float substrate_fresnel_share(float f0max) {
   return 1.0 - saturate((f0max - SUBSTRATE_COAT_DIELECTRIC_F0) * SUBSTRATE_COAT_CONDUCTOR_BLEND);
 }
 
+// F90 as Substrate defines it: "F90 can only change the chromaticity, not the
+// intensity" (the course notes: it does not take energy away at grazing
+// angles). A conductor's F90 (F0 from 0.2: substrate_fresnel_share 0) gives
+// the hue only, F90 / its largest channel (white for a black F90), so its
+// Fresnel reaches full intensity at grazing, as every conductor's does. A
+// dielectric's (F0 up to 0.1, share 1) keeps its intensity: importers switch
+// a dielectric's grazing reflection off with it (Standard Surface's
+// `specular` 0). Linear between, by the share. Without it a metal of F90 0
+// (Standard Surface with `specular` 0, as `Metal_Brushed`) went black at
+// grazing angles: -17.8 / -30.5 % at NoV 0.2 / 0.1 (issue 19, step 11).
+float3 substrate_f90_effective(float3 f0, float3 f90) {
+  float m = substrate_max3(f90);
+  float3 hue = lerp(SUBSTRATE_SPLAT3(1.0), f90 / max(m, 1e-6), step(1e-6, m));
+  return lerp(hue, f90, substrate_fresnel_share(substrate_max3(f0)));
+}
+
 // The Fresnel ends of a closure: its reflectance at normal incidence, and at
-// grazing incidence (white unless it has the F90 feature), and the share of
+// grazing incidence (white unless it has the F90 feature; then
+// substrate_f90_effective), and the share of
 // the dielectric curve between them (substrate_fresnel_share, from the
 // largest channel of the relative F0).
 //
@@ -91,7 +108,7 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   float3 f90f = SUBSTRATE_SPLAT3(1.0);
 #if SUBSTRATE_USE_F90
   if ((c.features & SUBSTRATE_FEATURE_F90) != 0u) {
-    f90f = saturate(c.f90);
+    f90f = substrate_f90_effective(f0f, saturate(c.f90));
   }
 #endif
   float f = substrate_max3(f0f);

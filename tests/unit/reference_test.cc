@@ -695,6 +695,50 @@ TEST(ReferenceFresnel, TheCurveIsExactFresnelOfIor1_5) {
   std::printf("[ reference ] Fresnel curve: within %.1e of exact Fresnel of IOR 1.5 over %d cosines\n", worst, cosines);
 }
 
+TEST(ReferenceFresnel, AConductorsF90IsAHueADielectricsKeepsItsIntensity) {
+  // Substrate's F90 "can only change the chromaticity, not the intensity"
+  // (the course notes): a conductor (F0 from 0.2) reads its F90 as a hue,
+  // largest channel 1, white for black; a dielectric (F0 up to 0.1) keeps it
+  // (importers switch a dielectric's grazing reflection off with F90 0).
+  const auto ends = [](V3<double> f0, V3<double> f90) {
+    Closure<double> c;
+    c.f0 = f0;
+    c.f90 = f90;
+    c.features = kFeatureF90;
+    V3<double> a, b;
+    double share;
+    closureFresnelEnds(c, a, b, share);
+    return b;
+  };
+  const V3<double> metal{0.9, 0.6, 0.3}, glass{0.04, 0.04, 0.04};
+  int cases = 0;
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_DOUBLE_EQ(ends(metal, {0, 0, 0})[ch], 1.0);                        // black: white
+    EXPECT_DOUBLE_EQ(ends(metal, {0.5, 0.25, 0})[ch], (V3<double>{1, 0.5, 0})[ch]);  // the hue
+    EXPECT_DOUBLE_EQ(ends(metal, {0.3, 0.3, 0.3})[ch], 1.0);                  // grey: white
+    EXPECT_DOUBLE_EQ(ends(glass, {0, 0, 0})[ch], 0.0);                        // kept
+    EXPECT_DOUBLE_EQ(ends(glass, {0.5, 0.25, 0})[ch], (V3<double>{0.5, 0.25, 0})[ch]);
+    cases += 5;
+  }
+  EXPECT_EQ(cases, 15);
+  // Between (F0 0.15, half way from 0.1 to 0.2): half way from the F90 to its hue.
+  EXPECT_NEAR(ends({0.15, 0.15, 0.15}, {0.5, 0.5, 0.5})[0], 0.75, 1e-12);
+  // So a metal of F90 0 reflects at grazing what one of F90 1 does: its
+  // directional albedo at NoV 0.1 (it went black at grazing before).
+  Closure<double> dark, white;
+  dark.f0 = white.f0 = metal;
+  dark.features = white.features = kFeatureF90;
+  dark.f90 = {0, 0, 0};
+  white.f90 = {1, 1, 1};
+  dark.diffuseAlbedo = white.diffuseAlbedo = {0, 0, 0};
+  dark.roughness = white.roughness = 0.4;
+  const D3 V = directionAt({0, 0, 1}, 0.1, 0);
+  const auto env = [](const V3<double>&) { return V3<double>{1, 1, 1}; };
+  const V3<double> a = envIntegrated(dark, V, env, kDiffuseLambert, 4096, 5);
+  const V3<double> b = envIntegrated(white, V, env, kDiffuseLambert, 4096, 5);
+  for (int ch = 0; ch < 3; ++ch) EXPECT_DOUBLE_EQ(a[ch], b[ch]);
+}
+
 TEST(ReferenceEnergy, TheDiffuseLightCouplingKeepsTheViewsAlbedo) {
   // substrate_diffuse_light_coupling: (1 - E~(NoL)) / (1 - Ē~), E~ Karis' fit of
   // the interface's albedo (refitted for the Fresnel curve chi) and Ē~ its

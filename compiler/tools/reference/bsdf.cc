@@ -476,6 +476,16 @@ T coatTransmission(T mu, T coatFloor) {
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
 template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
 
+// substrate_f90_effective: lerp(F90 / max(max3 F90, 1e-6) (white when max3 F90 < 1e-6),
+// F90, fresnelShare(max3 F0)): a conductor's F90 is a hue, a dielectric's keeps its intensity.
+template <class T>
+V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90) {
+  const T m = max3(f90);
+  const V3<T> hue = m >= T(1e-6) ? f90 * (T(1) / std::max(m, T(1e-6))) : splat3(T(1));
+  const T share = fresnelShare(max3(f0));
+  return hue + (f90 - hue) * share;
+}
+
 // F0 and F90 scaled by the ratio of the largest channel's F0 relative to a dielectric of
 // F0 0.04 above, ((s - 0.2) / (1 - 0.2 s))^2, to itself: never above 1, only
 // in the dielectric range (back to 1 over F0 0.1 .. 0.2), lerped toward 1 by
@@ -484,7 +494,7 @@ template <class T>
 void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share) {
   f0 = saturate(c.f0);
   f90 = splat3(T(1));
-  if (c.features & kFeatureF90) f90 = saturate(c.f90);
+  if (c.features & kFeatureF90) f90 = f90Effective(f0, saturate(c.f90));
   // No branch, as in the shader: at coverageAbove 0 the scale is exactly 1.
   const T cover = saturate(c.coverageAbove);
   const T f = max3(saturate(c.f0));
@@ -728,6 +738,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
   template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
+  template V3<T> f90Effective<T>(const V3<T>&, const V3<T>&);                                          \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \

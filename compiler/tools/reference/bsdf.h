@@ -38,6 +38,7 @@ template <class T> T coatTransmission(T mu, T coatFloor);                       
 template <class T> T coatFloor(T topRoughness);                                             // substrate_coat_floor
 template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
+template <class T> V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90);                   // substrate_f90_effective
 template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull
 template <class T>
 V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo

@@ -534,7 +534,8 @@ constexpr double kMultipleMinAlpha = 0.002;
 /// Gulbrandsen's edge tint from the slab's F0 and F90: g = F90 (1 - (1 - F0)^2.75).
 /// The factor is the g whose curve is closest to Schlick's with F90 = 1 (fitted
 /// over F0 in [0.02, 1]; random_walk.h has the differences), so the default
-/// F90 = 1 reads as the runtime's Schlick, and F90 < 1 lowers the edge tint.
+/// F90 = 1 reads as the runtime's Schlick, and a tinted F90 tints the edge
+/// (finishInterface passes the runtime's effective F90).
 double edgeTint(double f0, double f90) {
   return std::clamp(f90, 0.0, 1.0) * (1 - std::pow(1 - std::clamp(f0, 0.0, 1.0), 2.75));
 }
@@ -557,12 +558,15 @@ Lobe makeLobe(const Interface& I, double roughness, double anisotropy, bool sing
 }
 
 /// The interface of layer L (kind and eta set by the caller): frame, lobes, tint.
+/// F90 is the runtime's (f90Effective: a conductor's is a hue, a dielectric's
+/// keeps its intensity).
 void finishInterface(Interface& I, const WalkLayer& L, int rc, bool single) {
+  const V f90 = f90Effective(vclamp(L.f0, 0.0, 1.0), vclamp(L.f90, 0.0, 1.0));
   if (I.kind == Interface::Kind::Conductor)
-    for (int c = 0; c < 3; ++c) conductorIor(saturate(L.f0[c]), edgeTint(L.f0[c], L.f90[c]), I.n[c], I.k[c]);
+    for (int c = 0; c < 3; ++c) conductorIor(saturate(L.f0[c]), edgeTint(L.f0[c], f90[c]), I.n[c], I.k[c]);
   if (I.kind == Interface::Kind::Dielectric) {
     I.dielF0 = sq((I.eta - 1) / (I.eta + 1));
-    I.dielF90 = saturate(L.f90[rc]);
+    I.dielF90 = f90[rc];
   }
   I.cosT = std::cos(L.tangentAngle);
   I.sinT = std::sin(L.tangentAngle);

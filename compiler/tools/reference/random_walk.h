@@ -44,7 +44,9 @@
 //       F0)^2.75): the factor is the g whose curve is closest to Schlick's with
 //       F90 = 1, so the default F90 = 1 reads as the runtime's Schlick (max
 //       difference over angles 0.056 / 0.027 / 0.024 / 0.012 / 0.014 / 0.006 at
-//       F0 0.02 / 0.04 / 0.3 / 0.56 / 0.9 / 0.97); F90 < 1 lowers the edge tint.
+//       F0 0.02 / 0.04 / 0.3 / 0.56 / 0.9 / 0.97). F90 is the runtime's
+//       effective one (bsdf.h f90Effective): a conductor's gives the tint's hue
+//       only (its largest channel reads 1), a dielectric's keeps its intensity.
 //       Exact conductor Fresnel. A conductor hides everything below it.
 //     - Haze: the interface is the mixture of two microsurfaces, roughness and
 //       secondRoughness, by secondRoughnessWeight (as the runtime lerps its two
