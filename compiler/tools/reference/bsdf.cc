@@ -476,12 +476,12 @@ T coatTransmission(T mu, T coatFloor) {
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
 template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
 
-// substrate_f90_effective: lerp(F90 / max(max3 F90, 1e-6) (white when max3 F90 < 1e-6),
+// substrate_f90_effective: lerp(F90 / max3 F90 (white when max3 F90 < 1e-6),
 // F90, fresnelShare(max3 F0)): a conductor's F90 is a hue, a dielectric's keeps its intensity.
 template <class T>
 V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90) {
   const T m = max3(f90);
-  const V3<T> hue = m >= T(1e-6) ? f90 * (T(1) / std::max(m, T(1e-6))) : splat3(T(1));
+  const V3<T> hue = m >= T(1e-6) ? f90 * (T(1) / m) : splat3(T(1));
   const T share = fresnelShare(max3(f0));
   return hue + (f90 - hue) * share;
 }
