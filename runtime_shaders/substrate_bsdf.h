@@ -813,6 +813,57 @@ mfloat3 substrate_diffuse_wrap(mfloat3 albedo, float3 wrap, float NoL) {
 }
 
 // ---------------------------------------------------------------------------
+// A slab's medium seen through its interface (issue 19, step 12).
+//
+// A semi-infinite scattering medium is not Lambertian: light that enters
+// along the normal goes deep and less of it comes back than the medium's
+// albedo A (its spherical albedo, van de Hulst), light that enters at a
+// grazing angle stays shallow and more comes back. With s = sqrt(1 - w') the
+// medium's slope (w' its reduced single-scattering albedo), the directional
+// albedo is R(mu) = A (1 + 2 s m) / (1 + 2 s mu) (Chandrasekhar's H-function
+// in its first approximation, H(mu) ~ (1 + 2 mu) / (1 + 2 s mu)), mu the
+// cosine inside the medium and m its mean. The diffuse of a slab with a mean
+// free path is weighted by that ratio along the view and along the light,
+// which keeps it reciprocal (substrate_eval_closure; the split sum takes the
+// view's part):
+//   (1 + 2 s m)(1 + 2 s m') / ((1 + 2 s mu_v')(1 + 2 s mu_l')).
+// mu' = p + (1 - p) mu is the cosine inside for mu outside, on the line from
+// the critical cosine p = sqrt(1 - 1/eta^2) (1 - SPREAD r) at grazing (a
+// rough interface refracts a grazing view over a spread of directions, some
+// of them grazing inside) to 1 head-on; m' = p + (1 - p) m is the light
+// side's mean of mu', so the view's directional albedo is
+// A (1 + 2 s m) / (1 + 2 s mu_v') whatever the light. s comes from the
+// medium's albedo seen from inside, A' = A / (1 - R21 + R21 A): the
+// interface's underside reflects R21 of what leaves back in (R21 = 1 - (1 -
+// R12) / eta^2, R12 Schlick's hemispherical mean F0 + (1 - F0) / 21, eta
+// from the dielectric part's mean F0), and a rational inverse of van de
+// Hulst's albedo gives s. A closure without a medium (an opaque Lambertian:
+// no mean free path) has s = 0, weight 1, as has A = 1 (the white furnace
+// does not move). substrate_constants.h, SUBSTRATE_MEDIUM_*. Float; about thirty
+// operations and two square roots, for materials with an SSS medium only.
+
+// (1 / eta^2, p) of the dielectric part's interface (ends: the means of its
+// F0 and F90, substrate_diffuse_interface).
+float2 substrate_medium_interface(float2 ends, float roughness) {
+  float sq = sqrt(saturate(ends.x));
+  float ie = (1.0 - sq) / (1.0 + sq);
+  float ie2 = ie * ie;
+  return float2(ie2, sqrt(1.0 - ie2) * (1.0 - SUBSTRATE_MEDIUM_SPREAD * saturate(roughness)));
+}
+
+// 2 s per channel (0 for a closure without a medium): s = (1 - A') / (1 + c A'),
+// c = SUBSTRATE_MEDIUM_INVERSE, with A' = A / (t + (1 - t) A), t = 1 - R21:
+// s = t (1 - A) / (t + (1 - t + c) A), one division. R12 is the hemispherical
+// mean of a dielectric's Schlick curve to F90 = 1, F0 + (1 - F0) / 21, so
+// t = (1 - F0) (20 / 21) / eta^2 (at least 1e-4). albedo in [0, 1].
+float3 substrate_medium_slope2(float3 albedo, bool medium, float f0, float ie2) {
+  float t = max((1.0 - f0) * (20.0 / 21.0) * ie2, 1e-4);
+  float3 s2 = (medium ? 2.0 * t : 0.0) * (SUBSTRATE_SPLAT3(1.0) - albedo) /
+              (SUBSTRATE_SPLAT3(t) + (1.0 + SUBSTRATE_MEDIUM_INVERSE - t) * albedo);
+  return s2;
+}
+
+// ---------------------------------------------------------------------------
 // Fuzz: Charlie sheen (Estevez & Kulla 2017).
 
 // D = (2 + 1/a) sin(theta_h)^(1/a) / (2 pi), a = max(r^2, 1e-3).
@@ -1044,6 +1095,18 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
               substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
   }
+#if SUBSTRATE_USE_SSS
+  // A slab's medium: its view and light dependence ("A slab's medium", above;
+  // no branch: a closure without a mean free path has slope 0, weight 1).
+  {
+    float2 mi = substrate_medium_interface(ends, roughness);
+    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), c.sssType != SUBSTRATE_SSS_NONE, ends.x, mi.x);
+    float3 u = SUBSTRATE_SPLAT3(1.0) + s2 * mi.y;  // 1 + 2 s mu' = u + w mu
+    float3 w = s2 * (1.0 - mi.y);
+    diffuse *= SUBSTRATE_M3((SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) * (u + w * SUBSTRATE_MEDIUM_MEAN_COS) /
+                            ((u + w * NoV) * (u + w * NoLc)));
+  }
+#endif
   // Under layers: what their underside sends back down (float: a factor up to 1.1).
   float3 result = spec + SUBSTRATE_F3(diffuse * substrate_diffuse_transmission(albedo, specAlbedo, dielectric)) *
                              substrate_closure_coat_diffuse(c, ends);

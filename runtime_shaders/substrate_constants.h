@@ -48,6 +48,17 @@
 //         reflectance seen from inside (total internal reflection included).
 #define SUBSTRATE_COAT_SQRT_F0 0.2
 #define SUBSTRATE_COAT_TRAP 1.34177
+// A slab's medium seen through its interface (issue 19, step 12; substrate_bsdf.h,
+// "A slab's medium"). SPREAD: how far a rough interface pulls the critical
+// cosine toward 0, per unit of roughness (fitted to the random walk:
+// docs/accuracy.md, "12. A medium's view dependence"); MEAN_COS: the mean
+// cosine of the medium's normalization (0.631 .. 0.667 over the slopes under
+// an index-matched boundary); INVERSE: s = (1 - A) / (1 + INVERSE A) inverts
+// van de Hulst's A = (1 - s)(1 - 0.139 s) / (1 + 1.17 s) to within 0.0066 in
+// s, 0.1 % in the weight (minimax on the weight).
+#define SUBSTRATE_MEDIUM_SPREAD 0.35
+#define SUBSTRATE_MEDIUM_MEAN_COS 0.645
+#define SUBSTRATE_MEDIUM_INVERSE 1.376
 // Only a dielectric interface is made relative to the layers above: up to
 // F0 0.1 it is; from there it blends back to its own F0, reached at 0.2 (read
 // as a conductor, as the ground truth walks conductors). BLEND = 1 / (0.2 - 0.1).

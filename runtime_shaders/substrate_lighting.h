@@ -250,6 +250,16 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   float2 ends = substrate_diffuse_interface(f0, f90, fd);
   float3 diffuse = SUBSTRATE_F3(albedo * substrate_diffuse_transmission(albedo, specAlbedo, dielectric)) *
                    substrate_closure_coat_diffuse(c, ends) * irr;
+#if SUBSTRATE_USE_SSS
+  // A slab's medium: its view dependence (substrate_bsdf.h, "A slab's medium";
+  // the light's side averages to 1 over the hemisphere; no branch, as there).
+  {
+    float2 mi = substrate_medium_interface(ends, saturate(c.roughness));
+    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), c.sssType != SUBSTRATE_SSS_NONE, ends.x, mi.x);
+    diffuse *= (SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) /
+               (SUBSTRATE_SPLAT3(1.0) + s2 * (mi.y + (1.0 - mi.y) * NoV));
+  }
+#endif
   mfloat3 specLight = substrate_closure_light_throughput(c, NoV);
   mfloat3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
   float3 result = spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight);

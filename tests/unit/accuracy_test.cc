@@ -166,6 +166,38 @@ TEST(Accuracy, ADarkBaseUnderASmoothInterfaceFollowsExactFresnel) {
   EXPECT_EQ(rows, 6);
 }
 
+TEST(Accuracy, AScatteringMediumReturnsLessHeadOnThanAtGrazing) {
+  // Issue 19, step 12: a semi-infinite medium of albedo 0.35 under an interface
+  // of F0 0.04. Light that enters head-on goes deep and less of it returns than
+  // at grazing; a Lambertian returns the same at every angle. With the diffuse
+  // of a Lambertian the model read +11.5 / +10.3 / +7.8 / +4.8 / +0.6 / -0.1 %
+  // (NoV 1 .. 0.1, nearly smooth) and +11.1 / +9.3 / +3.6 / +1.4 / -2.1 / -3.5 %
+  // (roughness 0.45), BRDF medians up to 12.3 %; with the medium's weight
+  // (substrate_bsdf.h, "A slab's medium") -0.3 / +0.2 / -0.0 / -0.3 / -1.6 /
+  // -1.0 % and -0.7 / -0.1 / -2.8 / -2.5 / -3.6 / -4.0 % (these counts), BRDF
+  // medians 4.3 % at most, and the lobe stays as reciprocal (1.031 at most).
+  int rows = 0;
+  for (const char* roughness : {"0.05", "0.45"}) {
+    SCOPED_TRACE(roughness);
+    const CompileResult r = compileSlab(std::string(R"({"kind": "slab", "diffuse_albedo": 0.35, "f0": 0.04, "roughness": )") +
+                                        roughness + R"(, "sss_mfp": 1})");
+    accuracy::Options o = cheap(2);
+    o.samples = 8192;
+    o.evalSamples = 256;
+    const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+    ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+    for (const auto& row : c.rows) {
+      SCOPED_TRACE(row.nov);
+      ASSERT_TRUE(row.relError && row.brdfMedianRelError);
+      EXPECT_LE(std::fabs(*row.relError), 0.05);
+      EXPECT_LE(*row.brdfMedianRelError, 0.06);
+      EXPECT_LE(row.reciprocityMaxRatio, 1.05);
+      ++rows;
+    }
+  }
+  EXPECT_EQ(rows, 12);
+}
+
 TEST(Accuracy, AMetalnessSlabReturnsTheMixItStandsFor) {
   // Issue 19, item 5 (bench/materials/metalness_mix.json): one slab from
   // metalness_to_diffuse_f0 (base colour (0.8, 0.5, 0.2), metallic 0.6,

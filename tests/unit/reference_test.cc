@@ -616,7 +616,8 @@ TEST(ReferenceEnergy, IntegratorReproducesKnownIntegrals) {
   // No specular (F0 = F90 = 0): a Lambertian albedo a under radiance max(L.z, 0)
   // reflects a/pi * integral of cos^2 = 2a/3; under a unit environment, SSS wrap
   // reflects exactly a over the whole sphere (substrate_bsdf.h, "its integral
-  // over the sphere equals Lambert's over the hemisphere").
+  // over the sphere equals Lambert's over the hemisphere") — for a white medium,
+  // whose albedo does not depend on the view (substrate_medium_weight: slope 0).
   Closure<double> c;
   c.f0 = {0, 0, 0};
   c.features = kFeatureF90;
@@ -630,6 +631,7 @@ TEST(ReferenceEnergy, IntegratorReproducesKnownIntegrals) {
   EXPECT_EQ(lit[1], 0.0);
   c.sssType = kSssWrap;
   c.sssMfp = {0.001, 0.005, 0.05};
+  c.diffuseAlbedo = {1, 1, 1};
   const V3<double> wrap =
       envIntegrated(c, V, [](const V3<double>&) { return V3<double>{1, 1, 1}; }, kDiffuseLambert, 8192, 4);
   EXPECT_V3_NEAR(wrap, c.diffuseAlbedo, 3e-3);

@@ -340,6 +340,43 @@ V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL) {
 }
 
 // ---------------------------------------------------------------------------
+// A slab's medium seen through its interface (substrate_medium_*, issue 19 step 12).
+
+// substrate_medium_interface: (1 / eta^2, p), eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) of the
+// mean F0 of the dielectric part, p = sqrt(1 - 1 / eta^2) (1 - SPREAD sat(r)).
+template <class T>
+V2<T> mediumInterface(const V2<T>& ends, T roughness) {
+  const T sq = std::sqrt(saturate(ends[0]));
+  const T ie = (T(1) - sq) / (T(1) + sq);
+  const T ie2 = ie * ie;
+  return {ie2, std::sqrt(T(1) - ie2) * (T(1) - T(SUBSTRATE_MEDIUM_SPREAD) * saturate(roughness))};
+}
+
+// substrate_medium_slope2: 2 s = 2 t (1 - A) / (t + (1 - t + SUBSTRATE_MEDIUM_INVERSE) A),
+// t = max(1 - R21, 1e-4) = max((1 - F0) (20 / 21) / eta^2, 1e-4) (R12 = F0 + (1 - F0) / 21: the
+// rational inverse of van de Hulst's albedo at A' = A / (t + (1 - t) A), the albedo seen from
+// inside); 0 for a closure without a medium.
+template <class T>
+V3<T> mediumSlope2(const V3<T>& albedo, bool medium, T f0, T ie2) {
+  const T t = std::max((T(1) - f0) * (T(20) / T(21)) * ie2, T(1e-4));
+  V3<T> s2{};
+  if (!medium) return s2;
+  for (int i = 0; i < 3; ++i)
+    s2[i] = T(2) * t * (T(1) - albedo[i]) / (t + (T(1) + T(SUBSTRATE_MEDIUM_INVERSE) - t) * albedo[i]);
+  return s2;
+}
+
+// The medium's weight (1 + 2 s m) / (1 + 2 s mu') per channel, mu' = p + (1 - p) mu the
+// cosine inside for mu outside (substrate_eval_closure multiplies the view's, at m =
+// MEAN_COS, and the light's, at m = p + (1 - p) MEAN_COS; the split sum takes the view's).
+template <class T>
+V3<T> mediumWeight(const V3<T>& s2, T m, T p, T mu) {
+  V3<T> w{};
+  for (int i = 0; i < 3; ++i) w[i] = (T(1) + s2[i] * m) / (T(1) + s2[i] * (p + (T(1) - p) * mu));
+  return w;
+}
+
+// ---------------------------------------------------------------------------
 // Fuzz.
 
 // substrate_charlie_d: (2 + 1/a) substrate_pow(max(1 - NoH^2, 0), 0.5/a) / (2 pi).
@@ -713,6 +750,14 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
                       : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
+  // A slab's medium: its view and light dependence ("A slab's medium" in substrate_bsdf.h).
+  if (c.sssType != kSssNone) {
+    const V2<T> ends{mean3(f0d), mean3(f90d)};
+    const V2<T> mi = mediumInterface(ends, roughness);
+    const V3<T> s2 = mediumSlope2(albedo, true, ends[0], mi[0]);
+    const T m = T(SUBSTRATE_MEDIUM_MEAN_COS), p = mi[1];
+    diff = diff * mediumWeight(s2, m, p, NoV) * mediumWeight(s2, p + (T(1) - p) * m, p, NoLc);
+  }
   // Under layers: what their underside sends back down.
   V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) *
                             closureCoatDiffuse(c, f0d, f90d, diffuseModel);
@@ -773,6 +818,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
+  template V2<T> mediumInterface<T>(const V2<T>&, T);                                                  \
+  template V3<T> mediumSlope2<T>(const V3<T>&, bool, T, T);                                            \
+  template V3<T> mediumWeight<T>(const V3<T>&, T, T, T);                                               \
   template T charlieD<T>(T, T);                                                                        \
   template T charlieL<T>(T, T);                                                                        \
   template T charlieLambda<T>(T, T);                                                                   \

@@ -80,6 +80,12 @@ template <class T> V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T 
 template <class T> V3<T> sssWrapAmount(const V3<T>& mfp);
 template <class T> V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL);
 
+// A slab's medium seen through its interface (substrate_medium_interface / _slope2; the weight
+// is the shaders' inline expression).
+template <class T> V2<T> mediumInterface(const V2<T>& ends, T roughness);
+template <class T> V3<T> mediumSlope2(const V3<T>& albedo, bool medium, T f0, T ie2);
+template <class T> V3<T> mediumWeight(const V3<T>& s2, T m, T p, T mu);
+
 // Fuzz (Charlie sheen).
 template <class T> T charlieD(T a, T NoH);
 template <class T> T charlieL(T x, T a);

@@ -181,6 +181,12 @@ T pow5(T x) {
   return t2 * t2 * t;
 }
 
+// The mean of the three channels (substrate_diffuse_interface's dot with 1/3).
+template <class T>
+T mean3(const V3<T>& v) {
+  return (v[0] + v[1] + v[2]) / T(3);
+}
+
 template <class T>
 T max3(const V3<T>& v) {
   return std::max(v[0], std::max(v[1], v[2]));
