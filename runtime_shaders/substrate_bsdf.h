@@ -836,16 +836,23 @@ mfloat3 substrate_diffuse_wrap(mfloat3 albedo, float3 wrap, float NoL) {
 // medium's albedo seen from inside, A' = A / (1 - R21 + R21 A): the
 // interface's underside reflects R21 of what leaves back in (R21 = 1 - (1 -
 // R12) / eta^2, R12 Schlick's hemispherical mean F0 + (1 - F0) / 21, eta
-// from the dielectric part's mean F0), and a rational inverse of van de
+// from the closure's mean F0 against air, substrate_medium_f0), and a rational inverse of van de
 // Hulst's albedo gives s. A closure without a medium (an opaque Lambertian:
 // no mean free path) has s = 0, weight 1, as has A = 1 (the white furnace
 // does not move). substrate_constants.h, SUBSTRATE_MEDIUM_*. Float; about thirty
 // operations and two square roots, for materials with an SSS medium only.
 
-// (1 / eta^2, p) of the dielectric part's interface (ends: the means of its
-// F0 and F90, substrate_diffuse_interface).
-float2 substrate_medium_interface(float2 ends, float roughness) {
-  float sq = sqrt(saturate(ends.x));
+// The closure's own F0 against air, the mean of its channels: under layers
+// too (not the F0 relative to them, substrate_closure_fresnel_ends), since
+// light reaches the medium refracted by every interface above it, as by one
+// of the medium's own IOR.
+float substrate_medium_f0(SubstrateClosure c) {
+  return dot(saturate(c.f0), SUBSTRATE_SPLAT3(1.0 / 3.0));
+}
+
+// (1 / eta^2, p) of the interface of F0 f0 (substrate_medium_f0).
+float2 substrate_medium_interface(float f0, float roughness) {
+  float sq = sqrt(f0);
   float ie = (1.0 - sq) / (1.0 + sq);
   float ie2 = ie * ie;
   return float2(ie2, sqrt(1.0 - ie2) * (1.0 - SUBSTRATE_MEDIUM_SPREAD * saturate(roughness)));
@@ -1099,8 +1106,9 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   // A slab's medium: its view and light dependence ("A slab's medium", above;
   // no branch: a closure without a mean free path has slope 0, weight 1).
   {
-    float2 mi = substrate_medium_interface(ends, roughness);
-    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), c.sssType != SUBSTRATE_SSS_NONE, ends.x, mi.x);
+    float f0m = substrate_medium_f0(c);
+    float2 mi = substrate_medium_interface(f0m, roughness);
+    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), c.sssType != SUBSTRATE_SSS_NONE, f0m, mi.x);
     float3 u = SUBSTRATE_SPLAT3(1.0) + s2 * mi.y;  // 1 + 2 s mu' = u + w mu
     float3 w = s2 * (1.0 - mi.y);
     diffuse *= SUBSTRATE_M3((SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) * (u + w * SUBSTRATE_MEDIUM_MEAN_COS) /

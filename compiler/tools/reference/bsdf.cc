@@ -342,11 +342,12 @@ V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL) {
 // ---------------------------------------------------------------------------
 // A slab's medium seen through its interface (substrate_medium_*, issue 19 step 12).
 
-// substrate_medium_interface: (1 / eta^2, p), eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) of the
-// mean F0 of the dielectric part, p = sqrt(1 - 1 / eta^2) (1 - SPREAD sat(r)).
+// substrate_medium_interface: (1 / eta^2, p), eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) of
+// f0 (substrate_medium_f0: the mean of the closure's own saturated F0, against air under
+// layers too), p = sqrt(1 - 1 / eta^2) (1 - SPREAD sat(r)).
 template <class T>
-V2<T> mediumInterface(const V2<T>& ends, T roughness) {
-  const T sq = std::sqrt(saturate(ends[0]));
+V2<T> mediumInterface(T f0, T roughness) {
+  const T sq = std::sqrt(f0);
   const T ie = (T(1) - sq) / (T(1) + sq);
   const T ie2 = ie * ie;
   return {ie2, std::sqrt(T(1) - ie2) * (T(1) - T(SUBSTRATE_MEDIUM_SPREAD) * saturate(roughness))};
@@ -752,9 +753,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // A slab's medium: its view and light dependence ("A slab's medium" in substrate_bsdf.h).
   if (c.sssType != kSssNone) {
-    const V2<T> ends{mean3(f0d), mean3(f90d)};
-    const V2<T> mi = mediumInterface(ends, roughness);
-    const V3<T> s2 = mediumSlope2(albedo, true, ends[0], mi[0]);
+    const T f0m = mean3(saturate(c.f0));  // substrate_medium_f0
+    const V2<T> mi = mediumInterface(f0m, roughness);
+    const V3<T> s2 = mediumSlope2(albedo, true, f0m, mi[0]);
     const T m = T(SUBSTRATE_MEDIUM_MEAN_COS), p = mi[1];
     diff = diff * mediumWeight(s2, m, p, NoV) * mediumWeight(s2, p + (T(1) - p) * m, p, NoLc);
   }
@@ -818,7 +819,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
-  template V2<T> mediumInterface<T>(const V2<T>&, T);                                                  \
+  template V2<T> mediumInterface<T>(T, T);                                                             \
   template V3<T> mediumSlope2<T>(const V3<T>&, bool, T, T);                                            \
   template V3<T> mediumWeight<T>(const V3<T>&, T, T, T);                                               \
   template T charlieD<T>(T, T);                                                                        \
