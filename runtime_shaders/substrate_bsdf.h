@@ -842,12 +842,26 @@ mfloat3 substrate_diffuse_wrap(mfloat3 albedo, float3 wrap, float NoL) {
 // does not move). substrate_constants.h, SUBSTRATE_MEDIUM_*. Float; about thirty
 // operations and two square roots, for materials with an SSS medium only.
 
-// The closure's own F0 against air, the mean of its channels: under layers
-// too (not the F0 relative to them, substrate_closure_fresnel_ends), since
-// light reaches the medium refracted by every interface above it, as by one
-// of the medium's own IOR.
+// The F0 of the interface over the medium, against air: the mean of the
+// closure's own F0, under layers too (not the F0 relative to them,
+// substrate_closure_fresnel_ends): light reaches the medium refracted by every
+// interface above it, as by one of the medium's own IOR.
 float substrate_medium_f0(SubstrateClosure c) {
   return dot(saturate(c.f0), SUBSTRATE_SPLAT3(1.0 / 3.0));
+}
+
+// How much of the closure's diffuse is a medium's: 1 with a medium (sssType
+// not none), else 0. A metalness mix's medium lies under its dielectric part
+// with the base colour as its albedo, which the closure no longer holds (its
+// diffuse is the base colour times 1 - metallic, far darker): the weight fades
+// out by the mix's share, as substrate_closure_dielectric_part blends it in,
+// and the mix keeps the Lambertian's response.
+float substrate_medium_share(SubstrateClosure c) {
+  float share = c.sssType != SUBSTRATE_SSS_NONE ? 1.0 : 0.0;
+#if SUBSTRATE_USE_METALNESS_MIX
+  share *= 1.0 - saturate((substrate_max3(saturate(c.f0)) - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND);
+#endif
+  return share;
 }
 
 // (1 / eta^2, p) of the interface of F0 f0 (substrate_medium_f0).
@@ -858,14 +872,14 @@ float2 substrate_medium_interface(float f0, float roughness) {
   return float2(ie2, sqrt(1.0 - ie2) * (1.0 - SUBSTRATE_MEDIUM_SPREAD * saturate(roughness)));
 }
 
-// 2 s per channel (0 for a closure without a medium): s = (1 - A') / (1 + c A'),
+// 2 s per channel, times share (substrate_medium_share): s = (1 - A') / (1 + c A'),
 // c = SUBSTRATE_MEDIUM_INVERSE, with A' = A / (t + (1 - t) A), t = 1 - R21:
 // s = t (1 - A) / (t + (1 - t + c) A), one division. R12 is the hemispherical
 // mean of a dielectric's Schlick curve to F90 = 1, F0 + (1 - F0) / 21, so
 // t = (1 - F0) (20 / 21) / eta^2 (at least 1e-4). albedo in [0, 1].
-float3 substrate_medium_slope2(float3 albedo, bool medium, float f0, float ie2) {
+float3 substrate_medium_slope2(float3 albedo, float share, float f0, float ie2) {
   float t = max((1.0 - f0) * (20.0 / 21.0) * ie2, 1e-4);
-  float3 s2 = (medium ? 2.0 * t : 0.0) * (SUBSTRATE_SPLAT3(1.0) - albedo) /
+  float3 s2 = (2.0 * t * share) * (SUBSTRATE_SPLAT3(1.0) - albedo) /
               (SUBSTRATE_SPLAT3(t) + (1.0 + SUBSTRATE_MEDIUM_INVERSE - t) * albedo);
   return s2;
 }
@@ -1108,7 +1122,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   {
     float f0m = substrate_medium_f0(c);
     float2 mi = substrate_medium_interface(f0m, roughness);
-    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), c.sssType != SUBSTRATE_SSS_NONE, f0m, mi.x);
+    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), substrate_medium_share(c), f0m, mi.x);
     float3 u = SUBSTRATE_SPLAT3(1.0) + s2 * mi.y;  // 1 + 2 s mu' = u + w mu
     float3 w = s2 * (1.0 - mi.y);
     diffuse *= SUBSTRATE_M3((SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) * (u + w * SUBSTRATE_MEDIUM_MEAN_COS) /

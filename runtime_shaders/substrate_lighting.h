@@ -256,7 +256,7 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   {
     float f0m = substrate_medium_f0(c);
     float2 mi = substrate_medium_interface(f0m, saturate(c.roughness));
-    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), c.sssType != SUBSTRATE_SSS_NONE, f0m, mi.x);
+    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), substrate_medium_share(c), f0m, mi.x);
     diffuse *= (SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) /
                (SUBSTRATE_SPLAT3(1.0) + s2 * (mi.y + (1.0 - mi.y) * NoV));
   }

@@ -342,9 +342,24 @@ V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL) {
 // ---------------------------------------------------------------------------
 // A slab's medium seen through its interface (substrate_medium_*, issue 19 step 12).
 
+// substrate_medium_f0: the mean of the closure's own saturated F0 (against air, under layers too).
+template <class T>
+T mediumF0(const Closure<T>& c) {
+  return mean3(saturate(c.f0));
+}
+
+// substrate_medium_share: 1 with a medium (else 0), times 1 - sat((max3(F0) - SUBSTRATE_MIX_START)
+// SUBSTRATE_MIX_BLEND) for a metalness mix (its medium's albedo is the base colour, which the
+// closure does not hold).
+template <class T>
+T mediumShare(const Closure<T>& c) {
+  if (c.sssType == kSssNone) return T(0);
+  if (!c.metalnessMix) return T(1);
+  return T(1) - saturate((max3(saturate(c.f0)) - T(SUBSTRATE_MIX_START)) * T(SUBSTRATE_MIX_BLEND));
+}
+
 // substrate_medium_interface: (1 / eta^2, p), eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) of
-// f0 (substrate_medium_f0: the mean of the closure's own saturated F0, against air under
-// layers too), p = sqrt(1 - 1 / eta^2) (1 - SPREAD sat(r)).
+// f0 (substrate_medium_f0, mediumF0), p = sqrt(1 - 1 / eta^2) (1 - SPREAD sat(r)).
 template <class T>
 V2<T> mediumInterface(T f0, T roughness) {
   const T sq = std::sqrt(f0);
@@ -353,17 +368,16 @@ V2<T> mediumInterface(T f0, T roughness) {
   return {ie2, std::sqrt(T(1) - ie2) * (T(1) - T(SUBSTRATE_MEDIUM_SPREAD) * saturate(roughness))};
 }
 
-// substrate_medium_slope2: 2 s = 2 t (1 - A) / (t + (1 - t + SUBSTRATE_MEDIUM_INVERSE) A),
+// substrate_medium_slope2: 2 s = share 2 t (1 - A) / (t + (1 - t + SUBSTRATE_MEDIUM_INVERSE) A),
 // t = max(1 - R21, 1e-4) = max((1 - F0) (20 / 21) / eta^2, 1e-4) (R12 = F0 + (1 - F0) / 21: the
 // rational inverse of van de Hulst's albedo at A' = A / (t + (1 - t) A), the albedo seen from
-// inside); 0 for a closure without a medium.
+// inside); share = mediumShare.
 template <class T>
-V3<T> mediumSlope2(const V3<T>& albedo, bool medium, T f0, T ie2) {
+V3<T> mediumSlope2(const V3<T>& albedo, T share, T f0, T ie2) {
   const T t = std::max((T(1) - f0) * (T(20) / T(21)) * ie2, T(1e-4));
   V3<T> s2{};
-  if (!medium) return s2;
   for (int i = 0; i < 3; ++i)
-    s2[i] = T(2) * t * (T(1) - albedo[i]) / (t + (T(1) + T(SUBSTRATE_MEDIUM_INVERSE) - t) * albedo[i]);
+    s2[i] = T(2) * t * share * (T(1) - albedo[i]) / (t + (T(1) + T(SUBSTRATE_MEDIUM_INVERSE) - t) * albedo[i]);
   return s2;
 }
 
@@ -753,9 +767,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // A slab's medium: its view and light dependence ("A slab's medium" in substrate_bsdf.h).
   if (c.sssType != kSssNone) {
-    const T f0m = mean3(saturate(c.f0));  // substrate_medium_f0
+    const T f0m = mediumF0(c);
     const V2<T> mi = mediumInterface(f0m, roughness);
-    const V3<T> s2 = mediumSlope2(albedo, true, f0m, mi[0]);
+    const V3<T> s2 = mediumSlope2(albedo, mediumShare(c), f0m, mi[0]);
     const T m = T(SUBSTRATE_MEDIUM_MEAN_COS), p = mi[1];
     diff = diff * mediumWeight(s2, m, p, NoV) * mediumWeight(s2, p + (T(1) - p) * m, p, NoLc);
   }
@@ -819,8 +833,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
+  template T mediumF0<T>(const Closure<T>&);                                                            \
   template V2<T> mediumInterface<T>(T, T);                                                             \
-  template V3<T> mediumSlope2<T>(const V3<T>&, bool, T, T);                                            \
+  template T mediumShare<T>(const Closure<T>&);                                                         \
+  template V3<T> mediumSlope2<T>(const V3<T>&, T, T, T);                                               \
   template V3<T> mediumWeight<T>(const V3<T>&, T, T, T);                                               \
   template T charlieD<T>(T, T);                                                                        \
   template T charlieL<T>(T, T);                                                                        \

@@ -82,8 +82,10 @@ template <class T> V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T N
 
 // A slab's medium seen through its interface (substrate_medium_interface / _slope2; the weight
 // is the shaders' inline expression).
+template <class T> T mediumF0(const Closure<T>& c);
 template <class T> V2<T> mediumInterface(T f0, T roughness);
-template <class T> V3<T> mediumSlope2(const V3<T>& albedo, bool medium, T f0, T ie2);
+template <class T> T mediumShare(const Closure<T>& c);
+template <class T> V3<T> mediumSlope2(const V3<T>& albedo, T share, T f0, T ie2);
 template <class T> V3<T> mediumWeight(const V3<T>& s2, T m, T p, T mu);
 
 // Fuzz (Charlie sheen).

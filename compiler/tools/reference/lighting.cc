@@ -165,9 +165,9 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
                closureCoatDiffuse(c, f0d, f90d, diffuseModel) * irr;
   // A slab's medium: its view dependence (substrate_env_split_sum).
   if (c.sssType != kSssNone) {
-    const T f0m = mean3(saturate(c.f0));  // substrate_medium_f0
+    const T f0m = mediumF0(c);
     const V2<T> mi = mediumInterface(f0m, saturate(c.roughness));
-    diff = diff * mediumWeight(mediumSlope2(albedo, true, f0m, mi[0]), T(SUBSTRATE_MEDIUM_MEAN_COS), mi[1], NoV);
+    diff = diff * mediumWeight(mediumSlope2(albedo, mediumShare(c), f0m, mi[0]), T(SUBSTRATE_MEDIUM_MEAN_COS), mi[1], NoV);
   }
   V3<T> specLight = lightThroughput(c, NoV);
   V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
