@@ -884,6 +884,15 @@ float3 substrate_medium_slope2(float3 albedo, float share, float f0, float ie2) 
   return s2;
 }
 
+// What the weight needs of a closure: 2 s per channel (substrate_medium_slope2)
+// and, in p, the cosine inside at grazing (substrate_medium_interface).
+float3 substrate_closure_medium(SubstrateClosure c, float3 albedo, float roughness, out float p) {
+  float f0 = substrate_medium_f0(c);
+  float2 mi = substrate_medium_interface(f0, roughness);
+  p = mi.y;
+  return substrate_medium_slope2(albedo, substrate_medium_share(c), f0, mi.x);
+}
+
 // ---------------------------------------------------------------------------
 // Fuzz: Charlie sheen (Estevez & Kulla 2017).
 
@@ -1120,11 +1129,10 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   // A slab's medium: its view and light dependence ("A slab's medium", above;
   // no branch: a closure without a mean free path has slope 0, weight 1).
   {
-    float f0m = substrate_medium_f0(c);
-    float2 mi = substrate_medium_interface(f0m, roughness);
-    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), substrate_medium_share(c), f0m, mi.x);
-    float3 u = SUBSTRATE_SPLAT3(1.0) + s2 * mi.y;  // 1 + 2 s mu' = u + w mu
-    float3 w = s2 * (1.0 - mi.y);
+    float p;
+    float3 s2 = substrate_closure_medium(c, SUBSTRATE_F3(albedo), roughness, p);
+    float3 u = SUBSTRATE_SPLAT3(1.0) + s2 * p;  // 1 + 2 s mu' = u + w mu
+    float3 w = s2 * (1.0 - p);
     diffuse *= SUBSTRATE_M3((SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) * (u + w * SUBSTRATE_MEDIUM_MEAN_COS) /
                             ((u + w * NoV) * (u + w * NoLc)));
   }

@@ -254,11 +254,9 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   // A slab's medium: its view dependence (substrate_bsdf.h, "A slab's medium";
   // the light's side averages to 1 over the hemisphere; no branch, as there).
   {
-    float f0m = substrate_medium_f0(c);
-    float2 mi = substrate_medium_interface(f0m, saturate(c.roughness));
-    float3 s2 = substrate_medium_slope2(SUBSTRATE_F3(albedo), substrate_medium_share(c), f0m, mi.x);
-    diffuse *= (SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) /
-               (SUBSTRATE_SPLAT3(1.0) + s2 * (mi.y + (1.0 - mi.y) * NoV));
+    float p;
+    float3 s2 = substrate_closure_medium(c, SUBSTRATE_F3(albedo), saturate(c.roughness), p);
+    diffuse *= (SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) / (SUBSTRATE_SPLAT3(1.0) + s2 * (p + (1.0 - p) * NoV));
   }
 #endif
   mfloat3 specLight = substrate_closure_light_throughput(c, NoV);

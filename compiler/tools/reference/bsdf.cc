@@ -391,6 +391,15 @@ V3<T> mediumWeight(const V3<T>& s2, T m, T p, T mu) {
   return w;
 }
 
+// substrate_closure_medium: 2 s per channel of the closure's medium, and p.
+template <class T>
+V3<T> closureMedium(const Closure<T>& c, const V3<T>& albedo, T roughness, T& p) {
+  const T f0 = mediumF0(c);
+  const V2<T> mi = mediumInterface(f0, roughness);
+  p = mi[1];
+  return mediumSlope2(albedo, mediumShare(c), f0, mi[0]);
+}
+
 // ---------------------------------------------------------------------------
 // Fuzz.
 
@@ -767,10 +776,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
                             diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // A slab's medium: its view and light dependence ("A slab's medium" in substrate_bsdf.h).
   if (c.sssType != kSssNone) {
-    const T f0m = mediumF0(c);
-    const V2<T> mi = mediumInterface(f0m, roughness);
-    const V3<T> s2 = mediumSlope2(albedo, mediumShare(c), f0m, mi[0]);
-    const T m = T(SUBSTRATE_MEDIUM_MEAN_COS), p = mi[1];
+    T p;
+    const V3<T> s2 = closureMedium(c, albedo, roughness, p);
+    const T m = T(SUBSTRATE_MEDIUM_MEAN_COS);
     diff = diff * mediumWeight(s2, m, p, NoV) * mediumWeight(s2, p + (T(1) - p) * m, p, NoLc);
   }
   // Under layers: what their underside sends back down.
@@ -838,6 +846,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T mediumShare<T>(const Closure<T>&);                                                         \
   template V3<T> mediumSlope2<T>(const V3<T>&, T, T, T);                                               \
   template V3<T> mediumWeight<T>(const V3<T>&, T, T, T);                                               \
+  template V3<T> closureMedium<T>(const Closure<T>&, const V3<T>&, T, T&);                             \
   template T charlieD<T>(T, T);                                                                        \
   template T charlieL<T>(T, T);                                                                        \
   template T charlieLambda<T>(T, T);                                                                   \

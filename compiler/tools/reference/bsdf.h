@@ -80,13 +80,13 @@ template <class T> V3<T> diffuse(int model, const V3<T>& albedo, T roughness, T 
 template <class T> V3<T> sssWrapAmount(const V3<T>& mfp);
 template <class T> V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL);
 
-// A slab's medium seen through its interface (substrate_medium_interface / _slope2; the weight
-// is the shaders' inline expression).
+// A slab's medium seen through its interface (substrate_medium_* and substrate_closure_medium).
 template <class T> T mediumF0(const Closure<T>& c);
 template <class T> V2<T> mediumInterface(T f0, T roughness);
 template <class T> T mediumShare(const Closure<T>& c);
 template <class T> V3<T> mediumSlope2(const V3<T>& albedo, T share, T f0, T ie2);
 template <class T> V3<T> mediumWeight(const V3<T>& s2, T m, T p, T mu);
+template <class T> V3<T> closureMedium(const Closure<T>& c, const V3<T>& albedo, T roughness, T& p);
 
 // Fuzz (Charlie sheen).
 template <class T> T charlieD(T a, T NoH);

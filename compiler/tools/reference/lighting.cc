@@ -165,9 +165,9 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
                closureCoatDiffuse(c, f0d, f90d, diffuseModel) * irr;
   // A slab's medium: its view dependence (substrate_env_split_sum).
   if (c.sssType != kSssNone) {
-    const T f0m = mediumF0(c);
-    const V2<T> mi = mediumInterface(f0m, saturate(c.roughness));
-    diff = diff * mediumWeight(mediumSlope2(albedo, mediumShare(c), f0m, mi[0]), T(SUBSTRATE_MEDIUM_MEAN_COS), mi[1], NoV);
+    T p;
+    const V3<T> s2 = closureMedium(c, albedo, saturate(c.roughness), p);
+    diff = diff * mediumWeight(s2, T(SUBSTRATE_MEDIUM_MEAN_COS), p, NoV);
   }
   V3<T> specLight = lightThroughput(c, NoV);
   V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
