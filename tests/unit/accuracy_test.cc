@@ -177,6 +177,7 @@ TEST(Accuracy, AScatteringMediumReturnsLessHeadOnThanAtGrazing) {
   // -1.0 % and -0.7 / -0.1 / -2.8 / -2.5 / -3.6 / -4.0 % (these counts), BRDF
   // medians 4.3 % at most, and the lobe stays as reciprocal (1.031 at most).
   int rows = 0;
+  int pairs = 0;
   for (const char* roughness : {"0.05", "0.45"}) {
     SCOPED_TRACE(roughness);
     const CompileResult r = compileSlab(std::string(R"({"kind": "slab", "diffuse_albedo": 0.35, "f0": 0.04, "roughness": )") +
@@ -191,11 +192,14 @@ TEST(Accuracy, AScatteringMediumReturnsLessHeadOnThanAtGrazing) {
       ASSERT_TRUE(row.relError && row.brdfMedianRelError);
       EXPECT_LE(std::fabs(*row.relError), 0.05);
       EXPECT_LE(*row.brdfMedianRelError, 0.06);
+      EXPECT_GT(row.brdfCounted, 0);
       EXPECT_LE(row.reciprocityMaxRatio, 1.05);
+      pairs += row.reciprocityPairs;
       ++rows;
     }
   }
   EXPECT_EQ(rows, 12);
+  EXPECT_GE(pairs, 100);
 }
 
 TEST(Accuracy, AMetalnessSlabReturnsTheMixItStandsFor) {

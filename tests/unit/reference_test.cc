@@ -617,7 +617,7 @@ TEST(ReferenceEnergy, IntegratorReproducesKnownIntegrals) {
   // reflects a/pi * integral of cos^2 = 2a/3; under a unit environment, SSS wrap
   // reflects exactly a over the whole sphere (substrate_bsdf.h, "its integral
   // over the sphere equals Lambert's over the hemisphere") — for a white medium,
-  // whose albedo does not depend on the view (substrate_medium_weight: slope 0).
+  // whose albedo does not depend on the view (substrate_bsdf.h, "A slab's medium": slope 0).
   Closure<double> c;
   c.f0 = {0, 0, 0};
   c.features = kFeatureF90;
