@@ -409,6 +409,12 @@ float substrate_dielectric_albedo(float2 d, float e, float b) {
   return saturate((d.x * e + max(d.y - d.x, 0.0) * b) * (1.0 + d.x * ((1.0 - e) / e)));
 }
 
+// How much of a closure of largest F0 f0max is read as a metalness mix (0 up
+// to SUBSTRATE_MIX_START, 1 from 0.25; substrate_closure_dielectric_part).
+float substrate_mix_share(float f0max) {
+  return saturate((f0max - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND);
+}
+
 // The Fresnel ends (F0, F90) of the interface a closure's diffuse lies under:
 // its dielectric part (SUBSTRATE_MIX_START). A closure whose largest F0 is a
 // dielectric's (up to 0.18) is all dielectric: its largest channels (E_d >=
@@ -429,7 +435,7 @@ float2 substrate_closure_dielectric_part(SubstrateClosure c, mfloat3 f0, mfloat3
   float2 mixed = float2(lerp(SUBSTRATE_MIX_DIELECTRIC_F0, SUBSTRATE_MIX_DIELECTRIC_F0_UNDER, cover),
                         lerp(1.0, SUBSTRATE_MIX_DIELECTRIC_F0_UNDER / SUBSTRATE_MIX_DIELECTRIC_F0, cover));
   return lerp(float2(f, substrate_max3(SUBSTRATE_F3(f90))), mixed,
-              saturate((f - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND));
+              substrate_mix_share(f));
 #else
   return SUBSTRATE_SPLAT2(1.0);
 #endif
@@ -859,7 +865,7 @@ float substrate_medium_f0(SubstrateClosure c) {
 float substrate_medium_share(SubstrateClosure c) {
   float share = c.sssType != SUBSTRATE_SSS_NONE ? 1.0 : 0.0;
 #if SUBSTRATE_USE_METALNESS_MIX
-  share *= 1.0 - saturate((substrate_max3(saturate(c.f0)) - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND);
+  share *= 1.0 - substrate_mix_share(substrate_max3(saturate(c.f0)));
 #endif
   return share;
 }

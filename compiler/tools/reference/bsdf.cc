@@ -221,7 +221,7 @@ T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T 
     ab = lerp(ab, interfaceAlbedoFit(mu, hazeRoughness), hazeWeight);
     m = lerp(m, interfaceAlbedoMeans(hazeRoughness), hazeWeight);
   }
-  const T F0 = (f0[0] + f0[1] + f0[2]) / T(3), F90 = (f90[0] + f90[1] + f90[2]) / T(3);
+  const T F0 = mean3(f0), F90 = mean3(f90);
   const T numerator = std::max(T(1) - F0 * ab[0] - F90 * ab[1], T(0));
   const T denominator = std::max(T(1) - F0 * m[0] - F90 * m[1], T(1e-3));
   return std::min(numerator / denominator, F90 < F0 ? T(1) : T(1000));
@@ -342,20 +342,25 @@ V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL) {
 // ---------------------------------------------------------------------------
 // A slab's medium seen through its interface (substrate_medium_*, issue 19 step 12).
 
+// substrate_mix_share: sat((f0max - SUBSTRATE_MIX_START) SUBSTRATE_MIX_BLEND).
+template <class T>
+T mixShare(T f0max) {
+  return saturate((f0max - T(SUBSTRATE_MIX_START)) * T(SUBSTRATE_MIX_BLEND));
+}
+
 // substrate_medium_f0: the mean of the closure's own saturated F0 (against air, under layers too).
 template <class T>
 T mediumF0(const Closure<T>& c) {
   return mean3(saturate(c.f0));
 }
 
-// substrate_medium_share: 1 with a medium (else 0), times 1 - sat((max3(F0) - SUBSTRATE_MIX_START)
-// SUBSTRATE_MIX_BLEND) for a metalness mix (its medium's albedo is the base colour, which the
-// closure does not hold).
+// substrate_medium_share: 1 with a medium (else 0), times 1 - mixShare(max3(F0)) for a
+// metalness mix (its medium's albedo is the base colour, which the closure does not hold).
 template <class T>
 T mediumShare(const Closure<T>& c) {
   if (c.sssType == kSssNone) return T(0);
   if (!c.metalnessMix) return T(1);
-  return T(1) - saturate((max3(saturate(c.f0)) - T(SUBSTRATE_MIX_START)) * T(SUBSTRATE_MIX_BLEND));
+  return T(1) - mixShare(max3(saturate(c.f0)));
 }
 
 // substrate_medium_interface: (1 / eta^2, p), eta = (1 + sqrt(F0)) / (1 - sqrt(F0)) of
@@ -579,7 +584,7 @@ V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f
   const T f = max3(f0);
   const V2<T> mixed{lerp(T(SUBSTRATE_MIX_DIELECTRIC_F0), T(SUBSTRATE_MIX_DIELECTRIC_F0_UNDER), cover),
                     lerp(T(1), T(SUBSTRATE_MIX_DIELECTRIC_F0_UNDER / SUBSTRATE_MIX_DIELECTRIC_F0), cover)};
-  const T t = saturate((f - T(SUBSTRATE_MIX_START)) * T(SUBSTRATE_MIX_BLEND));
+  const T t = mixShare(f);
   return {lerp(f, mixed[0], t), lerp(max3(f90), mixed[1], t)};
 }
 
@@ -841,6 +846,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> diffuse<T>(int, const V3<T>&, T, T, T, T, T, T);                                      \
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
+  template T mixShare<T>(T);                                                                           \
   template T mediumF0<T>(const Closure<T>&);                                                            \
   template V2<T> mediumInterface<T>(T, T);                                                             \
   template T mediumShare<T>(const Closure<T>&);                                                         \

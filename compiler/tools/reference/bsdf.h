@@ -81,6 +81,7 @@ template <class T> V3<T> sssWrapAmount(const V3<T>& mfp);
 template <class T> V3<T> diffuseWrap(const V3<T>& albedo, const V3<T>& wrap, T NoL);
 
 // A slab's medium seen through its interface (substrate_medium_* and substrate_closure_medium).
+template <class T> T mixShare(T f0max);  // substrate_mix_share
 template <class T> T mediumF0(const Closure<T>& c);
 template <class T> V2<T> mediumInterface(T f0, T roughness);
 template <class T> T mediumShare(const Closure<T>& c);
