@@ -552,22 +552,24 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // SUBSTRATE_COAT_TIR_*, a fit to the integral, scripts/fit_coat_tir.py). Each
 // pass leaves the interface by (1 - R) g, g the layers' interface term at the
 // larger of NoV and NoL (substrate_coat_transmission, as the throughputs take
-// it), and the closure reflects e of the rest, times the media's round
+// it) times the interface's own transmission head-on, T_i = max(T_N, 0.96)
+// (1 - F0 of the layers' top: T_N holds it; the coat diffuse splits T_N so
+// too), and the closure reflects e of the rest, times the media's round
 // trip T_m^2, T_m = sat(T_N / 0.96): e is its hemispherical albedo (the mean
 // Fresnel F0 + (F90 - F0) / 21 and the diffuse below it,
 // substrate_diffuse_transmission_of: one value for every direction, so the
-// factor stays reciprocal). With R' = t R and g' = lerp(1, g, t),
+// factor stays reciprocal). With R' = t R and g' = lerp(1, T_i g, t),
 // t = coverageAbove (1 - share):
 //   k = (1 - R') / (1 - e T_m^2 (1 - (1 - R') g')).
 // A white closure under clear layers gets 1 / g'. The light-side throughput
 // is at most T_m g' (in every channel), and T_m h / (1 - T_m^2 (1 - h)) <= 1
 // for h = (1 - R') g' in [0, 1], so the lobe returns no more than the view's
 // throughput lets in, as without the factor; the media's scattering is the
-// layers' own albedo and is not given back. (g = 0.96 (1 - chi), the
-// interface's own transmission, gives back the 4 % it reflects head-on too,
-// but car_paint's slab forced to F0 0.616 and diffuse 1 under its coat then
-// returned 1.0019 of a white furnace: its lobe integrates 0.3 % above the
-// E_spec its diffuse is given.) Without the factor a rough conductor under a
+// layers' own albedo and is not given back. (Issue 19 step 13: with g' =
+// lerp(1, g, t) the 4 % the interface reflects head-on on the way out never
+// came back: a white conductor of roughness 0.4 under a clear coat returned
+// 0.90 .. 0.94 of a white furnace, 0.93 .. 0.97 with T_i.) Without the factor
+// a rough conductor under a
 // clear coat returned all its lobe reflects: +21 / +33 / +19 / +11 % at NoV
 // 1 / 0.6 / 0.2 / 0.1 over the truth
 // (bench/materials/conductor_under_clear_coat.json), +1.5 / +1.3 / +3.2 /
@@ -606,9 +608,11 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float dAvg = fd.x + (fd.y - fd.x) * (1.0 / 21.0);
   float3 albedo = saturate(c.diffuseAlbedo);
   float3 e = saturate(fAvg + albedo * substrate_diffuse_transmission_of(albedo, fAvg, dAvg));
-  float escape = (1.0 - trapped) * lerp(1.0, substrate_coat_transmission(max(v, l), c.coatFloor), t);
-  float3 tm = saturate(c.topTransmittance * SUBSTRATE_COAT_INV_T_0);
-  return (1.0 - trapped) / (SUBSTRATE_SPLAT3(1.0) - e * (tm * tm) * (1.0 - escape));
+  float3 tn = saturate(c.topTransmittance);
+  float3 tm = saturate(tn * SUBSTRATE_COAT_INV_T_0);
+  float3 ti = max(tn, SUBSTRATE_SPLAT3(SUBSTRATE_COAT_T_0));
+  float3 escape = (1.0 - trapped) * lerp(SUBSTRATE_SPLAT3(1.0), ti * substrate_coat_transmission(max(v, l), c.coatFloor), t);
+  return (1.0 - trapped) / (SUBSTRATE_SPLAT3(1.0) - e * (tm * tm) * (SUBSTRATE_SPLAT3(1.0) - escape));
 #endif
 }
 

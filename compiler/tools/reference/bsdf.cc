@@ -638,7 +638,7 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
 // substrate_closure_coat_specular: (1 - R') / (1 - e' (1 - (1 - R') g')) per channel, with
 // t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2, 1e-3),
 // d = max(mu_i - mu_c, 0) along the view and along the light), g' = lerp(1,
-// coatTransmission(max(NoV, NoL), coatFloor), t),
+// T_i coatTransmission(max(NoV, NoL), coatFloor), t), T_i = max(T_N, 0.96) the interface's own,
 // e' = e sat(T_N / 0.96)^2 and e the closure's hemispherical albedo, F_avg + A diffuseTransmission(A, F_avg,
 // d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the same of the dielectric part fd).
 template <class T>
@@ -657,7 +657,7 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   const T l = saturate(NoL);
   const T trapped = t * (T(SUBSTRATE_COAT_TIR_P1) * a2 / (a2 + T(SUBSTRATE_COAT_TIR_P2) * inner(v) * inner(l)) +
                          T(SUBSTRATE_COAT_TIR_P3) * a2);
-  const T escape = (T(1) - trapped) * lerp(T(1), coatTransmission(std::max(v, l), c.coatFloor), t);
+  const T g = coatTransmission(std::max(v, l), c.coatFloor);
   const V3<T> albedo = saturate(c.diffuseAlbedo);
   const V3<T> fAvg = f0 + (f90 - f0) * T(1.0 / 21.0);
   const T dAvg = fd[0] + (fd[1] - fd[0]) * T(1.0 / 21.0);
@@ -666,6 +666,8 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   for (int i = 0; i < 3; ++i) {
     const T tn = saturate(c.topTransmittance[i]);
     const T tm = saturate(tn * T(SUBSTRATE_COAT_INV_T_0));
+    const T ti = std::max(tn, T(SUBSTRATE_COAT_T_0));
+    const T escape = (T(1) - trapped) * lerp(T(1), ti * g, t);
     k[i] = (T(1) - trapped) / (T(1) - e[i] * (tm * tm) * (T(1) - escape));
   }
   return k;
