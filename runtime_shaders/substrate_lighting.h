@@ -6,65 +6,8 @@
 #ifndef SUBSTRATE_LIGHTING_H
 #define SUBSTRATE_LIGHTING_H 1
 
-// SUBSTRATE_DIFFUSE_MEAN_COS: substrate_constants.h.
-
-// The angular part of the 1 + `extra` interfaces above a closure (extra =
-// SubstrateClosure.extraInterfaces, 0..3): the interface term to the power
-// 1 + extra, by multiplies. A stack of clear coats lets through no more than
-// each of its interfaces in turn: with one term for the whole stack every
-// further interface reflected its F(mu) and still passed everything on (issue
-// 16: six white transparent slabs returned 1.38 of the light at NoV 0.1).
-// Interfaces beyond 1 + 3 are folded into topTransmittance by the material
-// (substrate_extra_interfaces, substrate_tree.h). Compiled only when some
-// closure of the material (or scene) has extra interfaces.
-float substrate_interfaces_transmission(float mu, uint extra, float coatFloor) {
-  float g = substrate_coat_transmission(mu, coatFloor);
-#if SUBSTRATE_USE_EXTRA_INTERFACES
-  float g2 = g * g;
-  if (extra == 1u) {
-    g = g2;
-  } else if (extra == 2u) {
-    g = g2 * g;
-  } else if (extra >= 3u) {
-    g = g2 * g2;
-  }
-#endif
-  return g;
-}
-
-// The path length, per unit thickness, of a direction at cosine mu above the
-// layers once refracted into them (read as a dielectric of IOR 1.5,
-// substrate_constants.h): 1 / mu_t, mu_t = sqrt(1 - (1 - mu^2) / 1.5^2) =
-// sqrt(1.25 + mu^2) / 1.5, so 1.5 rsqrt(1.25 + mu^2), in [1, 1.342]. Light
-// crosses the media above along it: with mu itself a grazing ray crossed them
-// 13x farther than it does (1 / 0.1 against 1 / 0.75), and the interfaces'
-// (1 - F0), which topTransmittance holds, was raised to the power 1 / mu too.
-float substrate_coat_path_length(float mu) {
-  float m = saturate(mu);
-  return 1.5 * rsqrt(1.25 + m * m);
-}
-
-// lerp(1, T_N^(1/mu_t) * g(mu)^(1 + extraInterfaces), coverageAbove), g the
-// layers' interface term under their top (substrate_coat_transmission):
-// the transmittance of the layers above along a direction at
-// cosine mu (their media along the refracted path 1 / mu_t =
-// substrate_coat_path_length(mu), T_N clamped to [1e-30, 1] as
-// substrate_transmittance_at_cosine does, and their interfaces), blended by their coverage. No
-// transcendental when nothing covers the closure (top layers). The remap
-// (exp, log) and the interface term (1 - chi(mu) cancels at grazing) are
-// float; the throughput, in [0, 1], is mfloat.
-mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
-#if SUBSTRATE_USE_LAYERS
-  float cover = saturate(c.coverageAbove);
-  if (cover > 0.0) {
-    float3 t = clamp(c.topTransmittance, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE), SUBSTRATE_SPLAT3(1.0));
-    float3 through = exp(log(t) * substrate_coat_path_length(mu)) *
-                     substrate_interfaces_transmission(mu, c.extraInterfaces, c.coatFloor);
-    return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
-  }
-#endif
-  return SUBSTRATE_MSPLAT3(1.0);
-}
+// SUBSTRATE_DIFFUSE_MEAN_COS: substrate_constants.h. The layers' throughput
+// along a direction (substrate_closure_above_throughput) is in substrate_bsdf.h.
 
 // Dynamic culling: false when the closure's weight is 0 (or not a number) at
 // this pixel, so the lighting skips it (its contribution would be 0).
@@ -95,7 +38,9 @@ float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 ra
   }
   float3 N = substrate_closure_normal(c);
   float3 f = substrate_eval_closure(c, V, L);
-  mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V)) * substrate_closure_light_throughput(c, dot(N, L));
+  // A wrap lobe's light crosses the layers above at its own cosine (substrate_wrap_light_cosine).
+  mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V)) *
+                       substrate_closure_light_throughput(c, substrate_wrap_light_cosine(c, dot(N, L)));
   return SUBSTRATE_F3(throughput) * f * radiance;
 }
 

@@ -192,6 +192,18 @@ std::vector<Config> furnaceGrid() {
           c.sssMfp = {mfp, mfp, mfp};
           addViews(out, "sss", c, kDiffuseLambert);
         }
+  // A wrap lobe under layers meets them at its own cosine, from the mean of
+  // its channels' wrap amounts: channels that wrap unequally (MFP 0, 5 mm, 1 m).
+  for (double r : {0.0, 0.5, 1.0})
+    for (double cover : {0.5, 1.0})
+      for (double f0 : {0.04, 1.0}) {
+        Closure<double> c = whiteClosure(f0, 1, r);
+        c.sssType = kSssWrap;
+        c.sssMfp = {0.0, 0.005, 1.0};
+        c.isTop = false;
+        c.coverageAbove = cover;
+        addViews(out, "wrap under a coat", c, kDiffuseLambert);
+      }
   for (double r : {0.0, 0.25, 0.5, 1.0})
     for (double cover : {0.5, 1.0})
       for (double t : {1.0, 0.9})

@@ -539,6 +539,67 @@ T coatTransmission(T mu, T coatFloor) {
   return std::max(T(1) - fresnelWeight(mu), T(1) - (T(1) - coatFloor) * (m * m));
 }
 
+// substrate_interfaces_transmission: the interface term to the power 1 + extra
+// by multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
+template <class T>
+T interfacesTransmission(T mu, std::uint32_t extra, T coatFloor) {
+  T g = coatTransmission(mu, coatFloor);
+  const T g2 = g * g;
+  if (extra == 1u) g = g2;
+  else if (extra == 2u) g = g2 * g;
+  else if (extra >= 3u) g = g2 * g2;
+  return g;
+}
+
+// substrate_coat_path_length: 1.5 rsqrt(1.25 + sat(mu)^2) = 1 / mu_t, the
+// path per unit thickness along the cosine refracted into the layers above.
+template <class T>
+T coatPathLength(T mu) {
+  const T m = saturate(mu);
+  return T(1.5) / std::sqrt(T(1.25) + m * m);
+}
+
+// substrate_closure_above_throughput: lerp(1, T_N^coatPathLength(mu) *
+// coatTransmission(mu, coatFloor)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
+// transcendental) when nothing covers the closure.
+template <class T>
+V3<T> aboveThroughput(const Closure<T>& c, T mu) {
+  T cover = saturate(c.coverageAbove);
+  if (cover > T(0)) {
+    const T path = coatPathLength(mu);
+    V3<T> t;
+    for (int k = 0; k < 3; ++k)
+      t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
+    const T i = interfacesTransmission(mu, c.extraInterfaces, c.coatFloor);
+    return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
+  }
+  return splat3(T(1));
+}
+
+// substrate_wrap_light_cosine: the cosine the layers above are crossed at by
+// the light of a wrap lobe, (NoL + w) / (1 + w), w the smallest channel's wrap
+// amount; NoL for every other closure.
+template <class T>
+T wrapLightCosine(const Closure<T>& c, T NoL) {
+  if (c.sssType != kSssWrap) return NoL;
+  const V3<T> w3 = sssWrapAmount(c.sssMfp);
+  const T w = saturate(std::min(w3[0], std::min(w3[1], w3[2])));
+  return (NoL + w) / (T(1) + w);
+}
+
+// substrate_wrap_light_ratio: for a wrap closure, what the layers above let
+// through at NoL over what they let through at the wrap's cosine, at most 1
+// (the lighting applies the latter to the whole closure); 1 otherwise.
+template <class T>
+V3<T> wrapLightRatio(const Closure<T>& c, bool isWrap, T NoLc, T NoL) {
+  if (!isWrap) return splat3(T(1));
+  const V3<T> at = aboveThroughput(c, NoLc);
+  const V3<T> wrapped = aboveThroughput(c, wrapLightCosine(c, NoL));
+  V3<T> r;
+  for (int k = 0; k < 3; ++k) r[k] = std::min(at[k] / std::max(wrapped[k], T(1e-4)), T(1));
+  return r;
+}
+
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
 template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
 
@@ -771,6 +832,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
     if (c.features & kFeatureGlint) spec = spec * glintFactor(c, d1, ToH, BoH, NoH);
     // Specular profile: SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint is 1.
   }
+  // A wrap lobe's light crosses the layers above at its own cosine
+  // (wrapLightCosine); the lobes on its interface at NoL.
+  const V3<T> lightRatio = wrapLightRatio(c, isWrap, NoLc, NoL);
+  spec = spec * lightRatio;
 
   // Diffuse, below the specular interface.
   V3<T> albedo = saturate(c.diffuseAlbedo);
@@ -802,7 +867,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
     V3<T> fuzz = zero;
     T eCaught = eFuzz;
     if (lightFacing) {
-      fuzz = saturate(c.fuzzColor) * (amount * charlieSheen(c.fuzzRoughness, NoV, NoLc, NoH) / std::max(T(1), eFuzz));
+      fuzz = saturate(c.fuzzColor) * (amount * charlieSheen(c.fuzzRoughness, NoV, NoLc, NoH) / std::max(T(1), eFuzz)) *
+             lightRatio;
       eCaught = std::max(eFuzz, fuzzAlbedo(NoLc, c.fuzzRoughness));
     }
     result = result * (T(1) - amount * std::min(eCaught, T(1))) + fuzz;
@@ -816,6 +882,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> f90Effective<T>(const V3<T>&, const V3<T>&);                                          \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
+  template V3<T> aboveThroughput<T>(const Closure<T>&, T);                                             \
+  template T wrapLightCosine<T>(const Closure<T>&, T);                                                 \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \
   template T ggxD<T>(T, T);                                                                            \

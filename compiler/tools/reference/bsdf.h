@@ -23,6 +23,11 @@ template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0
 template <class T>
 V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, const V2<T>& fd, T share, T NoV,
                           T NoL, T roughness);
+/// substrate_closure_above_throughput: what the layers above let through along a direction at cosine mu
+/// (their media along the refracted path, their interfaces), blended by coverageAbove; 1 on top.
+template <class T> V3<T> aboveThroughput(const Closure<T>& c, T mu);
+/// substrate_wrap_light_cosine: the cosine a wrap lobe's light crosses the layers above at.
+template <class T> T wrapLightCosine(const Closure<T>& c, T NoL);
 /// substrate_closure_dielectric_part: the Fresnel ends (F0, F90) of the interface the diffuse lies under.
 template <class T> V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
 

@@ -21,42 +21,6 @@ namespace {
 template <class T> constexpr T kDiffuseMeanCos = T(SUBSTRATE_DIFFUSE_MEAN_COS);
 template <class T> constexpr T kNoVBias = T(SUBSTRATE_NOV_BIAS);
 
-// substrate_interfaces_transmission: the interface term to the power 1 + extra
-// by multiplies (g, g2 = g g, then g2 | g2 g | g2 g2 for extra 1 | 2 | >= 3).
-template <class T>
-T interfacesTransmission(T mu, std::uint32_t extra, T coatFloor) {
-  T g = coatTransmission(mu, coatFloor);
-  const T g2 = g * g;
-  if (extra == 1u) g = g2;
-  else if (extra == 2u) g = g2 * g;
-  else if (extra >= 3u) g = g2 * g2;
-  return g;
-}
-
-// substrate_coat_path_length: 1.5 rsqrt(1.25 + sat(mu)^2) = 1 / mu_t, the
-// path per unit thickness along the cosine refracted into the layers above.
-template <class T>
-T coatPathLength(T mu) {
-  const T m = saturate(mu);
-  return T(1.5) / std::sqrt(T(1.25) + m * m);
-}
-
-// substrate_closure_above_throughput: lerp(1, T_N^coatPathLength(mu) *
-// coatTransmission(mu, coatFloor)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
-// transcendental) when nothing covers the closure.
-template <class T>
-V3<T> aboveThroughput(const Closure<T>& c, T mu) {
-  T cover = saturate(c.coverageAbove);
-  if (cover > T(0)) {
-    const T path = coatPathLength(mu);
-    V3<T> t;
-    for (int k = 0; k < 3; ++k)
-      t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
-    const T i = interfacesTransmission(mu, c.extraInterfaces, c.coatFloor);
-    return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
-  }
-  return splat3(T(1));
-}
 
 // substrate_env_roughness: r lerped toward the haze roughness by its weight.
 template <class T>
@@ -103,7 +67,7 @@ template <class T>
 V3<T> lightClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, const V3<T>& radiance, int diffuseModel) {
   V3<T> N = closureNormal(c);
   V3<T> f = evalClosure(c, V, L, diffuseModel);
-  V3<T> throughput = viewThroughput(c, dot(N, V)) * lightThroughput(c, dot(N, L));
+  V3<T> throughput = viewThroughput(c, dot(N, V)) * lightThroughput(c, wrapLightCosine(c, dot(N, L)));
   return throughput * f * radiance;
 }
 
