@@ -210,7 +210,7 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
     float amount = saturate(c.fuzzAmount);
-    float eFuzz = min(substrate_fuzz_albedo(NoV, c.fuzzRoughness), 1.0);
+    float eFuzz = min(substrate_fuzz_albedo(substrate_fuzz_cosine(c, NoV), c.fuzzRoughness), 1.0);
     result = result * (1.0 - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * SUBSTRATE_F3(diffuseLight);
   }
 #endif
@@ -236,7 +236,7 @@ void substrate_translucency(SubstrateClosure c, float NoV, out float coverage, o
   transmittance = SUBSTRATE_F3(substrate_closure_above_throughput(c, mu) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
-    transmittance *= 1.0 - saturate(c.fuzzAmount) * min(substrate_fuzz_albedo(mu, c.fuzzRoughness), 1.0);
+    transmittance *= 1.0 - saturate(c.fuzzAmount) * min(substrate_fuzz_albedo(substrate_fuzz_cosine(c, mu), c.fuzzRoughness), 1.0);
   }
 #endif
 }

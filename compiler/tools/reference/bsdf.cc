@@ -600,6 +600,34 @@ V3<T> wrapLightRatio(const Closure<T>& c, bool isWrap, T NoLc, T NoL) {
   return r;
 }
 
+// substrate_fuzz_cosine: under layers (coverageAbove > 0), the cosine mu
+// refracted into an interface of IOR eta = 1 + 0.5 coverageAbove, sqrt(max(1 -
+// (1 - mu^2) / eta^2, 0)); mu on top.
+template <class T>
+T fuzzCosine(const Closure<T>& c, T mu) {
+  const T cover = saturate(c.coverageAbove);
+  if (!(cover > T(0))) return mu;
+  const T inv = T(1) / (T(1) + T(0.5) * cover);
+  return std::sqrt(std::max(T(1) - (T(1) - mu * mu) * (inv * inv), T(0)));
+}
+
+// substrate_fuzz_under_layers: the cosines a fuzz under layers sees, the view
+// and the light refracted (fuzzCosine; V' = (V - N NoV) / eta + N fv), the
+// half vector's N.H' = (fv + fl) / sqrt(2 + 2 V'.L'), V'.L' = (VoL - NoV NoL) /
+// eta^2 + fv fl, and the lobe's spread 1 / eta^2 (cos dw = eta^2 cos' dw');
+// unchanged on top.
+template <class T>
+void fuzzUnderLayers(const Closure<T>& c, T NoV, T NoL, T VoL, T& fv, T& fl, T& fh, T& spread) {
+  const T cover = saturate(c.coverageAbove);
+  if (!(cover > T(0))) return;
+  const T inv = T(1) / (T(1) + T(0.5) * cover);
+  spread = inv * inv;
+  fv = fuzzCosine(c, NoV);
+  fl = fuzzCosine(c, std::max(NoL, T(0)));
+  const T vl = (VoL - NoV * NoL) * spread + fv * fl;
+  fh = saturate((fv + fl) / std::sqrt(std::max(T(2) + T(2) * vl, T(1e-8))));
+}
+
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
 template <class T> constexpr T kCoatTrap = T(SUBSTRATE_COAT_TRAP);
 
@@ -859,7 +887,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
-    T eFuzz = fuzzAlbedo(NoV, c.fuzzRoughness);
+    // Under layers the fuzz sees the view and the light refracted into them (fuzzUnderLayers).
+    T fv = NoV, fl = NoLc, fh = NoH, spread = T(1);
+    fuzzUnderLayers(c, NoV, NoL, VoL, fv, fl, fh, spread);
+    T eFuzz = fuzzAlbedo(fv, c.fuzzRoughness);
     // The lobe is normalized where the model's albedo exceeds 1; what it
     // reflects no longer reaches the layers below.
     // ... along the view and along the light alike (substrate_eval_closure):
@@ -867,9 +898,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
     V3<T> fuzz = zero;
     T eCaught = eFuzz;
     if (lightFacing) {
-      fuzz = saturate(c.fuzzColor) * (amount * charlieSheen(c.fuzzRoughness, NoV, NoLc, NoH) / std::max(T(1), eFuzz)) *
-             lightRatio;
-      eCaught = std::max(eFuzz, fuzzAlbedo(NoLc, c.fuzzRoughness));
+      fuzz = saturate(c.fuzzColor) *
+             (amount * spread * charlieSheen(c.fuzzRoughness, fv, fl, fh) / std::max(T(1), eFuzz)) * lightRatio;
+      eCaught = std::max(eFuzz, fuzzAlbedo(fl, c.fuzzRoughness));
     }
     result = result * (T(1) - amount * std::min(eCaught, T(1))) + fuzz;
   }
@@ -884,6 +915,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template V3<T> aboveThroughput<T>(const Closure<T>&, T);                                             \
   template T wrapLightCosine<T>(const Closure<T>&, T);                                                 \
+  template T fuzzCosine<T>(const Closure<T>&, T);                                                      \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
   template V2<T> ggxAlpha<T>(T, T);                                                                    \
   template T ggxD<T>(T, T);                                                                            \

@@ -28,6 +28,8 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
 template <class T> V3<T> aboveThroughput(const Closure<T>& c, T mu);
 /// substrate_wrap_light_cosine: the cosine a wrap lobe's light crosses the layers above at.
 template <class T> T wrapLightCosine(const Closure<T>& c, T NoL);
+/// substrate_fuzz_cosine: the cosine a fuzz under layers sees (refracted into them); mu on top.
+template <class T> T fuzzCosine(const Closure<T>& c, T mu);
 /// substrate_closure_dielectric_part: the Fresnel ends (F0, F90) of the interface the diffuse lies under.
 template <class T> V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
 

@@ -138,7 +138,7 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   V3<T> result = spec * specLight + diff * diffuseLight;
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
-    T eFuzz = std::min(fuzzAlbedo(NoV, c.fuzzRoughness), T(1));
+    T eFuzz = std::min(fuzzAlbedo(fuzzCosine(c, NoV), c.fuzzRoughness), T(1));
     result = result * (T(1) - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
   }
   return result;
@@ -154,7 +154,7 @@ void translucency(const Closure<T>& c, T NoV, T& coverage, V3<T>& transmittanceO
   V3<T> specAlbedo = specularAlbedo(c, mu, dielectric);
   transmittanceOut = aboveThroughput(c, mu) * (splat3(T(1)) - specAlbedo);
   if (c.features & kFeatureFuzz)
-    transmittanceOut = transmittanceOut * (T(1) - saturate(c.fuzzAmount) * std::min(fuzzAlbedo(mu, c.fuzzRoughness), T(1)));
+    transmittanceOut = transmittanceOut * (T(1) - saturate(c.fuzzAmount) * std::min(fuzzAlbedo(fuzzCosine(c, mu), c.fuzzRoughness), T(1)));
 }
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                         \
