@@ -925,8 +925,8 @@ float3 substrate_wrap_light_ratio(SubstrateClosure c, bool isWrap, float NoLc, f
 // V' = (V - N NoV) / eta + N mu'(NoV), mu'(mu) = sqrt(1 - (1 - mu^2) / eta^2)
 // (at least the critical cosine 0.745 under full cover), and the fuzz is
 // evaluated at N.V', N.L' and their half vector's N.H'; seen from above its
-// lobe is the lobe inside over eta^2 (`spread`: cos dw = eta^2 cos' dw'), so
-// it returns what it reflects of the light from inside the refracted cone.
+// lobe is the lobe inside over eta^2 (cos dw = eta^2 cos' dw'), so it returns
+// what it reflects of the light from inside the refracted cone.
 // The split sum and the translucency take the fuzz's albedo at the refracted
 // view too.
 // The sheen is strongest at grazing angles, which a fuzz under a clear coat
@@ -945,10 +945,12 @@ float substrate_fuzz_cosine(SubstrateClosure c, float mu) {
 }
 
 // substrate_fuzz_cosine along the view and the light, the half vector's N.H'
-// of the refracted pair and the lobe's spread 1 / eta^2 (fv, fl, fh, spread
-// keep NoV, NoLc, NoH, 1 on top). The refracted directions are unit vectors,
-// V' = (V - N NoV) / eta + N fv and L' likewise, so V'.L' = (VoL - NoV NoL) /
-// eta^2 + fv fl and N.H' = (fv + fl) / sqrt(2 + 2 V'.L') (1 where V' = -L').
+// of the refracted pair and `spread` = NoL / (eta^2 NoL'), which turns the
+// lobe inside times NoL' (substrate_charlie_sheen's f cos) into the lobe seen
+// from above times NoL (fv, fl, fh, spread keep NoV, NoLc, NoH, 1 on top).
+// The refracted directions are unit vectors, V' = (V - N NoV) / eta + N fv
+// and L' likewise, so V'.L' = (VoL - NoV NoL) / eta^2 + fv fl and
+// N.H' = (fv + fl) / sqrt(2 + 2 V'.L') (1 where V' = -L').
 void substrate_fuzz_under_layers(SubstrateClosure c, float NoV, float NoL, float VoL, inout float fv, inout float fl,
                                  inout float fh, inout float spread) {
 #if SUBSTRATE_USE_LAYERS
@@ -960,6 +962,7 @@ void substrate_fuzz_under_layers(SubstrateClosure c, float NoV, float NoL, float
     fl = substrate_fuzz_cosine(c, max(NoL, 0.0));
     float vl = (VoL - NoV * NoL) * spread + fv * fl;
     fh = saturate((fv + fl) * rsqrt(max(2.0 + 2.0 * vl, 1e-8)));
+    spread *= max(NoL, 0.0) / fl;  // the lobe times NoL, not NoL' (fl >= sqrt(1 - 1 / eta^2) > 0)
   }
 #endif
 }

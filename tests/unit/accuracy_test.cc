@@ -250,7 +250,9 @@ TEST(Accuracy, AConductorUnderACoatLosesWhatTheCoatTraps) {
   // returning the lobe whole read +21.1 / +32.6 / +18.9 / +11.1 % (NoV 1 / 0.6
   // / 0.2 / 0.1) and a white furnace of 0.88. With the trapped share and its
   // returns (substrate_closure_coat_specular): +1.5 / +1.3 / +3.2 / +3.2 %,
-  // furnace 0.91 .. 0.97, reciprocity 1.04 as before.
+  // furnace 0.91 .. 0.97, reciprocity 1.04 as before. Since step 13 the escape
+  // counts the interface's own head-on transmission, so the 4 % it reflects on
+  // the way out returns too: +2.7 / +2.2 / +3.5 / +3.4 %, furnace 0.94 .. 0.99.
   Diagnostics d("conductor_under_coat.json");
   CompileOptions co;
   co.budgetOverride = 1024;
@@ -274,12 +276,93 @@ TEST(Accuracy, AConductorUnderACoatLosesWhatTheCoatTraps) {
     EXPECT_GT(row.reciprocityPairs, 0);
     EXPECT_LE(row.reciprocityMaxRatio, 1.07);
     for (int k = 0; k < 3; ++k) {
-      EXPECT_GE((*row.furnaceAnalytic)[k], 0.90);
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.94);
       EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
     }
     ++rows;
   }
   EXPECT_EQ(rows, 6);
+}
+
+// A slab under a nearly smooth clear coat, as row40_coating has it (thickness 0.1 mm).
+CompileResult compileUnderClearCoat(const std::string& base) {
+  Diagnostics d("under_coat.json");
+  CompileOptions co;
+  co.budgetOverride = 1024;
+  co.maxClosuresOverride = 8;
+  auto r = compileText("under_coat.json", test::material(R"(
+      "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": 10},
+      "base": )" + base + R"(,
+      "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.0001})"),
+                       co, d);
+  EXPECT_TRUE(r) << d.formatAll();
+  return r ? std::move(*r) : CompileResult{};
+}
+
+TEST(Accuracy, AWrapLobeUnderAClearCoatMeetsItAtItsOwnCosine) {
+  // Issue 19, step 13: row40_coating's slab without its fuzz, haze, anisotropy
+  // and edge tint (albedo (0.55, 0.35, 0.25), F0 0.04, roughness 0.45, a wrap
+  // lobe of MFP (6, 3, 1.5) mm) under its clear coat. The wrap lobe lights down
+  // to NoL = -w; lit through the coat at NoL, its light from below the horizon
+  // met a transmission of 0 and the light near it little: -12.4 / -10.8 / -11.0
+  // / -8.7 / -5.6 / -3.0 % (NoV 1 .. 0.1, these counts), a white furnace of
+  // 0.87 .. 0.94 in luminance. Lit at its own cosine (substrate_wrap_light_cosine):
+  // -3.7 / -2.1 / -2.8 / -1.8 / -1.5 / -0.8 %, furnace 0.95 .. 0.98 (0.917 in
+  // red, which wraps furthest: the cosine is the smallest channel's). (Its truth
+  // has no wrap lobe: the BRDF's shape and its reciprocity are not compared.)
+  const CompileResult r = compileUnderClearCoat(
+      R"({"kind": "slab", "diffuse_albedo": [0.55, 0.35, 0.25], "f0": 0.04, "roughness": 0.45,
+          "sss_mfp": [0.006, 0.003, 0.0015], "sss_type": "wrap"})");
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 256;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+    EXPECT_LE(std::fabs(*row.relError), 0.05);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.91);
+      EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
+TEST(Accuracy, AFuzzUnderAClearCoatSeesTheRefractedLight) {
+  // Issue 19, step 13: a Lambertian of albedo 0.5 (F0 0.04, roughness 0.45)
+  // under fuzz (amount 0.5, white, roughness 0.6) under a clear coat. The
+  // sheen's peak is at grazing angles, which light refracted into the coat
+  // never reaches (NoL' >= 0.745). Evaluated at the angles in air the fuzz read
+  // -1.8 / +1.7 / +5.1 / +7.5 / +7.3 / +5.7 % (NoV 1 .. 0.1, these counts), BRDF
+  // medians up to 19.7 %; at the refracted angles (substrate_fuzz_under_layers)
+  // -1.6 / -1.8 / -2.1 / -2.5 / -2.0 / -0.4 %, medians 10.4 % at most (3.9 ..
+  // 4.8 % for NoV >= 0.2), and the lobe reciprocal.
+  const CompileResult r = compileUnderClearCoat(
+      R"({"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.45,
+          "fuzz_amount": 0.5, "fuzz_color": 1, "fuzz_roughness": 0.6})");
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 256;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  int pairs = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.brdfMedianRelError);
+    EXPECT_LE(std::fabs(*row.relError), 0.05);
+    EXPECT_GT(row.brdfCounted, 0);
+    if (row.nov >= 0.2) EXPECT_LE(*row.brdfMedianRelError, 0.06);
+    EXPECT_LE(row.reciprocityMaxRatio, 1.01);
+    pairs += row.reciprocityPairs;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+  EXPECT_GE(pairs, 100);
 }
 
 TEST(Accuracy, ARoughClearCoatLetsTheGrazingLightThrough) {

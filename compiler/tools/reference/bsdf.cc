@@ -614,8 +614,9 @@ T fuzzCosine(const Closure<T>& c, T mu) {
 // substrate_fuzz_under_layers: the cosines a fuzz under layers sees, the view
 // and the light refracted (fuzzCosine; V' = (V - N NoV) / eta + N fv), the
 // half vector's N.H' = (fv + fl) / sqrt(2 + 2 V'.L'), V'.L' = (VoL - NoV NoL) /
-// eta^2 + fv fl, and the lobe's spread 1 / eta^2 (cos dw = eta^2 cos' dw');
-// unchanged on top.
+// eta^2 + fv fl, and `spread` = NoL / (eta^2 fl), which turns the lobe inside
+// times fl into the lobe seen from above (1 / eta^2 of it: cos dw = eta^2
+// cos' dw') times NoL; unchanged on top.
 template <class T>
 void fuzzUnderLayers(const Closure<T>& c, T NoV, T NoL, T VoL, T& fv, T& fl, T& fh, T& spread) {
   const T cover = saturate(c.coverageAbove);
@@ -626,6 +627,7 @@ void fuzzUnderLayers(const Closure<T>& c, T NoV, T NoL, T VoL, T& fv, T& fl, T& 
   fl = fuzzCosine(c, std::max(NoL, T(0)));
   const T vl = (VoL - NoV * NoL) * spread + fv * fl;
   fh = saturate((fv + fl) / std::sqrt(std::max(T(2) + T(2) * vl, T(1e-8))));
+  spread = spread * std::max(NoL, T(0)) / fl;  // the lobe times NoL, not NoL' (fl >= sqrt(1 - 1 / eta^2) > 0)
 }
 
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
