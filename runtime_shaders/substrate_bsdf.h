@@ -894,7 +894,7 @@ mfloat3 substrate_diffuse_wrap(mfloat3 albedo, float3 wrap, float NoL) {
 // own cosine: the channels' mean gave 0.98 .. 0.99 there, but 1.044 for
 // channels of MFP 0, 5 mm and 1 m (Furnace.NoClosureReturnsMoreEnergyThanItReceives).
 float substrate_wrap_light_cosine(SubstrateClosure c, float NoL) {
-#if SUBSTRATE_USE_SSS && SUBSTRATE_USE_LAYERS
+#if SUBSTRATE_USE_SSS && SUBSTRATE_USE_LAYERS && SUBSTRATE_USE_WRAP_UNDER_LAYERS
   if (c.sssType == SUBSTRATE_SSS_WRAP) {
     float3 w3 = substrate_sss_wrap_amount(c.sssMfp);
     float w = saturate(min(w3.x, min(w3.y, w3.z)));
@@ -909,7 +909,7 @@ float substrate_wrap_light_cosine(SubstrateClosure c, float NoL) {
 // lighting applies the latter to the whole closure, and the lobes on its
 // interface (specular, fuzz) meet the layers at NoL. Float.
 float3 substrate_wrap_light_ratio(SubstrateClosure c, bool isWrap, float NoLc, float NoL) {
-#if SUBSTRATE_USE_SSS && SUBSTRATE_USE_LAYERS
+#if SUBSTRATE_USE_SSS && SUBSTRATE_USE_LAYERS && SUBSTRATE_USE_WRAP_UNDER_LAYERS
   if (isWrap) {
     float3 at = SUBSTRATE_F3(substrate_closure_above_throughput(c, NoLc));
     float3 wrapped = SUBSTRATE_F3(substrate_closure_above_throughput(c, substrate_wrap_light_cosine(c, NoL)));
@@ -934,7 +934,7 @@ float3 substrate_wrap_light_ratio(SubstrateClosure c, bool isWrap, float NoLc, f
 // NoV 0.4 and 0.2 (its slab alone: +2.2 / +1.9 %). On top the cosines are
 // NoV, NoLc and NoH untouched (no instruction but the test).
 float substrate_fuzz_cosine(SubstrateClosure c, float mu) {
-#if SUBSTRATE_USE_LAYERS
+#if SUBSTRATE_USE_LAYERS && SUBSTRATE_USE_FUZZ_UNDER_LAYERS
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
     float inv = 1.0 / (1.0 + 0.5 * cover);
@@ -953,7 +953,7 @@ float substrate_fuzz_cosine(SubstrateClosure c, float mu) {
 // N.H' = (fv + fl) / sqrt(2 + 2 V'.L') (1 where V' = -L').
 void substrate_fuzz_under_layers(SubstrateClosure c, float NoV, float NoL, float VoL, inout float fv, inout float fl,
                                  inout float fh, inout float spread) {
-#if SUBSTRATE_USE_LAYERS
+#if SUBSTRATE_USE_LAYERS && SUBSTRATE_USE_FUZZ_UNDER_LAYERS
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
     float inv = 1.0 / (1.0 + 0.5 * cover);

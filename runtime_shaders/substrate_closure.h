@@ -113,6 +113,17 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_COAT_FLOOR
 #define SUBSTRATE_USE_COAT_FLOOR 1
 #endif
+// 1: some closure under a layer may have a wrap lobe, whose light crosses the
+// layers at its own cosine (substrate_wrap_light_cosine), or a fuzz, seen at
+// the angles refracted into them (substrate_fuzz_under_layers): the compiler
+// clears each when no closure under a layer has one. A closure on top meets
+// layers of throughput 1 at every cosine and keeps its fuzz's angles.
+#ifndef SUBSTRATE_USE_WRAP_UNDER_LAYERS
+#define SUBSTRATE_USE_WRAP_UNDER_LAYERS 1
+#endif
+#ifndef SUBSTRATE_USE_FUZZ_UNDER_LAYERS
+#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS 1
+#endif
 // 1: a closure's diffuse lies under its dielectric part, and a conductor-like
 // F0 is read as a metalness mix (substrate_closure_dielectric_part): the
 // compiler sets it for materials with a metalness_to_diffuse_f0 slab; 0

@@ -90,7 +90,8 @@ float4 main([[vk::location(0)]] float3 inV : TEXCOORD0, [[vk::location(1)]] floa
 constexpr const char* kUseSwitches[] = {"SUBSTRATE_USE_F90",   "SUBSTRATE_USE_ANISOTROPY", "SUBSTRATE_USE_HAZE",
                                         "SUBSTRATE_USE_FUZZ",  "SUBSTRATE_USE_SSS",        "SUBSTRATE_USE_GLINT",
                                         "SUBSTRATE_USE_SPECULAR_PROFILE", "SUBSTRATE_USE_EMISSIVE",
-                                        "SUBSTRATE_USE_EXTRA_INTERFACES"};
+                                        "SUBSTRATE_USE_EXTRA_INTERFACES", "SUBSTRATE_USE_WRAP_UNDER_LAYERS",
+                                        "SUBSTRATE_USE_FUZZ_UNDER_LAYERS"};
 
 struct Config {
   ShaderLanguage language;

@@ -72,6 +72,24 @@ std::string coatConductorDefine(const Material& m, const StorageLayout& layout) 
   return fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", any ? 1 : 0);
 }
 
+/// SUBSTRATE_USE_WRAP_UNDER_LAYERS and SUBSTRATE_USE_FUZZ_UNDER_LAYERS: 1 when
+/// some closure under a layer has a wrap lobe (its light crosses the layers at
+/// its own cosine, substrate_wrap_light_cosine) or a fuzz (seen at the
+/// refracted angles, substrate_fuzz_under_layers). A closure on top meets
+/// layers of throughput 1 at every cosine and keeps its fuzz's angles, so a
+/// material with neither under a layer compiles none of it.
+std::string underLayersDefines(const Material& m, const StorageLayout& layout) {
+  bool wrap = false, fuzz = false;
+  for (const ClosureLayout& c : layout.closures) {
+    if (c.isTop || c.slab < 0) continue;
+    const Slab& slab = m.slabs[c.slab];
+    wrap = wrap || slab.sssType == SssType::Wrap;
+    fuzz = fuzz || (slab.features & kFeatFuzz) != 0;
+  }
+  return fmt::format("#define SUBSTRATE_USE_WRAP_UNDER_LAYERS {}\n#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS {}\n",
+                     wrap ? 1 : 0, fuzz ? 1 : 0);
+}
+
 /// The closures that read the layers' rough top (SubstrateClosure.coatFloor):
 /// when one closure, one isotropic lobe, is on top, those under that one
 /// interface (extraInterfaces 0); else none. None either when every closure is
@@ -657,6 +675,7 @@ std::string Emitter::run() {
   out_ += extraInterfacesDefine(L_);
   out_ += coatConductorDefine(m_, L_);
   out_ += coatFloorDefine(m_, L_);
+  out_ += underLayersDefines(m_, L_);
   line(fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}", m_.metalnessMix ? 1 : 0));
   line(fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}", diffuseModelNumber(opt_.diffuseModel)));
   line(fmt::format("#define {}_CLOSURE_COUNT {}", upper, L_.closures.size()));

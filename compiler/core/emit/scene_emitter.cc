@@ -137,6 +137,9 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
   // Nor what F0 the closures under layers have.
   s += fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", k.maxClosures > 1 ? 1 : 0);
   s += fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n", k.maxClosures > 1 ? 1 : 0);  // nor what is on top
+  // Nor which closures under layers wrap or have a fuzz.
+  s += fmt::format("#define SUBSTRATE_USE_WRAP_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
+  s += fmt::format("#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
   // The stream does not say which closures are metalness mixes: every
   // conductor-like F0 is read as one (the runtime's default).
   s += "#define SUBSTRATE_USE_METALNESS_MIX 1\n";
