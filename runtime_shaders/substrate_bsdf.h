@@ -626,9 +626,9 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // layers' own albedo and is not given back. (Issue 19 step 13: with g' =
 // lerp(1, g, t) the 4 % the interface reflects head-on on the way out never
 // came back: a white conductor of roughness 0.4 under a clear coat returned
-// 0.90 .. 0.94 of a white furnace, 0.93 .. 0.97 with T_i.) Without the factor
-// a rough conductor under a
-// clear coat returned all its lobe reflects: +21 / +33 / +19 / +11 % at NoV
+// 0.90 .. 0.94 of a white furnace, 0.93 .. 0.97 with T_i.) Without the
+// factor a rough conductor under a clear coat returned all its lobe reflects:
+// +21 / +33 / +19 / +11 % at NoV
 // 1 / 0.6 / 0.2 / 0.1 over the truth
 // (bench/materials/conductor_under_clear_coat.json), +1.5 / +1.3 / +3.2 /
 // +3.2 % with it. Only for conductors: at share 1 (F0 up to 0.1) the factor
@@ -938,7 +938,7 @@ float substrate_fuzz_cosine(SubstrateClosure c, float mu) {
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
     float inv = 1.0 / (1.0 + 0.5 * cover);
-    return sqrt(max(1.0 - (1.0 - mu * mu) * (inv * inv), 0.0));
+    return max(sqrt(max(1.0 - (1.0 - mu * mu) * (inv * inv), 0.0)), mu);  // never below mu, rounding included
   }
 #endif
   return mu;
@@ -962,7 +962,7 @@ void substrate_fuzz_under_layers(SubstrateClosure c, float NoV, float NoL, float
     fl = substrate_fuzz_cosine(c, max(NoL, 0.0));
     float vl = (VoL - NoV * NoL) * spread + fv * fl;
     fh = saturate((fv + fl) * rsqrt(max(2.0 + 2.0 * vl, 1e-8)));
-    spread *= max(NoL, 0.0) / fl;  // the lobe times NoL, not NoL' (fl >= sqrt(1 - 1 / eta^2) > 0)
+    spread *= max(NoL, 0.0) / max(fl, 1e-6);  // the lobe times NoL, not NoL' (fl >= NoL: at most 1)
   }
 #endif
 }

@@ -1005,11 +1005,21 @@ std::vector<HardCase<T>> hardCases() {
   add("opaque above", [](C& c) { c.coverageAbove = T(1); c.topTransmittance = v3<T>(0, 0, 0); c.isTop = false; });
   add("wrap, MFP 0", [](C& c) { c.sssType = kSssWrap; c.sssMfp = v3<T>(0, 0, 0); });
   add("wrap, MFP 1e9", [](C& c) { c.sssType = kSssWrap; c.sssMfp = v3<T>(1e9, 1e9, 1e9); });
+  // A sliver of cover: the fuzz's refracted cosines and the wrap's own cosine
+  // through layers that are barely there (issue 19, step 13).
+  add("fuzz under a cover of 1e-7", [](C& c) { c.coverageAbove = T(1e-7); c.isTop = false; });
+  add("wrap under a cover of 1e-7", [](C& c) {
+    c.coverageAbove = T(1e-7);
+    c.isTop = false;
+    c.sssType = kSssWrap;
+    c.sssMfp = v3<T>(0, 0.005, 1);
+  });
   add("glint footprint 0", [](C& c) { c.glintUvDerivatives = {T(0), T(0), T(0), T(0)}; c.glintValue = T(0); });
   add("huge glint uv", [](C& c) { c.glintUv = {T(1e30), T(-1e30)}; });
   const V3<T> n = v3<T>(0, 0, 1);
   const std::vector<std::pair<std::string, std::pair<V3<T>, V3<T>>>> dirs = {
       {"grazing V and L (NoV 1e-6, NoL 0)", {v3<T>(std::sqrt(1 - 1e-12), 0, 1e-6), v3<T>(0, 1, 0)}},
+      {"grazing L (NoL 1e-6)", {n, v3<T>(0, std::sqrt(1 - 1e-12), 1e-6)}},
       {"V = L normal", {n, n}},
       {"V = -L", {v3<T>(0.6, 0, 0.8), v3<T>(-0.6, 0, -0.8)}},
       {"L below", {v3<T>(0, 0.6, 0.8), v3<T>(0, 0.8, -0.6)}},

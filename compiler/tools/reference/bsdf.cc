@@ -602,13 +602,13 @@ V3<T> wrapLightRatio(const Closure<T>& c, bool isWrap, T NoLc, T NoL) {
 
 // substrate_fuzz_cosine: under layers (coverageAbove > 0), the cosine mu
 // refracted into an interface of IOR eta = 1 + 0.5 coverageAbove, sqrt(max(1 -
-// (1 - mu^2) / eta^2, 0)); mu on top.
+// (1 - mu^2) / eta^2, 0)), never below mu; mu on top.
 template <class T>
 T fuzzCosine(const Closure<T>& c, T mu) {
   const T cover = saturate(c.coverageAbove);
   if (!(cover > T(0))) return mu;
   const T inv = T(1) / (T(1) + T(0.5) * cover);
-  return std::sqrt(std::max(T(1) - (T(1) - mu * mu) * (inv * inv), T(0)));
+  return std::max(std::sqrt(std::max(T(1) - (T(1) - mu * mu) * (inv * inv), T(0))), mu);  // never below mu
 }
 
 // substrate_fuzz_under_layers: the cosines a fuzz under layers sees, the view
@@ -627,7 +627,7 @@ void fuzzUnderLayers(const Closure<T>& c, T NoV, T NoL, T VoL, T& fv, T& fl, T& 
   fl = fuzzCosine(c, std::max(NoL, T(0)));
   const T vl = (VoL - NoV * NoL) * spread + fv * fl;
   fh = saturate((fv + fl) / std::sqrt(std::max(T(2) + T(2) * vl, T(1e-8))));
-  spread = spread * std::max(NoL, T(0)) / fl;  // the lobe times NoL, not NoL' (fl >= sqrt(1 - 1 / eta^2) > 0)
+  spread = spread * std::max(NoL, T(0)) / std::max(fl, T(1e-6));  // the lobe times NoL, not NoL' (fl >= NoL)
 }
 
 template <class T> constexpr T kCoatSqrtF0 = T(SUBSTRATE_COAT_SQRT_F0);
