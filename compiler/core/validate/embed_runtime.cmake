@@ -3,8 +3,8 @@
 # built with, wherever the binary runs. Invoked by compiler/CMakeLists.txt.
 #
 # A file's text is kept in raw string literals of at most kChunk bytes each,
-# cut after a newline and joined into one std::string when first used: C++
-# compilers need support string literals of only 65,536 characters (Clang's
+# cut after a newline and joined into one std::string when first used: a C++
+# compiler need support string literals of only 65,536 characters (Clang's
 # -Woverlength-strings), and substrate_bsdf.h is longer.
 set(kChunk 60000)
 file(GLOB files RELATIVE "${DIR}" "${DIR}/*")
