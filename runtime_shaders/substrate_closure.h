@@ -193,4 +193,13 @@ float substrate_coat_floor(float topRoughness) {
   return SUBSTRATE_COAT_ROUGH_SCALE * x / (x + SUBSTRATE_COAT_ROUGH_HALF);
 }
 
+// The top's GGX alpha r^2 back from a floor f > 0, r = START + HALF f /
+// (SCALE - f) (the inverse of substrate_coat_floor, f < SCALE); 0 for f = 0:
+// no one rough top (issue 19, step 14: substrate_closure_coat_specular).
+float substrate_coat_top_alpha(float coatFloor) {
+  float f = clamp(coatFloor, 0.0, 0.99 * SUBSTRATE_COAT_ROUGH_SCALE);
+  float r = SUBSTRATE_COAT_ROUGH_START + SUBSTRATE_COAT_ROUGH_HALF * f / (SUBSTRATE_COAT_ROUGH_SCALE - f);
+  return f > 0.0 ? r * r : 0.0;
+}
+
 #endif

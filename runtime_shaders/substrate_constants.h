@@ -158,6 +158,20 @@
 #define SUBSTRATE_COAT_TIR_P3 0.1584
 #define SUBSTRATE_COAT_INV_ETA2 0.4444444444
 #define SUBSTRATE_COAT_CRITICAL_COS 0.7453559925
+// Under a rough top (issue 19, step 14; substrate_closure_coat_specular):
+//   TOP_SPREAD: the share of the top's alpha taken back out of the closure's
+//        widened alpha before R is read: the spread a rough top gives a lobe
+//        on the way in is mostly undone on the way out, and the TIR fit
+//        (above) is for a lobe that spreads below a smooth top;
+//   ROUGH_PATH: Q in the lobe's extra path through the media under a rough
+//        top, Q f^3 (p(NoV) (1 - NoV)^2 + p(NoL) (1 - NoL)^2), p =
+//        substrate_coat_path_length, f = coatFloor: grazing light refracted
+//        by tilted facets crosses the media more steeply than 1 / mu_t.
+// A scan against the Monte Carlo walk (a white mirror and rough conductors,
+// roughness 0.05 .. 0.7, under tops of roughness 0.1 .. 1 and transmittance
+// 0.7 and 0.4; scripts/scan_tinted_coat.py checks the shipped values).
+#define SUBSTRATE_COAT_TOP_SPREAD 0.6
+#define SUBSTRATE_COAT_ROUGH_PATH 1.2
 
 // substrate_diffuse_chan2024's multiple-scattering lobe (issue 19, step 7):
 // K1(mu) = int VoH^2 / (NoH + 0.025) cos / pi over the light hemisphere ~

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -39,6 +40,20 @@ accuracy::Options cheap(int threads) {
 }
 
 bool sameBits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+// `top` over `base` (each a slab's JSON), `thickness` mm apart, under the
+// largest budget (every closure kept).
+CompileResult compileLayered(const std::string& top, const std::string& base, const std::string& thickness) {
+  Diagnostics d("layered.json");
+  CompileOptions co;
+  co.budgetOverride = 1024;
+  co.maxClosuresOverride = 8;
+  auto r = compileText("layered.json", test::material(R"("coat": )" + top + R"(, "base": )" + base + R"(,
+      "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": )" + thickness + "}"),
+                       co, d);
+  EXPECT_TRUE(r) << d.formatAll();
+  return r ? std::move(*r) : CompileResult{};
+}
 
 TEST(Accuracy, ALambertianSlabAgreesWithItsTruthNearNormalIncidence) {
   // No specular to speak of (F0 0): the walk's Lambertian and the analytic
@@ -104,20 +119,15 @@ TEST(Accuracy, ACoatGivesBackWhatItsUndersideReflects) {
   int rows = 0;
   for (const char* mfp : {"10", "[0.2, 1, 5]"}) {
     SCOPED_TRACE(mfp);
-    Diagnostics d("coat.json");
-    CompileOptions co;
-    co.budgetOverride = 1024;
-    co.maxClosuresOverride = 8;
-    const std::string nodes =
-        std::string(R"("coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": )") +
-        mfp + R"(}, "base": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.05},
-           "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.1})";
-    auto r = compileText("coat.json", test::material(nodes), co, d);
-    ASSERT_TRUE(r) << d.formatAll();
+    const CompileResult r =
+        compileLayered(std::string(R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": )") +
+                           mfp + "}",
+                       R"({"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.04, "roughness": 0.05})", "0.1");
+    ASSERT_GE(r.material.root, 0);
     accuracy::Options o = cheap(2);
     o.samples = 8192;
     o.evalSamples = 512;  // the BRDF grid's noise near the coat's mirror peak at 64 walks reads ~19 %
-    const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(*r, o), accuracy::truthOf(*r, o));
+    const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
     ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
     for (const auto& row : c.rows) {
       SCOPED_TRACE(row.nov);
@@ -253,20 +263,14 @@ TEST(Accuracy, AConductorUnderACoatLosesWhatTheCoatTraps) {
   // furnace 0.91 .. 0.97, reciprocity 1.04 as before. Since step 13 the escape
   // counts the interface's own head-on transmission, so the 4 % it reflects on
   // the way out returns too: +2.7 / +2.2 / +3.5 / +3.4 %, furnace 0.94 .. 0.99.
-  Diagnostics d("conductor_under_coat.json");
-  CompileOptions co;
-  co.budgetOverride = 1024;
-  co.maxClosuresOverride = 8;
-  auto compiled = compileText("conductor_under_coat.json", test::material(R"(
-      "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": 10},
-      "base": {"kind": "slab", "diffuse_albedo": 0, "f0": [0.55, 0.3, 0.1], "roughness": 0.5},
-      "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.1})"),
-                              co, d);
-  ASSERT_TRUE(compiled) << d.formatAll();
+  const CompileResult compiled =
+      compileLayered(R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": 10})",
+                     R"({"kind": "slab", "diffuse_albedo": 0, "f0": [0.55, 0.3, 0.1], "roughness": 0.5})", "0.1");
+  ASSERT_GE(compiled.material.root, 0);
   accuracy::Options o = cheap(2);
   o.samples = 8192;
   o.evalSamples = 256;
-  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(*compiled, o), accuracy::truthOf(*compiled, o));
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(compiled, o), accuracy::truthOf(compiled, o));
   ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
   int rows = 0;
   for (const auto& row : c.rows) {
@@ -284,19 +288,63 @@ TEST(Accuracy, AConductorUnderACoatLosesWhatTheCoatTraps) {
   EXPECT_EQ(rows, 6);
 }
 
+// A white conductor of roughness `base` under a top of roughness `top` whose
+// medium lets 0.7 through head-on (an MFP of 2.8037e-4 mm over 1e-4 mm), as
+// MaterialX's coat_color does: its albedo against the truth, per NoV.
+std::vector<double> conductorUnderTintedCoat(const std::string& top, const std::string& base) {
+  const CompileResult r =
+      compileLayered(R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": )" + top +
+                         R"(, "sss_mfp": 0.00028036732})",
+                     R"({"kind": "slab", "diffuse_albedo": 0, "f0": 1, "roughness": )" + base + "}", "0.0001");
+  if (r.material.root < 0) return {};
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 64;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+  std::vector<double> errors;
+  for (const auto& row : c.rows) {
+    EXPECT_TRUE(row.relError);
+    if (row.relError) errors.push_back(*row.relError);
+  }
+  return errors;
+}
+
+TEST(Accuracy, TheLightATintedCoatTrapsCrossesItsMediumTwiceAsFar) {
+  // Issue 19, step 14: what a rough lobe sends below the critical angle is
+  // reflected back down by the top and crosses the medium at its grazing
+  // angles, twice the vertical path or more; returned through T_m^2 a white
+  // conductor of roughness 0.7 under a smooth top of transmittance 0.7 read
+  // +19.8 / +16.2 / +12.7 / +9.8 / +4.5 / +1.3 % (NoV 1 .. 0.1, 16,384 walks),
+  // through T_m^4 (substrate_closure_coat_specular) +6.3 / +2.4 / -0.3 / -0.5 /
+  // -0.6 / -1.0 %; head-on the goal's 5 % is not met yet.
+  const std::vector<double> errors = conductorUnderTintedCoat("0.05", "0.7");
+  ASSERT_EQ(errors.size(), accuracy::kNoV.size());
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    SCOPED_TRACE(accuracy::kNoV[i]);
+    EXPECT_LE(std::fabs(errors[i]), accuracy::kNoV[i] == 1.0 ? 0.08 : 0.05);
+  }
+}
+
+TEST(Accuracy, ARoughTintedTopDoesNotTrapTheSpreadItGives) {
+  // Issue 19, step 14 (MaterialX Tiled_Brass: base and coat of one roughness):
+  // a white conductor of roughness 0.4 under a top of roughness 0.4 and
+  // transmittance 0.7. The closure's roughness holds the top's spread, which
+  // the way out mostly undoes, and grazing light refracted by the top's tilted
+  // facets runs flatter through the medium than 1 / mu_t:
+  // -5.2 / +1.0 / +9.8 / +15.0 / +17.5 / +19.7 % before, -5.3 / -2.1 / +1.4 /
+  // +1.5 / +2.5 / +5.2 % with both (16,384 walks, scripts/scan_tinted_coat.py).
+  const std::vector<double> errors = conductorUnderTintedCoat("0.4", "0.4");
+  ASSERT_EQ(errors.size(), accuracy::kNoV.size());
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    SCOPED_TRACE(accuracy::kNoV[i]);
+    EXPECT_LE(std::fabs(errors[i]), accuracy::kNoV[i] >= 0.2 ? 0.06 : 0.08);
+  }
+}
+
 // A slab under a nearly smooth clear coat, as row40_coating has it (thickness 0.1 mm).
 CompileResult compileUnderClearCoat(const std::string& base) {
-  Diagnostics d("under_coat.json");
-  CompileOptions co;
-  co.budgetOverride = 1024;
-  co.maxClosuresOverride = 8;
-  auto r = compileText("under_coat.json", test::material(R"(
-      "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": 10},
-      "base": )" + base + R"(,
-      "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.0001})"),
-                       co, d);
-  EXPECT_TRUE(r) << d.formatAll();
-  return r ? std::move(*r) : CompileResult{};
+  return compileLayered(R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.05, "sss_mfp": 10})", base,
+                        "0.0001");
 }
 
 TEST(Accuracy, AWrapLobeUnderAClearCoatMeetsItAtItsOwnCosine) {
@@ -373,20 +421,14 @@ TEST(Accuracy, ARoughClearCoatLetsTheGrazingLightThrough) {
   // -44.3 % (NoV 1 / 0.6 / 0.2 / 0.1), a white furnace of 0.55 at NoV 0.1. With
   // the rough top's floor (substrate_coat_transmission): -1.2 / -3.0 / -7.0 /
   // -7.3 %, furnace 0.93 .. 0.99, reciprocity 1.00 as before.
-  Diagnostics d("rough_coat.json");
-  CompileOptions co;
-  co.budgetOverride = 1024;
-  co.maxClosuresOverride = 8;
-  auto compiled = compileText("rough_coat.json", test::material(R"(
-      "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.6, "sss_mfp": 1000},
-      "base": {"kind": "slab", "diffuse_albedo": 0.9, "f0": 0.04, "roughness": 0.5},
-      "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.0001})"),
-                              co, d);
-  ASSERT_TRUE(compiled) << d.formatAll();
+  const CompileResult compiled =
+      compileLayered(R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.6, "sss_mfp": 1000})",
+                     R"({"kind": "slab", "diffuse_albedo": 0.9, "f0": 0.04, "roughness": 0.5})", "0.0001");
+  ASSERT_GE(compiled.material.root, 0);
   accuracy::Options o = cheap(2);
   o.samples = 8192;
   o.evalSamples = 256;
-  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(*compiled, o), accuracy::truthOf(*compiled, o));
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(compiled, o), accuracy::truthOf(compiled, o));
   ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
   int rows = 0;
   for (const auto& row : c.rows) {

@@ -512,6 +512,15 @@ T coatFloor(T topRoughness) {
   return T(SUBSTRATE_COAT_ROUGH_SCALE) * x / (x + T(SUBSTRATE_COAT_ROUGH_HALF));
 }
 
+// substrate_coat_top_alpha: r^2, r = START + HALF f / (SCALE - f) (f clamped to
+// [0, 0.99 SCALE]), the inverse of coatFloor; 0 for f = 0.
+template <class T>
+T coatTopAlpha(T floor) {
+  const T f = clampT(floor, T(0), T(0.99) * T(SUBSTRATE_COAT_ROUGH_SCALE));
+  const T r = T(SUBSTRATE_COAT_ROUGH_START) + T(SUBSTRATE_COAT_ROUGH_HALF) * f / (T(SUBSTRATE_COAT_ROUGH_SCALE) - f);
+  return f > T(0) ? r * r : T(0);
+}
+
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
   int tops = 0;
@@ -726,19 +735,22 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
   return r;
 }
 
-// substrate_closure_coat_specular: (1 - R') / (1 - e' (1 - (1 - R') g')) per channel, with
-// t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2, 1e-3),
-// d = max(mu_i - mu_c, 0) along the view and along the light), g' = lerp(1,
-// T_i coatTransmission(max(NoV, NoL), coatFloor), t), T_i = max(T_N, 0.96) the interface's own,
-// e' = e sat(T_N / 0.96)^2 and e the closure's hemispherical albedo, F_avg + A diffuseTransmission(A, F_avg,
-// d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the same of the dielectric part fd).
+// substrate_closure_coat_specular: (1 - R') / (1 - e T_m^2 (R' T_m^2 + (1 - R') (1 - g'))) per channel,
+// with t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2 -
+// TOP_SPREAD sat(coverageAbove) coatTopAlpha(coatFloor), 1e-3), d = max(mu_i - mu_c, 0) along the view
+// and along the light), g' = lerp(1, T_i coatTransmission(max(NoV, NoL), coatFloor), t), T_i =
+// max(T_N, 0.96) the interface's own, T_m = sat(T_N / 0.96) and e the closure's hemispherical albedo,
+// F_avg + A diffuseTransmission(A, F_avg, d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the
+// same of the dielectric part fd); times max(T_m, 1e-30)^x, x = ROUGH_PATH f^3 t (coatPathLength(NoV)
+// (1 - NoV)^2 + coatPathLength(NoL) (1 - NoL)^2), f = sat(coatFloor).
 template <class T>
 V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, const V2<T>& fd, T share, T NoV,
                           T NoL, T roughness) {
   // No branch, as in the shader: at coverageAbove 0 (or share 1) the factor is exactly 1.
-  const T t = saturate(c.coverageAbove) * (T(1) - share);
+  const T cover = saturate(c.coverageAbove);
+  const T t = cover * (T(1) - share);
   const T r = saturate(roughness);
-  const T a = std::max(r * r, kMinAlpha<T>);
+  const T a = std::max(r * r - T(SUBSTRATE_COAT_TOP_SPREAD) * cover * coatTopAlpha(c.coatFloor), kMinAlpha<T>);
   const T a2 = a * a;
   auto inner = [](T mu) {
     const T inside = std::sqrt(T(1) - (T(1) - mu * mu) * T(SUBSTRATE_COAT_INV_ETA2));
@@ -758,8 +770,17 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
     const T tn = saturate(c.topTransmittance[i]);
     const T tm = saturate(tn * T(SUBSTRATE_COAT_INV_T_0));
     const T ti = std::max(tn, T(SUBSTRATE_COAT_T_0));
-    const T escape = (T(1) - trapped) * lerp(T(1), ti * g, t);
-    k[i] = (T(1) - trapped) / (T(1) - e[i] * (tm * tm) * (T(1) - escape));
+    const T tm2 = tm * tm;
+    const T back = tm2 * (trapped * tm2 + (T(1) - trapped) * (T(1) - lerp(T(1), ti * g, t)));
+    k[i] = (T(1) - trapped) / (T(1) - e[i] * back);
+  }
+  const T f = saturate(c.coatFloor);
+  const T mv = T(1) - v, ml = T(1) - l;
+  const T extra = T(SUBSTRATE_COAT_ROUGH_PATH) * (f * f * f) * t *
+                  (coatPathLength(v) * (mv * mv) + coatPathLength(l) * (ml * ml));
+  for (int i = 0; i < 3; ++i) {
+    const T tm = saturate(saturate(c.topTransmittance[i]) * T(SUBSTRATE_COAT_INV_T_0));
+    k[i] *= std::exp(std::log(std::max(tm, K<T>::minTransmittance)) * extra);
   }
   return k;
 }
