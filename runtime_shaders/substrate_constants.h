@@ -166,7 +166,7 @@
 //   ROUGH_PATH: Q in the lobe's extra path through the media under a rough
 //        top, Q f^3 (p(NoV) (1 - NoV)^2 + p(NoL) (1 - NoL)^2), p =
 //        substrate_coat_path_length, f = coatFloor: grazing light refracted
-//        by tilted facets crosses the media more steeply than 1 / mu_t.
+//        by tilted facets crosses the media flatter, farther than 1 / mu_t.
 // A scan against the Monte Carlo walk (a white mirror and rough conductors,
 // roughness 0.05 .. 0.7, under tops of roughness 0.1 .. 1 and transmittance
 // 0.7 and 0.4; scripts/scan_tinted_coat.py checks the shipped values).

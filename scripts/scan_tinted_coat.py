@@ -14,8 +14,8 @@ second build on the same truth samples and prints both side by side.
 
 The constants were chosen by a scan over (TOP_SPREAD, ROUGH_PATH, the power of
 f) with this grid as the objective (docs/accuracy.md, step 14); this script
-checks the shipped build. Writes nothing but a temporary directory; about 30 s
-on two cores at the default 16,384 walks per albedo.
+checks the shipped build. Writes nothing but a temporary directory; about 12 s
+per build on two cores at the default 16,384 walks per albedo.
 
 usage: scripts/scan_tinted_coat.py [--bin BIN] [--before BIN] [--samples N] [--jobs J]
 """
@@ -77,7 +77,7 @@ def main():
     def row(errs):
         return " ".join("%+6.1f" % (100 * e) for e in errs)
 
-    print("top  base  T    | albedo error %% at NoV 1 / 0.8 / 0.6 / 0.4 / 0.2 / 0.1")
+    print("top  base  T    | albedo error % at NoV 1 / 0.8 / 0.6 / 0.4 / 0.2 / 0.1")
     for case in cases:
         line = "%.2f %.2f  %.1f | " % case
         line += " | ".join("%s %s" % (name, row(table[(name, case)])) for name, _ in reversed(builds))
