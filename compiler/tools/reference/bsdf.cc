@@ -765,6 +765,10 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   const V3<T> fAvg = f0 + (f90 - f0) * T(1.0 / 21.0);
   const T dAvg = fd[0] + (fd[1] - fd[0]) * T(1.0 / 21.0);
   const V3<T> e = saturate(fAvg + albedo * diffuseTransmission(albedo, fAvg, dAvg));
+  const T f = saturate(c.coatFloor);
+  const T mv = T(1) - v, ml = T(1) - l;
+  const T extra = T(SUBSTRATE_COAT_ROUGH_PATH) * (f * f * f) * t *
+                  (coatPathLength(v) * (mv * mv) + coatPathLength(l) * (ml * ml));
   V3<T> k;
   for (int i = 0; i < 3; ++i) {
     const T tn = saturate(c.topTransmittance[i]);
@@ -773,13 +777,6 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
     const T tm2 = tm * tm;
     const T back = tm2 * (trapped * tm2 + (T(1) - trapped) * (T(1) - lerp(T(1), ti * g, t)));
     k[i] = (T(1) - trapped) / (T(1) - e[i] * back);
-  }
-  const T f = saturate(c.coatFloor);
-  const T mv = T(1) - v, ml = T(1) - l;
-  const T extra = T(SUBSTRATE_COAT_ROUGH_PATH) * (f * f * f) * t *
-                  (coatPathLength(v) * (mv * mv) + coatPathLength(l) * (ml * ml));
-  for (int i = 0; i < 3; ++i) {
-    const T tm = saturate(saturate(c.topTransmittance[i]) * T(SUBSTRATE_COAT_INV_T_0));
     k[i] *= std::exp(std::log(std::max(tm, K<T>::minTransmittance)) * extra);
   }
   return k;
