@@ -965,12 +965,18 @@ float3 substrate_wrap_light_ratio(SubstrateClosure c, bool isWrap, float NoLc, f
 // never sees: evaluated at NoV, row40's fuzz read +8.6 % against the truth at
 // NoV 0.4 and 0.2 (its slab alone: +2.2 / +1.9 %). On top the cosines are
 // NoV, NoLc and NoH untouched (no instruction but the test).
+// The cosine mu refracted into an interface of 1 / eta^2 = inv2, never below
+// mu (rounding included).
+float substrate_fuzz_refracted_cosine(float mu, float inv2) {
+  return max(sqrt(max(1.0 - (1.0 - mu * mu) * inv2, 0.0)), mu);
+}
+
 float substrate_fuzz_cosine(SubstrateClosure c, float mu) {
 #if SUBSTRATE_USE_LAYERS && SUBSTRATE_USE_FUZZ_UNDER_LAYERS
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
     float inv = 1.0 / (1.0 + 0.5 * cover);
-    return max(sqrt(max(1.0 - (1.0 - mu * mu) * (inv * inv), 0.0)), mu);  // never below mu, rounding included
+    return substrate_fuzz_refracted_cosine(mu, inv * inv);
   }
 #endif
   return mu;
@@ -990,8 +996,8 @@ void substrate_fuzz_under_layers(SubstrateClosure c, float NoV, float NoL, float
   if (cover > 0.0) {
     float inv = 1.0 / (1.0 + 0.5 * cover);
     spread = inv * inv;
-    fv = substrate_fuzz_cosine(c, NoV);
-    fl = substrate_fuzz_cosine(c, max(NoL, 0.0));
+    fv = substrate_fuzz_refracted_cosine(NoV, spread);
+    fl = substrate_fuzz_refracted_cosine(max(NoL, 0.0), spread);
     float vl = (VoL - NoV * NoL) * spread + fv * fl;
     fh = saturate((fv + fl) * rsqrt(max(2.0 + 2.0 * vl, 1e-8)));
     spread *= max(NoL, 0.0) / max(fl, 1e-6);  // the lobe times NoL, not NoL' (fl >= NoL: at most 1)

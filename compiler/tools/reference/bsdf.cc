@@ -613,11 +613,16 @@ V3<T> wrapLightRatio(const Closure<T>& c, bool isWrap, T NoLc, T NoL) {
 // refracted into an interface of IOR eta = 1 + 0.5 coverageAbove, sqrt(max(1 -
 // (1 - mu^2) / eta^2, 0)), never below mu; mu on top.
 template <class T>
+T fuzzRefractedCosine(T mu, T inv2) {  // substrate_fuzz_refracted_cosine, inv2 = 1 / eta^2
+  return std::max(std::sqrt(std::max(T(1) - (T(1) - mu * mu) * inv2, T(0))), mu);  // never below mu
+}
+
+template <class T>
 T fuzzCosine(const Closure<T>& c, T mu) {
   const T cover = saturate(c.coverageAbove);
   if (!(cover > T(0))) return mu;
   const T inv = T(1) / (T(1) + T(0.5) * cover);
-  return std::max(std::sqrt(std::max(T(1) - (T(1) - mu * mu) * (inv * inv), T(0))), mu);  // never below mu
+  return fuzzRefractedCosine(mu, inv * inv);
 }
 
 // substrate_fuzz_under_layers: the cosines a fuzz under layers sees, the view
@@ -632,8 +637,8 @@ void fuzzUnderLayers(const Closure<T>& c, T NoV, T NoL, T VoL, T& fv, T& fl, T& 
   if (!(cover > T(0))) return;
   const T inv = T(1) / (T(1) + T(0.5) * cover);
   spread = inv * inv;
-  fv = fuzzCosine(c, NoV);
-  fl = fuzzCosine(c, std::max(NoL, T(0)));
+  fv = fuzzRefractedCosine(NoV, spread);
+  fl = fuzzRefractedCosine(std::max(NoL, T(0)), spread);
   const T vl = (VoL - NoV * NoL) * spread + fv * fl;
   fh = saturate((fv + fl) / std::sqrt(std::max(T(2) + T(2) * vl, T(1e-8))));
   spread = spread * std::max(NoL, T(0)) / std::max(fl, T(1e-6));  // the lobe times NoL, not NoL' (fl >= NoL)
