@@ -499,6 +499,31 @@ float2 substrate_closure_dielectric_part(SubstrateClosure c, mfloat3 f0, mfloat3
 #endif
 }
 
+// The F0 that Turquin's W reads (substrate_specular_energy), per channel. A
+// metalness mix (issue 19, step 15; docs/accuracy.md, "15. A metalness mix
+// scatters in each part") is a conductor of F0 b beside a dielectric part of
+// F0 d = fd.x (substrate_closure_dielectric_part), of metallic m, each
+// compensated for its own multiple scattering: the F0-weighted mean of their
+// W = 1 + F_i k is 1 + k E[F_i^2] / E[F_i], so W reads F + Var / F, with
+// Var = m (1 - m)(b - d)^2 = (F - d)(b - F): the mixed F0 is F = d + m (b - d)
+// and the diffuse albedo A = b (1 - m), so b is the larger root of
+// b^2 - (F + A) b + d A = 0, at most 1; times t = substrate_mix_share (0 for
+// a dielectric). At most 1 (Var / F <= b - F). One lobe of the mixed F0 with
+// W = 1 + F k returned 0.90 of a white furnace (metallic 0.5, roughness 0.8).
+// The closure's own F0 without SUBSTRATE_USE_METALNESS_MIX.
+mfloat3 substrate_closure_compensated_f0(SubstrateClosure c, mfloat3 f0, float2 fd) {
+#if SUBSTRATE_USE_METALNESS_MIX
+  float3 f = SUBSTRATE_F3(f0);
+  float3 a = saturate(c.diffuseAlbedo);
+  float3 s = f + a;
+  float3 b = min(0.5 * (s + sqrt(max(s * s - (4.0 * fd.x) * a, SUBSTRATE_SPLAT3(0.0)))), SUBSTRATE_SPLAT3(1.0));
+  float3 var = max(f - SUBSTRATE_SPLAT3(fd.x), SUBSTRATE_SPLAT3(0.0)) * max(b - f, SUBSTRATE_SPLAT3(0.0));
+  return SUBSTRATE_M3(f + substrate_mix_share(substrate_max3(f)) * var / max(f, SUBSTRATE_SPLAT3(1e-4)));
+#else
+  return f0;
+#endif
+}
+
 // The channel means of F0 and F90 of the interface the diffuse lies under, for
 // its light-side coupling and the layers' covariance term: F0 and F90 at most
 // the dielectric part's (substrate_closure_dielectric_part) per channel. (F90
@@ -515,7 +540,8 @@ float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
   return float2(dot(f, SUBSTRATE_SPLAT3(1.0 / 3.0)), dot(g, SUBSTRATE_SPLAT3(1.0 / 3.0)));
 }
 
-// Turquin 2019 multiple-scattering compensation W = 1 + F0 (1 - E) / E and the
+// Turquin 2019 multiple-scattering compensation W = 1 + F0w (1 - E) / E (F0w
+// the closure's F0, or a metalness mix's substrate_closure_compensated_f0) and the
 // compensated lobe's directional albedo E_spec = (F0 E + (F90 - F0) B_chi) W,
 // from the tables at (NoV, r) (upper bounds of E - B and B; E = their sum
 // clamped to [1e-3, 1]; B_chi bounded from them, substrate_fresnel_b and
@@ -523,11 +549,11 @@ float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
 // energy: W E <= 1 and E_spec is never below the compensated lobe's true
 // albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
 // (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, float NoV, float roughness,
-                                  out mfloat3 albedo, out float dielectric) {
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float NoV,
+                                  float roughness, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
-  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
+  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e);
   float2 b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
   albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
   dielectric = substrate_dielectric_albedo(fd, e, b.y);
@@ -547,8 +573,8 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 f
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, float NoV, float roughness,
-                                        float anisotropy, out mfloat3 albedo, out float dielectric) {
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float NoV,
+                                        float roughness, float anisotropy, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float pull = substrate_fresnel_pull(roughness);
@@ -561,7 +587,7 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, fl
     pull = 1.0;
   }
 #endif
-  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0 * SUBSTRATE_M((1.0 - e) / e);
+  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e);
   float2 b = substrate_fresnel_b(dfg, e, pull, share);
   albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
   dielectric = substrate_dielectric_albedo(fd, e, b.y);
@@ -1232,9 +1258,11 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
   float2 fd = substrate_closure_dielectric_part(c, f0, f90);
+  mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
   mfloat3 specAlbedo;
   float dielectric;
-  mfloat3 w1 = substrate_specular_energy_aniso(f0, f90, share, fd, NoV, roughness, anisotropy, specAlbedo, dielectric);
+  mfloat3 w1 =
+      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -1247,7 +1275,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (hazeWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
+    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2,
+                                         dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }

@@ -153,11 +153,11 @@ T dielectricAlbedo(const V2<T>& d, T e, T b) {
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
 // B -> min(B_max, e), pull 1 (else fresnelPull(r));
-// W = 1 + F0 (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
+// W = 1 + F0w (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
 // the dielectric part's (ends fd) dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)).
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness, T anisotropy,
-                          V3<T>& albedo, T& dielectric) {
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
+                          T roughness, T anisotropy, V3<T>& albedo, T& dielectric) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
   T pull = fresnelPull(roughness);
@@ -168,7 +168,7 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T
     dfg[1] = std::min(eb[1], e);
     pull = T(1);
   }
-  V3<T> w = splat3(T(1)) + f0 * ((T(1) - e) / e);
+  V3<T> w = splat3(T(1)) + f0w * ((T(1) - e) / e);
   albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull, share)) * w);
   dielectric = dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, T(1)));
   return w;
@@ -176,9 +176,9 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness, V3<T>& albedo,
-                     T& dielectric) {
-  return specularEnergyAniso(f0, f90, share, fd, NoV, roughness, T(0), albedo, dielectric);
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
+                     T roughness, V3<T>& albedo, T& dielectric) {
+  return specularEnergyAniso(f0, f90, share, fd, f0w, NoV, roughness, T(0), albedo, dielectric);
 }
 
 // substrate_diffuse_transmission: min(1 - min(E_spec, E_d), (1 - E_spec) / max(albedo, 1e-3)).
@@ -693,6 +693,24 @@ V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f
   return {lerp(f, mixed[0], t), lerp(max3(f90), mixed[1], t)};
 }
 
+// substrate_closure_compensated_f0: F + t (F - d)^+ (b - F)^+ / max(F, 1e-4) per channel, d = fd.x,
+// b = min((s + sqrt(max(s^2 - 4 d A, 0))) / 2, 1), s = F + A, A the saturated diffuse albedo,
+// t = mixShare(max F0); F without a metalness mix.
+template <class T>
+V3<T> closureCompensatedF0(const Closure<T>& c, const V3<T>& f0, const V2<T>& fd) {
+  if (!c.metalnessMix) return f0;
+  const T t = mixShare(max3(f0));
+  const V3<T> a = saturate(c.diffuseAlbedo);
+  V3<T> r;
+  for (int i = 0; i < 3; ++i) {
+    const T s = f0[i] + a[i];
+    const T b = std::min(T(0.5) * (s + std::sqrt(std::max(s * s - T(4) * fd[0] * a[i], T(0)))), T(1));
+    const T var = std::max(f0[i] - fd[0], T(0)) * std::max(b - f0[i], T(0));
+    r[i] = f0[i] + t * var / std::max(f0[i], T(1e-4));
+  }
+  return r;
+}
+
 // 1 / lerp(1, D, cover), D = G_k(f) T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
 // G_k(f) = G_k + (1 - G_k) coatMeanShare(coatFloor),
 // T_i = max(T_N, 0.96^(1+k)), T_m = sat(T_N / 0.96^(1+k)).
@@ -827,9 +845,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   // Energy terms (needed by the diffuse even when NoL <= 0; anisotropic lobes
   // widen them, substrate_specular_energy_aniso).
   const V2<T> fd = closureDielectricPart(c, f0, f90);
+  const V3<T> f0w = closureCompensatedF0(c, f0, fd);
   V3<T> specAlbedo;
   T dielectric;
-  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, NoV, roughness, anisotropy, specAlbedo, dielectric);
+  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -840,7 +859,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    w2 = specularEnergyAniso(f0, f90, share, fd, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
+    w2 = specularEnergyAniso(f0, f90, share, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }
@@ -957,11 +976,12 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T fresnelPull<T>(T);                                                                        \
   template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, T, T, V3<T>&, T&);    \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, T, T, T, V3<T>&, T&); \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);    \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
   template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
   template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \
-  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);              \
+  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                \
+  template V3<T> closureCompensatedF0<T>(const Closure<T>&, const V3<T>&, const V2<T>&);              \
   template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
   template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \

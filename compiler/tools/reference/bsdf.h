@@ -32,6 +32,8 @@ template <class T> T wrapLightCosine(const Closure<T>& c, T NoL);
 template <class T> T fuzzCosine(const Closure<T>& c, T mu);
 /// substrate_closure_dielectric_part: the Fresnel ends (F0, F90) of the interface the diffuse lies under.
 template <class T> V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90);
+/// substrate_closure_compensated_f0: the F0 that Turquin's W reads (a metalness mix's parts' mean).
+template <class T> V3<T> closureCompensatedF0(const Closure<T>& c, const V3<T>& f0, const V2<T>& fd);
 
 // GGX.
 template <class T> V2<T> ggxAlpha(T roughness, T anisotropy);                               // substrate_ggx_alpha
@@ -50,15 +52,15 @@ template <class T> T fresnelPull(T roughness);                                  
 template <class T>
 V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
 template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH);        // substrate_fresnel
-/// substrate_specular_energy: returns W = 1 + F0 (1 - E) / E; E_spec in `albedo`, and in
+/// substrate_specular_energy: returns W = 1 + F0w (1 - E) / E; E_spec in `albedo`, and in
 /// `dielectric` the albedo of the closure's dielectric part (ends fd, closureDielectricPart).
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness,
-                     V3<T>& albedo, T& dielectric);
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
+                     T roughness, V3<T>& albedo, T& dielectric);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, T NoV, T roughness,
-                          T anisotropy, V3<T>& albedo, T& dielectric);
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
+                          T roughness, T anisotropy, V3<T>& albedo, T& dielectric);
 /// substrate_dielectric_albedo: the compensated albedo of a grey interface of ends d.
 template <class T> T dielectricAlbedo(const V2<T>& d, T e, T b);
 /// substrate_diffuse_transmission: what the interface lets through to the diffuse along the view,
