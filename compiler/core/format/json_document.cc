@@ -488,8 +488,8 @@ class StrictDomBuilder {
  private:
   struct Frame {
     Json* node;
-    std::string key;                                 // objects: the current key
-    std::unique_ptr<KeyIndex> keys;                  // objects past kLinearKeys keys: key -> ordinal
+    std::string key{};                               // objects: the current key
+    std::unique_ptr<KeyIndex> keys{};                // objects past kLinearKeys keys: key -> ordinal
     bool duplicate = false;                          // the current key repeats an earlier one
     bool keyTooLong = false;                         // the current key is over the limit
   };

@@ -14,6 +14,15 @@
 #include "gpu/vulkan_loader.h"
 
 namespace substratec::gpu {
+
+/// Validation messages, appended by the debug-utils callback (any thread).
+/// Outside the anonymous namespace: Context::Impl, which has external linkage,
+/// holds one (GCC's -Wsubobject-linkage warned on every build).
+struct ValidationMessageLog {
+  std::mutex mutex;
+  std::vector<std::string> messages;
+};
+
 namespace {
 
 constexpr const char* kLavapipeIcd = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
@@ -21,13 +30,7 @@ constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
 constexpr uint32_t kQuietNan = 0x7fc00000u;
 constexpr uint32_t kExecutionModelGLCompute = 5;
 
-/// Validation messages, appended by the debug-utils callback (any thread).
-struct MessageLog {
-  std::mutex mutex;
-  std::vector<std::string> messages;
-};
-
-/// The VK_EXT_debug_utils callback: records warnings and errors into the MessageLog.
+/// The VK_EXT_debug_utils callback: records warnings and errors into the ValidationMessageLog.
 VKAPI_ATTR VkBool32 VKAPI_CALL recordMessage(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
                                              VkDebugUtilsMessageTypeFlagsEXT types,
                                              const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
@@ -36,13 +39,13 @@ VKAPI_ATTR VkBool32 VKAPI_CALL recordMessage(VkDebugUtilsMessageSeverityFlagBits
           : (types & VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT) ? " [performance] "
                                                                        : " [general] ";
   text += data && data->pMessage ? data->pMessage : "(no message)";
-  auto* log = static_cast<MessageLog*>(user);
+  auto* log = static_cast<ValidationMessageLog*>(user);
   std::lock_guard<std::mutex> lock(log->mutex);
   log->messages.push_back(std::move(text));
   return VK_FALSE;
 }
 
-VkDebugUtilsMessengerCreateInfoEXT messengerInfo(MessageLog* log) {
+VkDebugUtilsMessengerCreateInfoEXT messengerInfo(ValidationMessageLog* log) {
   VkDebugUtilsMessengerCreateInfoEXT info{};
   info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
   info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
@@ -200,7 +203,7 @@ bool resourcesMatch(const ShaderReflection& refl, const Resources& resources, Di
 struct Context::Impl {
   VulkanFunctions vk;
   Options options;
-  std::unique_ptr<MessageLog> log = std::make_unique<MessageLog>();  // the messenger's user data
+  std::unique_ptr<ValidationMessageLog> log = std::make_unique<ValidationMessageLog>();  // the messenger's user data
   VkInstance instance = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
   VkPhysicalDevice physical = VK_NULL_HANDLE;
