@@ -141,6 +141,20 @@ float substrate_coat_lobe(float chan2024, float eon) {
 #endif
 }
 
+// What the diffuse model adds to the mean of the fuzz pair's light term at
+// roughness r (SUBSTRATE_FUZZ_PAIR_MARGIN_*): 0 for Lambert.
+float substrate_fuzz_pair_margin(float roughness) {
+#if SUBSTRATE_DIFFUSE_MODEL == 1
+  return SUBSTRATE_FUZZ_PAIR_MARGIN_CHAN2018_0;
+#elif SUBSTRATE_DIFFUSE_MODEL == 2
+  return SUBSTRATE_FUZZ_PAIR_MARGIN_CHAN2024_1 * roughness;
+#elif SUBSTRATE_DIFFUSE_MODEL == 3
+  return SUBSTRATE_FUZZ_PAIR_MARGIN_EON_1 * roughness;
+#else
+  return 0.0;
+#endif
+}
+
 // The share of the way from G_k to 1 that a rough top moves the mean of the
 // layers' interface term (substrate_coat_transmission, issue 19 step 9):
 // h(f) = sat(f (0.2533 + f (-1.2067 + 1.9925 f))), f = c.coatFloor. The
@@ -800,6 +814,32 @@ mfloat substrate_diffuse_light_coupling(float2 ends, float NoL, float roughness,
   return SUBSTRATE_M(min(numerator / denominator, cap));
 }
 
+// An upper bound of the coupling's standard deviation over the cosine-weighted
+// hemisphere of light (issue 19, step 16: the normalization of the diffuse's
+// pair of fuzz terms in substrate_eval_closure uses it). Karis' fit is affine
+// in one function a(mu, r): the coupling is 1.0091 (F90 - F0) a / D plus a
+// constant (D its denominator), clamped, which never widens a spread. So its
+// deviation is at most 1.0091 (F90 - F0) sigma_a(r) / D, sigma_a a cubic in r
+// at or above a's deviation at every roughness (0.113 at r = 0, 0.035 at 0.5,
+// 0 at 1; fitted to the midpoint rule with 4,000 points at 1,001 roughnesses,
+// at most 0.004 above it; ReferenceEnergy.TheCouplingDeviationBoundsTheFits),
+// blended toward the haze lobe's by its weight (the deviation of a blend is at
+// most the blend of the deviations). Only F90 > F0 counts: a and
+// min(E_fuzz, 1) both fall as the light rises, so under an inverted edge the
+// coupling rises toward the horizon and the two never correlate positively.
+float substrate_diffuse_light_coupling_deviation(float2 ends, float roughness, float hazeRoughness,
+                                                 float hazeWeight) {
+  float2 r = saturate(float2(roughness, hazeRoughness));
+  float2 s = ((0.184984 * r - 0.192478) * r - 0.101418) * r + 0.112939;
+  float2 m = substrate_interface_albedo_means(roughness);
+  if (hazeWeight > 0.0) {
+    s.x = lerp(s.x, s.y, hazeWeight);
+    m = lerp(m, substrate_interface_albedo_means(hazeRoughness), hazeWeight);
+  }
+  float denominator = max(1.0 - ends.x * m.x - ends.y * m.y, 1e-3);
+  return 1.0091 * max(ends.y - ends.x, 0.0) * max(s.x, 0.0) / denominator;
+}
+
 // ---------------------------------------------------------------------------
 // Diffuse models (each returns BRDF * NoL for albedo `albedo`).
 
@@ -1214,6 +1254,48 @@ float substrate_glint_factor(SubstrateClosure c, float d, float ToH, float BoH, 
 // ---------------------------------------------------------------------------
 // The closure.
 
+// What a diffuse under a fuzz on top keeps of a light (issue 19, step 16):
+// the light crosses the fuzz on the way in and on the way out, each crossing
+// keeping 1 - q (q = amount min(E_fuzz, 1) at its cosine, what the fuzz
+// catches), and what the fuzz catches of the base's light from below it sends
+// back down in its colour, so the base's light bounces between the two:
+//   (1 - q(NoV)) (1 - q(NoL)) / N,
+//   N = (1 - amount (albedo colour mean E' - deviation sigma'(r_f))) (1 + amount margin(r)),
+// E' = min(E_fuzz, 1), the base's share of what comes back up read as its
+// diffuse albedo. Reciprocal. The larger of the two crossings, 1 - max(q(NoV),
+// q(NoL)), lost for a white base the light arriving where the fuzz catches
+// more than along the view (a white velvet read 0.89 of a white furnace
+// head-on), and for a dark one kept what the truth's fuzz sends back into it
+// (FuzzParameterSweep's black base under a white fuzz, +8.8 ... +30.5 %).
+// For a white base under a white fuzz, N bounds the mean over the light of the
+// light crossing times the diffuse's light coupling, which both favour light
+// near the normal: their means (substrate_fuzz_mean_albedo, a lower bound of
+// E''s), the most their covariance can be (Cauchy-Schwarz: the product of
+// their deviations, substrate_diffuse_light_coupling_deviation and
+// substrate_fuzz_albedo_deviation; `deviation` is the coupling's, 0 for a lobe
+// without one) and the diffuse model's own margin (substrate_fuzz_pair_margin).
+// With the means alone a white Lambertian under a smooth interface and a fuzz
+// of roughness 1 returned 1.009. At amount 0 it is exactly 1, as without a fuzz.
+float3 substrate_fuzz_diffuse_pair(SubstrateClosure c, float amount, float eView, float eLight, float3 albedo,
+                                   float deviation) {
+  float crossings = (1.0 - amount * min(eView, 1.0)) * (1.0 - amount * min(eLight, 1.0));
+  float3 bounce = albedo * saturate(c.fuzzColor) * substrate_fuzz_mean_albedo(c.fuzzRoughness);
+  float covariance = deviation * substrate_fuzz_albedo_deviation(c.fuzzRoughness);
+  return SUBSTRATE_SPLAT3(crossings) /
+         ((SUBSTRATE_SPLAT3(1.0) - amount * (bounce - SUBSTRATE_SPLAT3(covariance))) *
+          (1.0 + amount * substrate_fuzz_pair_margin(saturate(c.roughness))));
+}
+
+// The pair's mean over light from the whole hemisphere, as a share of the view's
+// crossing (the split sum's diffuse under a fuzz, substrate_env_split_sum):
+// (1 - amount mean E') / (1 - amount albedo colour mean E'). 1 for a white base
+// under a white fuzz (the split sum's white furnace unchanged); lower as the
+// base darkens, which absorbs what the fuzz sends back down.
+float3 substrate_fuzz_diffuse_pair_mean(SubstrateClosure c, float amount, float3 albedo) {
+  float caught = amount * substrate_fuzz_mean_albedo(c.fuzzRoughness);
+  return SUBSTRATE_SPLAT3(1.0 - caught) / (SUBSTRATE_SPLAT3(1.0) - albedo * saturate(c.fuzzColor) * caught);
+}
+
 float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   float3 N = substrate_closure_normal(c);
   float NoVraw = dot(N, V);
@@ -1364,8 +1446,9 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   }
 #endif
   // Under layers: what their underside sends back down (float: a factor up to 1.1).
-  float3 result = spec + SUBSTRATE_F3(diffuse * substrate_diffuse_transmission(albedo, specAlbedo, dielectric)) *
-                             substrate_closure_coat_diffuse(c, ends);
+  float3 under = SUBSTRATE_F3(diffuse * substrate_diffuse_transmission(albedo, specAlbedo, dielectric)) *
+                 substrate_closure_coat_diffuse(c, ends);
+  float3 result = spec + under;
 
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
@@ -1383,15 +1466,33 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     // 1 - amount min(max(E_fuzz(NoV), E_fuzz(NoL)), 1) (KHR_materials_sheen's
     // min of the two albedo scalings). With the view's alone, light arriving at
     // grazing was reflected by the fuzz and still fed the base whole: a white
-    // diffuse under fuzz returned up to 1.48 of a light at NoL 0.1.
+    // diffuse under fuzz returned up to 1.48 of a light at NoL 0.1. The
+    // specular keeps that; the diffuse takes the pair of crossings instead
+    // (substrate_fuzz_diffuse_pair; issue 19, step 16), on top only: under
+    // layers the light meets the fuzz within their refraction cone, where the
+    // pair's hemispherical means do not hold (lerped by coverageAbove toward
+    // the larger of the two). Not for the wrap lobe either, whose light
+    // reaches below the horizon and weighs grazing light more than the cosine
+    // the means assume (it keeps the larger of the two, as it keeps no light
+    // coupling: the pair lost 2 points of row28_anisotropy's furnace).
     float3 fuzz = SUBSTRATE_SPLAT3(0.0);
     float eCaught = eFuzz;
+    float3 diffuseKept = SUBSTRATE_SPLAT3(1.0 - amount * min(eFuzz, 1.0));
     if (lightFacing) {
       fuzz = saturate(c.fuzzColor) *
              (amount * spread * substrate_charlie_sheen(c.fuzzRoughness, fv, fl, fh) / max(1.0, eFuzz)) * lightRatio;
-      eCaught = max(eFuzz, substrate_fuzz_albedo(fl, c.fuzzRoughness));
+      float eLight = substrate_fuzz_albedo(fl, c.fuzzRoughness);
+      eCaught = max(eFuzz, eLight);
+      float deviation =
+          isWrap ? 0.0 : substrate_diffuse_light_coupling_deviation(ends, roughness, hazeRoughness, hazeWeight);
+      float cover = isWrap ? 1.0 : 0.0;
+#if SUBSTRATE_USE_LAYERS
+      cover = max(cover, saturate(c.coverageAbove));
+#endif
+      diffuseKept = lerp(substrate_fuzz_diffuse_pair(c, amount, eFuzz, eLight, SUBSTRATE_F3(albedo), deviation),
+                         SUBSTRATE_SPLAT3(1.0 - amount * min(eCaught, 1.0)), cover);
     }
-    result = result * (1.0 - amount * min(eCaught, 1.0)) + fuzz;
+    result = spec * (1.0 - amount * min(eCaught, 1.0)) + under * diffuseKept + fuzz;
   }
 #endif
   return result;

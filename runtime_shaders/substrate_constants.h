@@ -220,4 +220,43 @@
 #define SUBSTRATE_DIFFUSE_MEAN_COS 0.5
 #endif
 
+// The cosine-weighted hemispherical mean of min(E_fuzz(mu, r), 1) (issue 19,
+// step 16; substrate_fuzz_mean_albedo): a quartic in the fuzz roughness r,
+// 0.0006 + 0.1835 r + 0.0960 r^2 + 0.4185 r^3 - 0.3972 r^4, fitted to the
+// table's quadrature at 401 roughnesses and shifted down so that it is nowhere
+// above it (at most 0.005 below at 1,001 roughnesses;
+// ReferenceEnergy.TheFuzzAlbedoMomentsBoundTheTables).
+#define SUBSTRATE_FUZZ_MEAN_0 0.000614
+#define SUBSTRATE_FUZZ_MEAN_1 0.183517
+#define SUBSTRATE_FUZZ_MEAN_2 0.095986
+#define SUBSTRATE_FUZZ_MEAN_3 0.418528
+#define SUBSTRATE_FUZZ_MEAN_4 -0.397177
+
+// An upper bound of the standard deviation of min(E_fuzz(mu, r), 1) over the
+// cosine-weighted hemisphere (substrate_fuzz_albedo_deviation; issue 19, step
+// 16): min(0.06 + 0.4 r, 0.134). The largest is 0.1337 near r = 0.86 (0.059 at
+// r = 0, 0.096 at 0.1, 0.127 at 1; midpoint rule with 4,000 points at 1,001
+// roughnesses; ReferenceEnergy.TheFuzzAlbedoMomentsBoundTheTables). With
+// substrate_diffuse_light_coupling_deviation, the most the diffuse's light
+// coupling and the fuzz's light term can covary.
+#define SUBSTRATE_FUZZ_DEVIATION_0 0.06
+#define SUBSTRATE_FUZZ_DEVIATION_SLOPE 0.4
+#define SUBSTRATE_FUZZ_DEVIATION_MAX 0.134
+
+// What the diffuse models add to the mean of the fuzz pair's light term
+// (substrate_fuzz_pair_margin; issue 19, step 16), a + b r at the slab's
+// roughness r: Chan 2018 (its smooth term), Chan 2024 and EON (their
+// retro-reflection) weigh light near the normal more than Lambert's cosine at
+// some views, so the light-weighted mean of the pair's light term can exceed
+// its cosine-weighted bound. The most it did, over a grid of 21 roughnesses,
+// 20 view cosines, 20 fuzz roughnesses and F0 / F90 of 0 / 1 and 0 / 0 (160 x
+// 48 light directions each), as a share of the model's own albedo: Chan 2018
+// 0.0142 at r = 0 falling to 0.0083 at 1; Chan 2024 0.0000 at r = 0.1, 0.0041
+// at 0.35, 0.0088 at 1; EON 0.0010 at 0.5, 0.0038 at 1 (bounded above at every
+// roughness; ReferenceEnergy.TheFuzzPairMarginsCoverEachDiffuseModelsLightWeighting).
+// Lambert's is 0: its light weighting is the cosine the bound assumes.
+#define SUBSTRATE_FUZZ_PAIR_MARGIN_CHAN2018_0 0.016
+#define SUBSTRATE_FUZZ_PAIR_MARGIN_CHAN2024_1 0.0125
+#define SUBSTRATE_FUZZ_PAIR_MARGIN_EON_1 0.0045
+
 #endif

@@ -179,6 +179,23 @@ float substrate_fuzz_albedo(float NoV, float fuzzRoughness) {
   return max(SUBSTRATE_LUT_BILINEAR(SUBSTRATE_LUT_FUZZ, i, f), 0.0);
 }
 
+// The cosine-weighted hemispherical mean of min(E_fuzz, 1) at fuzz roughness
+// r, a lower bound (SUBSTRATE_FUZZ_MEAN_*; issue 19, step 16): the
+// normalization of the diffuse's pair of fuzz terms (substrate_eval_closure).
+float substrate_fuzz_mean_albedo(float fuzzRoughness) {
+  float r = saturate(fuzzRoughness);
+  return max((((SUBSTRATE_FUZZ_MEAN_4 * r + SUBSTRATE_FUZZ_MEAN_3) * r + SUBSTRATE_FUZZ_MEAN_2) * r +
+              SUBSTRATE_FUZZ_MEAN_1) * r + SUBSTRATE_FUZZ_MEAN_0,
+             0.0);
+}
+
+// An upper bound of the deviation of min(E_fuzz, 1) over the cosine-weighted
+// hemisphere at fuzz roughness r (SUBSTRATE_FUZZ_DEVIATION_*; issue 19, step 16).
+float substrate_fuzz_albedo_deviation(float fuzzRoughness) {
+  return min(SUBSTRATE_FUZZ_DEVIATION_0 + SUBSTRATE_FUZZ_DEVIATION_SLOPE * saturate(fuzzRoughness),
+             SUBSTRATE_FUZZ_DEVIATION_MAX);
+}
+
 // What a slab's fuzz lets through to the layers under it, seen at cosine NoV:
 // 1 - amount min(E_fuzz(NoV), 1), the factor the slab's own lobes take along
 // the view (substrate_eval_closure). The generated material multiplies the

@@ -163,7 +163,10 @@ float substrate_env_mip(float roughness, float mipCount) {
 // uses albedo as its hemispherical albedo); fuzz: amount colour
 // min(E_fuzz, 1) E / pi on top, the rest attenuated by (1 - amount min(E_fuzz, 1))
 // at NoV (the direct light's light-side term, E_fuzz(NoL), is not applied here:
-// the environment has no single light direction).
+// the environment has no single light direction), the diffuse on top also by
+// the mean of the direct light's pair of crossings
+// (substrate_fuzz_diffuse_pair_mean: what a darker base absorbs of what the
+// fuzz sends back down).
 // The layers above are crossed at NoV by the specular (its light comes from
 // the mirror direction) and at SUBSTRATE_DIFFUSE_MEAN_COS by the diffuse and fuzz.
 float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredRadiance, float3 irradiance) {
@@ -212,7 +215,18 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
     float amount = saturate(c.fuzzAmount);
     float eFuzz = min(substrate_fuzz_albedo(substrate_fuzz_cosine(c, NoV), c.fuzzRoughness), 1.0);
-    result = result * (1.0 - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * SUBSTRATE_F3(diffuseLight);
+    // The diffuse on top: the direct light's pair of crossings averaged over
+    // the hemisphere (not under layers, nor for the wrap lobe, as there).
+    float cover = 0.0;
+#if SUBSTRATE_USE_LAYERS
+    cover = saturate(c.coverageAbove);
+#endif
+#if SUBSTRATE_USE_SSS
+    cover = c.sssType == SUBSTRATE_SSS_WRAP ? 1.0 : cover;
+#endif
+    float3 pairMean = lerp(substrate_fuzz_diffuse_pair_mean(c, amount, SUBSTRATE_F3(albedo)), SUBSTRATE_SPLAT3(1.0), cover);
+    result = (spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight) * pairMean) * (1.0 - amount * eFuzz) +
+             saturate(c.fuzzColor) * (amount * eFuzz) * irr * SUBSTRATE_F3(diffuseLight);
   }
 #endif
   return result;

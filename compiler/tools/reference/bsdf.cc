@@ -227,6 +227,34 @@ T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T 
   return std::min(numerator / denominator, F90 < F0 ? T(1) : T(1000));
 }
 
+// substrate_diffuse_light_coupling_deviation: 1.0091 max(F90 - F0, 0) max(s, 0) / max(1 - F0 X - F90 Y, 1e-3),
+// s = ((0.184984 r - 0.192478) r - 0.101418) r + 0.112939, s and (X, Y) blended
+// toward the haze lobe's by its weight; F0, F90 the means of the three channels.
+template <class T>
+T diffuseLightCouplingDeviation(const V3<T>& f0, const V3<T>& f90, T roughness, T hazeRoughness, T hazeWeight) {
+  const auto deviation = [](T r) {
+    r = saturate(r);
+    return ((T(0.184984) * r - T(0.192478)) * r - T(0.101418)) * r + T(0.112939);
+  };
+  T s = deviation(roughness);
+  V2<T> m = interfaceAlbedoMeans(roughness);
+  if (hazeWeight > T(0)) {
+    s = lerp(s, deviation(hazeRoughness), hazeWeight);
+    m = lerp(m, interfaceAlbedoMeans(hazeRoughness), hazeWeight);
+  }
+  const T F0 = mean3(f0), F90 = mean3(f90);
+  const T denominator = std::max(T(1) - F0 * m[0] - F90 * m[1], T(1e-3));
+  return T(1.0091) * std::max(F90 - F0, T(0)) * std::max(s, T(0)) / denominator;
+}
+
+double fuzzPairMargin(int diffuseModel, double roughness) {
+  const double r = std::clamp(roughness, 0.0, 1.0);
+  return diffuseModel == kDiffuseChan2018   ? SUBSTRATE_FUZZ_PAIR_MARGIN_CHAN2018_0
+         : diffuseModel == kDiffuseChan2024 ? SUBSTRATE_FUZZ_PAIR_MARGIN_CHAN2024_1 * r
+         : diffuseModel == kDiffuseEon      ? SUBSTRATE_FUZZ_PAIR_MARGIN_EON_1 * r
+                                            : 0.0;
+}
+
 // ---------------------------------------------------------------------------
 // Diffuse models.
 
@@ -807,6 +835,31 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
 
 // substrate_eval_closure.
 
+// substrate_fuzz_diffuse_pair: (1 - q(NoV)) (1 - q(NoL)) / N, q = amount min(E_fuzz, 1),
+// N = (1 - amount (albedo colour fuzzMeanAlbedo - deviation fuzzAlbedoDeviation))
+// (1 + amount fuzzPairMargin(model, roughness)).
+template <class T>
+V3<T> fuzzDiffusePair(const Closure<T>& c, T amount, T eView, T eLight, const V3<T>& albedo, T deviation,
+                      int diffuseModel) {
+  const T crossings = (T(1) - amount * std::min(eView, T(1))) * (T(1) - amount * std::min(eLight, T(1)));
+  const V3<T> bounce = albedo * saturate(c.fuzzColor) * fuzzMeanAlbedo(c.fuzzRoughness);
+  const T covariance = deviation * fuzzAlbedoDeviation(c.fuzzRoughness);
+  const T margin = T(1) + amount * T(fuzzPairMargin(diffuseModel, double(saturate(c.roughness))));
+  V3<T> pair;
+  for (int i = 0; i < 3; ++i) pair[i] = crossings / ((T(1) - amount * (bounce[i] - covariance)) * margin);
+  return pair;
+}
+
+// substrate_fuzz_diffuse_pair_mean: (1 - amount fuzzMeanAlbedo) / (1 - amount albedo colour fuzzMeanAlbedo).
+template <class T>
+V3<T> fuzzDiffusePairMean(const Closure<T>& c, T amount, const V3<T>& albedo) {
+  const T caught = amount * fuzzMeanAlbedo(c.fuzzRoughness);
+  const V3<T> colour = saturate(c.fuzzColor);
+  V3<T> mean;
+  for (int i = 0; i < 3; ++i) mean[i] = (T(1) - caught) / (T(1) - albedo[i] * colour[i] * caught);
+  return mean;
+}
+
 // long: it mirrors substrate_eval_closure statement for statement, so the two
 // are compared side by side (the float instantiation must round as the shader).
 template <class T>
@@ -926,8 +979,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
     diff = diff * mediumWeight(s2, m, p, NoV) * mediumWeight(s2, p + (T(1) - p) * m, p, NoLc);
   }
   // Under layers: what their underside sends back down.
-  V3<T> result = spec + diff * diffuseTransmission(albedo, specAlbedo, dielectric) *
-                            closureCoatDiffuse(c, f0d, f90d, diffuseModel);
+  const V3<T> under = diff * diffuseTransmission(albedo, specAlbedo, dielectric) *
+                      closureCoatDiffuse(c, f0d, f90d, diffuseModel);
+  V3<T> result = spec + under;
 
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -941,18 +995,28 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
     // the layers below are scaled by 1 - amount min(max(E_fuzz(NoV), E_fuzz(NoL)), 1).
     V3<T> fuzz = zero;
     T eCaught = eFuzz;
+    // The diffuse: the pair of crossings (fuzzDiffusePair), lerped toward the
+    // larger of the two by coverageAbove, and the larger of the two for the wrap lobe.
+    V3<T> diffuseKept = V3<T>{1, 1, 1} * (T(1) - amount * std::min(eFuzz, T(1)));
     if (lightFacing) {
       fuzz = saturate(c.fuzzColor) *
              (amount * spread * charlieSheen(c.fuzzRoughness, fv, fl, fh) / std::max(T(1), eFuzz)) * lightRatio;
-      eCaught = std::max(eFuzz, fuzzAlbedo(fl, c.fuzzRoughness));
+      const T eLight = fuzzAlbedo(fl, c.fuzzRoughness);
+      eCaught = std::max(eFuzz, eLight);
+      const T deviation =
+          isWrap ? T(0) : diffuseLightCouplingDeviation(f0d, f90d, roughness, hazeRoughness, hazeWeight);
+      diffuseKept = lerp(fuzzDiffusePair(c, amount, eFuzz, eLight, albedo, deviation, diffuseModel),
+                         V3<T>{1, 1, 1} * (T(1) - amount * std::min(eCaught, T(1))),
+                         isWrap ? T(1) : saturate(c.coverageAbove));
     }
-    result = result * (T(1) - amount * std::min(eCaught, T(1))) + fuzz;
+    result = spec * (T(1) - amount * std::min(eCaught, T(1))) + under * diffuseKept + fuzz;
   }
   return result;
 }
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
+  template V3<T> fuzzDiffusePairMean<T>(const Closure<T>&, T, const V3<T>&);                          \
   template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
   template V3<T> f90Effective<T>(const V3<T>&, const V3<T>&);                                          \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
@@ -985,6 +1049,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
   template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
+  template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                   \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
   template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \

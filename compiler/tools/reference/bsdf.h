@@ -75,6 +75,17 @@ template <class T> V2<T> interfaceAlbedoMeans(T roughness);
 /// substrate_diffuse_interface; the same arithmetic).
 template <class T>
 T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T hazeRoughness, T hazeWeight);
+/// substrate_diffuse_light_coupling_deviation: an upper bound of the coupling's standard
+/// deviation over the cosine-weighted hemisphere of light.
+template <class T>
+T diffuseLightCouplingDeviation(const V3<T>& f0, const V3<T>& f90, T roughness, T hazeRoughness, T hazeWeight);
+/// substrate_fuzz_diffuse_pair_mean: the mean over a uniform hemisphere of light of the
+/// diffuse's pair of fuzz crossings, as a share of the view's crossing (the split sum's).
+template <class T>
+V3<T> fuzzDiffusePairMean(const Closure<T>& c, T amount, const V3<T>& albedo);
+/// substrate_fuzz_pair_margin: what the diffuse model adds to the mean of the fuzz pair's
+/// light term at the slab's roughness (SUBSTRATE_FUZZ_PAIR_MARGIN_*; 0 for Lambert).
+double fuzzPairMargin(int diffuseModel, double roughness);
 
 // Diffuse models (BRDF * NoL).
 template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);

@@ -10,6 +10,7 @@
 #include <cstdint>
 
 #include "reference/common.h"
+#include "substrate_constants.h"  // runtime_shaders/
 #include "storage/pack.h"
 #include "validate/runtime_files.h"
 
@@ -105,7 +106,26 @@ T fuzzAlbedo(T NoV, T fuzzRoughness) {
   return std::max(blend(kFuzz, i, f), T(0));
 }
 
+// substrate_fuzz_mean_albedo: the quartic in r, SUBSTRATE_FUZZ_MEAN_*.
+template <class T>
+T fuzzMeanAlbedo(T fuzzRoughness) {
+  const T r = saturate(fuzzRoughness);
+  return std::max(
+      (((T(SUBSTRATE_FUZZ_MEAN_4) * r + T(SUBSTRATE_FUZZ_MEAN_3)) * r + T(SUBSTRATE_FUZZ_MEAN_2)) * r +
+       T(SUBSTRATE_FUZZ_MEAN_1)) * r + T(SUBSTRATE_FUZZ_MEAN_0),
+      T(0));
+}
+
+// substrate_fuzz_albedo_deviation: min(0.06 + 0.4 r, 0.134), SUBSTRATE_FUZZ_DEVIATION_*.
+template <class T>
+T fuzzAlbedoDeviation(T fuzzRoughness) {
+  return std::min(T(SUBSTRATE_FUZZ_DEVIATION_0) + T(SUBSTRATE_FUZZ_DEVIATION_SLOPE) * saturate(fuzzRoughness),
+                  T(SUBSTRATE_FUZZ_DEVIATION_MAX));
+}
+
 #define SUBSTRATEC_INSTANTIATE(T)                                                  \
+  template T fuzzMeanAlbedo<T>(T);                                                 \
+  template T fuzzAlbedoDeviation<T>(T);                                            \
   template void lutCoords<T>(T, T, std::array<int, 4>&, V2<T>&);                   \
   template T energyAlbedo<T>(T, T);                                                \
   template V2<T> energyDfg<T>(T, T);                                               \

@@ -33,4 +33,14 @@ V2<T> energyAniso(T NoV, T roughness, T absAnisotropy, const V2<T>& iso);
 template <class T>
 T fuzzAlbedo(T NoV, T fuzzRoughness);
 
+/// substrate_fuzz_mean_albedo: a lower bound of the cosine-weighted mean of min(E_fuzz, 1) over
+/// the hemisphere, a quartic in the fuzz roughness.
+template <class T>
+T fuzzMeanAlbedo(T fuzzRoughness);
+
+/// substrate_fuzz_albedo_deviation: an upper bound of the standard deviation of
+/// min(E_fuzz, 1) over the cosine-weighted hemisphere, min(0.06 + 0.4 r, 0.134).
+template <class T>
+T fuzzAlbedoDeviation(T fuzzRoughness);
+
 }  // namespace substratec::reference

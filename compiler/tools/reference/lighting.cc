@@ -103,7 +103,9 @@ T envMip(T roughness, T mipCount) {
 // substrate_env_split_sum: specular E_spec * prefiltered through the layers above
 // at NoV; diffuse albedo T irradiance / pi (T: diffuseTransmission) and fuzz through them at
 // SUBSTRATE_DIFFUSE_MEAN_COS (every diffuse model, wrap included, uses albedo as
-// its hemispherical albedo). The view-side throughput is the caller's.
+// its hemispherical albedo); under a fuzz on top the diffuse also by the mean of
+// the direct light's pair of crossings (fuzzDiffusePairMean). The view-side
+// throughput is the caller's.
 template <class T>
 V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredRadiance, const V3<T>& irradiance,
                   int diffuseModel /* the diffuse is albedo for every model; its coat factor is the model's */) {
@@ -140,7 +142,11 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
     T eFuzz = std::min(fuzzAlbedo(fuzzCosine(c, NoV), c.fuzzRoughness), T(1));
-    result = result * (T(1) - amount * eFuzz) + saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
+    // The diffuse on top: the pair's mean (not under layers, nor for the wrap lobe).
+    const V3<T> pairMean = lerp(fuzzDiffusePairMean(c, amount, albedo), splat3(T(1)),
+                                c.sssType == kSssWrap ? T(1) : saturate(c.coverageAbove));
+    result = (spec * specLight + diff * diffuseLight * pairMean) * (T(1) - amount * eFuzz) +
+             saturate(c.fuzzColor) * (amount * eFuzz) * irr * diffuseLight;
   }
   return result;
 }
