@@ -90,10 +90,10 @@ int main(int argc, char** argv) {
           e[k] = albedo(mu, k * std::numbers::pi / (2 * (kPhis - 1)), ax, ay, n);
           eMax = std::max(eMax, e[k]);
         }
-        V3<double> one{1, 1, 1}, zero{0, 0, 0}, specAlbedo;  // F0 1: a conductor's share 0, exponent 1
+        V3<double> one{1, 1, 1}, specAlbedo;
         double dielectric = 0;
         const double w =
-            specularEnergyAniso<double>(one, one, zero, one, V2<double>{1, 1}, one, mu, r, A, specAlbedo,
+            specularEnergyAniso<double>(one, one, fresnelShare(1.0), V2<double>{1, 1}, one, mu, r, A, specAlbedo,
                                         dielectric)[0];
         for (int k = 0; k < kPhis; ++k) {
           const double today = e[k] * w, ideal = e[k] / eMax;

@@ -64,17 +64,6 @@ float substrate_fresnel_share(float f0max) {
   return 1.0 - saturate((f0max - SUBSTRATE_COAT_DIELECTRIC_F0) * SUBSTRATE_COAT_CONDUCTOR_BLEND);
 }
 
-// The same per channel, from each channel's own F0: the curve of an
-// interface's Fresnel (substrate_fresnel, substrate_fresnel_albedo). A
-// conductor's channel of low F0 (the blue of a red metal, a channel a thin
-// film cancels) follows the dielectric curve of its IOR, as the ground truth's
-// Gulbrandsen mapping does there (substrate_fresnel_exponent); a grey F0 has
-// the closure's share in every channel.
-float3 substrate_fresnel_shares(float3 f0) {
-  return SUBSTRATE_SPLAT3(1.0) -
-         saturate((f0 - SUBSTRATE_SPLAT3(SUBSTRATE_COAT_DIELECTRIC_F0)) * SUBSTRATE_COAT_CONDUCTOR_BLEND);
-}
-
 // F90 as Substrate defines it: "F90 can only change the chromaticity, not the
 // intensity" (the course notes: it does not take energy away at grazing
 // angles). A conductor's F90 (F0 from 0.2: substrate_fresnel_share 0) gives
@@ -357,13 +346,11 @@ float substrate_fresnel_weight(float c) {
 // still let 1 - F0 reach the base: a white base under a clear coat returned
 // 1.21 of the light at NoV 0.1 (docs/stability.md). The smooth transmission
 // falls to 0 at grazing angles; a rough top reflects far less there, and what
-// it does not reflect reaches the layers under it (issue 19, step 9). What an
-// interface of roughness r on IOR 1.5's curve chi with F0 0 and F90 1 lets
-// through, 1 - b (b the chi-weighted part of the tables' albedo,
-// substrate_fresnel_parts' t + x), is the least any top of F0 0 .. 0.04 lets
-// through per unit of T_N (which holds its 1 - F0): 1 - b + F0 (1 - e) / (1 -
-// F0) >= 1 - b (a top of F0 below 0.04 follows a curve under chi since step
-// 17, and lets through more still). Without a lookup: max(1 - chi(mu), 1 - (1 - f)
+// it does not reflect reaches the layers under it (issue 19, step 9). What an interface of F0 0 and F90 1
+// and roughness r lets through, 1 - b (b the chi-weighted part of the tables'
+// albedo, substrate_fresnel_b at share 1), is the least any top of F0 0 ..
+// 0.04 lets through per unit of T_N (which holds its 1 - F0): 1 - b + F0 (1 -
+// e) / (1 - F0) >= 1 - b. Without a lookup: max(1 - chi(mu), 1 - (1 - f)
 // (1 - mu)^2), f = c.coatFloor (substrate_coat_floor of the top layer's
 // roughness): the largest f of that form that keeps the term within max(1 -
 // chi(mu), 1 - b) at every mu (scripts/fit_coat_transmission.py; it takes 46 %
@@ -438,159 +425,59 @@ mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
   return SUBSTRATE_MSPLAT3(1.0);
 }
 
-// The exponent of an interface's Fresnel curve, per channel (issue 19, step
-// 17; docs/accuracy.md, "17. A low-F0 interface follows its own IOR"): the
-// curve of a dielectric of F0 f is chi^p, p = 1 + max(0.04 / sqrt(f) - 0.2, 0)
-// times the channel's share of the dielectric curve. chi is IOR 1.5's (F0
-// 0.04); a lower F0 is a lower IOR, whose normalized Fresnel rises later:
-// (F_eta(c) - F0) / (1 - F0) is chi(c)^p within 0.007 at every cosine for
-// F0 from 0.002 to 0.04 (the best p for each F0 within 0.04 of this one
-// there; scripts/fit_fresnel_ior.py), where chi itself is off by up to 0.186
-// (F0 0.002) and 0.118 (F0 0.005). Below, this p is steeper than the best
-// (0.022 off at F0 0.001, 0.047 at 5e-4, reflecting less than the IOR does).
-// At F0 0 the curve is 0 but at the horizon (p = 40.8 from F0 1e-6 down): an
-// interface of IOR 1 is no interface. Above F0 0.04, chi (p = 1). The same holds for a conductor's
-// channel of low F0 (the ground truth's Gulbrandsen mapping has almost no
-// edge tint there: within 0.007 of chi^p up to F0 0.02, Schlick's t is
-// 0.099 off at 0.01), so each channel takes its own share.
-float3 substrate_fresnel_exponent(float3 f0, float3 share) {
-  float3 k = SUBSTRATE_FRESNEL_IOR_K * rsqrt(max(f0, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_IOR_MIN_F0)));
-  return SUBSTRATE_SPLAT3(1.0) + share * max(k - SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_IOR_K / SUBSTRATE_FRESNEL_IOR_F0_SQRT),
-                                             SUBSTRATE_SPLAT3(0.0));
-}
-
-// The same for one grey interface.
-float substrate_fresnel_exponent(float f0, float share) {
-  float k = SUBSTRATE_FRESNEL_IOR_K * rsqrt(max(f0, SUBSTRATE_FRESNEL_IOR_MIN_F0));
-  return 1.0 + share * max(k - SUBSTRATE_FRESNEL_IOR_K / SUBSTRATE_FRESNEL_IOR_F0_SQRT, 0.0);
-}
-
-// w^p per channel for w in [0, 1] and p >= 1 (substrate_fresnel_exponent):
-// the base is kept at 1e-30 or above, so pow() never sees 0 (1e-30 where w is
-// 0: nothing a colour holds).
-float3 substrate_fresnel_curve_power(float3 w, float3 p) {
-  return pow(clamp(w, SUBSTRATE_SPLAT3(1e-30), SUBSTRATE_SPLAT3(1.0)), p);
-}
-
-// The curve of a closure's Fresnel per channel, once per closure: each
-// channel's share of the dielectric curve (substrate_fresnel_shares) and its
-// exponent (substrate_fresnel_exponent), from F0 (issue 19, step 17). Only a
-// closure on top that covers nothing takes them; the layers keep the curve
-// they had (the closure's one `share`, substrate_closure_fresnel_ends, and
-// exponent 1: IOR 1.5's curve for a dielectric). A top over layers (coversLayers): the layers' interface term lets
-// 1 - chi(mu) through to the closures under it (substrate_coat_transmission),
-// which is what such a top does not reflect only on that curve; with its own,
-// a clear coat of F0 0 reflected nothing but still let only 1 - chi(mu)
-// through (glTF CoatParameterSweep's coat of IOR 1 returned 0.44 of a white
-// furnace at NoV 0.1; skin_coated, a coat of IOR 1.33, fell from -5.8 to
-// -8.1 % at NoV 0.1). A closure under layers reads its F0 relative to them as
-// IOR 1.5 (substrate_closure_fresnel_ends), a reading made on that curve;
-// with its own exponent skin_coated read -6.4 % at NoV 0.1 and MaterialX
-// Tiled_Wood -10.6 % (-5.8 and -9.5 % with chi), and with each channel's own
-// share the red paint of car_paint (a metal under a coat) +8.1 % at NoV 0.6
-// (+7.2 %).
-void substrate_fresnel_curve(SubstrateClosure c, mfloat3 f0, float share, out float3 shares, out float3 exponents) {
-  float3 f = SUBSTRATE_F3(f0);
-#if SUBSTRATE_USE_LAYERS
-  bool own = c.isTop && !c.coversLayers;
-#else
-  bool own = true;  // no closure lies under layers: every one is on top over nothing
-#endif
-  shares = own ? substrate_fresnel_shares(f) : SUBSTRATE_SPLAT3(share);
-  exponents = own ? substrate_fresnel_exponent(f, shares) : SUBSTRATE_SPLAT3(1.0);
-}
-
-// The exponent of the curve of the interface a closure's diffuse lies under
-// (its dielectric part, substrate_closure_dielectric_part): that of its
-// largest F0, the smallest of the channels' exponents. Where the dielectric
-// part is the closure's largest channel (F0 up to 0.18) this is its own
-// exponent; above, 1 (a metalness mix's dielectric part is read as F0 0.04,
-// or under layers as index-matched, F0 = F90 = 0, where the curve weighs
-// nothing).
-float substrate_dielectric_exponent(float3 exponents) {
-  return substrate_min3(exponents);
-}
-
-// The Fresnel of an interface with an F0 and an F90, per channel:
-// F0 + (F90 - F0) w^p, w = t + s D(t), t = (1 - VoH)^5, s the channel's share
-// of the dielectric curve (chi for a dielectric, Schlick's t for a conductor)
-// and p its exponent (substrate_fresnel_curve). The weight from the half
-// vector in float, the blend of the colours in mfloat.
-mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float3 shares, float3 exponents, float VoH) {
+// The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH),
+// w = t + share D(t) (chi for a dielectric, Schlick's t for a conductor; the
+// weight from the half vector in float, the blend of the colours in mfloat).
+mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float share, float VoH) {
   float t = substrate_pow5(1.0 - VoH);
-  float3 w = substrate_fresnel_curve_power(SUBSTRATE_SPLAT3(t) + shares * substrate_fresnel_delta(t), exponents);
-  return f0 + (f90 - f0) * SUBSTRATE_M3(w);
+  float w = t + share * substrate_fresnel_delta(t);
+  return f0 + (f90 - f0) * SUBSTRATE_M(w);
 }
 
-// The parts of a lobe's albedo that the Fresnel curve weighs, from the
-// tables' (E - B, B) (B weighted by Schlick's t = (1 - VoH)^5) and e, their
-// sum clamped (an upper bound of E): (t, x, kappa), t = B / e the lobe's mean
-// Schlick weight and x the curve's excess over it, so that e (t + s x) bounds
-// the part weighted by a curve of share s, and e (t + s x)^q the part weighted
-// by that curve to the power p, q = 1 + kappa (p - 1) (substrate_fresnel_albedo).
-// With the lobe's mean t, e (t + D(t)) for a smooth lobe, exactly; a rough
-// one's mean of D(t) is below D(mean t) where D < 0 (Jensen's inequality), so
-// that part is taken times 1 - pull: x = D(t) - pull min(D(t), 0). With pull =
-// k(r) (substrate_fresnel_pull, fitted on the integral at every roughness and
-// view, scripts/fit_fresnel_albedo.py) it is at most 0.016 above the lobe's in
-// the albedo of an F0 0.04 interface (Schlick's missed by up to 0.036 either
-// way). The mean of w^p exceeds (mean w)^p where the lobe spreads its half
-// vectors (Jensen again, w^p convex): kappa = `spread` (substrate_fresnel_spread).
-// A stretched lobe, whose B_max and E_max (substrate_energy_aniso) the fits do
-// not cover, takes pull = 1 (x = max(D(t), 0)) and spread 0 (q = 1).
-float3 substrate_fresnel_parts(float2 dfg, float e, float pull, float spread) {
+// An upper bound of the part of a lobe's albedo weighted by the Fresnel curve
+// chi, E mean(chi(VoH)), from the tables' (E - B, B) (B weighted by
+// Schlick's t = (1 - VoH)^5) and e, their sum clamped (an upper bound of E):
+// with the lobe's mean t = B / e, e (t + D(t)) for a smooth lobe, exactly;
+// a rough one's mean of D(t) is below D(mean t) where D < 0 (Jensen's
+// inequality), so that part is taken times 1 - pull:
+// e (t + D(t) - pull min(D(t), 0)). With pull = k(r) (substrate_fresnel_pull,
+// fitted on the integral at every roughness and view,
+// scripts/fit_fresnel_albedo.py) it is at most 0.016 above the lobe's in the
+// albedo of an F0 0.04 interface (Schlick's missed by up to 0.036 either
+// way); a stretched lobe, whose B_max and E_max (substrate_energy_aniso) the
+// fit does not cover, takes pull = 1: e (t + max(D(t), 0)). `share` is the
+// curve's (substrate_fresnel_share): e (t + share (D - pull min(D, 0))).
+// Returns it at `share` (x) and at share 1 (y: a closure's dielectric part,
+// substrate_dielectric_albedo), from one evaluation of the curve.
+float2 substrate_fresnel_b(float2 dfg, float e, float pull, float share) {
   float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
   float d = substrate_fresnel_delta(t);
-  return float3(t, d - pull * min(d, 0.0), spread);
+  float x = d - pull * min(d, 0.0);
+  return e * float2(t + share * x, t + x);
 }
 
-// kappa(r) of substrate_fresnel_parts: max(0.78 - 1.15 r, 0.48), under the
-// largest kappa that keeps the bound within 2e-4 of the lobe at 41 roughnesses,
-// 33 view cosines and the curves of 10 F0 from 0 to 0.03, the albedo bound's
-// exponent at most 3 (substrate_fresnel_albedo; scripts/fit_fresnel_ior.py:
-// 0.789 at r 0, 0.489 at r 1; even a smooth lobe spreads its half vectors at
-// grazing views). The bound then stays at most 0.076 above the lobe in the
-// albedo for NoV >= 0.2 (0.319 with chi's own, kappa 0); below, up to 0.78 at
-// F0 0, whose curve is far steeper than the cap (0.89 with chi's).
-float substrate_fresnel_spread(float roughness) {
-  return max(SUBSTRATE_FRESNEL_IOR_SPREAD_0 - SUBSTRATE_FRESNEL_IOR_SPREAD_SLOPE * roughness,
-             SUBSTRATE_FRESNEL_IOR_SPREAD_MIN);
-}
-
-// k(r) of substrate_fresnel_parts: 0.43 below roughness 0.45, 0 from there (the
+// k(r) of substrate_fresnel_b: 0.43 below roughness 0.45, 0 from there (the
 // share the fit needs is at most 0.425, at r 0.225, and 0 from r 0.45 on).
 float substrate_fresnel_pull(float roughness) {
   return roughness < SUBSTRATE_FRESNEL_ROUGH_END ? SUBSTRATE_FRESNEL_ROUGH_K : 0.0;
 }
 
 // The directional albedo of a lobe whose albedo with F = 1 is below e and
-// whose curve-weighted part is below e u^q (substrate_fresnel_parts), per
-// channel: F0 e + max(F90 - F0, 0) e u^q, u = min(t + s x, 1), q = 1 + kappa
-// (p - 1), s and p the channel's share and exponent (substrate_fresnel_shares,
-// substrate_fresnel_exponent). An inverted edge (F90 < F0) reflects at most
-// F0 at any angle: F0 e (the tables give no lower bound of the curve-weighted
-// part; with Schlick's curve the pair's E - B bounded it).
-// Furnace.TheEnergyTablesNeverUnderestimate checks the bound against the
-// reference's integrator at F0 0.04, 0.01 and 0.002. In float (one conversion back): in half precision
-// the clamp of the colour difference cost lavapipe 25 % more executed
-// instructions on row12_simple.
-mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float3 parts, float3 shares, float3 exponents) {
+// whose chi-weighted part is below b (substrate_fresnel_b), an upper bound:
+// F0 e + max(F90 - F0, 0) b per channel. An inverted edge (F90 < F0) reflects
+// at most F0 at any angle: F0 e (the tables give no lower bound of the
+// chi-weighted part; with Schlick's curve the pair's E - B bounded it).
+// In float (one conversion back): in half precision the clamp of the colour
+// difference cost lavapipe 25 % more executed instructions on row12_simple.
+mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
   float3 f0f = SUBSTRATE_F3(f0);
-  float3 q = SUBSTRATE_SPLAT3(1.0) +
-             parts.z * (min(exponents, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_IOR_BOUND_P_MAX)) - SUBSTRATE_SPLAT3(1.0));
-  float3 b = e * substrate_fresnel_curve_power(SUBSTRATE_SPLAT3(parts.x) + shares * parts.y, q);
   return SUBSTRATE_M3(f0f * e + max(SUBSTRATE_F3(f90) - f0f, SUBSTRATE_SPLAT3(0.0)) * b);
 }
 
 // The compensated albedo of a closure's dielectric part (substrate_closure_dielectric_part),
-// a grey interface of F0 d.x and F90 d.y on the whole curve of exponent p:
-// (d.x e + max(d.y - d.x, 0) e min(t + x, 1)^q) (1 + d.x (1 - e) / e),
-// q = 1 + kappa (min(p, 3) - 1) (substrate_fresnel_albedo). p is the
-// exponent of the closure's largest F0 (substrate_dielectric_exponent).
-// Scalar.
-float substrate_dielectric_albedo(float2 d, float e, float3 parts, float exponent) {
-  float q = 1.0 + parts.z * (min(exponent, SUBSTRATE_FRESNEL_IOR_BOUND_P_MAX) - 1.0);
-  float b = e * pow(clamp(parts.x + parts.y, 1e-30, 1.0), q);
+// a grey interface of F0 d.x and F90 d.y on the whole curve (b: substrate_fresnel_b
+// at share 1): (d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e). Scalar.
+float substrate_dielectric_albedo(float2 d, float e, float b) {
   return saturate((d.x * e + max(d.y - d.x, 0.0) * b) * (1.0 + d.x * ((1.0 - e) / e)));
 }
 
@@ -671,19 +558,19 @@ float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
 // the closure's F0, or a metalness mix's substrate_closure_compensated_f0) and the
 // compensated lobe's directional albedo E_spec = (F0 E + (F90 - F0) B_chi) W,
 // from the tables at (NoV, r) (upper bounds of E - B and B; E = their sum
-// clamped to [1e-3, 1]; B_chi bounded from them, substrate_fresnel_parts and
+// clamped to [1e-3, 1]; B_chi bounded from them, substrate_fresnel_b and
 // substrate_fresnel_albedo). Returns W; E_spec in `albedo`. Both are safe for
 // energy: W E <= 1 and E_spec is never below the compensated lobe's true
 // albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
 // (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float3 shares, float3 exponents, float2 fd, mfloat3 f0w,
-                                  float NoV, float roughness, out mfloat3 albedo, out float dielectric) {
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float NoV,
+                                  float roughness, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e);
-  float3 parts = substrate_fresnel_parts(dfg, e, substrate_fresnel_pull(roughness), substrate_fresnel_spread(roughness));
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, parts, shares, exponents) * w);
-  dielectric = substrate_dielectric_albedo(fd, e, parts, substrate_dielectric_exponent(exponents));
+  float2 b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
+  dielectric = substrate_dielectric_albedo(fd, e, b.y);
   return w;
 }
 
@@ -700,13 +587,11 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float3 shares, float3
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float3 shares, float3 exponents, float2 fd,
-                                        mfloat3 f0w, float NoV, float roughness, float anisotropy, out mfloat3 albedo,
-                                        out float dielectric) {
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float NoV,
+                                        float roughness, float anisotropy, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float pull = substrate_fresnel_pull(roughness);
-  float spread = substrate_fresnel_spread(roughness);
 #if SUBSTRATE_USE_ANISOTROPY
   float A = min(abs(anisotropy), 1.0);
   if (A > 0.0) {
@@ -714,13 +599,12 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float3 shares, 
     e = eb.x;
     dfg.y = min(eb.y, e);
     pull = 1.0;
-    spread = 0.0;
   }
 #endif
   mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e);
-  float3 parts = substrate_fresnel_parts(dfg, e, pull, spread);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, parts, shares, exponents) * w);
-  dielectric = substrate_dielectric_albedo(fd, e, parts, substrate_dielectric_exponent(exponents));
+  float2 b = substrate_fresnel_b(dfg, e, pull, share);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
+  dielectric = substrate_dielectric_albedo(fd, e, b.y);
   return w;
 }
 
@@ -869,7 +753,7 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
 // c.y = 0.0425 - 0.0275 r): the cosine-weighted squared error against the
 // integral of chi over the lobe, at 41 roughnesses and 30 cosines from 0.005
 // to 1 (scripts/fit_fresnel_albedo.py), falls from 7.2e-5 to 3.9e-5. (Fitted to
-// the view side's bound, substrate_fresnel_parts, instead, the rough dielectric
+// the view side's bound, substrate_fresnel_b, instead, the rough dielectric
 // of Accuracy.ADiffuseUnderAnInterfaceIsReciprocal read 1.055, not 1.052.)
 // c = r (-1, -0.00645, -0.572, 0.022) + (1, 0.03195, 1.04, -0.04),
 // a = min(c.x^2, 2^(-7.925 mu)) c.x + c.y, (A, B) = (-1.0091, 1.0091) a + c.zw.
@@ -893,20 +777,6 @@ float2 substrate_interface_albedo_means(float roughness) {
   return float2(x - 4e-4, 1.0 - 0.55 * r - x - 4e-4);
 }
 
-// Karis' (A, B) (or their means (X, Y)) for an interface whose curve has
-// exponent p (substrate_fresnel_exponent): (E, B_p), E = A + B the lobe's
-// albedo and B_p = E (max(B, 0) / E)^p its curve-weighted part, so that
-// E~ = F0 E + (F90 - F0) B_p (F0 A + F90 B at p 1 where the fit's B >= 0; it
-// dips to -0.014 near normal incidence, which no longer raises the coupling
-// there). Of the means, Y_p = X' (Y / X')^p (X' = X + Y, E is X' + 8e-4 at
-// every cosine) is at most the mean of B_p (Jensen's inequality, x^p convex),
-// so the coupling's mean stays at most 1; by that inequality's gap it falls
-// below 1 for a low F0: 0.9947 at F0 0.02, r 0 (ReferenceEnergy.TheDiffuseLightCouplingKeepsTheViewsAlbedo).
-float2 substrate_interface_albedo_curve(float2 ab, float p) {
-  float e = ab.x + ab.y;
-  return float2(e, e * pow(clamp(ab.y / e, 1e-30, 1.0), p));
-}
-
 // The diffuse lobe's light-side coupling, (1 - E~(NoL)) / (1 - Ē~)
 // (Kelemen & Szirmay-Kalos 2001; Kulla & Conty 2017's coupling of a lobe
 // under an interface): light entering at a grazing NoL is mostly reflected by
@@ -927,10 +797,7 @@ float2 substrate_interface_albedo_curve(float2 ab, float p) {
 // channels, from the means of F0 and F90 (any scalar interface keeps the mean
 // of 1; one division instead of three). Float; converted once (<= 1000). No
 // table: the fit and the means' polynomial cost about as much as one fetch.
-// A low-F0 interface's curve (issue 19, step 17): E~ = F0 E + (F90 - F0) B_p
-// and its mean likewise (substrate_interface_albedo_curve, p = `exponent`,
-// substrate_dielectric_exponent), as the view side's albedo reads it.
-mfloat substrate_diffuse_light_coupling(float2 ends, float exponent, float NoL, float roughness, float hazeRoughness,
+mfloat substrate_diffuse_light_coupling(float2 ends, float NoL, float roughness, float hazeRoughness,
                                         float hazeWeight) {
   float mu = max(NoL, SUBSTRATE_MIN_COS);
   float2 ab = substrate_interface_albedo_fit(mu, roughness);
@@ -941,10 +808,8 @@ mfloat substrate_diffuse_light_coupling(float2 ends, float exponent, float NoL, 
   }
   float F0 = ends.x;  // the means of F0 and F90 (substrate_diffuse_interface)
   float F90 = ends.y;
-  float2 e = substrate_interface_albedo_curve(ab, exponent);
-  float2 em = substrate_interface_albedo_curve(m, exponent);
-  float numerator = max(1.0 - F0 * e.x - (F90 - F0) * e.y, 0.0);
-  float denominator = max(1.0 - F0 * em.x - (F90 - F0) * em.y, 1e-3);
+  float numerator = max(1.0 - F0 * ab.x - F90 * ab.y, 0.0);
+  float denominator = max(1.0 - F0 * m.x - F90 * m.y, 1e-3);
   float cap = F90 < F0 ? 1.0 : 1000.0;
   return SUBSTRATE_M(min(numerator / denominator, cap));
 }
@@ -1475,16 +1340,12 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 #endif
 
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
-  float3 shares;
-  float3 exponents;
-  substrate_fresnel_curve(c, f0, share, shares, exponents);
   float2 fd = substrate_closure_dielectric_part(c, f0, f90);
   mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
   mfloat3 specAlbedo;
   float dielectric;
   mfloat3 w1 =
-      substrate_specular_energy_aniso(f0, f90, shares, exponents, fd, f0w, NoV, roughness, anisotropy, specAlbedo,
-                                      dielectric);
+      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -1497,8 +1358,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (hazeWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    w2 = substrate_specular_energy_aniso(f0, f90, shares, exponents, fd, f0w, NoV, hazeRoughness, anisotropy,
-                                         specAlbedo2, dielectric2);
+    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2,
+                                         dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }
@@ -1540,7 +1401,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
       lobe = lerp(lobe, SUBSTRATE_F3(w2) * (d2 * vis2 * NoLc), hazeWeight);
     }
     // Under layers: what their top sends back down instead of out.
-    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, shares, exponents, VoH)) * lobe *
+    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, share, VoH)) * lobe *
            substrate_closure_coat_specular(c, f0, f90, fd, share, NoV, NoLc,
                                            lerp(roughness, hazeRoughness, hazeWeight));
 #if SUBSTRATE_USE_GLINT
@@ -1571,8 +1432,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
     diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
-              substrate_diffuse_light_coupling(ends, substrate_dielectric_exponent(exponents), NoLc, roughness,
-                                               hazeRoughness, hazeWeight);
+              substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
   }
 #if SUBSTRATE_USE_SSS
   // A slab's medium: its view and light dependence ("A slab's medium", above;

@@ -44,9 +44,6 @@ struct SubstrateClosure {
                               // under more than one interface and under a mix of tops
   uint features;              // SUBSTRATE_FEATURE_* bits
   bool isTop;                 // nothing layered above
-  bool coversLayers;          // on top of a pixel where some closure lies under layers (not stored per
-                              // closure): its Fresnel curve stays IOR 1.5's, which the layers' term
-                              // reads (substrate_fresnel_curve)
 };
 
 // The shading point as the generated material function sees it.
@@ -177,7 +174,6 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.coatFloor = 0.0;
   c.features = 0u;
   c.isTop = true;
-  c.coversLayers = false;
 }
 
 // What the rough top of the layers above a closure lets through at grazing

@@ -57,10 +57,6 @@ float substrate_max3(float3 v) {
   return max(v.x, max(v.y, v.z));
 }
 
-float substrate_min3(float3 v) {
-  return min(v.x, min(v.y, v.z));
-}
-
 // Rec. 709 / linear sRGB luminance.
 float substrate_luminance(float3 c) {
   return dot(c, float3(0.2126, 0.7152, 0.0722));

@@ -91,24 +91,12 @@
 // within 9.7e-4 (a least-squares fit, scripts/fit_fresnel_albedo.py).
 //   ROUGH_K, ROUGH_END: the share of a negative D(mean t) that the albedo
 //   bound of a lobe gives up, K below roughness END and 0 from there
-//   (substrate_fresnel_pull, substrate_fresnel_parts; fitted as a bound on the
+//   (substrate_fresnel_pull, substrate_fresnel_b; fitted as a bound on the
 //   integral: the largest share needed is 0.425, at r 0.225).
 #define SUBSTRATE_FRESNEL_CURVE_A 0.18317
 #define SUBSTRATE_FRESNEL_CURVE_B -0.39315
 #define SUBSTRATE_FRESNEL_ROUGH_K 0.43
 #define SUBSTRATE_FRESNEL_ROUGH_END 0.45
-// A low-F0 interface's curve (issue 19, step 17; substrate_fresnel_exponent):
-// chi^p, p = 1 + max(K / sqrt(max(F0, MIN_F0)) - K / F0_SQRT, 0); a lobe's
-// albedo bound takes u^q, q = 1 + kappa (min(p, BOUND_P_MAX) - 1), kappa =
-// max(SPREAD_0 - SPREAD_SLOPE r, SPREAD_MIN) (substrate_fresnel_spread; all
-// fitted by scripts/fit_fresnel_ior.py).
-#define SUBSTRATE_FRESNEL_IOR_K 0.04
-#define SUBSTRATE_FRESNEL_IOR_F0_SQRT 0.2
-#define SUBSTRATE_FRESNEL_IOR_MIN_F0 1e-6
-#define SUBSTRATE_FRESNEL_IOR_SPREAD_0 0.78
-#define SUBSTRATE_FRESNEL_IOR_SPREAD_SLOPE 1.15
-#define SUBSTRATE_FRESNEL_IOR_SPREAD_MIN 0.48
-#define SUBSTRATE_FRESNEL_IOR_BOUND_P_MAX 3.0
 // substrate_closure_coat_diffuse's terms, for k = extraInterfaces 0..3:
 //   G_k: 2 int mu g(mu)^(1 + k) dmu, the cosine-weighted mean of the lighting's
 //        light-side interface term g (substrate_coat_transmission:

@@ -61,25 +61,20 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
 // What a closure's interface reflects at cosine NoV (its directional albedo,
 // E_spec = (F0 (E - B) + F90 B) W): the primary lobe's, lerped toward the haze
 // lobe's by the haze weight, from the closure's Fresnel ends f0, f90 and the
-// curve's share (substrate_closure_fresnel_ends; the curve per channel:
-// substrate_fresnel_curve). The environment and the translucency both
+// curve's share (substrate_closure_fresnel_ends). The environment and the translucency both
 // remove it from what reaches the diffuse or passes through. `dielectric`: the
 // same for the closure's dielectric part of ends fd (substrate_closure_dielectric_part,
 // for substrate_diffuse_transmission).
 mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float share, float2 fd,
                                              float NoV, out float dielectric) {
   mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
-  float3 shares;
-  float3 exponents;
-  substrate_fresnel_curve(c, f0, share, shares, exponents);
   mfloat3 specAlbedo;
-  substrate_specular_energy(f0, f90, shares, exponents, fd, f0w, NoV, saturate(c.roughness), specAlbedo, dielectric);
+  substrate_specular_energy(f0, f90, share, fd, f0w, NoV, saturate(c.roughness), specAlbedo, dielectric);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    substrate_specular_energy(f0, f90, shares, exponents, fd, f0w, NoV, saturate(c.secondRoughness), specAlbedo2,
-                              dielectric2);
+    substrate_specular_energy(f0, f90, share, fd, f0w, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
     dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }

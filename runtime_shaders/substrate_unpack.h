@@ -202,7 +202,6 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       closures[j].N = basisN[closureBasis[j]];
       closures[j].T = basisT[closureBasis[j]];
       closures[j].coatFloor = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatFloor;
-      closures[j].coversLayers = closures[j].isTop && tops < count;  // substrate_fresnel_curve
     }
   }
   return count;

@@ -11,7 +11,7 @@ transmission is 1 - chi(mu) (chi: the runtime's Fresnel curve,
 substrate_fresnel_weight). A rough top reflects less at grazing angles: what an
 interface of F0 0 and F90 1 of roughness r does not reflect is 1 - b(mu, r),
 b the chi-weighted part of the tables' albedo as the runtime computes it
-(substrate_energy_dfg, substrate_fresnel_parts' t + x), and no top of F0 0 ..
+(substrate_energy_dfg, substrate_fresnel_b at share 1), and no top of F0 0 ..
 0.04 lets through less per unit of its T_N. The term shipped is
 
     g(mu) = max(1 - chi(mu), 1 - (1 - f) (1 - mu)^2),
@@ -85,7 +85,7 @@ def chi(c):
 
 
 def b_part(mu, r):
-    """e (t + x) of substrate_fresnel_parts(substrate_energy_dfg(mu, r), e, pull(r), .) (share 1, exponent 1)."""
+    """substrate_fresnel_b(substrate_energy_dfg(mu, r), e, pull(r), 1).y."""
     e_raw = lut(E_TABLE, mu, r)
     b = min(max(lut(B_TABLE, mu, r), 0.0), 1.0)
     e = min(max(min(max(e_raw - b, 0.0), 1.0) + b, 1e-3), 1.0)

@@ -9,7 +9,7 @@ nothing. Pure Python 3 (no numpy), deterministic, about 30 s on 2 cores.
    chi is t + D(t), t = (1 - c)^5 (Schlick's weight), D(t) = (1 - t) s (A + B s),
    s = sqrt(t): A and B by least squares on 4,001 cosines (SUBSTRATE_FRESNEL_CURVE_*).
 2. G_k = 2 int mu (1 - chi(mu))^(1 + k) dmu (SUBSTRATE_COAT_G_*).
-3. The albedo bound (substrate_fresnel_parts): for a GGX lobe (the tables' lobe:
+3. The albedo bound (substrate_fresnel_b): for a GGX lobe (the tables' lobe:
    height-correlated Smith, alpha = max(r^2, 1e-3)) integrated by visible
    normals at 41 roughnesses and 33 cosines, the share `pull` of a negative
    D(mean t) that e (t + D(t) - pull min(D, 0)) must give up to stay above the

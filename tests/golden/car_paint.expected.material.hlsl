@@ -90,7 +90,6 @@ void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_P
   closures[1].features = 20u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

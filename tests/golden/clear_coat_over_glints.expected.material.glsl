@@ -81,7 +81,6 @@ void clear_coat_over_glints_evaluate(SubstrateGeometry g, out SubstrateClosure c
   closures[1].features = 16u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -131,7 +131,6 @@ void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure clos
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
   closures[2].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

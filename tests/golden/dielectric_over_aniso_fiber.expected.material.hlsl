@@ -80,7 +80,6 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   closures[1].features = 2u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -93,7 +93,6 @@ void row40_coating_evaluate(SubstrateGeometry g, out SubstrateClosure closures[R
   closures[1].features = 15u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -94,7 +94,6 @@ void row44_specular_profile_evaluate(SubstrateGeometry g, out SubstrateClosure c
   closures[1].features = 47u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -102,7 +102,6 @@ void row60_glint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[ROW
   closures[1].features = 63u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -127,7 +127,6 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
   closures[2].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

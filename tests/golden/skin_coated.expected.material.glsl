@@ -96,7 +96,6 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
   closures[1].features = 128u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

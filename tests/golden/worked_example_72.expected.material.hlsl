@@ -149,7 +149,6 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   closures[2].coverageAbove = ca_fabric_b;
   closures[2].isTop = false;
   closures[2].features = 78u;
-  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

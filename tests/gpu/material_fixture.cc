@@ -106,7 +106,6 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.coatFloor = static_cast<T>(c.coatFloor);
   o.features = c.features;
   o.isTop = c.isTop;
-  o.coversLayers = c.coversLayers;
   o.metalnessMix = c.metalnessMix;
   return o;
 }
@@ -215,7 +214,6 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.isTop = p[kClosureIsTop] != 0.0f;
   c.extraInterfaces = static_cast<uint32_t>(p[kClosureExtraInterfaces]);
   c.coatFloor = p[kClosureCoatFloor];
-  c.coversLayers = p[kClosureCoversLayers] != 0.0f;
   c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }

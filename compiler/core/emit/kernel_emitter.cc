@@ -67,8 +67,7 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   put(kClosureIsTop, c + ".isTop ? 1.0 : 0.0");
   put(kClosureExtraInterfaces, "float(" + c + ".extraInterfaces)");
   put(kClosureCoatFloor, c + ".coatFloor");
-  put(kClosureCoversLayers, c + ".coversLayers ? 1.0 : 0.0");
-  for (int at = kClosureCoversLayers + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
+  for (int at = kClosureCoatFloor + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
   return s;
 }
 

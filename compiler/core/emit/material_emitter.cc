@@ -182,7 +182,6 @@ class Emitter {
                            const std::string& t);  // substrate_op_* of a binary operator (emitTree)
   void emitClosures();
   void emitCoatFloor();
-  void emitCoversLayers();
   std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
@@ -661,16 +660,6 @@ void Emitter::emitCoatFloor() {
   for (std::size_t i : under) line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
 }
 
-/// SubstrateClosure.coversLayers of every closure on top when some closure lies
-/// under layers, as the deferred unpacker derives it from the closure headers
-/// (a top closure keeps IOR 1.5's Fresnel curve there: substrate_fresnel_curve).
-void Emitter::emitCoversLayers() {
-  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
-  if (std::all_of(L_.closures.begin(), L_.closures.end(), isTop)) return;
-  for (std::size_t i = 0; i < L_.closures.size(); ++i)
-    if (L_.closures[i].isTop) line(fmt::format("closures[{}].coversLayers = true;", i));
-}
-
 std::string Emitter::run() {
   const std::string upper = materialUpper(m_);
   collectNeeded();
@@ -711,7 +700,6 @@ std::string Emitter::run() {
   emitTree();
   emitClosures();
   emitCoatFloor();
-  emitCoversLayers();
   line("");
   line(fmt::format("coverage = C_{};", m_.nodes[m_.root].id));
   line(fmt::format("transmittance = T_{};", m_.nodes[m_.root].id));

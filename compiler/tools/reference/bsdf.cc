@@ -116,59 +116,19 @@ T fresnelShare(T f0max) {
   return T(1) - saturate((f0max - T(SUBSTRATE_COAT_DIELECTRIC_F0)) * T(SUBSTRATE_COAT_CONDUCTOR_BLEND));
 }
 
-// substrate_fresnel_exponent: 1 + share max(0.04 / sqrt(max(F0, 1e-6)) - 0.2, 0).
+// substrate_fresnel: F0 + (F90 - F0) (t + share D(t)), t = pow5(1 - VoH).
 template <class T>
-T fresnelExponent(T f0, T share) {
-  return T(1) + share * std::max(T(SUBSTRATE_FRESNEL_IOR_K) / std::sqrt(std::max(f0, T(SUBSTRATE_FRESNEL_IOR_MIN_F0))) -
-                                     T(SUBSTRATE_FRESNEL_IOR_K / SUBSTRATE_FRESNEL_IOR_F0_SQRT), T(0));
-}
-
-// substrate_fresnel_curve_power: clamp(w, 1e-30, 1)^p.
-template <class T>
-T fresnelCurvePower(T w, T p) {
-  return std::pow(clampT(w, T(1e-30), T(1)), p);
-}
-
-// substrate_fresnel_curve: on top over nothing, shares = fresnelShare per channel and exponents =
-// fresnelExponent(F0, share) per channel; else the closure's share in every channel and exponents 1.
-template <class T>
-void fresnelCurve(const Closure<T>& c, const V3<T>& f0, T share, V3<T>& shares, V3<T>& exponents) {
-  const bool own = c.isTop && !c.coversLayers;
-  for (int i = 0; i < 3; ++i) {
-    shares[i] = own ? fresnelShare(f0[i]) : share;
-    exponents[i] = own ? fresnelExponent(f0[i], shares[i]) : T(1);
-  }
-}
-
-// substrate_dielectric_exponent: the smallest of the exponents.
-template <class T>
-T dielectricExponent(const V3<T>& exponents) {
-  return std::min(exponents[0], std::min(exponents[1], exponents[2]));
-}
-
-// substrate_fresnel: per channel F0 + (F90 - F0) clamp(t + s D(t), 1e-30, 1)^p, t = pow5(1 - VoH).
-template <class T>
-V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, const V3<T>& shares, const V3<T>& exponents, T VoH) {
+V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH) {
   const T t = pow5(T(1) - VoH);
-  const T d = fresnelDelta(t);
-  V3<T> out;
-  for (int i = 0; i < 3; ++i) out[i] = f0[i] + (f90[i] - f0[i]) * fresnelCurvePower(t + shares[i] * d, exponents[i]);
-  return out;
+  return f0 + (f90 - f0) * (t + share * fresnelDelta(t));
 }
 
-// substrate_fresnel_parts: t = min(B / e, 1), d = D(t): (t, d - pull min(d, 0), spread).
+// substrate_fresnel_b: t = min(B / e, 1), d = D(t): e (t + share (d - pull min(d, 0))).
 template <class T>
-V3<T> fresnelParts(const V2<T>& dfg, T e, T pull, T spread) {
+T fresnelB(const V2<T>& dfg, T e, T pull, T share) {
   const T t = std::min(dfg[1] / e, T(1));
   const T d = fresnelDelta(t);
-  return {t, d - pull * std::min(d, T(0)), spread};
-}
-
-// substrate_fresnel_spread: max(0.78 - 1.15 r, 0.48).
-template <class T>
-T fresnelSpread(T roughness) {
-  return std::max(T(SUBSTRATE_FRESNEL_IOR_SPREAD_0) - T(SUBSTRATE_FRESNEL_IOR_SPREAD_SLOPE) * roughness,
-                  T(SUBSTRATE_FRESNEL_IOR_SPREAD_MIN));
+  return e * (t + share * (d - pull * std::min(d, T(0))));
 }
 
 // substrate_fresnel_pull: 0.43 below roughness 0.45, else 0.
@@ -177,64 +137,48 @@ T fresnelPull(T roughness) {
   return roughness < T(SUBSTRATE_FRESNEL_ROUGH_END) ? T(SUBSTRATE_FRESNEL_ROUGH_K) : T(0);
 }
 
-// substrate_fresnel_albedo: per channel F0 e + max(F90 - F0, 0) e clamp(t + s x, 1e-30, 1)^q, (t, x, kappa)
-// the parts, q = 1 + kappa (min(p, 3) - 1), s and p the channel's share and exponent.
+// substrate_fresnel_albedo: F0 e + max(F90 - F0, 0) b.
 template <class T>
-V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, const V3<T>& parts, const V3<T>& shares,
-                    const V3<T>& exponents) {
-  V3<T> out;
-  for (int i = 0; i < 3; ++i) {
-    const T q = T(1) + parts[2] * (std::min(exponents[i], T(SUBSTRATE_FRESNEL_IOR_BOUND_P_MAX)) - T(1));
-    const T b = e * fresnelCurvePower(parts[0] + shares[i] * parts[1], q);
-    out[i] = f0[i] * e + std::max(f90[i] - f0[i], T(0)) * b;
-  }
-  return out;
+V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b) {
+  return f0 * e + vmax(f90 - f0, splat3(T(0))) * b;
 }
 
-// substrate_dielectric_albedo: sat((d.x e + max(d.y - d.x, 0) e clamp(t + x, 1e-30, 1)^q) (1 + d.x (1 - e) / e)),
-// q = 1 + kappa (min(p, 3) - 1).
+// substrate_dielectric_albedo: sat((d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e)).
 template <class T>
-T dielectricAlbedo(const V2<T>& d, T e, const V3<T>& parts, T exponent) {
-  const T q = T(1) + parts[2] * (std::min(exponent, T(SUBSTRATE_FRESNEL_IOR_BOUND_P_MAX)) - T(1));
-  const T bp = e * fresnelCurvePower(parts[0] + parts[1], q);
-  return saturate((d[0] * e + std::max(d[1] - d[0], T(0)) * bp) * (T(1) + d[0] * ((T(1) - e) / e)));
+T dielectricAlbedo(const V2<T>& d, T e, T b) {
+  return saturate((d[0] * e + std::max(d[1] - d[0], T(0)) * b) * (T(1) + d[0] * ((T(1) - e) / e)));
 }
 
 // substrate_specular_energy_aniso: e = clamp(E - B + B, 1e-3, 1) from the dfg
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
-// B -> min(B_max, e), pull 1, spread 0 (else fresnelPull(r), fresnelSpread(r));
-// W = 1 + F0w (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelParts(dfg, e, pull, spread)) W);
-// the dielectric part's (ends fd) dielectricAlbedo(fd, e, fresnelParts(dfg, e, pull, spread)).
+// B -> min(B_max, e), pull 1 (else fresnelPull(r));
+// W = 1 + F0w (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
+// the dielectric part's (ends fd) dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)).
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const V3<T>& shares, const V3<T>& exponents,
-                          const V2<T>& fd, const V3<T>& f0w, T NoV,
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
                           T roughness, T anisotropy, V3<T>& albedo, T& dielectric) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
   T pull = fresnelPull(roughness);
-  T spread = fresnelSpread(roughness);
   T A = std::min(std::fabs(anisotropy), T(1));
   if (A > T(0)) {
     const V2<T> eb = energyAniso(NoV, roughness, A, V2<T>{e, dfg[1]});
     e = eb[0];
     dfg[1] = std::min(eb[1], e);
     pull = T(1);
-    spread = T(0);
   }
   V3<T> w = splat3(T(1)) + f0w * ((T(1) - e) / e);
-  const V3<T> parts = fresnelParts(dfg, e, pull, spread);
-  albedo = saturate(fresnelAlbedo(f0, f90, e, parts, shares, exponents) * w);
-  dielectric = dielectricAlbedo(fd, e, parts, dielectricExponent(exponents));
+  albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull, share)) * w);
+  dielectric = dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, T(1)));
   return w;
 }
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const V3<T>& shares, const V3<T>& exponents,
-                     const V2<T>& fd, const V3<T>& f0w, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric) {
-  return specularEnergyAniso(f0, f90, shares, exponents, fd, f0w, NoV, roughness, T(0), albedo, dielectric);
+  return specularEnergyAniso(f0, f90, share, fd, f0w, NoV, roughness, T(0), albedo, dielectric);
 }
 
 // substrate_diffuse_transmission: min(1 - min(E_spec, E_d), (1 - E_spec) / max(albedo, 1e-3)).
@@ -264,21 +208,12 @@ V2<T> interfaceAlbedoMeans(T roughness) {
   return {x - T(4e-4), T(1) - T(0.55) * r - x - T(4e-4)};
 }
 
-// substrate_interface_albedo_curve: (E, E clamp(B / E, 1e-30, 1)^p), E = A + B.
+// substrate_diffuse_light_coupling: min(max(1 - f0 A - f90 B, 0) / max(1 - f0 X - f90 Y, 1e-3), cap)
+// at max(NoL, 1e-4) with f0, f90 the means of the three channels, (A, B) and
+// (X, Y) blended toward the haze lobe's by its weight first; cap 1 when
+// f90 < f0, else 1000. One scalar for the three channels.
 template <class T>
-V2<T> interfaceAlbedoCurve(const V2<T>& ab, T p) {
-  const T e = ab[0] + ab[1];
-  return {e, e * fresnelCurvePower(ab[1] / e, p)};
-}
-
-// substrate_diffuse_light_coupling: min(max(1 - f0 E - (f90 - f0) B_p, 0) / max(1 - f0 X' - (f90 - f0) Y_p, 1e-3), cap)
-// at max(NoL, 1e-4) with f0, f90 the means of the three channels, (E, B_p) and
-// (X', Y_p) from (A, B) and (X, Y) blended toward the haze lobe's by its weight
-// first (interfaceAlbedoCurve at `exponent`); cap 1 when f90 < f0, else 1000.
-// One scalar for the three channels.
-template <class T>
-T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T exponent, T NoL, T roughness, T hazeRoughness,
-                       T hazeWeight) {
+T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T hazeRoughness, T hazeWeight) {
   const T mu = std::max(NoL, K<T>::minCos);
   V2<T> ab = interfaceAlbedoFit(mu, roughness);
   V2<T> m = interfaceAlbedoMeans(roughness);
@@ -287,9 +222,8 @@ T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T exponent, T NoL, T r
     m = lerp(m, interfaceAlbedoMeans(hazeRoughness), hazeWeight);
   }
   const T F0 = mean3(f0), F90 = mean3(f90);
-  const V2<T> e = interfaceAlbedoCurve(ab, exponent), mm = interfaceAlbedoCurve(m, exponent);
-  const T numerator = std::max(T(1) - F0 * e[0] - (F90 - F0) * e[1], T(0));
-  const T denominator = std::max(T(1) - F0 * mm[0] - (F90 - F0) * mm[1], T(1e-3));
+  const T numerator = std::max(T(1) - F0 * ab[0] - F90 * ab[1], T(0));
+  const T denominator = std::max(T(1) - F0 * m[0] - F90 * m[1], T(1e-3));
   return std::min(numerator / denominator, F90 < F0 ? T(1) : T(1000));
 }
 
@@ -626,13 +560,6 @@ void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
     }
   const T f = tops == 1 && plain ? coatFloor(topR) : T(0);
   for (Closure<T>& c : closures) c.coatFloor = !c.isTop && c.extraInterfaces == 0 ? f : T(0);
-}
-
-// substrate_unpack_material / the emitter's emitCoversLayers: on top, when some closure is not.
-template <class T>
-void setCoversLayers(std::vector<Closure<T>>& closures) {
-  const bool under = std::any_of(closures.begin(), closures.end(), [](const Closure<T>& c) { return !c.isTop; });
-  for (Closure<T>& c : closures) c.coversLayers = c.isTop && under;
 }
 
 // substrate_coat_mean_share: sat(f (A + f (B + C f))).
@@ -974,9 +901,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   const V3<T> f0w = closureCompensatedF0(c, f0, fd);
   V3<T> specAlbedo;
   T dielectric;
-  V3<T> shares, exponents;
-  fresnelCurve(c, f0, share, shares, exponents);
-  V3<T> w1 = specularEnergyAniso(f0, f90, shares, exponents, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
+  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -987,8 +912,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    w2 = specularEnergyAniso(f0, f90, shares, exponents, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2,
-                             dielectric2);
+    w2 = specularEnergyAniso(f0, f90, share, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }
@@ -1028,7 +952,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
       lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
     }
     // Under layers: what the layers' top sends back down instead of out (a conductor's lobe).
-    spec = fresnel(f0, f90, shares, exponents, VoH) * lobe *
+    spec = fresnel(f0, f90, share, VoH) * lobe *
            closureCoatSpecular(c, f0, f90, fd, share, NoV, NoLc, lerp(roughness, hazeRoughness, hazeWeight));
     if (c.features & kFeatureGlint) spec = spec * glintFactor(c, d1, ToH, BoH, NoH);
     // Specular profile: SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint is 1.
@@ -1046,8 +970,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
   V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
                       : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
-                            diffuseLightCoupling(f0d, f90d, dielectricExponent(exponents), NoLc, roughness,
-                                                 hazeRoughness, hazeWeight);
+                            diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // A slab's medium: its view and light dependence ("A slab's medium" in substrate_bsdf.h).
   if (c.sssType != kSssNone) {
     T p;
@@ -1112,27 +1035,20 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T coatTransmission<T>(T, T);                                                                \
   template T coatFloor<T>(T);                                                                          \
   template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                         \
-  template void setCoversLayers<T>(std::vector<Closure<T>>&);                                         \
-  template V3<T> fresnelParts<T>(const V2<T>&, T, T, T);                                                 \
-  template T fresnelSpread<T>(T);                                                       \
+  template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \
-  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, const V3<T>&, const V3<T>&, const V3<T>&); \
-  template void fresnelCurve<T>(const Closure<T>&, const V3<T>&, T, V3<T>&, V3<T>&);                                        \
-  template T dielectricExponent<T>(const V3<T>&);                               \
-  template T fresnelExponent<T>(T, T);                                                                 \
-  template T fresnelCurvePower<T>(T, T);                                  \
-  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, const V3<T>&, const V3<T>&, T);                  \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, const V3<T>&, const V3<T>&, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);    \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, const V3<T>&, const V3<T>&, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
+  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
+  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);    \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
   template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
-  template T dielectricAlbedo<T>(const V2<T>&, T, const V3<T>&, T);                                                \
+  template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \
   template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                \
   template V3<T> closureCompensatedF0<T>(const Closure<T>&, const V3<T>&, const V2<T>&);              \
   template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
   template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
-  template V2<T> interfaceAlbedoCurve<T>(const V2<T>&, T);                                                          \
-  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T, T);                         \
+  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
   template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                   \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \

@@ -45,35 +45,24 @@ template <class T> T fresnelDelta(T t);                                         
 template <class T> T fresnelWeight(T c);                                                    // substrate_fresnel_weight
 template <class T> T coatTransmission(T mu, T coatFloor);                                   // substrate_coat_transmission
 template <class T> T coatFloor(T topRoughness);                                             // substrate_coat_floor
-template <class T> V3<T> fresnelParts(const V2<T>& dfg, T e, T pull, T spread);            // substrate_fresnel_parts
-template <class T> T fresnelSpread(T roughness);                                            // substrate_fresnel_spread
+template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
 template <class T> V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90);                   // substrate_f90_effective
 template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull
 template <class T>
-V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, const V3<T>& parts, const V3<T>& shares,
-                    const V3<T>& exponents);  // substrate_fresnel_albedo
-template <class T> T fresnelExponent(T f0, T share);                                        // substrate_fresnel_exponent
-template <class T> T fresnelCurvePower(T w, T p);                                           // substrate_fresnel_curve_power
-template <class T>
-V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, const V3<T>& shares, const V3<T>& exponents, T VoH);  // substrate_fresnel
-/// substrate_fresnel_curve: each channel's share of the dielectric curve and its exponent.
-template <class T>
-void fresnelCurve(const Closure<T>& c, const V3<T>& f0, T share, V3<T>& shares, V3<T>& exponents);
-template <class T> T dielectricExponent(const V3<T>& exponents);                            // substrate_dielectric_exponent
+V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
+template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH);        // substrate_fresnel
 /// substrate_specular_energy: returns W = 1 + F0w (1 - E) / E; E_spec in `albedo`, and in
 /// `dielectric` the albedo of the closure's dielectric part (ends fd, closureDielectricPart).
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const V3<T>& shares, const V3<T>& exponents,
-                     const V2<T>& fd, const V3<T>& f0w, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const V3<T>& shares, const V3<T>& exponents,
-                          const V2<T>& fd, const V3<T>& f0w, T NoV,
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
                           T roughness, T anisotropy, V3<T>& albedo, T& dielectric);
 /// substrate_dielectric_albedo: the compensated albedo of a grey interface of ends d.
-template <class T> T dielectricAlbedo(const V2<T>& d, T e, const V3<T>& parts, T exponent);
+template <class T> T dielectricAlbedo(const V2<T>& d, T e, T b);
 /// substrate_diffuse_transmission: what the interface lets through to the diffuse along the view,
 /// 1 - E_spec, or 1 - E_d of the dielectric part where that is larger, within the energy 1 - E_spec.
 template <class T> V3<T> diffuseTransmission(const V3<T>& albedo, const V3<T>& specAlbedo, T dielectric);
@@ -81,14 +70,11 @@ template <class T> V3<T> diffuseTransmission(const V3<T>& albedo, const V3<T>& s
 template <class T> V2<T> interfaceAlbedoFit(T mu, T roughness);
 /// substrate_interface_albedo_means: (X, Y), the fit's hemispherical means (lower bounds).
 template <class T> V2<T> interfaceAlbedoMeans(T roughness);
-/// substrate_interface_albedo_curve: (E, B_p) of Karis' (A, B) or their means for a curve of exponent p.
-template <class T> V2<T> interfaceAlbedoCurve(const V2<T>& ab, T p);
 /// substrate_diffuse_light_coupling: (1 - E~(NoL)) / max(1 - Ē~, 1e-3), haze-blended,
 /// one scalar from the channels' mean F0 and F90 (the shader takes those means,
 /// substrate_diffuse_interface; the same arithmetic).
 template <class T>
-T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T exponent, T NoL, T roughness, T hazeRoughness,
-                       T hazeWeight);
+T diffuseLightCoupling(const V3<T>& f0, const V3<T>& f90, T NoL, T roughness, T hazeRoughness, T hazeWeight);
 /// substrate_diffuse_light_coupling_deviation: an upper bound of the coupling's standard
 /// deviation over the cosine-weighted hemisphere of light.
 template <class T>

@@ -40,14 +40,12 @@ V3<T> specularAlbedo(const Closure<T>& c, T NoV, T& dielectric) {
   closureFresnelEnds(c, f0, f90, share);
   const V2<T> fd = closureDielectricPart(c, f0, f90);
   const V3<T> f0w = closureCompensatedF0(c, f0, fd);
-  V3<T> shares, exponents;
-  fresnelCurve(c, f0, share, shares, exponents);
   V3<T> specAlbedo;
-  specularEnergy(f0, f90, shares, exponents, fd, f0w, NoV, saturate(c.roughness), specAlbedo, dielectric);
+  specularEnergy(f0, f90, share, fd, f0w, NoV, saturate(c.roughness), specAlbedo, dielectric);
   if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    specularEnergy(f0, f90, shares, exponents, fd, f0w, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
+    specularEnergy(f0, f90, share, fd, f0w, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
     dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }

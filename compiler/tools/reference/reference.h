@@ -80,7 +80,6 @@ struct Closure {
   T coatFloor = T(0);  // what the layers' top lets through at grazing angles: coatFloor(topRoughness)
   std::uint32_t features = 0;
   bool isTop = true;
-  bool coversLayers = false;  // on top of a pixel where some closure lies under layers: setCoversLayers
   /// SUBSTRATE_USE_METALNESS_MIX of the shader that lights it (Material::metalnessMix;
   /// the deferred scene lighting always has it): false reads the diffuse under the whole
   /// interface (closureDielectricPart (1, 1)).
@@ -132,12 +131,6 @@ T topRoughness(const std::vector<Closure<T>>& closures) {
 /// haze feature), else 0.
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR);
-
-/// SubstrateClosure.coversLayers of every closure, as the material function and
-/// the unpacker set it: true on top when some closure of the pixel is not
-/// (its Fresnel curve stays IOR 1.5's, which the layers' term reads).
-template <class T>
-void setCoversLayers(std::vector<Closure<T>>& closures);
 
 template <class T>
 struct MaterialResult {

@@ -175,7 +175,6 @@ class Walk {
     for (const ClosureLayout& cl : L_.closures) out.closures.push_back(closure(cl));
     // What the layers' top lets through at grazing angles (the emitter's emitCoatFloor).
     setCoatFloor(out.closures, topRoughness(out.closures));
-    setCoversLayers(out.closures);  // the emitter's emitCoversLayers
     return out;
   }
 
