@@ -3,7 +3,8 @@
 and the share of it that a lobe's albedo bound may take. Step 17 was tried and
 reverted for its cost (docs/accuracy.md, "17. A low-F0 interface follows the
 Fresnel of its own IOR (tried, reverted)"; commit 80ca3cc holds the runtime
-that used these constants); the script keeps the fit for the next attempt.
+that used these constants; the SUBSTRATE_* and substrate_* names below are
+its); the script keeps the fit for the next attempt.
 Writes nothing. Pure Python 3, deterministic, about a minute on 2 cores.
 
 1. The curve. The ground truth reads a dielectric's IOR from its F0, eta =
@@ -14,7 +15,7 @@ Writes nothing. Pure Python 3, deterministic, about a minute on 2 cores.
    the largest error of p = 1 + max(0.04 / sqrt(F0) - 0.2, 0)
    (SUBSTRATE_FRESNEL_IOR_K, _F0_SQRT), against chi's own.
 2. The albedo. The tables bound the mean of chi over a lobe by u = t + x
-   (substrate_fresnel_parts); the mean of chi^p exceeds u^p where the lobe
+   (substrate_fresnel_b's bound; substrate_fresnel_parts in 80ca3cc); the mean of chi^p exceeds u^p where the lobe
    spreads its half vectors (Jensen's inequality, x^p convex). The bound takes
    u^q, q = 1 + kappa (min(p, P_MAX) - 1) (w^p <= w^P_MAX where p > P_MAX,
    so the cap keeps it a bound; without it the steep curves of F0 near 0
