@@ -92,9 +92,10 @@ ROUGHNESSES = [i / 40 for i in range(41)]
 PTS = lut.hammersley(2048)
 
 
-def lobe(args):
-    """(E, B, X) of the lobe: albedo with F = 1, its (1 - VoH)^5 and chi parts."""
-    mu, r = args
+def lobe_samples(mu, r):
+    """(weight, VoH) of each of the tables' GGX lobe's visible-normal samples at
+    (mu, r) that reflect above the horizon; a lobe's mean of f(VoH) is the sum
+    of weight * f(VoH) over len(PTS)."""
     a = max(r * r, lut.GGX_MIN_ALPHA)
     a2 = a * a
     vx, vz = math.sqrt(max(0.0, 1 - mu * mu)), mu
@@ -103,7 +104,6 @@ def lobe(args):
     hl = math.hypot(hx, hz)
     hx, hz = hx / hl, hz / hl
     s = 0.5 * (1 + hz)
-    e = b = x = 0.0
     for u1, u2 in PTS:
         rr, phi = math.sqrt(u1), 2 * math.pi * u2
         t1, t2 = rr * math.cos(phi), rr * math.sin(phi)
@@ -121,7 +121,13 @@ def lobe(args):
         lz = 2 * voh * mz - vz
         if lz <= 0:
             continue
-        w = (1 + lam_v) / (1 + lam_v + lut.ggx_lambda(min(lz, 1.0), a2))
+        yield (1 + lam_v) / (1 + lam_v + lut.ggx_lambda(min(lz, 1.0), a2)), voh
+
+
+def lobe(args):
+    """(E, B, X) of the lobe: albedo with F = 1, its (1 - VoH)^5 and chi parts."""
+    e = b = x = 0.0
+    for w, voh in lobe_samples(*args):
         e += w
         b += w * (1 - voh) ** 5
         x += w * chi(voh)

@@ -36,7 +36,6 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fit_fresnel_albedo as fa  # noqa: E402  (the curve chi and the tables' lobe)
-import gen_energy_lut as lut  # noqa: E402
 
 K, F0_SQRT = 0.04, 0.2  # SUBSTRATE_FRESNEL_IOR_K, SUBSTRATE_FRESNEL_IOR_F0_SQRT
 P_MAX = 3.0  # SUBSTRATE_FRESNEL_IOR_BOUND_P_MAX: the albedo bound's exponent at most (F0 3.3e-4)
@@ -78,36 +77,10 @@ def curve_fit():
 
 def lobe(args):
     """(e, B, [mean chi^p for p of each F0]) of the tables' GGX lobe at (mu, r)."""
-    mu, r = args
     ps = [exponent(f0) for f0 in F0S]
-    a = max(r * r, lut.GGX_MIN_ALPHA)
-    a2 = a * a
-    vx, vz = math.sqrt(max(0.0, 1 - mu * mu)), mu
-    lam_v = lut.ggx_lambda(vz, a2)
-    hx, hz = a * vx, vz
-    hl = math.hypot(hx, hz)
-    hx, hz = hx / hl, hz / hl
-    s = 0.5 * (1 + hz)
     e = b = 0.0
     xs = [0.0] * len(ps)
-    for u1, u2 in fa.PTS:
-        rr, phi = math.sqrt(u1), 2 * math.pi * u2
-        t1, t2 = rr * math.cos(phi), rr * math.sin(phi)
-        t2 = (1 - s) * math.sqrt(max(0.0, 1 - t1 * t1)) + s * t2
-        tn = math.sqrt(max(0.0, 1 - t1 * t1 - t2 * t2))
-        nx, ny, nz = -t2 * hz + tn * hx, t1, t2 * hx + tn * hz
-        mx, my, mz = a * nx, a * ny, max(0.0, nz)
-        ml = math.sqrt(mx * mx + my * my + mz * mz)
-        if ml <= 0:
-            continue
-        mx, my, mz = mx / ml, my / ml, mz / ml
-        voh = vx * mx + vz * mz
-        if voh <= 0:
-            continue
-        lz = 2 * voh * mz - vz
-        if lz <= 0:
-            continue
-        w = (1 + lam_v) / (1 + lam_v + lut.ggx_lambda(min(lz, 1.0), a2))
+    for w, voh in fa.lobe_samples(*args):
         e += w
         b += w * (1 - voh) ** 5
         c = fa.chi(voh)
