@@ -222,6 +222,30 @@ TEST(RandomWalkGroundTruth, NoProvenanceWhenOnlyF0ComesFromTheHelper) {
   EXPECT_TRUE(groundTruthExcluded(r2).empty());
 }
 
+TEST(RandomWalkGroundTruth, ABlackSlabIsAConductorOnlyWhereItsF0IsNoDielectrics) {
+  // Black plastic (F0 0.04) and a black fabric's F0 0.005 are dielectric
+  // interfaces over matter that absorbs what enters; a black slab of F0 0.9 in
+  // one channel is a conductor, and a conductor hides nothing below it.
+  struct Case {
+    const char* f0;
+    bool conductor;
+  };
+  int checked = 0;
+  for (const Case& c : {Case{"0.04", false}, Case{"0.005", false}, Case{"0.1", false}, Case{"[0.9, 0.6, 0.3]", true},
+                        Case{"0.11", true}}) {
+    const std::string nodes = std::string(R"("root": {"kind": "slab", "diffuse_albedo": 0, "f0": )") + c.f0 +
+                              R"(, "roughness": 0.5, "sss_mfp": 0})";
+    CompileResult r = compileUnsimplified("black.json", test::material(nodes));
+    std::vector<WalkTerm> t = groundTruthTerms(r, Geometry{}, {});
+    ASSERT_EQ(t.size(), 1u) << c.f0;
+    ASSERT_EQ(t[0].stack.size(), 1u) << c.f0;
+    EXPECT_EQ(t[0].stack[0].conductor, c.conductor) << c.f0;
+    EXPECT_TRUE(t[0].stack[0].opaqueBase) << c.f0;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 5);
+}
+
 TEST(RandomWalkGroundTruth, ATiltedNormalPinRotatesTheTruth) {
   // A slab whose normal pin tilts by 0.4 rad about x equals the untilted slab
   // seen with the view and light rotated the other way.

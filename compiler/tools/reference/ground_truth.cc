@@ -159,7 +159,11 @@ class LayerReader {
     // MFP 0 is opaque matter (docs/format.md), but a layer of no thickness is
     // no matter (the runtime's transmittance exp(-0 / 0) is 1).
     L.opaqueBase = L.mfp[0] <= 0 && L.mfp[1] <= 0 && L.mfp[2] <= 0 && L.thickness > 0;
-    L.conductor = L.opaqueBase && max3(L.diffuseAlbedo) <= 0;
+    // A black opaque slab is a conductor only where its F0 is none of a
+    // dielectric's: a black plastic or fabric (F0 0.04, 0.005) is a dielectric
+    // interface over matter that absorbs what enters, as the runtime reads it
+    // (substrate_closure_dielectric_part), not Gulbrandsen's conductor of n < 1.
+    L.conductor = L.opaqueBase && max3(L.diffuseAlbedo) <= 0 && max3(L.f0) > kPlausibleDielectricF0;
     L.anisotropy = std::clamp(scalar(s.pin(SlabPin::Anisotropy)), -1.0, 1.0);
     L.secondRoughness = scalar(s.pin(SlabPin::SecondRoughness));
     L.secondRoughnessWeight = saturate(scalar(s.pin(SlabPin::SecondRoughnessWeight)));

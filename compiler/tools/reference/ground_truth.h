@@ -31,8 +31,10 @@ namespace substratec::reference {
 ///    ends the stack) and (1 - m) x a dielectric (f0 = 0.08 specular, diffuse
 ///    albedo = base colour, the rest of the slab unchanged).
 ///  * Without it: an opaque slab (MFP 0, thickness > 0) of diffuse albedo 0 in
-///    every channel is a conductor; any other slab is a dielectric whose IOR
-///    its F0 gives. A dielectric F0 above kPlausibleDielectricF0 (IOR > ~1.93)
+///    every channel and an F0 above kPlausibleDielectricF0 in some channel is a
+///    conductor; any other slab is a dielectric whose IOR its F0 gives (a
+///    black one of F0 0.04 is a dielectric over matter that absorbs all that
+///    enters: black plastic, not a conductor of n < 1). A dielectric F0 above kPlausibleDielectricF0 (IOR > ~1.93)
 ///    is walked as is and listed by groundTruthExcluded ("implausible
 ///    dielectric f0").
 ///  * Every feature pin goes into the layer (f90, anisotropy, tangent angle of
