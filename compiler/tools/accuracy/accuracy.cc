@@ -111,8 +111,15 @@ double percentile(std::vector<double> v, double p) {
   return v[i] + (x - static_cast<double>(i)) * (v[i + 1] - v[i]);  // linear between closest ranks
 }
 
+/// A truth albedo (or a BRDF grid whose largest f cos is) at or below this
+/// is black: no relative error is read from it. A conductor of F0 0 reflects
+/// 1e-67 head-on in the walk (rounding), and an error relative to that read
+/// 3e63 (glTF AnisotropyDiscTest's black text); 1e-9 is far below what a
+/// half-float G-buffer or a display can show.
+constexpr double kBlackAlbedo = 1e-9;
+
 std::optional<double> relative(double a, double t) {
-  if (!(t > 0)) return std::nullopt;
+  if (!(t > kBlackAlbedo)) return std::nullopt;
   return a / t - 1;
 }
 
@@ -230,7 +237,7 @@ ComparisonRow compareRow(const AnalyticRow& a, const TruthRow& t, double thresho
   std::vector<double> errors;
   for (std::size_t j = 0; j < t.grid.size() && j < a.grid.size(); ++j) {
     const double lt = luminance(t.grid[j].value);
-    if (maxLum > 0 && lt > threshold * maxLum) errors.push_back(std::abs(luminance(a.grid[j]) / lt - 1));
+    if (maxLum > kBlackAlbedo && lt > threshold * maxLum) errors.push_back(std::abs(luminance(a.grid[j]) / lt - 1));
   }
   row.brdfTotal = static_cast<int>(t.grid.size());
   row.brdfCounted = static_cast<int>(errors.size());
@@ -259,7 +266,8 @@ Comparison compare(const Analytic& analytic, const Truth& truth) {
     const ComparisonRow& row = c.rows.back();
     if (!row.relError) {
       ++black;
-      c.problems.push_back(fmt::format("the truth's albedo is 0 at NoV {}: no relative error", row.nov));
+      c.problems.push_back(
+          fmt::format("the truth's albedo is 0 (at most {:g}) at NoV {}: no relative error", kBlackAlbedo, row.nov));
     } else if (!row.brdfMedianRelError) {
       c.problems.push_back(fmt::format("the truth's f * cos is 0 over the whole grid at NoV {}: no BRDF error", row.nov));
     }
