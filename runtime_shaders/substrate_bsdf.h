@@ -188,9 +188,12 @@ float substrate_coat_mean_share(float coatFloor) {
 // n^2 (1 - R_i) is replaced by the cosine-weighted mean of the lighting's own
 // light-side interface term, G_k T_i^1.13 (G_k = 2 int mu g(mu)^(1 + k) dmu:
 // 0.95238 / 0.91991 / 0.89524 / 0.87535 for k = extraInterfaces 0..3, T_i the
-// interfaces' share of topTransmittance, 0.96^(1 + k) unless the layers let
-// more through), bounded above by Bernoulli's inequality so that the normalized
-// light side never averages above 1. T_m = topTransmittance / 0.96^(1 + k).
+// interfaces' share of topTransmittance, I 0.96^k unless the layers let more
+// through, I = c.coatInterface the top's own 1 - F0 (substrate_coat_interface;
+// 0.96 before issue 19 step 18, when a clear coat of F0 0.06 read as media of
+// transmittance 0.98 and lost 12 % of a white furnace), the k interfaces under
+// it read as IOR 1.5's), bounded above by Bernoulli's inequality so that the
+// normalized light side never averages above 1. T_m = topTransmittance / (I 0.96^k).
 // A is the closure's diffuse albedo. The closure's own interface (f0, f90:
 // substrate_closure_fresnel_ends) couples the diffuse to the light too, and
 // both couplings fall toward grazing light, so the mean of their product
@@ -215,30 +218,26 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
   float cover = saturate(c.coverageAbove);
   float gk = SUBSTRATE_COAT_G_0;
   float lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
-  float ifc = SUBSTRATE_COAT_T_0;
-  float invIfc = SUBSTRATE_COAT_INV_T_0;
+  float ifc = c.coatInterface;  // the top's; each interface under it 0.96
 #if SUBSTRATE_USE_EXTRA_INTERFACES
   if (c.extraInterfaces == 1u) {
     gk = SUBSTRATE_COAT_G_1;
     lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
-    ifc = SUBSTRATE_COAT_T_1;
-    invIfc = SUBSTRATE_COAT_INV_T_1;
+    ifc *= SUBSTRATE_COAT_T_0;
   } else if (c.extraInterfaces == 2u) {
     gk = SUBSTRATE_COAT_G_2;
     lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
-    ifc = SUBSTRATE_COAT_T_2;
-    invIfc = SUBSTRATE_COAT_INV_T_2;
+    ifc *= SUBSTRATE_COAT_T_1;
   } else if (c.extraInterfaces >= 3u) {
     gk = SUBSTRATE_COAT_G_3;
     lobe = substrate_coat_lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
-    ifc = SUBSTRATE_COAT_T_3;
-    invIfc = SUBSTRATE_COAT_INV_T_3;
+    ifc *= SUBSTRATE_COAT_T_2;
   }
 #endif
   float g = (gk + (1.0 - gk) * substrate_coat_mean_share(c.coatFloor)) * lobe;
   float3 tn = saturate(c.topTransmittance);
   float3 ti = max(tn, SUBSTRATE_SPLAT3(ifc));
-  float3 tm = saturate(tn * invIfc);
+  float3 tm = saturate(tn / ifc);  // ifc >= 0.82 * 0.96^3
   float3 tm2 = tm * tm;
   float own = saturate(ends.y - ends.x);
   float3 d = (g * (1.0 + SUBSTRATE_COAT_COVARIANCE * own)) * ti * (1.0 - SUBSTRATE_COAT_BEND * (1.0 - ti)) +
@@ -650,10 +649,10 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // SUBSTRATE_COAT_TIR_*, a fit to the integral, scripts/fit_coat_tir.py). Each
 // pass leaves the interface by (1 - R) g, g the layers' interface term at the
 // larger of NoV and NoL (substrate_coat_transmission, as the throughputs take
-// it) times the interface's own transmission head-on, T_i = max(T_N, 0.96)
-// (1 - F0 of the layers' top: T_N holds it; the coat diffuse splits T_N so
-// too), and the closure reflects e of the rest, times the media's round
-// trip, T_m = sat(T_N / 0.96): e is its hemispherical albedo (the mean
+// it) times the interface's own transmission head-on, T_i = max(T_N, I)
+// (I = c.coatInterface, 1 - F0 of the layers' top: T_N holds it; the coat
+// diffuse splits T_N so too), and the closure reflects e of the rest, times the
+// media's round trip, T_m = sat(T_N / I): e is its hemispherical albedo (the mean
 // Fresnel F0 + (F90 - F0) / 21 and the diffuse below it,
 // substrate_diffuse_transmission_of: one value for every direction, so the
 // factor stays reciprocal). The round trip is T_m^2 for what the interface
@@ -728,9 +727,9 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float3 albedo = saturate(c.diffuseAlbedo);
   float3 e = saturate(fAvg + albedo * substrate_diffuse_transmission_of(albedo, fAvg, dAvg));
   float3 tn = saturate(c.topTransmittance);
-  float3 tm = saturate(tn * SUBSTRATE_COAT_INV_T_0);
+  float3 tm = saturate(tn / c.coatInterface);  // coatInterface >= 0.82
   float3 tm2 = tm * tm;
-  float3 ti = max(tn, SUBSTRATE_SPLAT3(SUBSTRATE_COAT_T_0));
+  float3 ti = max(tn, SUBSTRATE_SPLAT3(c.coatInterface));
   float3 gl = lerp(SUBSTRATE_SPLAT3(1.0), ti * substrate_coat_transmission(max(v, l), c.coatFloor), t);
   float3 back = tm2 * (trapped * tm2 + (1.0 - trapped) * (SUBSTRATE_SPLAT3(1.0) - gl));
   float3 k = (1.0 - trapped) / (SUBSTRATE_SPLAT3(1.0) - e * back);

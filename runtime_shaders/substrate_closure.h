@@ -42,6 +42,9 @@ struct SubstrateClosure {
   float coatFloor;            // what the layers' rough top lets through at grazing angles, substrate_coat_floor
                               // of the top-layer roughness (not stored per closure); 0 under a smooth top,
                               // under more than one interface and under a mix of tops
+  float coatInterface;        // what the layers' top interface lets through head-on, 1 - its F0
+                              // (substrate_coat_interface of the one closure on top; not stored per
+                              // closure); 0.96, IOR 1.5's, under a mix of tops
   uint features;              // SUBSTRATE_FEATURE_* bits
   bool isTop;                 // nothing layered above
 };
@@ -172,6 +175,7 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.coverageAbove = 0.0;
   c.extraInterfaces = 0u;
   c.coatFloor = 0.0;
+  c.coatInterface = SUBSTRATE_COAT_T_0;
   c.features = 0u;
   c.isTop = true;
 }
@@ -191,6 +195,21 @@ void substrate_closure_init(out SubstrateClosure c) {
 float substrate_coat_floor(float topRoughness) {
   float x = max(topRoughness - SUBSTRATE_COAT_ROUGH_START, 0.0);
   return SUBSTRATE_COAT_ROUGH_SCALE * x / (x + SUBSTRATE_COAT_ROUGH_HALF);
+}
+
+// What the layers' top interface lets through head-on, for the closures under
+// it (SubstrateClosure.coatInterface; issue 19, step 18): 1 - F0 of the one
+// closure on top, F0 its channels' mean clamped to [0, SUBSTRATE_COAT_TOP_F0_MAX]
+// (a dielectric's; the layers' term reads the rest of topTransmittance as
+// their media). Set per pixel, like coatFloor, by the material function and
+// the unpacker (the top closure is in the pixel: nothing more is stored).
+// With 0.96, IOR 1.5's, for every top, a clear coat of F0 0.06 (IOR 1.65)
+// left T_N 0.94, read as media of transmittance 0.98 whose trapped light the
+// diffuse lost: a white Lambertian under it returned 0.88 of a white furnace
+// head-on, 0.70 under a coat of IOR 2 (glTF CoatParameterSweep, OpenPBR's
+// default coat IOR 1.6).
+float substrate_coat_interface(float3 topF0) {
+  return 1.0 - clamp(dot(topF0, SUBSTRATE_SPLAT3(1.0 / 3.0)), 0.0, SUBSTRATE_COAT_TOP_F0_MAX);
 }
 
 // The top's GGX alpha r^2 back from a floor f > 0, r = START + HALF f /

@@ -67,6 +67,15 @@
 // F0 0.1 it is; from there it blends back to its own F0, reached at 0.2 (read
 // as a conductor, as the ground truth walks conductors). BLEND = 1 / (0.2 - 0.1).
 #define SUBSTRATE_COAT_DIELECTRIC_F0 0.1
+// The largest F0 substrate_coat_interface reads as the layers' top interface
+// (issue 19, step 18): a top that lets light through is a dielectric's
+// interface, IOR 2.4 at this F0 (an opaque top lets nothing through, T_N 0,
+// whatever this reads). Up to SUBSTRATE_MIX_START, where the runtime still
+// reads a closure as all dielectric: read up to 0.25, a smooth top of F0 0.2,
+// whose own curve has left chi for Schlick's (substrate_fresnel_share), let
+// through more than it does not reflect: 1.0018 of a white furnace at NoV 0.1
+// (furnace_test.cc). Beyond it the rest of T_N reads as media, as before.
+#define SUBSTRATE_COAT_TOP_F0_MAX 0.18
 #define SUBSTRATE_COAT_CONDUCTOR_BLEND 10.0
 // The diffuse of a slab lies under its dielectric part (issue 19, item 5;
 // substrate_closure_dielectric_part). No dielectric reflects more than
@@ -102,8 +111,10 @@
 //        light-side interface term g (substrate_coat_transmission:
 //        1 - chi(mu) since issue 19 step 4; with Schlick's 1 - (1 - mu)^5
 //        they were 0.95238 / 0.91991 / 0.89524 / 0.87535);
-//   T_k: 0.96^(1 + k), the interfaces' share of topTransmittance (1 - F0 of
-//        each), and INV_T_k = 1 / T_k;
+//   T_k: 0.96^(1 + k), the share of topTransmittance of 1 + k interfaces of
+//        IOR 1.5 (1 - F0 of each): T_0 is SubstrateClosure.coatInterface's
+//        default, the top's 1 - F0 since issue 19 step 18 (substrate_coat_interface),
+//        and the k interfaces under the top take T_(k-1);
 //   BEND: T_i^1.13 bounded above by Bernoulli's inequality, T_i (1 - 0.12 (1 - T_i));
 //   COVARIANCE: the closure's own interface coupling's covariance with the
 //        layers', per unit of mean F90 - mean F0.
@@ -139,11 +150,6 @@
 #define SUBSTRATE_COAT_T_0 0.96
 #define SUBSTRATE_COAT_T_1 0.9216
 #define SUBSTRATE_COAT_T_2 0.884736
-#define SUBSTRATE_COAT_T_3 0.84934656
-#define SUBSTRATE_COAT_INV_T_0 1.0416666667
-#define SUBSTRATE_COAT_INV_T_1 1.0850694444
-#define SUBSTRATE_COAT_INV_T_2 1.1302806713
-#define SUBSTRATE_COAT_INV_T_3 1.1773756993
 #define SUBSTRATE_COAT_BEND 0.12
 #define SUBSTRATE_COAT_COVARIANCE 0.0145
 // substrate_closure_coat_specular (issue 19, step 6): the share R of a

@@ -137,6 +137,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
   bool topShare = true;
   uint tops = 0u;
   bool topPlainLobe = true;  // the top closure's lobe is one isotropic GGX lobe
+  float coatInterface = SUBSTRATE_COAT_T_0;  // the top closure's substrate_coat_interface
   for (int i = 0; i < SUBSTRATE_MAX_CLOSURES; ++i) {
     closureBasis[i] = 0u;
     if (uint(i) < count) {
@@ -167,6 +168,9 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
         basisAniso[basis] = true;
       }
       substrate_unpack_closure_fields(words, pos, feats, sss, isTop, closures[i]);
+      if (isTop) {
+        coatInterface = substrate_coat_interface(closures[i].f0);
+      }
     }
   }
 
@@ -202,6 +206,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       closures[j].N = basisN[closureBasis[j]];
       closures[j].T = basisT[closureBasis[j]];
       closures[j].coatFloor = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatFloor;
+      closures[j].coatInterface = !closures[j].isTop && tops == 1u ? coatInterface : SUBSTRATE_COAT_T_0;
     }
   }
   return count;

@@ -129,6 +129,9 @@ void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure clos
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
   closures[2].coatFloor = coatFloor;
+  float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
+  closures[1].coatInterface = coatInterface;
+  closures[2].coatInterface = coatInterface;
 
   coverage = C_root;
   transmittance = T_root;

@@ -80,6 +80,8 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   closures[1].features = 2u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
+  float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
+  closures[1].coatInterface = coatInterface;
 
   coverage = C_root;
   transmittance = T_root;

@@ -94,6 +94,8 @@ void row44_specular_profile_evaluate(SubstrateGeometry g, out SubstrateClosure c
   closures[1].features = 47u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
+  float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
+  closures[1].coatInterface = coatInterface;
 
   coverage = C_root;
   transmittance = T_root;

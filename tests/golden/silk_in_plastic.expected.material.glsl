@@ -126,6 +126,9 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
   closures[2].coatFloor = coatFloor;
+  float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
+  closures[1].coatInterface = coatInterface;
+  closures[2].coatInterface = coatInterface;
 
   coverage = C_root;
   transmittance = T_root;

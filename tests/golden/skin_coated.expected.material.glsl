@@ -96,6 +96,8 @@ void skin_coated_evaluate(SubstrateGeometry g, out SubstrateClosure closures[SKI
   closures[1].features = 128u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
   closures[1].coatFloor = coatFloor;
+  float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
+  closures[1].coatInterface = coatInterface;
 
   coverage = C_root;
   transmittance = T_root;

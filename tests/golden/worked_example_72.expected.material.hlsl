@@ -149,6 +149,9 @@ void worked_example_72_evaluate(SubstrateGeometry g, out SubstrateClosure closur
   closures[2].coverageAbove = ca_fabric_b;
   closures[2].isTop = false;
   closures[2].features = 78u;
+  float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
+  closures[1].coatInterface = coatInterface;
+  closures[2].coatInterface = coatInterface;
 
   coverage = C_root;
   transmittance = T_root;

@@ -104,6 +104,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.coverageAbove = static_cast<T>(c.coverageAbove);
   o.extraInterfaces = c.extraInterfaces;
   o.coatFloor = static_cast<T>(c.coatFloor);
+  o.coatInterface = static_cast<T>(c.coatInterface);
   o.features = c.features;
   o.isTop = c.isTop;
   o.metalnessMix = c.metalnessMix;
@@ -214,6 +215,7 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.isTop = p[kClosureIsTop] != 0.0f;
   c.extraInterfaces = static_cast<uint32_t>(p[kClosureExtraInterfaces]);
   c.coatFloor = p[kClosureCoatFloor];
+  c.coatInterface = p[kClosureCoatInterface];
   c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }

@@ -251,6 +251,7 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
         check("isTop", at + kClosureIsTop, c64.isTop ? 1 : 0, c64.isTop ? 1 : 0);
         check("extraInterfaces", at + kClosureExtraInterfaces, c64.extraInterfaces, c64.extraInterfaces);
         check("coatFloor", at + kClosureCoatFloor, c64.coatFloor, c32.coatFloor);
+        check("coatInterface", at + kClosureCoatInterface, c64.coatInterface, c32.coatInterface);
       }
       check("coverage", kResultCoverage, ref.material.coverage, r32.material.coverage);
       for (int c = 0; c < 3; ++c) {

@@ -478,6 +478,7 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.coverageAbove = static_cast<To>(c.coverageAbove);
   o.extraInterfaces = c.extraInterfaces;
   o.coatFloor = static_cast<To>(c.coatFloor);
+  o.coatInterface = static_cast<To>(c.coatInterface);
   o.features = c.features;
   o.isTop = c.isTop;
   o.metalnessMix = c.metalnessMix;

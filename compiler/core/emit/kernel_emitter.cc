@@ -67,7 +67,8 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   put(kClosureIsTop, c + ".isTop ? 1.0 : 0.0");
   put(kClosureExtraInterfaces, "float(" + c + ".extraInterfaces)");
   put(kClosureCoatFloor, c + ".coatFloor");
-  for (int at = kClosureCoatFloor + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
+  put(kClosureCoatInterface, c + ".coatInterface");
+  for (int at = kClosureCoatInterface + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
   return s;
 }
 

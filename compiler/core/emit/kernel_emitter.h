@@ -68,7 +68,7 @@ inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6,
                      kClosureGlintUvDerivatives = 32, kClosureSpecularProfile = 36, kClosureEmissive = 37,
                      kClosureWeight = 40, kClosureTopTransmittance = 41, kClosureCoverageAbove = 44,
                      kClosureFeatures = 45, kClosureIsTop = 46, kClosureExtraInterfaces = 47,
-                     kClosureCoatFloor = 48;
+                     kClosureCoatFloor = 48, kClosureCoatInterface = 49;
 
 /// Preview parameters (set 0, binding 0, std140 / cbuffer, float4 each):
 ///   camera: xyz eye position, w tan(vertical half field of view)

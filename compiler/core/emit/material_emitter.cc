@@ -182,6 +182,7 @@ class Emitter {
                            const std::string& t);  // substrate_op_* of a binary operator (emitTree)
   void emitClosures();
   void emitCoatFloor();
+  void emitCoatInterface();
   std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
@@ -660,6 +661,22 @@ void Emitter::emitCoatFloor() {
   for (std::size_t i : under) line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
 }
 
+/// What the layers' top interface lets through head-on (substrate_coat_interface
+/// of the one closure on top's F0, as the deferred unpacker derives it from the
+/// unpacked top closure), for every closure under it when one closure is on
+/// top; the others keep 0.96 (substrate_closure_init). Nothing when no closure
+/// lies under layers.
+void Emitter::emitCoatInterface() {
+  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
+  const auto top = std::find_if(L_.closures.begin(), L_.closures.end(), isTop);
+  if (std::count_if(L_.closures.begin(), L_.closures.end(), isTop) != 1) return;
+  if (std::all_of(L_.closures.begin(), L_.closures.end(), isTop)) return;
+  line(fmt::format("float coatInterface = substrate_coat_interface(closures[{}].f0);  // of the top closure",
+                   top - L_.closures.begin()));
+  for (std::size_t i = 0; i < L_.closures.size(); ++i)
+    if (!L_.closures[i].isTop) line(fmt::format("closures[{}].coatInterface = coatInterface;", i));
+}
+
 std::string Emitter::run() {
   const std::string upper = materialUpper(m_);
   collectNeeded();
@@ -700,6 +717,7 @@ std::string Emitter::run() {
   emitTree();
   emitClosures();
   emitCoatFloor();
+  emitCoatInterface();
   line("");
   line(fmt::format("coverage = C_{};", m_.nodes[m_.root].id));
   line(fmt::format("transmittance = T_{};", m_.nodes[m_.root].id));

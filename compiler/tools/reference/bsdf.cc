@@ -562,6 +562,24 @@ void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
   for (Closure<T>& c : closures) c.coatFloor = !c.isTop && c.extraInterfaces == 0 ? f : T(0);
 }
 
+// substrate_coat_interface: 1 - clamp(mean F0, 0, SUBSTRATE_COAT_TOP_F0_MAX).
+template <class T>
+T coatInterface(const V3<T>& topF0) {
+  return T(1) - clampT(dot(topF0, splat3(T(1) / T(3))), T(0), T(SUBSTRATE_COAT_TOP_F0_MAX));
+}
+
+template <class T>
+void setCoatInterface(std::vector<Closure<T>>& closures) {
+  int tops = 0;
+  T ifc = T(SUBSTRATE_COAT_T_0);
+  for (const Closure<T>& c : closures)
+    if (c.isTop) {
+      ++tops;
+      ifc = coatInterface(c.f0);
+    }
+  for (Closure<T>& c : closures) c.coatInterface = !c.isTop && tops == 1 ? ifc : T(SUBSTRATE_COAT_T_0);
+}
+
 // substrate_coat_mean_share: sat(f (A + f (B + C f))).
 template <class T>
 T coatMeanShare(T coatFloor) {
@@ -741,7 +759,7 @@ V3<T> closureCompensatedF0(const Closure<T>& c, const V3<T>& f0, const V2<T>& fd
 
 // 1 / lerp(1, D, cover), D = G_k(f) T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
 // G_k(f) = G_k + (1 - G_k) coatMeanShare(coatFloor),
-// T_i = max(T_N, 0.96^(1+k)), T_m = sat(T_N / 0.96^(1+k)).
+// T_i = max(T_N, I), T_m = sat(T_N / I), I = coatInterface 0.96^k.
 // The first term raised by 1 + 0.0145 sat(mean F90 - mean F0) of the closure's
 // own (relative) interface: the covariance of its coupling with the layers' (the
 // shader takes the two means, substrate_diffuse_interface).
@@ -754,22 +772,19 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
     return T(diffuseModel == kDiffuseChan2024 ? chan2024 : diffuseModel == kDiffuseEon ? eon : 1.0);
   };
   T gk = T(SUBSTRATE_COAT_G_0), lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_0, SUBSTRATE_COAT_LOBE_EON_0);
-  T ifc = T(SUBSTRATE_COAT_T_0), invIfc = T(SUBSTRATE_COAT_INV_T_0);
+  T ifc = c.coatInterface;  // the top's; each interface under it 0.96
   if (c.extraInterfaces == 1u) {
     gk = T(SUBSTRATE_COAT_G_1);
     lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_1, SUBSTRATE_COAT_LOBE_EON_1);
-    ifc = T(SUBSTRATE_COAT_T_1);
-    invIfc = T(SUBSTRATE_COAT_INV_T_1);
+    ifc = ifc * T(SUBSTRATE_COAT_T_0);
   } else if (c.extraInterfaces == 2u) {
     gk = T(SUBSTRATE_COAT_G_2);
     lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_2, SUBSTRATE_COAT_LOBE_EON_2);
-    ifc = T(SUBSTRATE_COAT_T_2);
-    invIfc = T(SUBSTRATE_COAT_INV_T_2);
+    ifc = ifc * T(SUBSTRATE_COAT_T_1);
   } else if (c.extraInterfaces >= 3u) {
     gk = T(SUBSTRATE_COAT_G_3);
     lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
-    ifc = T(SUBSTRATE_COAT_T_3);
-    invIfc = T(SUBSTRATE_COAT_INV_T_3);
+    ifc = ifc * T(SUBSTRATE_COAT_T_2);
   }
   T g = (gk + (T(1) - gk) * coatMeanShare(c.coatFloor)) * lb;
   const T own = saturate(dot(f90 - f0, splat3(T(1) / T(3))));
@@ -778,7 +793,7 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
   for (int i = 0; i < 3; ++i) {
     const T tn = saturate(c.topTransmittance[i]);
     const T ti = std::max(tn, ifc);
-    const T tm = saturate(tn * invIfc);
+    const T tm = saturate(tn / ifc);
     const T tm2 = tm * tm;
     const T d = g * ti * (T(1) - T(SUBSTRATE_COAT_BEND) * (T(1) - ti)) + kCoatTrap<T> * saturate(c.diffuseAlbedo[i]) * (T(1) - tm2 * tm2);
     r[i] = T(1) / lerp(T(1), d, cover);
@@ -790,7 +805,7 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
 // with t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2 -
 // TOP_SPREAD sat(coverageAbove) coatTopAlpha(coatFloor), 1e-3), d = max(mu_i - mu_c, 0) along the view
 // and along the light), g' = lerp(1, T_i coatTransmission(max(NoV, NoL), coatFloor), t), T_i =
-// max(T_N, 0.96) the interface's own, T_m = sat(T_N / 0.96) and e the closure's hemispherical albedo,
+// max(T_N, I) the interface's own (I = coatInterface), T_m = sat(T_N / I) and e the closure's hemispherical albedo,
 // F_avg + A diffuseTransmission(A, F_avg, d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the
 // same of the dielectric part fd); times max(T_m, 1e-30)^x, x = ROUGH_PATH f^3 t (coatPathLength(NoV)
 // (1 - NoV)^2 + coatPathLength(NoL) (1 - NoL)^2), f = sat(coatFloor).
@@ -823,8 +838,8 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   V3<T> k;
   for (int i = 0; i < 3; ++i) {
     const T tn = saturate(c.topTransmittance[i]);
-    const T tm = saturate(tn * T(SUBSTRATE_COAT_INV_T_0));
-    const T ti = std::max(tn, T(SUBSTRATE_COAT_T_0));
+    const T tm = saturate(tn / c.coatInterface);
+    const T ti = std::max(tn, c.coatInterface);
     const T tm2 = tm * tm;
     const T back = tm2 * (trapped * tm2 + (T(1) - trapped) * (T(1) - lerp(T(1), ti * g, t)));
     k[i] = (T(1) - trapped) / (T(1) - e[i] * back);
@@ -1034,7 +1049,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T fresnelWeight<T>(T);                                                                      \
   template T coatTransmission<T>(T, T);                                                                \
   template T coatFloor<T>(T);                                                                          \
+  template T coatInterface<T>(const V3<T>&);                                                           \
   template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                         \
+  template void setCoatInterface<T>(std::vector<Closure<T>>&);                                        \
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \

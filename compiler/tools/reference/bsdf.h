@@ -45,6 +45,7 @@ template <class T> T fresnelDelta(T t);                                         
 template <class T> T fresnelWeight(T c);                                                    // substrate_fresnel_weight
 template <class T> T coatTransmission(T mu, T coatFloor);                                   // substrate_coat_transmission
 template <class T> T coatFloor(T topRoughness);                                             // substrate_coat_floor
+template <class T> T coatInterface(const V3<T>& topF0);                                     // substrate_coat_interface
 template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
 template <class T> V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90);                   // substrate_f90_effective

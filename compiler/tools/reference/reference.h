@@ -78,6 +78,7 @@ struct Closure {
   T coverageAbove = T(0);
   std::uint32_t extraInterfaces = 0;  // interfaces above beyond the first, 0..3
   T coatFloor = T(0);  // what the layers' top lets through at grazing angles: coatFloor(topRoughness)
+  T coatInterface = T(SUBSTRATE_COAT_T_0);  // the layers' top's 1 - F0 head-on: setCoatInterface
   std::uint32_t features = 0;
   bool isTop = true;
   /// SUBSTRATE_USE_METALNESS_MIX of the shader that lights it (Material::metalnessMix;
@@ -131,6 +132,14 @@ T topRoughness(const std::vector<Closure<T>>& closures) {
 /// haze feature), else 0.
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR);
+
+/// SubstrateClosure.coatInterface of every closure, as the material function
+/// and the unpacker set it (substrate_coat_interface): 1 - the mean F0 of the
+/// one closure on top, clamped to [0, SUBSTRATE_COAT_TOP_F0_MAX], for the
+/// closures under it; SUBSTRATE_COAT_T_0 (0.96) for the others and under a mix
+/// of tops.
+template <class T>
+void setCoatInterface(std::vector<Closure<T>>& closures);
 
 template <class T>
 struct MaterialResult {

@@ -175,6 +175,7 @@ class Walk {
     for (const ClosureLayout& cl : L_.closures) out.closures.push_back(closure(cl));
     // What the layers' top lets through at grazing angles (the emitter's emitCoatFloor).
     setCoatFloor(out.closures, topRoughness(out.closures));
+    setCoatInterface(out.closures);  // the emitter's emitCoatInterface
     return out;
   }
 
