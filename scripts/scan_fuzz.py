@@ -10,7 +10,8 @@ shipping model's directional albedo against the truth's at NoV 1 / 0.8 / 0.6 /
 0.4 / 0.2 / 0.1 and the white furnace; the script prints the relative errors
 (luminance) and the lowest furnace, then how many materials meet issue 19's
 goals (albedo within 5 % at NoV >= 0.2 and 8 % at 0.1; a white furnace of at
-least 0.97). With --before BIN it runs a second build on the same truth samples
+least 0.97), in all and per set (examples, controls, the MaterialX corpus, the
+glTF corpus). With --before BIN it runs a second build on the same truth samples
 and prints both. The corpora's textures read 0.5 (no image is bound). With
 --all it takes every material of those sets, with a fuzz or not (issue 19,
 step 17 measured the Fresnel curve of low-F0 interfaces on all of them).
@@ -32,6 +33,7 @@ import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+SETS = ("examples", "controls", "MaterialX corpus", "glTF corpus")
 
 
 def sets_fuzz(path):
@@ -40,15 +42,16 @@ def sets_fuzz(path):
 
 
 def cases(binary, tmp, every):
-    """(label, file, extra accuracy arguments) for every material with a fuzz (every one with `every`)."""
+    """(label, file, extra accuracy arguments, set) for every material with a fuzz (every one with `every`);
+    set is one of SETS."""
     out = []
     selected = (lambda path: True) if every else sets_fuzz
     for path in sorted(glob.glob(os.path.join(ROOT, "examples", "*.json"))):
         if selected(path):
-            out.append((os.path.basename(path)[:-5], path, []))
+            out.append((os.path.basename(path)[:-5], path, [], "examples"))
     for path in sorted(glob.glob(os.path.join(ROOT, "bench", "materials", "*.json"))):
         if selected(path):
-            out.append((os.path.basename(path)[:-5], path, ["--diffuse", "lambert"]))
+            out.append((os.path.basename(path)[:-5], path, ["--diffuse", "lambert"], "controls"))
     corpus = sorted(glob.glob(os.path.join(ROOT, "tests", "import", "corpus", "materialx", "**", "*.mtlx"),
                               recursive=True))
     corpus += sorted(glob.glob(os.path.join(ROOT, "tests", "import", "corpus", "gltf", "*.materials.json")))
@@ -57,16 +60,17 @@ def cases(binary, tmp, every):
         if subprocess.run([binary, "import", path, "-o", target], capture_output=True).returncode != 0:
             continue
         stem = os.path.basename(path).split(".")[0]
+        kind = "MaterialX corpus" if path.endswith(".mtlx") else "glTF corpus"
         for imported in sorted(glob.glob(os.path.join(target, "*.json"))):
             if selected(imported):
                 with open(imported) as f:
                     name = json.load(f)["name"]
-                out.append(("%s / %s" % (stem, name), path, ["--material", name]))
+                out.append(("%s / %s" % (stem, name), path, ["--material", name], kind))
     return out
 
 
 def measure(binary, case, samples):
-    _, path, extra = case
+    _, path, extra, _ = case
     run = subprocess.run([binary, "accuracy", path, "--json", "--samples", str(samples), "--eval-samples", "256",
                           "-j", "1"] + extra, capture_output=True, text=True)
     if run.returncode != 0:
@@ -115,6 +119,12 @@ def main():
         goals = [meets_goal(r) for r in measured]
         print("%s: %d materials measured; albedo within the goal %d, furnace >= 0.97 %d" %
               (name, len(measured), sum(g[0] for g in goals), sum(g[1] for g in goals)))
+        for kind in SETS:  # the issue's goal names each set
+            of_set = [c for c in found if c[3] == kind]
+            got = [table[(name, c[0])] for c in of_set if table[(name, c[0])] is not None]
+            if of_set:
+                print("  %s: %d of %d measured, albedo within the goal %d" %
+                      (kind, len(got), len(of_set), sum(meets_goal(r)[0] for r in got)))
     return 0 if found and all(r is not None for r in results) else 1
 
 
