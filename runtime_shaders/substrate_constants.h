@@ -69,7 +69,7 @@
 #define SUBSTRATE_COAT_DIELECTRIC_F0 0.1
 // The largest F0 substrate_coat_interface reads as the layers' top interface
 // (issue 19, step 18): a top that lets light through is a dielectric's
-// interface, IOR 2.4 at this F0 (an opaque top lets nothing through, T_N 0,
+// interface, IOR 2.47 at this F0 (an opaque top lets nothing through, T_N 0,
 // whatever this reads). Up to SUBSTRATE_MIX_START, where the runtime still
 // reads a closure as all dielectric: read up to 0.25, a smooth top of F0 0.2,
 // whose own curve has left chi for Schlick's (substrate_fresnel_share), let
