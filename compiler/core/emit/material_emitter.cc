@@ -90,16 +90,23 @@ std::string underLayersDefines(const Material& m, const StorageLayout& layout) {
                      wrap ? 1 : 0, fuzz ? 1 : 0);
 }
 
+/// The index of the one closure on top, or -1 when there are several (a mix
+/// of tops: no one interface above the others).
+int oneTopClosure(const StorageLayout& layout) {
+  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
+  if (std::count_if(layout.closures.begin(), layout.closures.end(), isTop) != 1) return -1;
+  return static_cast<int>(std::find_if(layout.closures.begin(), layout.closures.end(), isTop) - layout.closures.begin());
+}
+
 /// The closures that read the layers' rough top (SubstrateClosure.coatFloor):
 /// when one closure, one isotropic lobe, is on top, those under that one
 /// interface (extraInterfaces 0); else none. None either when every closure is
 /// on top, or when the top's roughness is a constant up to
 /// SUBSTRATE_COAT_ROUGH_START, whose floor is 0 (a clear coat of roughness 0.05).
 std::vector<std::size_t> coatFloorClosures(const Material& m, const StorageLayout& layout) {
-  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
-  const auto top = std::find_if(layout.closures.begin(), layout.closures.end(), isTop);
-  if (std::count_if(layout.closures.begin(), layout.closures.end(), isTop) != 1) return {};  // no one roughness
-  const Slab& slab = m.slabs[top->slab];
+  const int top = oneTopClosure(layout);
+  if (top < 0) return {};  // no one roughness
+  const Slab& slab = m.slabs[layout.closures[static_cast<std::size_t>(top)].slab];
   if (slab.features & (kFeatAnisotropy | kFeatHaze)) return {};  // not one isotropic lobe
   const ValueId r = slab.pin(SlabPin::Roughness);
   if (r != kNoValue && m.values.isConst(r) && m.values.node(r).c[0] <= SUBSTRATE_COAT_ROUGH_START) return {};
@@ -667,12 +674,9 @@ void Emitter::emitCoatFloor() {
 /// top; the others keep 0.96 (substrate_closure_init). Nothing when no closure
 /// lies under layers.
 void Emitter::emitCoatInterface() {
-  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
-  const auto top = std::find_if(L_.closures.begin(), L_.closures.end(), isTop);
-  if (std::count_if(L_.closures.begin(), L_.closures.end(), isTop) != 1) return;
-  if (std::all_of(L_.closures.begin(), L_.closures.end(), isTop)) return;
-  line(fmt::format("float coatInterface = substrate_coat_interface(closures[{}].f0);  // of the top closure",
-                   top - L_.closures.begin()));
+  const int top = oneTopClosure(L_);
+  if (top < 0 || L_.closures.size() == 1) return;  // a mix of tops, or nothing under the top
+  line(fmt::format("float coatInterface = substrate_coat_interface(closures[{}].f0);  // of the top closure", top));
   for (std::size_t i = 0; i < L_.closures.size(); ++i)
     if (!L_.closures[i].isTop) line(fmt::format("closures[{}].coatInterface = coatInterface;", i));
 }
