@@ -23,8 +23,7 @@
 
 // SUBSTRATE_NOV_BIAS, SUBSTRATE_SSS_WRAP_MFP_SCALE, SUBSTRATE_GLINT_*: substrate_constants.h.
 
-// Smallest GGX alpha (Kulla-Conty clamp; scripts/gen_energy_lut.py uses the same).
-SUBSTRATE_CONST float SUBSTRATE_MIN_ALPHA = 1e-3;
+// SUBSTRATE_MIN_ALPHA, the smallest GGX alpha: substrate_closure.h.
 // Smallest Charlie sheen alpha (the table generator uses the same).
 SUBSTRATE_CONST float SUBSTRATE_FUZZ_MIN_ALPHA = 1e-3;
 
@@ -155,20 +154,7 @@ float substrate_fuzz_pair_margin(float roughness) {
 #endif
 }
 
-// The share of the way from G_k to 1 that a rough top moves the mean of the
-// layers' interface term (substrate_coat_transmission, issue 19 step 9):
-// h(f) = sat(f (0.2533 + f (-1.2067 + 1.9925 f))), f = c.coatFloor. The
-// cosine-weighted mean of the term to the power 1 + k is at most G_k + (1 -
-// G_k) h(f) for k = 0..3 (h is fitted above the largest of the four shares,
-// within 0.017 of it; scripts/fit_coat_transmission.py), so the diffuse's
-// normalization never gains energy; h(0) = 0: a smooth top keeps G_k.
-float substrate_coat_mean_share(float coatFloor) {
-#if SUBSTRATE_USE_COAT_FLOOR
-  return saturate(coatFloor * (SUBSTRATE_COAT_MEAN_A + coatFloor * (SUBSTRATE_COAT_MEAN_B + SUBSTRATE_COAT_MEAN_C * coatFloor)));
-#else
-  return 0.0;
-#endif
-}
+// substrate_coat_mean_share, h(f): substrate_closure.h (set per pixel in SubstrateClosure.coatShare).
 
 // What the diffuse of a closure under layers gets back from them, per
 // channel: 1 / lerp(1, D, coverageAbove), with
@@ -234,7 +220,12 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
     ifc *= SUBSTRATE_COAT_T_2;
   }
 #endif
-  float g = (gk + (1.0 - gk) * substrate_coat_mean_share(c.coatFloor)) * lobe;
+#if SUBSTRATE_USE_COAT_FLOOR
+  float share = c.coatShare;  // 0 under a smooth top
+#else
+  float share = 0.0;  // the floor is 0
+#endif
+  float g = (gk + (1.0 - gk) * share) * lobe;
   float3 tn = saturate(c.topTransmittance);
   float3 ti = max(tn, SUBSTRATE_SPLAT3(ifc));
   float3 tm = saturate(tn / ifc);  // ifc >= 0.82 * 0.96^3
@@ -249,14 +240,7 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
 // ---------------------------------------------------------------------------
 // GGX.
 
-// (ax, ay) from perceptual roughness r and anisotropy A (Kulla & Conty 2017):
-// a = r^2, ax = a (1 + A), ay = a (1 - A), each clamped to [1e-3, 1].
-float2 substrate_ggx_alpha(float roughness, float anisotropy) {
-  float r = saturate(roughness);
-  float a = r * r;
-  float A = clamp(anisotropy, -1.0, 1.0);
-  return clamp(float2(a * (1.0 + A), a * (1.0 - A)), SUBSTRATE_SPLAT2(SUBSTRATE_MIN_ALPHA), SUBSTRATE_SPLAT2(1.0));
-}
+// substrate_ggx_alpha, (ax, ay) from roughness and anisotropy: substrate_closure.h.
 
 // Isotropic GGX NDF: a^2 / (pi ((a^2 - 1) NoH^2 + 1)^2). With NoH in [0, 1]
 // the bracket is >= a^2, so D <= 1 / (pi a^2).
@@ -366,6 +350,30 @@ float substrate_coat_transmission(float mu, float coatFloor) {
 #endif
 }
 
+// The floor of the layers' top along the unit direction w at cosine mu
+// (issue 19, step 19): c.coatFloor, but under one stretched top
+// (c.coatStretch) substrate_coat_floor_projected at w's azimuth about the
+// top's tangent, cos^2 phi = sat((T.w)^2 / (1 - mu^2)). No branch: one of the
+// two is 0 (a stretched top has no coatFloor; any other leaves coatStretch 0).
+// Compiled only with SUBSTRATE_USE_COAT_ANISO.
+float substrate_coat_floor_along(SubstrateClosure c, float mu, float3 w) {
+#if SUBSTRATE_USE_COAT_FLOOR && SUBSTRATE_USE_COAT_ANISO
+  float tw = dot(c.coatTangent, w);
+  float c2 = saturate(tw * tw / max(1.0 - mu * mu, 1e-8));
+  return max(c.coatFloor, substrate_coat_floor_projected(c.coatStretch, c2));
+#else
+  return c.coatFloor;
+#endif
+}
+
+// For light with no one direction (the split sum's diffuse, at cosine mu): a
+// direction at the azimuths' mean about the layers' stretched top, cos^2 phi
+// = 0.5. substrate_coat_floor_along reads only T.w of it, so T sqrt((1 -
+// mu^2) / 2) stands for it (a constant factor at a constant mu).
+float3 substrate_coat_mean_direction(SubstrateClosure c, float mu) {
+  return c.coatTangent * sqrt(0.5 * (1.0 - mu * mu));
+}
+
 // The angular part of the 1 + `extra` interfaces above a closure (extra =
 // SubstrateClosure.extraInterfaces, 0..3): the interface term to the power
 // 1 + extra, by multiplies. A stack of clear coats lets through no more than
@@ -411,13 +419,13 @@ float substrate_coat_path_length(float mu) {
 // transcendental when nothing covers the closure (top layers). The remap
 // (exp, log) and the interface term (1 - chi(mu) cancels at grazing) are
 // float; the throughput, in [0, 1], is mfloat.
-mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu) {
+mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu, float3 w) {
 #if SUBSTRATE_USE_LAYERS
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
     float3 t = clamp(c.topTransmittance, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE), SUBSTRATE_SPLAT3(1.0));
     float3 through = exp(log(t) * substrate_coat_path_length(mu)) *
-                     substrate_interfaces_transmission(mu, c.extraInterfaces, c.coatFloor);
+                     substrate_interfaces_transmission(mu, c.extraInterfaces, substrate_coat_floor_along(c, mu, w));
     return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
   }
 #endif
@@ -1005,11 +1013,11 @@ float substrate_wrap_light_cosine(SubstrateClosure c, float NoL) {
 // wrap lobe's cosine (at most 1, per channel; 1 for any other closure): the
 // lighting applies the latter to the whole closure, and the lobes on its
 // interface (specular, fuzz) meet the layers at NoL. Float.
-float3 substrate_wrap_light_ratio(SubstrateClosure c, bool isWrap, float NoLc, float NoL) {
+float3 substrate_wrap_light_ratio(SubstrateClosure c, bool isWrap, float NoLc, float NoL, float3 L) {
 #if SUBSTRATE_USE_SSS && SUBSTRATE_USE_LAYERS && SUBSTRATE_USE_WRAP_UNDER_LAYERS
   if (isWrap) {
-    float3 at = SUBSTRATE_F3(substrate_closure_above_throughput(c, NoLc));
-    float3 wrapped = SUBSTRATE_F3(substrate_closure_above_throughput(c, substrate_wrap_light_cosine(c, NoL)));
+    float3 at = SUBSTRATE_F3(substrate_closure_above_throughput(c, NoLc, L));
+    float3 wrapped = SUBSTRATE_F3(substrate_closure_above_throughput(c, substrate_wrap_light_cosine(c, NoL), L));
     return min(at / max(wrapped, SUBSTRATE_SPLAT3(1e-4)), SUBSTRATE_SPLAT3(1.0));
   }
 #endif
@@ -1416,7 +1424,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   }
   // A wrap lobe's light crosses the layers above at its own cosine
   // (substrate_wrap_light_cosine); the lobes on its interface at NoL.
-  float3 lightRatio = substrate_wrap_light_ratio(c, isWrap, NoLc, NoL);
+  float3 lightRatio = substrate_wrap_light_ratio(c, isWrap, NoLc, NoL, L);
   spec *= lightRatio;
 
   // Diffuse, below the specular interface: what the interface lets in along

@@ -45,6 +45,12 @@ struct SubstrateClosure {
   float coatInterface;        // what the layers' top interface lets through head-on, 1 - its F0
                               // (substrate_coat_interface of the one closure on top; not stored per
                               // closure); 0.96, IOR 1.5's, under a mix of tops
+  float2 coatStretch;         // the one stretched closure on top's squared GGX alphas as (ay^2, ax^2 - ay^2)
+                              // (substrate_coat_stretch): its floor follows a direction's azimuth
+                              // (substrate_coat_floor_along); 0 else
+  float3 coatTangent;         // that top's tangent
+  float coatShare;            // substrate_coat_mean_share of the floor (its mean over the azimuths under
+                              // a stretched top), per pixel like coatFloor; 0 under a smooth top
   uint features;              // SUBSTRATE_FEATURE_* bits
   bool isTop;                 // nothing layered above
 };
@@ -116,6 +122,13 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_COAT_FLOOR
 #define SUBSTRATE_USE_COAT_FLOOR 1
 #endif
+// 1: some closure may lie under one stretched top (SubstrateClosure.coatStretch,
+// issue 19 step 19), whose floor follows a direction's azimuth about the
+// top's tangent (substrate_coat_floor_along): the compiler clears it when the
+// material has no anisotropic closure on top of others.
+#ifndef SUBSTRATE_USE_COAT_ANISO
+#define SUBSTRATE_USE_COAT_ANISO 1
+#endif
 // 1: some closure under a layer may have a wrap lobe, whose light crosses the
 // layers at its own cosine (substrate_wrap_light_cosine), or a fuzz, seen at
 // the angles refracted into them (substrate_fuzz_under_layers): the compiler
@@ -176,6 +189,9 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.extraInterfaces = 0u;
   c.coatFloor = 0.0;
   c.coatInterface = SUBSTRATE_COAT_T_0;
+  c.coatStretch = SUBSTRATE_SPLAT2(0.0);
+  c.coatTangent = float3(1.0, 0.0, 0.0);
+  c.coatShare = 0.0;
   c.features = 0u;
   c.isTop = true;
 }
@@ -195,6 +211,63 @@ void substrate_closure_init(out SubstrateClosure c) {
 float substrate_coat_floor(float topRoughness) {
   float x = max(topRoughness - SUBSTRATE_COAT_ROUGH_START, 0.0);
   return SUBSTRATE_COAT_ROUGH_SCALE * x / (x + SUBSTRATE_COAT_ROUGH_HALF);
+}
+
+// The share of the way from G_k to 1 that a rough top moves the mean of the
+// layers' interface term (substrate_coat_transmission, issue 19 step 9):
+// h(f) = sat(f (0.2533 + f (-1.2067 + 1.9925 f))), f the floor. The
+// cosine-weighted mean of the term to the power 1 + k is at most G_k + (1 -
+// G_k) h(f) for k = 0..3 (h is fitted above the largest of the four shares,
+// within 0.017 of it; scripts/fit_coat_transmission.py), so the diffuse's
+// normalization (substrate_closure_coat_diffuse) never gains energy; h(0) =
+// 0: a smooth top keeps G_k. Set per pixel in SubstrateClosure.coatShare.
+float substrate_coat_mean_share(float coatFloor) {
+  return saturate(coatFloor * (SUBSTRATE_COAT_MEAN_A + coatFloor * (SUBSTRATE_COAT_MEAN_B + SUBSTRATE_COAT_MEAN_C * coatFloor)));
+}
+
+// Smallest GGX alpha (Kulla-Conty clamp; scripts/gen_energy_lut.py uses the same).
+SUBSTRATE_CONST float SUBSTRATE_MIN_ALPHA = 1e-3;
+
+// (ax, ay) from perceptual roughness r and anisotropy A (Kulla & Conty 2017):
+// a = r^2, ax = a (1 + A), ay = a (1 - A), each clamped to [1e-3, 1].
+float2 substrate_ggx_alpha(float roughness, float anisotropy) {
+  float r = saturate(roughness);
+  float a = r * r;
+  float A = clamp(anisotropy, -1.0, 1.0);
+  return clamp(float2(a * (1.0 + A), a * (1.0 - A)), SUBSTRATE_SPLAT2(SUBSTRATE_MIN_ALPHA), SUBSTRATE_SPLAT2(1.0));
+}
+
+// SubstrateClosure.coatStretch of a stretched top of roughness r and
+// anisotropy A: its squared GGX alphas (substrate_ggx_alpha) as (ay^2, ax^2 -
+// ay^2), so that the projected one at any azimuth is one multiply-add away.
+float2 substrate_coat_stretch(float roughness, float anisotropy) {
+  float2 a = substrate_ggx_alpha(roughness, anisotropy);
+  return float2(a.y * a.y, a.x * a.x - a.y * a.y);
+}
+
+// The floor under a stretched top (coatStretch s) along a direction whose
+// azimuth phi about the top's tangent has cos^2 phi = c2 in [0, 1] (issue 19,
+// step 19): substrate_coat_floor of the roughness the lobe projects on that
+// azimuth, r_o = (ax^2 c2 + ay^2 (1 - c2))^(1/4) = (s.x + s.y c2)^(1/4) (the
+// projected alpha of an anisotropic GGX, Heitz 2014, under which its masking
+// is an isotropic lobe's). A stretched top is rough along one azimuth and
+// smooth along the other: read as smooth everywhere (a floor of 0, before
+// step 19), a white base under glTF CoatParameterSweep's coat of anisotropy 1
+// returned 0.47 of a white furnace at NoV 0.1 (-53 % against the truth).
+// 0 for s = 0 (no stretched top).
+float substrate_coat_floor_projected(float2 stretch, float c2) {
+  return substrate_coat_floor(sqrt(sqrt(stretch.x + stretch.y * c2)));
+}
+
+// SubstrateClosure.coatShare under a stretched top: h of the projected floor
+// (substrate_coat_floor_projected) averaged over the azimuths, by Gauss-Chebyshev
+// in cos 2phi at two nodes (c2 = (1 -+ cos(pi/4)) / 2): a bound of the term's
+// mean as h is of each azimuth's (their mean is the term's), within the fit's
+// margin (Furnace.AWhiteBaseUnderAStretchedClearCoatIsLitThroughItsRoughAxis).
+float substrate_coat_aniso_share(float2 stretch) {
+  return (substrate_coat_mean_share(substrate_coat_floor_projected(stretch, SUBSTRATE_COAT_AZIMUTH_C2_0)) +
+          substrate_coat_mean_share(substrate_coat_floor_projected(stretch, SUBSTRATE_COAT_AZIMUTH_C2_1))) *
+         0.5;
 }
 
 // What the layers' top interface lets through head-on, for the closures under

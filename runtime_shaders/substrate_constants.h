@@ -128,6 +128,10 @@
 #define SUBSTRATE_COAT_MEAN_A 0.2533
 #define SUBSTRATE_COAT_MEAN_B -1.2067
 #define SUBSTRATE_COAT_MEAN_C 1.9925
+// substrate_coat_aniso_share (issue 19, step 19): the nodes of the two-node
+// Gauss-Chebyshev rule in cos 2phi, as cos^2 phi = (1 -+ cos(pi/4)) / 2.
+#define SUBSTRATE_COAT_AZIMUTH_C2_0 0.1464466094
+#define SUBSTRATE_COAT_AZIMUTH_C2_1 0.8535533906
 #define SUBSTRATE_COAT_G_0 0.94642
 #define SUBSTRATE_COAT_G_1 0.90734
 #define SUBSTRATE_COAT_G_2 0.87632

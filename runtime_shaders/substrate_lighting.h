@@ -15,16 +15,18 @@ bool substrate_closure_visible(SubstrateClosure c) {
   return c.weight > 0.0;
 }
 
-// Along the view: c.weight * substrate_closure_above_throughput(c, NoV) (the
-// weight clamped to half's range in half precision).
-mfloat3 substrate_closure_view_throughput(SubstrateClosure c, float NoV) {
-  return SUBSTRATE_M_CLAMPED(max(c.weight, 0.0)) * substrate_closure_above_throughput(c, NoV);
+// Along the view: c.weight * substrate_closure_above_throughput(c, NoV, V) (the
+// weight clamped to half's range in half precision). V: the view direction
+// (its azimuth about a stretched top matters, substrate_coat_floor_along).
+mfloat3 substrate_closure_view_throughput(SubstrateClosure c, float NoV, float3 V) {
+  return SUBSTRATE_M_CLAMPED(max(c.weight, 0.0)) * substrate_closure_above_throughput(c, NoV, V);
 }
 
-// Along the light: substrate_closure_above_throughput(c, NoL). The closure's
-// weight is counted once, in the view throughput.
-mfloat3 substrate_closure_light_throughput(SubstrateClosure c, float NoL) {
-  return substrate_closure_above_throughput(c, NoL);
+// Along the light: substrate_closure_above_throughput(c, NoL, L). The closure's
+// weight is counted once, in the view throughput. L: the unit light direction
+// (substrate_coat_mean_direction for light with no one direction).
+mfloat3 substrate_closure_light_throughput(SubstrateClosure c, float NoL, float3 L) {
+  return substrate_closure_above_throughput(c, NoL, L);
 }
 
 // One closure lit by one light of radiance `radiance` (the light's radiance
@@ -39,8 +41,8 @@ float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 ra
   float3 N = substrate_closure_normal(c);
   float3 f = substrate_eval_closure(c, V, L);
   // A wrap lobe's light crosses the layers above at its own cosine (substrate_wrap_light_cosine).
-  mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V)) *
-                       substrate_closure_light_throughput(c, substrate_wrap_light_cosine(c, dot(N, L)));
+  mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V), V) *
+                       substrate_closure_light_throughput(c, substrate_wrap_light_cosine(c, dot(N, L)), L);
   return SUBSTRATE_F3(throughput) * f * radiance;
 }
 
@@ -208,8 +210,11 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
     diffuse *= (SUBSTRATE_SPLAT3(1.0) + s2 * SUBSTRATE_MEDIUM_MEAN_COS) / (SUBSTRATE_SPLAT3(1.0) + s2 * (p + (1.0 - p) * NoV));
   }
 #endif
-  mfloat3 specLight = substrate_closure_light_throughput(c, NoV);
-  mfloat3 diffuseLight = substrate_closure_light_throughput(c, SUBSTRATE_DIFFUSE_MEAN_COS);
+  // The mirror direction's azimuth is the view's (cos^2 alike); the diffuse's light has
+  // none: the azimuths' mean (substrate_coat_mean_direction).
+  mfloat3 specLight = substrate_closure_light_throughput(c, NoV, V);
+  mfloat3 diffuseLight = substrate_closure_light_throughput(
+      c, SUBSTRATE_DIFFUSE_MEAN_COS, substrate_coat_mean_direction(c, SUBSTRATE_DIFFUSE_MEAN_COS));
   float3 result = spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight);
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
@@ -237,18 +242,18 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 
 // coverage:      saturate(c.weight), the share of the pixel this closure covers;
 // transmittance: what the covered part lets through from behind, per channel:
-//                substrate_closure_above_throughput(c, NoV) (the layers above, along V)
+//                substrate_closure_above_throughput(c, NoV, V) (the layers above, along V)
 //                * (1 - E_spec(NoV)) (reflected by the interface)
 //                * (1 - fuzzAmount min(E_fuzz, 1)) (caught by the fuzz).
 // The caller blends dst = colour + dst * ((1 - coverage) + coverage * transmittance)
 // (dual-source: src1 = that factor) and multiplies `transmittance` by the
 // slab's own medium, substrate_transmittance(mfp, thickness / max(NoV, 1e-4)),
 // which the closure does not carry.
-void substrate_translucency(SubstrateClosure c, float NoV, out float coverage, out float3 transmittance) {
+void substrate_translucency(SubstrateClosure c, float NoV, float3 V, out float coverage, out float3 transmittance) {
   coverage = saturate(c.weight);
   float mu = clamp(NoV, SUBSTRATE_MIN_COS, 1.0);
   mfloat3 specAlbedo = substrate_closure_specular_albedo(c, mu);
-  transmittance = SUBSTRATE_F3(substrate_closure_above_throughput(c, mu) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
+  transmittance = SUBSTRATE_F3(substrate_closure_above_throughput(c, mu, V) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {
     transmittance *= 1.0 - saturate(c.fuzzAmount) * min(substrate_fuzz_albedo(substrate_fuzz_cosine(c, mu), c.fuzzRoughness), 1.0);

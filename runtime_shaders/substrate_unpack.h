@@ -137,6 +137,8 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
   bool topShare = true;
   uint tops = 0u;
   bool topPlainLobe = true;  // the top closure's lobe is one isotropic GGX lobe
+  bool topStretched = false;  // one anisotropic GGX lobe (no haze)
+  uint topIndex = 0u;
   float coatInterface = SUBSTRATE_COAT_T_0;  // the top closure's substrate_coat_interface
   for (int i = 0; i < SUBSTRATE_MAX_CLOSURES; ++i) {
     closureBasis[i] = 0u;
@@ -163,6 +165,8 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       if (isTop) {
         tops += 1u;
         topPlainLobe = (feats & (SUBSTRATE_FEATURE_ANISOTROPY | SUBSTRATE_FEATURE_HAZE)) == 0u;
+        topStretched = (feats & (SUBSTRATE_FEATURE_ANISOTROPY | SUBSTRATE_FEATURE_HAZE)) == SUBSTRATE_FEATURE_ANISOTROPY;
+        topIndex = uint(i);
       }
       if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
         basisAniso[basis] = true;
@@ -178,8 +182,10 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
   float topRoughness;
   substrate_dq_top_layer(topLayer, topN, topRoughness);
   // The top-layer roughness is the top's own when one closure is on top; a
-  // closure under that one interface alone reads its floor (substrate_coat_floor).
+  // closure under that one interface alone reads its floor (substrate_coat_floor),
+  // and the mean share of it (substrate_coat_mean_share).
   float coatFloor = tops == 1u && topPlainLobe ? substrate_coat_floor(topRoughness) : 0.0;
+  float coatShare = substrate_coat_mean_share(coatFloor);
   float3 basisN[SUBSTRATE_MAX_BASES];
   float3 basisT[SUBSTRATE_MAX_BASES];
   for (int b = 0; b < SUBSTRATE_MAX_BASES; ++b) {
@@ -207,8 +213,34 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       closures[j].T = basisT[closureBasis[j]];
       closures[j].coatFloor = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatFloor;
       closures[j].coatInterface = !closures[j].isTop && tops == 1u ? coatInterface : SUBSTRATE_COAT_T_0;
+      closures[j].coatShare = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatShare;
     }
   }
+#if SUBSTRATE_USE_COAT_FLOOR && SUBSTRATE_USE_COAT_ANISO
+  // One stretched top: its floor follows a direction's azimuth (substrate_coat_floor_along),
+  // from its own unpacked roughness, anisotropy and tangent.
+  if (tops == 1u && topStretched) {
+    float topR = closures[0].roughness;
+    float topA = closures[0].anisotropy;
+    float3 topT = closures[0].T;
+    for (int k = 1; k < SUBSTRATE_MAX_CLOSURES; ++k) {
+      if (uint(k) == topIndex) {
+        topR = closures[k].roughness;
+        topA = closures[k].anisotropy;
+        topT = closures[k].T;
+      }
+    }
+    float2 stretch = substrate_coat_stretch(topR, topA);
+    float share = substrate_coat_aniso_share(stretch);
+    for (int j = 0; j < SUBSTRATE_MAX_CLOSURES; ++j) {
+      if (uint(j) < count && !closures[j].isTop && closures[j].extraInterfaces == 0u) {
+        closures[j].coatStretch = stretch;
+        closures[j].coatTangent = topT;
+        closures[j].coatShare = share;
+      }
+    }
+  }
+#endif
   return count;
 }
 

@@ -195,7 +195,7 @@ inline double furnace(std::vector<reference::Closure<double>> closures, const re
     c.features &= ~reference::kFeatureGlint;
     c.glintValue = 1;
     const double NoV = c.N[0] * V[0] + c.N[1] * V[1] + c.N[2] * V[2];
-    const auto t = reference::viewThroughput<double>(c, NoV);
+    const auto t = reference::viewThroughput<double>(c, NoV, V);
     const auto e = reference::envIntegrated(
         c, V, [](const reference::V3<double>&) { return reference::V3<double>{1, 1, 1}; },
         reference::kDiffuseLambert, kSamples, seed);

@@ -17,6 +17,7 @@
 #define SUBSTRATE_USE_LAYERS 1
 #define SUBSTRATE_USE_COAT_CONDUCTOR 1
 #define SUBSTRATE_USE_COAT_FLOOR 1
+#define SUBSTRATE_USE_COAT_ANISO 0
 #define SUBSTRATE_USE_WRAP_UNDER_LAYERS 0
 #define SUBSTRATE_USE_FUZZ_UNDER_LAYERS 0
 #define SUBSTRATE_USE_METALNESS_MIX 0
@@ -79,7 +80,9 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   closures[1].isTop = false;
   closures[1].features = 2u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
+  float coatShare = substrate_coat_mean_share(coatFloor);
   closures[1].coatFloor = coatFloor;
+  closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
 

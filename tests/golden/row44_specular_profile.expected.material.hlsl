@@ -17,6 +17,7 @@
 #define SUBSTRATE_USE_LAYERS 1
 #define SUBSTRATE_USE_COAT_CONDUCTOR 1
 #define SUBSTRATE_USE_COAT_FLOOR 1
+#define SUBSTRATE_USE_COAT_ANISO 0
 #define SUBSTRATE_USE_WRAP_UNDER_LAYERS 1
 #define SUBSTRATE_USE_FUZZ_UNDER_LAYERS 1
 #define SUBSTRATE_USE_METALNESS_MIX 0
@@ -93,7 +94,9 @@ void row44_specular_profile_evaluate(SubstrateGeometry g, out SubstrateClosure c
   closures[1].isTop = false;
   closures[1].features = 47u;
   float coatFloor = substrate_coat_floor(saturate(closures[0].roughness));  // of the top-layer roughness
+  float coatShare = substrate_coat_mean_share(coatFloor);
   closures[1].coatFloor = coatFloor;
+  closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
 

@@ -63,7 +63,7 @@ void lightInto(Shaded<T>& out, const std::vector<reference::Closure<T>>& closure
   for (const auto& c : closures) {
     add(out.direct, reference::lightClosure<T>(c, V, L, radiance, diffuseModel));
     T NoV = c.N[0] * V[0] + c.N[1] * V[1] + c.N[2] * V[2];
-    auto viewT = reference::viewThroughput<T>(c, NoV);
+    auto viewT = reference::viewThroughput<T>(c, NoV, V);
     add(out.environment, mul(viewT, reference::envSplitSum<T>(c, V, pre, irr, diffuseModel)));
     add(out.emissive, mul(viewT, c.emissive));
   }
@@ -105,6 +105,9 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.extraInterfaces = c.extraInterfaces;
   o.coatFloor = static_cast<T>(c.coatFloor);
   o.coatInterface = static_cast<T>(c.coatInterface);
+  o.coatStretch = arrayOf<T>(c.coatStretch);
+  o.coatTangent = arrayOf<T>(c.coatTangent);
+  o.coatShare = static_cast<T>(c.coatShare);
   o.features = c.features;
   o.isTop = c.isTop;
   o.metalnessMix = c.metalnessMix;
@@ -216,6 +219,9 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.extraInterfaces = static_cast<uint32_t>(p[kClosureExtraInterfaces]);
   c.coatFloor = p[kClosureCoatFloor];
   c.coatInterface = p[kClosureCoatInterface];
+  c.coatStretch = {p[kClosureCoatStretch], p[kClosureCoatStretch + 1]};
+  c.coatTangent = v3(kClosureCoatTangent);
+  c.coatShare = p[kClosureCoatShare];
   c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }

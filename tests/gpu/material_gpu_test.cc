@@ -252,6 +252,10 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
         check("extraInterfaces", at + kClosureExtraInterfaces, c64.extraInterfaces, c64.extraInterfaces);
         check("coatFloor", at + kClosureCoatFloor, c64.coatFloor, c32.coatFloor);
         check("coatInterface", at + kClosureCoatInterface, c64.coatInterface, c32.coatInterface);
+        for (int c = 0; c < 2; ++c)
+          check("coatStretch", at + kClosureCoatStretch + c, c64.coatStretch[c], c32.coatStretch[c]);
+        field3("coatTangent", kClosureCoatTangent, c64.coatTangent, c32.coatTangent);
+        check("coatShare", at + kClosureCoatShare, c64.coatShare, c32.coatShare);
       }
       check("coverage", kResultCoverage, ref.material.coverage, r32.material.coverage);
       for (int c = 0; c < 3; ++c) {

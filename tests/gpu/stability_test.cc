@@ -339,7 +339,7 @@ double materialAlbedo(const CompileResult& r, double mu) {
   double sum = 0;
   for (const auto& c : m.closures) {
     const double NoV = c.N[0] * g.V[0] + c.N[1] * g.V[1] + c.N[2] * g.V[2];
-    const auto t = reference::viewThroughput<double>(c, NoV);
+    const auto t = reference::viewThroughput<double>(c, NoV, reference::V3<double>{g.V[0], g.V[1], g.V[2]});
     const auto e = reference::envIntegrated(
         c, g.V, [](const reference::V3<double>&) { return reference::V3<double>{1, 1, 1}; },
         reference::kDiffuseLambert, 4096, 3);

@@ -489,6 +489,41 @@ TEST(Accuracy, ARoughClearCoatLetsTheGrazingLightThrough) {
   EXPECT_EQ(rows, 6);
 }
 
+TEST(Accuracy, AStretchedClearCoatLetsTheGrazingLightThroughAlongItsRoughAxis) {
+  // Issue 19, step 19 (bench/materials/stretched_clear_coat_over_lambert.json):
+  // the rough clear coat above, stretched along its tangent (anisotropy 0.8),
+  // seen along that rough axis. A stretched top had no rough floor, so the
+  // layers' term was a smooth interface's at every azimuth: -1.3 / -3.5 /
+  // -28.4 / -49.7 % (NoV 1 / 0.6 / 0.2 / 0.1), a white furnace of 0.50 at NoV
+  // 0.1. With the floor of the roughness the lobe projects on the direction's
+  // azimuth (substrate_coat_floor_along): -1.4 / -3.1 / -6.7 / -7.3 %, furnace
+  // 0.93 .. 0.99: the isotropic coat's figures.
+  const CompileResult compiled = compileLayered(
+      R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.6, "anisotropy": 0.8, "sss_mfp": 1000})",
+      R"({"kind": "slab", "diffuse_albedo": 0.9, "f0": 0.04, "roughness": 0.5})", "0.0001");
+  ASSERT_GE(compiled.material.root, 0);
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  o.evalSamples = 256;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(compiled, o), accuracy::truthOf(compiled, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic && row.brdfMedianRelError);
+    EXPECT_LE(std::fabs(*row.relError), 0.08);
+    EXPECT_LE(*row.brdfMedianRelError, 0.10);
+    EXPECT_GT(row.reciprocityPairs, 0);
+    EXPECT_LE(row.reciprocityMaxRatio, 1.02);
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.92);
+      EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
 TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   // Issue 19, item 1: a coloured conductor of roughness 0.6 stretched to
   // |A| 0.8 (bench/materials/stretched_conductor.json) against the walk, whose

@@ -409,8 +409,9 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
     for (std::uint32_t k : {0u, 1u, 2u, 3u}) {
       Closure<double> c = base;
       c.extraInterfaces = k;
-      const auto a = viewThroughput<double>(c, mu), b = viewThroughput<double>(one, mu);
-      const auto l = lightThroughput<double>(c, mu), lb = lightThroughput<double>(one, mu);
+      const V3<double> w{std::sqrt(1 - mu * mu), 0, mu};
+      const auto a = viewThroughput<double>(c, mu, w), b = viewThroughput<double>(one, mu, w);
+      const auto l = lightThroughput<double>(c, mu, w), lb = lightThroughput<double>(one, mu, w);
       for (int ch = 0; ch < 3; ++ch) {
         EXPECT_NEAR(a[ch], b[ch] * std::pow(g, k), 1e-9) << "mu " << mu << ", k " << k;
         EXPECT_NEAR(l[ch], lb[ch] * std::pow(g, k), 1e-9) << "mu " << mu << ", k " << k;
@@ -559,8 +560,8 @@ TEST(ReferencePrecision, FloatAgreesWithDoubleOnBenignSamples) {
     double cov64;
     V3<float> tr32;
     V3<double> tr64;
-    translucency(c32, static_cast<float>(NoV), cov32, tr32);
-    translucency(c, NoV, cov64, tr64);
+    translucency(c32, static_cast<float>(NoV), V32, cov32, tr32);
+    translucency(c, NoV, V64, cov64, tr64);
     expectClose(tr32, tr64, 1e-4, 1e-9, "translucency");
     expectClose(reflectionDir(c32, V32), reflectionDir(c, V64), 1e-4, 1e-6, "reflectionDir");
   }
@@ -1160,13 +1161,13 @@ void expectFiniteLighting(const Closure<T>& c, const V3<T>& V, const V3<T>& L, c
   }
   const V3<T> N = closureNormal(c);
   T NoV = N[0] * V[0] + N[1] * V[1] + N[2] * V[2];
-  EXPECT_TRUE(finite(viewThroughput(c, NoV))) << what;
-  EXPECT_TRUE(finite(lightThroughput(c, N[0] * L[0] + N[1] * L[1] + N[2] * L[2]))) << what;
+  EXPECT_TRUE(finite(viewThroughput(c, NoV, V))) << what;
+  EXPECT_TRUE(finite(lightThroughput(c, N[0] * L[0] + N[1] * L[1] + N[2] * L[2], L))) << what;
   EXPECT_TRUE(finite(reflectionDir(c, V))) << what;
   EXPECT_TRUE(std::isfinite(envMip(c.roughness, T(8)))) << what;
   T cov;
   V3<T> tr;
-  translucency(c, NoV, cov, tr);
+  translucency(c, NoV, V, cov, tr);
   EXPECT_TRUE(std::isfinite(cov) && finite(tr)) << what;
 }
 
@@ -1335,7 +1336,7 @@ TEST(ReferenceExamples, EveryExampleEvaluatesToFiniteClosures) {
           }
           T cov;
           V3<T> tr;
-          translucency(c, T(0.5), cov, tr);
+          translucency(c, T(0.5), v3<T>(g.V), cov, tr);
           EXPECT_TRUE(std::isfinite(cov) && finite(tr));
         }
       };
@@ -1365,7 +1366,7 @@ TEST(ReferenceOperators, TheClearCoatExampleLetsThePaintShow) {
   EXPECT_FALSE(paint.isTop);
   EXPECT_NEAR(paint.coverageAbove, 1.0, 1e-12);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(paint.topTransmittance[c], 0.96, 1e-6);
-  const D3 view = viewThroughput<double>(paint, 1.0);
+  const D3 view = viewThroughput<double>(paint, 1.0, D3{0, 0, 1});
   for (int c = 0; c < 3; ++c) EXPECT_GT(view[c], 0.95);
   EXPECT_NE(paint.features & kFeatureGlint, 0u);
   const CompileResult opaque = compile(read("tests/warnings/001_opaque_clear_coat.json"));

@@ -43,13 +43,13 @@ void main() {
   vec3 color = substrate_light_closures(closures, count, V, normalize(inL), vec3(1.0));
   for (uint k = 0u; k < count; ++k) {
     vec3 R = substrate_reflection_dir(closures[k], V);
-    color += substrate_closure_view_throughput(closures[k], dot(closures[k].N, V)) *
+    color += substrate_closure_view_throughput(closures[k], dot(closures[k].N, V), V) *
              substrate_env_split_sum(closures[k], V, textureLod(envPrefiltered, R, substrate_env_mip(closures[k].roughness, 8.0)).rgb,
                                      textureLod(envIrradiance, closures[k].N, 0.0).rgb);
   }
   float coverage;
   vec3 transmittance;
-  substrate_translucency(closures[0], dot(closures[0].N, V), coverage, transmittance);
+  substrate_translucency(closures[0], dot(closures[0].N, V), V, coverage, transmittance);
   outColor = vec4(color * transmittance, coverage);
 }
 )";
@@ -75,14 +75,14 @@ float4 main([[vk::location(0)]] float3 inV : TEXCOORD0, [[vk::location(1)]] floa
   float3 color = substrate_light_closures(closures, count, V, normalize(inL), float3(1.0, 1.0, 1.0));
   for (uint k = 0u; k < count; ++k) {
     float3 R = substrate_reflection_dir(closures[k], V);
-    color += substrate_closure_view_throughput(closures[k], dot(closures[k].N, V)) *
+    color += substrate_closure_view_throughput(closures[k], dot(closures[k].N, V), V) *
              substrate_env_split_sum(closures[k], V,
                                      envPrefiltered.SampleLevel(envSampler, R, substrate_env_mip(closures[k].roughness, 8.0)).rgb,
                                      envIrradiance.SampleLevel(envSampler, closures[k].N, 0.0).rgb);
   }
   float coverage;
   float3 transmittance;
-  substrate_translucency(closures[0], dot(closures[0].N, V), coverage, transmittance);
+  substrate_translucency(closures[0], dot(closures[0].N, V), V, coverage, transmittance);
   return float4(color * transmittance, coverage);
 }
 )";

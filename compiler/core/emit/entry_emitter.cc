@@ -79,7 +79,7 @@ std::string forwardLighting(const Material& m, const StorageLayout& L) {
   const std::string in = test ? "    " : "  ";
   s += lightClosureCode(cl, "g.V", in);
   if (anyEmissive(m, L))
-    s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V)) * {1}.emissive;\n", in, cl);
+    s += fmt::format("{0}color += substrate_closure_view_throughput({1}, dot({1}.N, g.V), g.V) * {1}.emissive;\n", in, cl);
   if (test) s += "  }\n";
   return s;
 }

@@ -68,7 +68,11 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   put(kClosureExtraInterfaces, "float(" + c + ".extraInterfaces)");
   put(kClosureCoatFloor, c + ".coatFloor");
   put(kClosureCoatInterface, c + ".coatInterface");
-  for (int at = kClosureCoatInterface + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding
+  put(kClosureCoatStretch, c + ".coatStretch.x");
+  put(kClosureCoatStretch + 1, c + ".coatStretch.y");
+  put3(kClosureCoatTangent, "coatTangent");
+  put(kClosureCoatShare, c + ".coatShare");
+  for (int at = kClosureCoatShare + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 56)
   return s;
 }
 
@@ -142,7 +146,7 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   if (mode == KernelMode::Deferred) s += "    if (uint(k) >= count) continue;\n";
   s += "    if (!substrate_closure_visible(closures[k])) continue;  // dynamic culling: weight 0\n";
   s += "    direct += substrate_light_closure(closures[k], g.V, L, radiance);\n";
-  s += "    float3 viewT = substrate_closure_view_throughput(closures[k], dot(closures[k].N, g.V));\n";
+  s += "    float3 viewT = substrate_closure_view_throughput(closures[k], dot(closures[k].N, g.V), g.V);\n";
   s += "    environment += viewT * substrate_env_split_sum(closures[k], g.V, prefiltered, irradiance);\n";
   if (mode == KernelMode::Forward && anyEmissive(m, L)) s += "    emissive += viewT * closures[k].emissive;\n";
   s += "  }\n";
@@ -239,7 +243,7 @@ std::string previewLighting(const Material& m, const StorageLayout& L) {
     for (int l = 0; l < {1}; ++l) {{
       color += substrate_light_closure(closures[k], g.V, preview.lightDirection[l].xyz, preview.lightRadiance[l].rgb);
     }}
-    float3 viewT = substrate_closure_view_throughput(closures[k], dot(closures[k].N, g.V));
+    float3 viewT = substrate_closure_view_throughput(closures[k], dot(closures[k].N, g.V), g.V);
     float3 pre = SUBSTRATE_ENV_PREFILTERED(substrate_reflection_dir(closures[k], g.V),
                                            substrate_env_mip(substrate_env_roughness(closures[k]), preview.viewport.z));
     color += viewT * substrate_env_split_sum(closures[k], g.V, pre, SUBSTRATE_ENV_IRRADIANCE(closures[k].N));
@@ -316,7 +320,7 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
   for (int c = 0; c < {0}_CLOSURE_COUNT; ++c) {{
     if (!substrate_closure_visible(closures[c])) continue;  // dynamic culling: weight 0
     color += substrate_light_closure(closures[c], g.V, L, SUBSTRATE_SPLAT3(1.0));
-    color += substrate_closure_view_throughput(closures[c], dot(closures[c].N, g.V)) *
+    color += substrate_closure_view_throughput(closures[c], dot(closures[c].N, g.V), g.V) *
              substrate_env_split_sum(closures[c], g.V, SUBSTRATE_SPLAT3(0.5), SUBSTRATE_SPLAT3(1.5));
   }}
   results[i] = float4(color, coverage);

@@ -98,18 +98,30 @@ int oneTopClosure(const StorageLayout& layout) {
   return static_cast<int>(std::find_if(layout.closures.begin(), layout.closures.end(), isTop) - layout.closures.begin());
 }
 
-/// The closures that read the layers' rough top (SubstrateClosure.coatFloor):
-/// when one closure, one isotropic lobe, is on top, those under that one
+/// The one closure on top when it is one stretched GGX lobe (anisotropy, no
+/// haze), whose floor follows a direction's azimuth (SubstrateClosure.coatStretch); else -1.
+int stretchedTopClosure(const Material& m, const StorageLayout& layout) {
+  const int top = oneTopClosure(layout);
+  if (top < 0) return -1;
+  const std::uint16_t f = m.slabs[layout.closures[static_cast<std::size_t>(top)].slab].features;
+  return (f & (kFeatAnisotropy | kFeatHaze)) == kFeatAnisotropy ? top : -1;
+}
+
+/// The closures that read the layers' rough top (SubstrateClosure.coatFloor,
+/// or coatStretch under a stretched top): when one closure, one GGX lobe
+/// (isotropic or stretched, not hazy), is on top, those under that one
 /// interface (extraInterfaces 0); else none. None either when every closure is
-/// on top, or when the top's roughness is a constant up to
+/// on top, or when an isotropic top's roughness is a constant up to
 /// SUBSTRATE_COAT_ROUGH_START, whose floor is 0 (a clear coat of roughness 0.05).
 std::vector<std::size_t> coatFloorClosures(const Material& m, const StorageLayout& layout) {
   const int top = oneTopClosure(layout);
   if (top < 0) return {};  // no one roughness
   const Slab& slab = m.slabs[layout.closures[static_cast<std::size_t>(top)].slab];
-  if (slab.features & (kFeatAnisotropy | kFeatHaze)) return {};  // not one isotropic lobe
+  if (slab.features & kFeatHaze) return {};  // two lobes
   const ValueId r = slab.pin(SlabPin::Roughness);
-  if (r != kNoValue && m.values.isConst(r) && m.values.node(r).c[0] <= SUBSTRATE_COAT_ROUGH_START) return {};
+  if (!(slab.features & kFeatAnisotropy) && r != kNoValue && m.values.isConst(r) &&
+      m.values.node(r).c[0] <= SUBSTRATE_COAT_ROUGH_START)
+    return {};
   std::vector<std::size_t> out;
   for (std::size_t i = 0; i < layout.closures.size(); ++i)
     if (!layout.closures[i].isTop && layout.closures[i].extraInterfaces == 0) out.push_back(i);
@@ -120,8 +132,12 @@ std::vector<std::size_t> coatFloorClosures(const Material& m, const StorageLayou
 /// (coatFloorClosures); the others' floor is 0, for which the layers'
 /// interface term is the smooth one exactly, so a material with none compiles
 /// none of it.
+/// SUBSTRATE_USE_COAT_ANISO likewise: 1 when they lie under a stretched top
+/// (stretchedTopClosure), so that no other material compiles the azimuth's floor.
 std::string coatFloorDefine(const Material& m, const StorageLayout& layout) {
-  return fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n", coatFloorClosures(m, layout).empty() ? 0 : 1);
+  const bool any = !coatFloorClosures(m, layout).empty();
+  return fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n#define SUBSTRATE_USE_COAT_ANISO {}\n", any ? 1 : 0,
+                     any && stretchedTopClosure(m, layout) >= 0 ? 1 : 0);
 }
 
 bool translucentBlend(const Material& m) {
@@ -144,7 +160,7 @@ std::string backgroundThroughput(const Material& m) {
 std::string lightClosureCode(const std::string& c, const std::string& view, const std::string& indent) {
   return fmt::format(
       "{0}color += substrate_light_closure({1}, {2}, L, frame.lightRadiance.rgb);\n"
-      "{0}color += substrate_closure_view_throughput({1}, dot({1}.N, {2})) *\n"
+      "{0}color += substrate_closure_view_throughput({1}, dot({1}.N, {2}), {2}) *\n"
       "{0}         substrate_env_split_sum({1}, {2},\n"
       "{0}                                 SUBSTRATE_ENV_PREFILTERED(substrate_reflection_dir({1}, {2}),\n"
       "{0}                                                           substrate_env_mip(substrate_env_roughness({1}), "
@@ -655,17 +671,36 @@ void Emitter::emitClosures() {
   }
 }
 
-/// What the layers' top lets through at grazing angles (substrate_coat_floor of
-/// the pixel's top-layer roughness, as the deferred unpacker derives it from the
-/// top-layer word, so that the forward pass lights as the deferred one does),
-/// for every closure under one interface when one closure, one isotropic lobe,
-/// is on top; the others keep 0 (substrate_closure_init).
+/// What the layers' top lets through at grazing angles, for every closure
+/// under one interface when one closure, one GGX lobe, is on top (coatFloorClosures;
+/// the others keep 0, substrate_closure_init), as the deferred unpacker derives it:
+/// under an isotropic top, substrate_coat_floor of the pixel's top-layer
+/// roughness (the top-layer word's, so that the forward pass lights as the
+/// deferred one does) and its mean share; under a stretched top, its GGX
+/// alphas and tangent (the floor follows a direction's azimuth,
+/// substrate_coat_floor_along) and the azimuths' mean share.
 void Emitter::emitCoatFloor() {
   const std::vector<std::size_t> under = coatFloorClosures(m_, L_);
   if (under.empty()) return;
+  if (const int top = stretchedTopClosure(m_, L_); top >= 0) {
+    line(fmt::format("float2 coatStretch = substrate_coat_stretch(closures[{0}].roughness, closures[{0}].anisotropy);"
+                     "  // of the stretched top",
+                     top));
+    line("float coatShare = substrate_coat_aniso_share(coatStretch);");
+    for (std::size_t i : under) {
+      line(fmt::format("closures[{}].coatStretch = coatStretch;", i));
+      line(fmt::format("closures[{}].coatTangent = closures[{}].T;", i, top));
+      line(fmt::format("closures[{}].coatShare = coatShare;", i));
+    }
+    return;
+  }
   line(fmt::format("float coatFloor = substrate_coat_floor({});  // of the top-layer roughness",
                    topRoughnessExpr(L_, "closures")));
-  for (std::size_t i : under) line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
+  line("float coatShare = substrate_coat_mean_share(coatFloor);");
+  for (std::size_t i : under) {
+    line(fmt::format("closures[{}].coatFloor = coatFloor;", i));
+    line(fmt::format("closures[{}].coatShare = coatShare;", i));
+  }
 }
 
 /// What the layers' top interface lets through head-on (substrate_coat_interface

@@ -120,6 +120,32 @@ std::string tileClassificationFileName(const SceneShape& scene, const Syntax& sy
   return fmt::format("{}.classify_tiles{}", scene.name, syn.computeExtension);
 }
 
+namespace {
+
+/// The runtime's switches for one tile class's lighting: what the stream's
+/// headers cannot rule out stays compiled.
+std::string sceneUseDefines(const SceneLightingClass& k) {
+  std::string s;
+  s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
+  // Extra interfaces are in closure headers only: a lone closure is on top.
+  s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
+  s += fmt::format("#define SUBSTRATE_USE_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);  // so are layers
+  // Nor what F0 the closures under layers have.
+  s += fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", k.maxClosures > 1 ? 1 : 0);
+  s += fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n", k.maxClosures > 1 ? 1 : 0);  // nor what is on top
+  // A stretched top's floor only where some closure of the class is anisotropic.
+  s += fmt::format("#define SUBSTRATE_USE_COAT_ANISO {}\n", k.maxClosures > 1 && (k.features & kFeatAnisotropy) ? 1 : 0);
+  // Nor which closures under layers wrap or have a fuzz.
+  s += fmt::format("#define SUBSTRATE_USE_WRAP_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
+  s += fmt::format("#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
+  // The stream does not say which closures are metalness mixes: every
+  // conductor-like F0 is read as one (the runtime's default).
+  s += "#define SUBSTRATE_USE_METALNESS_MIX 1\n";
+  return s;
+}
+
+}  // namespace
+
 std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass& k, const Syntax& syn) {
   const bool simple = k.cls == LayoutClass::Simple;
   const bool one = k.maxClosures == 1;  // every pixel has a single-closure header
@@ -130,19 +156,7 @@ std::string emitSceneLighting(const SceneShape& scene, const SceneLightingClass&
       "// Stored features: {}; at most {} closure(s) and {} word(s) a pixel. Bindings: compiler/core/emit/scene_emitter.h.\n",
       scene.name, layoutClassName(k.cls), layoutClassName(k.cls), materialList(k.materials), featureNames(k.features),
       k.maxClosures, k.maxWords);
-  s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
-  // Extra interfaces are in closure headers only: a lone closure is on top.
-  s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
-  s += fmt::format("#define SUBSTRATE_USE_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);  // so are layers
-  // Nor what F0 the closures under layers have.
-  s += fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", k.maxClosures > 1 ? 1 : 0);
-  s += fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n", k.maxClosures > 1 ? 1 : 0);  // nor what is on top
-  // Nor which closures under layers wrap or have a fuzz.
-  s += fmt::format("#define SUBSTRATE_USE_WRAP_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
-  s += fmt::format("#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
-  // The stream does not say which closures are metalness mixes: every
-  // conductor-like F0 is read as one (the runtime's default).
-  s += "#define SUBSTRATE_USE_METALNESS_MIX 1\n";
+  s += sceneUseDefines(k);
   s += fmt::format("#define SUBSTRATE_DIFFUSE_MODEL {}\n", diffuseModelNumber(scene.diffuseModel));
   s += fmt::format("#define SUBSTRATE_MAX_CLOSURES {}\n", k.maxClosures);
   s += fmt::format("#define SUBSTRATE_MAX_WORDS {}\n", k.maxWords);

@@ -77,7 +77,7 @@ Rgb analyticAlbedo(const CompileResult& r, const reference::Geometry& g, const O
   Rgb sum{0, 0, 0};
   for (std::size_t i = 0; i < closures.size(); ++i) {
     const reference::Closure<double>& c = closures[i];
-    const Rgb t = reference::viewThroughput<double>(c, dot3(c.N, V));
+    const Rgb t = reference::viewThroughput<double>(c, dot3(c.N, V), V);
     const Rgb e = reference::envIntegrated(
         c, V, [](const Rgb&) { return Rgb{1, 1, 1}; }, o.diffuseModel, o.envSamples, seedOf(o.seed, salt * 64 + i));
     for (int k = 0; k < 3; ++k) sum[k] += t[k] * e[k];

@@ -69,7 +69,7 @@ std::vector<double> blendProbeRadiance(const CompileResult& r) {
       V3<double> ambient{0, 0, 0};
       for (const Closure<double>& c : m.closures) {
         const double NoV = c.N[0] * V[0] + c.N[1] * V[1] + c.N[2] * V[2];
-        const V3<double> vt = viewThroughput(c, NoV);
+        const V3<double> vt = viewThroughput(c, NoV, V);
         const V3<double> env = envSplitSum(c, V, {0.5, 0.5, 0.5}, {0.5 * std::numbers::pi, 0.5 * std::numbers::pi, 0.5 * std::numbers::pi}, kDiffuseModel);
         for (int k = 0; k < 3; ++k) ambient[k] += vt[k] * (env[k] + c.emissive[k]);
       }

@@ -549,17 +549,73 @@ T coatTopAlpha(T floor) {
   return f > T(0) ? r * r : T(0);
 }
 
+// substrate_coat_mean_share: sat(f (A + f (B + C f))).
+template <class T>
+T coatMeanShare(T coatFloor) {
+  return saturate(coatFloor *
+                  (T(SUBSTRATE_COAT_MEAN_A) + coatFloor * (T(SUBSTRATE_COAT_MEAN_B) + T(SUBSTRATE_COAT_MEAN_C) * coatFloor)));
+}
+
+// substrate_coat_stretch: (ay^2, ax^2 - ay^2) of ggxAlpha(r, A).
+template <class T>
+V2<T> coatStretch(T roughness, T anisotropy) {
+  const V2<T> a = ggxAlpha(roughness, anisotropy);
+  return {a[1] * a[1], a[0] * a[0] - a[1] * a[1]};
+}
+
+// substrate_coat_floor_projected: coatFloor((s.x + s.y c2)^(1/4)).
+template <class T>
+T coatFloorProjected(const V2<T>& stretch, T c2) {
+  return coatFloor(std::sqrt(std::sqrt(stretch[0] + stretch[1] * c2)));
+}
+
+// substrate_coat_aniso_share: the mean of coatMeanShare(coatFloorProjected) at
+// c2 = AZIMUTH_C2_0 and AZIMUTH_C2_1.
+template <class T>
+T coatAnisoShare(const V2<T>& stretch) {
+  return (coatMeanShare(coatFloorProjected(stretch, T(SUBSTRATE_COAT_AZIMUTH_C2_0))) +
+          coatMeanShare(coatFloorProjected(stretch, T(SUBSTRATE_COAT_AZIMUTH_C2_1)))) *
+         T(0.5);
+}
+
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
   int tops = 0;
-  bool plain = true;
+  const Closure<T>* top = nullptr;
   for (const Closure<T>& c : closures)
     if (c.isTop) {
       ++tops;
-      plain = (c.features & (kFeatureAnisotropy | kFeatureHaze)) == 0;
+      top = &c;
     }
-  const T f = tops == 1 && plain ? coatFloor(topR) : T(0);
-  for (Closure<T>& c : closures) c.coatFloor = !c.isTop && c.extraInterfaces == 0 ? f : T(0);
+  const bool one = tops == 1;
+  const bool haze = one && (top->features & kFeatureHaze);
+  const bool stretched = one && !haze && (top->features & kFeatureAnisotropy);
+  const T f = one && !haze && !stretched ? coatFloor(topR) : T(0);
+  const V2<T> stretch = stretched ? coatStretch(top->roughness, top->anisotropy) : V2<T>{T(0), T(0)};
+  const V3<T> tangent = stretched ? top->T_ : V3<T>{T(1), T(0), T(0)};
+  const T share = stretched ? coatAnisoShare(stretch) : coatMeanShare(f);
+  for (Closure<T>& c : closures) {
+    const bool under = !c.isTop && c.extraInterfaces == 0;
+    c.coatFloor = under ? f : T(0);
+    c.coatStretch = under ? stretch : V2<T>{T(0), T(0)};
+    c.coatTangent = under ? tangent : V3<T>{T(1), T(0), T(0)};
+    c.coatShare = under ? share : T(0);
+  }
+}
+
+// substrate_coat_floor_along: max(coatFloor, coatFloorProjected(coatStretch, c2)),
+// c2 = sat((T.w)^2 / max(1 - mu^2, 1e-8)), T = coatTangent, w a unit direction.
+template <class T>
+T coatFloorAlong(const Closure<T>& c, T mu, const V3<T>& w) {
+  const T tw = dot(c.coatTangent, w);
+  const T c2 = saturate(tw * tw / std::max(T(1) - mu * mu, T(1e-8)));
+  return std::max(c.coatFloor, coatFloorProjected(c.coatStretch, c2));
+}
+
+// substrate_coat_mean_direction: T sqrt((1 - mu^2) / 2), T = coatTangent.
+template <class T>
+V3<T> coatMeanDirection(const Closure<T>& c, T mu) {
+  return c.coatTangent * std::sqrt(T(0.5) * (T(1) - mu * mu));
 }
 
 // substrate_coat_interface: 1 - clamp(mean F0, 0, SUBSTRATE_COAT_TOP_F0_MAX).
@@ -578,13 +634,6 @@ void setCoatInterface(std::vector<Closure<T>>& closures) {
       ifc = coatInterface(c.f0);
     }
   for (Closure<T>& c : closures) c.coatInterface = !c.isTop && tops == 1 ? ifc : T(SUBSTRATE_COAT_T_0);
-}
-
-// substrate_coat_mean_share: sat(f (A + f (B + C f))).
-template <class T>
-T coatMeanShare(T coatFloor) {
-  return saturate(coatFloor *
-                  (T(SUBSTRATE_COAT_MEAN_A) + coatFloor * (T(SUBSTRATE_COAT_MEAN_B) + T(SUBSTRATE_COAT_MEAN_C) * coatFloor)));
 }
 
 // substrate_coat_transmission: max(1 - chi(mu), 1 - (1 - f) (1 - sat(mu))^2).
@@ -618,14 +667,14 @@ T coatPathLength(T mu) {
 // coatTransmission(mu, coatFloor)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
 // transcendental) when nothing covers the closure.
 template <class T>
-V3<T> aboveThroughput(const Closure<T>& c, T mu) {
+V3<T> aboveThroughput(const Closure<T>& c, T mu, const V3<T>& w) {
   T cover = saturate(c.coverageAbove);
   if (cover > T(0)) {
     const T path = coatPathLength(mu);
     V3<T> t;
     for (int k = 0; k < 3; ++k)
       t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
-    const T i = interfacesTransmission(mu, c.extraInterfaces, c.coatFloor);
+    const T i = interfacesTransmission(mu, c.extraInterfaces, coatFloorAlong(c, mu, w));
     return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
   }
   return splat3(T(1));
@@ -646,10 +695,10 @@ T wrapLightCosine(const Closure<T>& c, T NoL) {
 // through at NoL over what they let through at the wrap's cosine, at most 1
 // (the lighting applies the latter to the whole closure); 1 otherwise.
 template <class T>
-V3<T> wrapLightRatio(const Closure<T>& c, bool isWrap, T NoLc, T NoL) {
+V3<T> wrapLightRatio(const Closure<T>& c, bool isWrap, T NoLc, T NoL, const V3<T>& L) {
   if (!isWrap) return splat3(T(1));
-  const V3<T> at = aboveThroughput(c, NoLc);
-  const V3<T> wrapped = aboveThroughput(c, wrapLightCosine(c, NoL));
+  const V3<T> at = aboveThroughput(c, NoLc, L);
+  const V3<T> wrapped = aboveThroughput(c, wrapLightCosine(c, NoL), L);
   V3<T> r;
   for (int k = 0; k < 3; ++k) r[k] = std::min(at[k] / std::max(wrapped[k], T(1e-4)), T(1));
   return r;
@@ -758,7 +807,7 @@ V3<T> closureCompensatedF0(const Closure<T>& c, const V3<T>& f0, const V2<T>& fd
 }
 
 // 1 / lerp(1, D, cover), D = G_k(f) T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4),
-// G_k(f) = G_k + (1 - G_k) coatMeanShare(coatFloor),
+// G_k(f) = G_k + (1 - G_k) coatShare (setCoatFloor: coatMeanShare(coatFloor), or coatAnisoShare),
 // T_i = max(T_N, I), T_m = sat(T_N / I), I = coatInterface 0.96^k.
 // The first term raised by 1 + 0.0145 sat(mean F90 - mean F0) of the closure's
 // own (relative) interface: the covariance of its coupling with the layers' (the
@@ -786,7 +835,7 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
     lb = lobe(SUBSTRATE_COAT_LOBE_CHAN2024_3, SUBSTRATE_COAT_LOBE_EON_3);
     ifc = ifc * T(SUBSTRATE_COAT_T_2);
   }
-  T g = (gk + (T(1) - gk) * coatMeanShare(c.coatFloor)) * lb;
+  T g = (gk + (T(1) - gk) * c.coatShare) * lb;
   const T own = saturate(dot(f90 - f0, splat3(T(1) / T(3))));
   g = g * (T(1) + T(SUBSTRATE_COAT_COVARIANCE) * own);
   V3<T> r;
@@ -974,7 +1023,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   }
   // A wrap lobe's light crosses the layers above at its own cosine
   // (wrapLightCosine); the lobes on its interface at NoL.
-  const V3<T> lightRatio = wrapLightRatio(c, isWrap, NoLc, NoL);
+  const V3<T> lightRatio = wrapLightRatio(c, isWrap, NoLc, NoL, L);
   spec = spec * lightRatio;
 
   // Diffuse, below the specular interface.
@@ -1031,12 +1080,12 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
-  template V3<T> fuzzDiffusePairMean<T>(const Closure<T>&, T, const V3<T>&);                          \
-  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
+  template V3<T> fuzzDiffusePairMean<T>(const Closure<T>&, T, const V3<T>&);                           \
+  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                          \
   template V3<T> f90Effective<T>(const V3<T>&, const V3<T>&);                                          \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
-  template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
-  template V3<T> aboveThroughput<T>(const Closure<T>&, T);                                             \
+  template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T);\
+  template V3<T> aboveThroughput<T>(const Closure<T>&, T, const V3<T>&);                               \
   template T wrapLightCosine<T>(const Closure<T>&, T);                                                 \
   template T fuzzCosine<T>(const Closure<T>&, T);                                                      \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \
@@ -1049,24 +1098,30 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T fresnelWeight<T>(T);                                                                      \
   template T coatTransmission<T>(T, T);                                                                \
   template T coatFloor<T>(T);                                                                          \
+  template T coatMeanShare<T>(T);                                                                      \
+  template V2<T> coatStretch<T>(T, T);                                                                 \
+  template T coatFloorProjected<T>(const V2<T>&, T);                                                   \
+  template T coatAnisoShare<T>(const V2<T>&);                                                          \
+  template T coatFloorAlong<T>(const Closure<T>&, T, const V3<T>&);                                    \
+  template V3<T> coatMeanDirection<T>(const Closure<T>&, T);                                           \
   template T coatInterface<T>(const V3<T>&);                                                           \
-  template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                         \
-  template void setCoatInterface<T>(std::vector<Closure<T>>&);                                        \
+  template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                          \
+  template void setCoatInterface<T>(std::vector<Closure<T>>&);                                         \
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \
-  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
+  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                   \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);    \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
-  template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
-  template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \
-  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                \
-  template V3<T> closureCompensatedF0<T>(const Closure<T>&, const V3<T>&, const V2<T>&);              \
-  template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
-  template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
-  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
-  template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                   \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);\
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&);\
+  template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                                \
+  template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                  \
+  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);              \
+  template V3<T> closureCompensatedF0<T>(const Closure<T>&, const V3<T>&, const V2<T>&);               \
+  template V2<T> interfaceAlbedoFit<T>(T, T);                                                          \
+  template V2<T> interfaceAlbedoMeans<T>(T);                                                           \
+  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                          \
+  template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                    \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
   template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \
@@ -1076,9 +1131,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
   template T mixShare<T>(T);                                                                           \
-  template T mediumF0<T>(const Closure<T>&);                                                            \
+  template T mediumF0<T>(const Closure<T>&);                                                           \
   template V2<T> mediumInterface<T>(T, T);                                                             \
-  template T mediumShare<T>(const Closure<T>&);                                                         \
+  template T mediumShare<T>(const Closure<T>&);                                                        \
   template V3<T> mediumSlope2<T>(const V3<T>&, T, T, T);                                               \
   template V3<T> mediumWeight<T>(const V3<T>&, T, T, T);                                               \
   template V3<T> closureMedium<T>(const Closure<T>&, const V3<T>&, T, T&);                             \

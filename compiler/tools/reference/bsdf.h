@@ -25,7 +25,8 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
                           T NoL, T roughness);
 /// substrate_closure_above_throughput: what the layers above let through along a direction at cosine mu
 /// (their media along the refracted path, their interfaces), blended by coverageAbove; 1 on top.
-template <class T> V3<T> aboveThroughput(const Closure<T>& c, T mu);
+/// w: the unit direction (its azimuth about a stretched top: coatFloorAlong; coatMeanDirection for none).
+template <class T> V3<T> aboveThroughput(const Closure<T>& c, T mu, const V3<T>& w);
 /// substrate_wrap_light_cosine: the cosine a wrap lobe's light crosses the layers above at.
 template <class T> T wrapLightCosine(const Closure<T>& c, T NoL);
 /// substrate_fuzz_cosine: the cosine a fuzz under layers sees (refracted into them); mu on top.
@@ -45,6 +46,12 @@ template <class T> T fresnelDelta(T t);                                         
 template <class T> T fresnelWeight(T c);                                                    // substrate_fresnel_weight
 template <class T> T coatTransmission(T mu, T coatFloor);                                   // substrate_coat_transmission
 template <class T> T coatFloor(T topRoughness);                                             // substrate_coat_floor
+template <class T> T coatMeanShare(T coatFloor);                                            // substrate_coat_mean_share
+template <class T> V2<T> coatStretch(T roughness, T anisotropy);                            // substrate_coat_stretch
+template <class T> T coatFloorProjected(const V2<T>& stretch, T c2);                        // substrate_coat_floor_projected
+template <class T> T coatAnisoShare(const V2<T>& stretch);                                  // substrate_coat_aniso_share
+template <class T> T coatFloorAlong(const Closure<T>& c, T mu, const V3<T>& w);             // substrate_coat_floor_along
+template <class T> V3<T> coatMeanDirection(const Closure<T>& c, T mu);                      // substrate_coat_mean_direction
 template <class T> T coatInterface(const V3<T>& topF0);                                     // substrate_coat_interface
 template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share

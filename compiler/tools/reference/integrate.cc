@@ -207,7 +207,7 @@ V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
       const D3 L = fr.toWorld(l);
       const D3 f = evalClosure(c, V, L, diffuseModel);
       if (f[0] == 0 && f[1] == 0 && f[2] == 0) continue;
-      acc = acc + radiance(L) * lightThroughput(c, wrapLightCosine(c, dot(fr.n, L))) * f / pdfSum;
+      acc = acc + radiance(L) * lightThroughput(c, wrapLightCosine(c, dot(fr.n, L)), L) * f / pdfSum;
     }
     sum = sum + acc / static_cast<double>(samples);
   }

@@ -55,20 +55,20 @@ V3<T> specularAlbedo(const Closure<T>& c, T NoV, T& dielectric) {
 }  // namespace
 
 template <class T>
-V3<T> viewThroughput(const Closure<T>& c, T NoV) {
-  return aboveThroughput(c, NoV) * std::max(c.weight, T(0));  // max(weight, 0) * above
+V3<T> viewThroughput(const Closure<T>& c, T NoV, const V3<T>& V) {
+  return aboveThroughput(c, NoV, V) * std::max(c.weight, T(0));  // max(weight, 0) * above
 }
 
 template <class T>
-V3<T> lightThroughput(const Closure<T>& c, T NoL) {
-  return aboveThroughput(c, NoL);  // the weight counts once, on the view side
+V3<T> lightThroughput(const Closure<T>& c, T NoL, const V3<T>& L) {
+  return aboveThroughput(c, NoL, L);  // the weight counts once, on the view side
 }
 
 template <class T>
 V3<T> lightClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, const V3<T>& radiance, int diffuseModel) {
   V3<T> N = closureNormal(c);
   V3<T> f = evalClosure(c, V, L, diffuseModel);
-  V3<T> throughput = viewThroughput(c, dot(N, V)) * lightThroughput(c, wrapLightCosine(c, dot(N, L)));
+  V3<T> throughput = viewThroughput(c, dot(N, V), V) * lightThroughput(c, wrapLightCosine(c, dot(N, L)), L);
   return throughput * f * radiance;
 }
 
@@ -136,8 +136,9 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
     const V3<T> s2 = closureMedium(c, albedo, saturate(c.roughness), p);
     diff = diff * mediumWeight(s2, T(SUBSTRATE_MEDIUM_MEAN_COS), p, NoV);
   }
-  V3<T> specLight = lightThroughput(c, NoV);
-  V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>);
+  V3<T> specLight = lightThroughput(c, NoV, V);  // the mirror direction's azimuth is the view's
+  // no one direction: the azimuths' mean (coatMeanDirection)
+  V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>, coatMeanDirection(c, kDiffuseMeanCos<T>));
   V3<T> result = spec * specLight + diff * diffuseLight;
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -154,24 +155,24 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
 // substrate_translucency: coverage sat(weight); transmittance = the layers above
 // at mu = clamp(NoV, 1e-4, 1), times (1 - E_spec(mu)), times (1 - fuzz min(E_fuzz, 1)).
 template <class T>
-void translucency(const Closure<T>& c, T NoV, T& coverage, V3<T>& transmittanceOut) {
+void translucency(const Closure<T>& c, T NoV, const V3<T>& V, T& coverage, V3<T>& transmittanceOut) {
   coverage = saturate(c.weight);
   T mu = clampT(NoV, K<T>::minCos, T(1));
   T dielectric;
   V3<T> specAlbedo = specularAlbedo(c, mu, dielectric);
-  transmittanceOut = aboveThroughput(c, mu) * (splat3(T(1)) - specAlbedo);
+  transmittanceOut = aboveThroughput(c, mu, V) * (splat3(T(1)) - specAlbedo);
   if (c.features & kFeatureFuzz)
     transmittanceOut = transmittanceOut * (T(1) - saturate(c.fuzzAmount) * std::min(fuzzAlbedo(fuzzCosine(c, mu), c.fuzzRoughness), T(1)));
 }
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                         \
-  template V3<T> viewThroughput<T>(const Closure<T>&, T);                                                 \
-  template V3<T> lightThroughput<T>(const Closure<T>&, T);                                                \
+  template V3<T> viewThroughput<T>(const Closure<T>&, T, const V3<T>&);                                                 \
+  template V3<T> lightThroughput<T>(const Closure<T>&, T, const V3<T>&);                                                \
   template V3<T> lightClosure<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V3<T>&, int);       \
   template V3<T> reflectionDir<T>(const Closure<T>&, const V3<T>&);                                       \
   template T envMip<T>(T, T);                                                                             \
   template V3<T> envSplitSum<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V3<T>&, int);        \
-  template void translucency<T>(const Closure<T>&, T, T&, V3<T>&);
+  template void translucency<T>(const Closure<T>&, T, const V3<T>&, T&, V3<T>&);
 SUBSTRATEC_INSTANTIATE(float)
 SUBSTRATEC_INSTANTIATE(double)
 #undef SUBSTRATEC_INSTANTIATE

@@ -79,6 +79,9 @@ struct Closure {
   std::uint32_t extraInterfaces = 0;  // interfaces above beyond the first, 0..3
   T coatFloor = T(0);  // what the layers' top lets through at grazing angles: coatFloor(topRoughness)
   T coatInterface = T(SUBSTRATE_COAT_T_0);  // the layers' top's 1 - F0 head-on: setCoatInterface
+  V2<T> coatStretch{T(0), T(0)};        // the one stretched top's (ay^2, ax^2 - ay^2) (0: none): setCoatFloor
+  V3<T> coatTangent{T(1), T(0), T(0)};  // its tangent
+  T coatShare = T(0);  // coatMeanShare of the floor (coatAnisoShare under a stretched top): setCoatFloor
   std::uint32_t features = 0;
   bool isTop = true;
   /// SUBSTRATE_USE_METALNESS_MIX of the shader that lights it (Material::metalnessMix;
@@ -125,11 +128,13 @@ T topRoughness(const std::vector<Closure<T>>& closures) {
   return std::clamp(r / std::max(w, T(1e-6)), T(0), T(1));
 }
 
-/// SubstrateClosure.coatFloor of every closure, as the material function and
-/// the unpacker set it (substrate_coat_floor): coatFloor(topR), topR the
-/// pixel's top-layer roughness, for the closures under one interface when one
-/// closure is on top and its lobe is one isotropic GGX lobe (no anisotropy or
-/// haze feature), else 0.
+/// SubstrateClosure.coatFloor, coatStretch, coatTangent and coatShare of every
+/// closure, as the material function and the unpacker set them, for the
+/// closures under one interface when one closure is on top (else 0): its lobe
+/// one isotropic GGX lobe (no anisotropy or haze feature), coatFloor(topR), topR
+/// the pixel's top-layer roughness, and coatShare = coatMeanShare of it; one
+/// stretched lobe (anisotropy, no haze), coatStretch = coatStretch(r, A), coatTangent
+/// its tangent and coatShare = coatAnisoShare(coatStretch) (coatFloor 0).
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR);
 
@@ -163,9 +168,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
 /// substrate_closure_view_throughput / substrate_closure_light_throughput.
 template <class T>
-V3<T> viewThroughput(const Closure<T>& c, T NoV);
+V3<T> viewThroughput(const Closure<T>& c, T NoV, const V3<T>& V);
 template <class T>
-V3<T> lightThroughput(const Closure<T>& c, T NoL);
+V3<T> lightThroughput(const Closure<T>& c, T NoL, const V3<T>& L);  // L unit (coatMeanDirection: no one)
 
 /// substrate_light_closure: viewT(NoV) * lightT(NoL) * evalClosure * radiance.
 template <class T>
@@ -186,7 +191,7 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
 
 /// substrate_translucency.
 template <class T>
-void translucency(const Closure<T>& c, T NoV, T& coverage, V3<T>& transmittance);
+void translucency(const Closure<T>& c, T NoV, const V3<T>& V, T& coverage, V3<T>& transmittance);
 
 /// The reference for environment lighting: the integral over the sphere of
 /// radiance(L) * lightThroughput(c, N.L) * evalClosure(c, V, L) dL (the

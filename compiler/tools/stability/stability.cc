@@ -268,13 +268,13 @@ std::string evaluate(const CompileResult& r, const Point& p, const reference::In
     const T NoV = c.N[0] * V[0] + c.N[1] * V[1] + c.N[2] * V[2];
     const auto direct = reference::lightClosure<T>(c, V, L, one, kDiffuseModel);
     if (!finite3(direct)) return *value = direct[0], fmt::format("closure {} direct light", k);
-    const auto viewT = reference::viewThroughput<T>(c, NoV);
+    const auto viewT = reference::viewThroughput<T>(c, NoV, V);
     if (!finite3(viewT)) return *value = viewT[0], fmt::format("closure {} view throughput", k);
     const auto env = reference::envSplitSum<T>(c, V, one, pi, kDiffuseModel);
     if (!finite3(env)) return *value = env[0], fmt::format("closure {} split-sum environment", k);
     T coverage = T(1);
     std::array<T, 3> transmittance{};
-    reference::translucency<T>(c, NoV, coverage, transmittance);
+    reference::translucency<T>(c, NoV, V, coverage, transmittance);
     if (!std::isfinite(coverage) || !finite3(transmittance))
       return *value = coverage, fmt::format("closure {} translucency", k);
   }
@@ -405,7 +405,7 @@ void furnace(const CompileResult& r, const Grid& grid, int samples, const refere
         cl.features &= ~reference::kFeatureGlint;
         cl.glintValue = 1;
         const double NoV = cl.N[0] * g.V[0] + cl.N[1] * g.V[1] + cl.N[2] * g.V[2];
-        const V3 t = reference::viewThroughput<double>(cl, NoV);
+        const V3 t = reference::viewThroughput<double>(cl, NoV, V3{g.V[0], g.V[1], g.V[2]});
         const V3 e = reference::envIntegrated(
             cl, g.V, [](const V3&) { return V3{1, 1, 1}; }, kDiffuseModel, samples, seed++);
         for (int k = 0; k < 3; ++k) albedoSum[k] += t[k] * e[k];

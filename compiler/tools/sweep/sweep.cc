@@ -36,7 +36,7 @@ std::vector<double> radiance(const CompileResult& r, const std::vector<gpu::Samp
     for (const auto& c : m.closures) {
       const V3 direct = reference::lightClosure<double>(c, s.geometry.V, s.light, s.radiance, diffuseModel);
       const double NoV = c.N[0] * s.geometry.V[0] + c.N[1] * s.geometry.V[1] + c.N[2] * s.geometry.V[2];
-      const V3 viewT = reference::viewThroughput<double>(c, NoV);
+      const V3 viewT = reference::viewThroughput<double>(c, NoV, V3{s.geometry.V[0], s.geometry.V[1], s.geometry.V[2]});
       const V3 env = reference::envSplitSum<double>(c, s.geometry.V, s.prefiltered, s.irradiance, diffuseModel);
       for (int k = 0; k < 3; ++k) sum[k] += direct[k] + viewT[k] * (env[k] + c.emissive[k]);
     }
