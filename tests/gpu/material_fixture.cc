@@ -78,6 +78,9 @@ std::array<T, N> arrayOf(const std::array<double, N>& a) {
 
 template <class T>
 reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
+  // Every field is copied by name: a new one left out would keep its default here.
+  static_assert(sizeof(reference::Closure<double>) == 440,
+                "Closure gained or lost a field: copy it below, then update the size");
   reference::Closure<T> o;
   o.diffuseAlbedo = arrayOf<T>(c.diffuseAlbedo);
   o.f0 = arrayOf<T>(c.f0);

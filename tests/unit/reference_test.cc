@@ -448,6 +448,8 @@ D3 directionAt(const D3& N, double cosine, double azimuth) {
 
 template <class To>
 Closure<To> castClosure(const Closure<double>& c) {
+  // Every field is copied by name: a new one left out would keep its default here.
+  static_assert(sizeof(Closure<double>) == 440, "Closure gained or lost a field: copy it below, then update the size");
   auto v = [](const auto& a) {
     std::array<To, std::tuple_size_v<std::decay_t<decltype(a)>>> r;
     for (std::size_t i = 0; i < r.size(); ++i) r[i] = static_cast<To>(a[i]);
@@ -480,6 +482,9 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.extraInterfaces = c.extraInterfaces;
   o.coatFloor = static_cast<To>(c.coatFloor);
   o.coatInterface = static_cast<To>(c.coatInterface);
+  o.coatStretch = v(c.coatStretch);
+  o.coatTangent = v(c.coatTangent);
+  o.coatShare = static_cast<To>(c.coatShare);
   o.features = c.features;
   o.isTop = c.isTop;
   o.metalnessMix = c.metalnessMix;
