@@ -207,7 +207,9 @@ void substrate_closure_init(out SubstrateClosure c) {
 // lobe, so that r is that interface's own roughness; else 0 (the smooth term:
 // an inner interface may be smoother than the top, a mix of tops has no one
 // roughness, and a stretched or hazy top reflects more at grazing angles than
-// one lobe of roughness r: anisotropy -1 read 1.19 of a white furnace).
+// one lobe of roughness r: anisotropy -1 read 1.19 of a white furnace). Under
+// one stretched top the floor follows a direction's azimuth instead
+// (SubstrateClosure.coatStretch, substrate_coat_floor_projected; step 19).
 float substrate_coat_floor(float topRoughness) {
   float x = max(topRoughness - SUBSTRATE_COAT_ROUGH_START, 0.0);
   return SUBSTRATE_COAT_ROUGH_SCALE * x / (x + SUBSTRATE_COAT_ROUGH_HALF);

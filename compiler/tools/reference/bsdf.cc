@@ -1080,11 +1080,11 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
-  template V3<T> fuzzDiffusePairMean<T>(const Closure<T>&, T, const V3<T>&);                           \
-  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                          \
+  template V3<T> fuzzDiffusePairMean<T>(const Closure<T>&, T, const V3<T>&);                          \
+  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
   template V3<T> f90Effective<T>(const V3<T>&, const V3<T>&);                                          \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
-  template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T);\
+  template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template V3<T> aboveThroughput<T>(const Closure<T>&, T, const V3<T>&);                               \
   template T wrapLightCosine<T>(const Closure<T>&, T);                                                 \
   template T fuzzCosine<T>(const Closure<T>&, T);                                                      \
@@ -1105,23 +1105,23 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T coatFloorAlong<T>(const Closure<T>&, T, const V3<T>&);                                    \
   template V3<T> coatMeanDirection<T>(const Closure<T>&, T);                                           \
   template T coatInterface<T>(const V3<T>&);                                                           \
-  template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                          \
-  template void setCoatInterface<T>(std::vector<Closure<T>>&);                                         \
+  template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                         \
+  template void setCoatInterface<T>(std::vector<Closure<T>>&);                                        \
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \
-  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                   \
+  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);\
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&);\
-  template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                                \
-  template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                  \
-  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);              \
-  template V3<T> closureCompensatedF0<T>(const Closure<T>&, const V3<T>&, const V2<T>&);               \
-  template V2<T> interfaceAlbedoFit<T>(T, T);                                                          \
-  template V2<T> interfaceAlbedoMeans<T>(T);                                                           \
-  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                          \
-  template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                    \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);    \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
+  template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
+  template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \
+  template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                \
+  template V3<T> closureCompensatedF0<T>(const Closure<T>&, const V3<T>&, const V2<T>&);              \
+  template V2<T> interfaceAlbedoFit<T>(T, T);                                                         \
+  template V2<T> interfaceAlbedoMeans<T>(T);                                                          \
+  template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
+  template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                   \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
   template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \
@@ -1131,9 +1131,9 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> sssWrapAmount<T>(const V3<T>&);                                                       \
   template V3<T> diffuseWrap<T>(const V3<T>&, const V3<T>&, T);                                        \
   template T mixShare<T>(T);                                                                           \
-  template T mediumF0<T>(const Closure<T>&);                                                           \
+  template T mediumF0<T>(const Closure<T>&);                                                            \
   template V2<T> mediumInterface<T>(T, T);                                                             \
-  template T mediumShare<T>(const Closure<T>&);                                                        \
+  template T mediumShare<T>(const Closure<T>&);                                                         \
   template V3<T> mediumSlope2<T>(const V3<T>&, T, T, T);                                               \
   template V3<T> mediumWeight<T>(const V3<T>&, T, T, T);                                               \
   template V3<T> closureMedium<T>(const Closure<T>&, const V3<T>&, T, T&);                             \
