@@ -220,7 +220,7 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
     ifc *= SUBSTRATE_COAT_T_2;
   }
 #endif
-#if SUBSTRATE_USE_COAT_FLOOR
+#if SUBSTRATE_USE_COAT_FLOOR || SUBSTRATE_USE_COAT_ANISO
   float share = c.coatShare;  // 0 under a smooth top
 #else
   float share = 0.0;  // the floor is 0
@@ -342,7 +342,7 @@ float substrate_fresnel_weight(float c) {
 // Without it a white Lambertian under a clear coat of roughness 1 returned
 // 0.46 of the light at NoV 0.1, a white conductor 0.46.
 float substrate_coat_transmission(float mu, float coatFloor) {
-#if SUBSTRATE_USE_COAT_FLOOR
+#if SUBSTRATE_USE_COAT_FLOOR || SUBSTRATE_USE_COAT_ANISO
   float m = 1.0 - saturate(mu);
   return max(1.0 - substrate_fresnel_weight(mu), 1.0 - (1.0 - coatFloor) * (m * m));
 #else
@@ -357,7 +357,7 @@ float substrate_coat_transmission(float mu, float coatFloor) {
 // two is 0 (a stretched top has no coatFloor; any other leaves coatStretch 0).
 // Compiled only with SUBSTRATE_USE_COAT_ANISO.
 float substrate_coat_floor_along(SubstrateClosure c, float mu, float3 w) {
-#if SUBSTRATE_USE_COAT_FLOOR && SUBSTRATE_USE_COAT_ANISO
+#if SUBSTRATE_USE_COAT_ANISO
   float tw = dot(c.coatTangent, w);
   float c2 = saturate(tw * tw / max(1.0 - mu * mu, 1e-8));
   return max(c.coatFloor, substrate_coat_floor_projected(c.coatStretch, c2));
@@ -706,6 +706,24 @@ float substrate_coat_critical_margin(float mu) {
   return max(sqrt(1.0 - (1.0 - mu * mu) * SUBSTRATE_COAT_INV_ETA2) - SUBSTRATE_COAT_CRITICAL_COS, 0.0);
 }
 
+// The GGX alpha of the layers' one rough top, whose spread the closure's
+// roughness holds (substrate_closure_coat_specular): substrate_coat_top_alpha
+// of the floor under an isotropic top; under a stretched one (issue 19, step
+// 19) its alphas' mean, (a_x + a_y) / 2 = r^2, back from coatStretch (a
+// conductor of roughness 0.4 under a clear coat of roughness 0.6 and
+// anisotropy 0.8 read -6.1 / -7.3 / -6.0 % at NoV 1 / 0.6 / 0.2 with none,
+// -3.0 / -4.8 / -4.9 % with it). 0 under no one rough top.
+float substrate_closure_coat_top_alpha(SubstrateClosure c) {
+  float a = 0.0;
+#if SUBSTRATE_USE_COAT_FLOOR
+  a = substrate_coat_top_alpha(c.coatFloor);
+#endif
+#if SUBSTRATE_USE_COAT_ANISO
+  a = max(a, 0.5 * (sqrt(c.coatStretch.x) + sqrt(c.coatStretch.x + c.coatStretch.y)));  // one of the two is 0
+#endif
+  return a;
+}
+
 float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float2 fd, float share, float NoV,
                                        float NoL, float roughness) {
 #if !SUBSTRATE_USE_LAYERS || !SUBSTRATE_USE_COAT_CONDUCTOR
@@ -716,8 +734,8 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float t = cover * (1.0 - share);
   float r = saturate(roughness);
   float a = r * r;
-#if SUBSTRATE_USE_COAT_FLOOR
-  a -= SUBSTRATE_COAT_TOP_SPREAD * cover * substrate_coat_top_alpha(c.coatFloor);
+#if SUBSTRATE_USE_COAT_FLOOR || SUBSTRATE_USE_COAT_ANISO
+  a -= SUBSTRATE_COAT_TOP_SPREAD * cover * substrate_closure_coat_top_alpha(c);
 #endif
   a = max(a, SUBSTRATE_MIN_ALPHA);
   float a2 = a * a;

@@ -114,18 +114,21 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_COAT_CONDUCTOR
 #define SUBSTRATE_USE_COAT_CONDUCTOR 1
 #endif
-// 1: some closure may lie under a rough top's floor (SubstrateClosure.coatFloor,
-// substrate_coat_floor): the compiler clears it when no closure of the
-// material gets one (several closures on top, a stretched or hazy top, or
-// every closure under layers under more than one interface), where the floor
-// is 0 and the layers' interface term is the smooth one exactly.
+// 1: some closure may lie under an isotropic rough top's floor
+// (SubstrateClosure.coatFloor, substrate_coat_floor): the compiler clears it
+// when no closure of the material gets one (several closures on top, a
+// stretched or hazy top, or every closure under layers under more than one
+// interface), where the floor is 0 and the layers' interface term is the
+// smooth one exactly.
 #ifndef SUBSTRATE_USE_COAT_FLOOR
 #define SUBSTRATE_USE_COAT_FLOOR 1
 #endif
 // 1: some closure may lie under one stretched top (SubstrateClosure.coatStretch,
 // issue 19 step 19), whose floor follows a direction's azimuth about the
 // top's tangent (substrate_coat_floor_along): the compiler clears it when the
-// material has no anisotropic closure on top of others.
+// material has no anisotropic closure on top of others. Either switch compiles
+// the floor's term and its share (coatShare); the isotropic floor's own uses
+// (a conductor's rough path, substrate_coat_top_alpha) only the first.
 #ifndef SUBSTRATE_USE_COAT_ANISO
 #define SUBSTRATE_USE_COAT_ANISO 1
 #endif

@@ -216,7 +216,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       closures[j].coatShare = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatShare;
     }
   }
-#if SUBSTRATE_USE_COAT_FLOOR && SUBSTRATE_USE_COAT_ANISO
+#if SUBSTRATE_USE_COAT_ANISO
   // One stretched top: its floor follows a direction's azimuth (substrate_coat_floor_along),
   // from its own unpacked roughness, anisotropy and tangent.
   if (tops == 1u && topStretched) {

@@ -132,12 +132,14 @@ std::vector<std::size_t> coatFloorClosures(const Material& m, const StorageLayou
 /// (coatFloorClosures); the others' floor is 0, for which the layers'
 /// interface term is the smooth one exactly, so a material with none compiles
 /// none of it.
-/// SUBSTRATE_USE_COAT_ANISO likewise: 1 when they lie under a stretched top
-/// (stretchedTopClosure), so that no other material compiles the azimuth's floor.
+/// Under a stretched top (stretchedTopClosure) SUBSTRATE_USE_COAT_ANISO is 1
+/// instead: the floor follows a direction's azimuth, and the isotropic floor's
+/// own terms (coatFloor stays 0) compile out.
 std::string coatFloorDefine(const Material& m, const StorageLayout& layout) {
   const bool any = !coatFloorClosures(m, layout).empty();
-  return fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n#define SUBSTRATE_USE_COAT_ANISO {}\n", any ? 1 : 0,
-                     any && stretchedTopClosure(m, layout) >= 0 ? 1 : 0);
+  const bool stretched = any && stretchedTopClosure(m, layout) >= 0;
+  return fmt::format("#define SUBSTRATE_USE_COAT_FLOOR {}\n#define SUBSTRATE_USE_COAT_ANISO {}\n",
+                     any && !stretched ? 1 : 0, stretched ? 1 : 0);
 }
 
 bool translucentBlend(const Material& m) {

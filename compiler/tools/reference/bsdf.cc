@@ -578,6 +578,14 @@ T coatAnisoShare(const V2<T>& stretch) {
          T(0.5);
 }
 
+// substrate_closure_coat_top_alpha: max(coatTopAlpha(coatFloor), (sqrt(s.x) + sqrt(s.x + s.y)) / 2),
+// s = coatStretch (one of the two is 0).
+template <class T>
+T closureCoatTopAlpha(const Closure<T>& c) {
+  return std::max(coatTopAlpha(c.coatFloor),
+                  (std::sqrt(c.coatStretch[0]) + std::sqrt(c.coatStretch[0] + c.coatStretch[1])) / T(2));
+}
+
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
   int tops = 0;
@@ -852,7 +860,7 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
 
 // substrate_closure_coat_specular: (1 - R') / (1 - e T_m^2 (R' T_m^2 + (1 - R') (1 - g'))) per channel,
 // with t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2 -
-// TOP_SPREAD sat(coverageAbove) coatTopAlpha(coatFloor), 1e-3), d = max(mu_i - mu_c, 0) along the view
+// TOP_SPREAD sat(coverageAbove) closureCoatTopAlpha(c), 1e-3), d = max(mu_i - mu_c, 0) along the view
 // and along the light), g' = lerp(1, T_i coatTransmission(max(NoV, NoL), coatFloor), t), T_i =
 // max(T_N, I) the interface's own (I = coatInterface), T_m = sat(T_N / I) and e the closure's hemispherical albedo,
 // F_avg + A diffuseTransmission(A, F_avg, d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the
@@ -865,7 +873,7 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
   const T cover = saturate(c.coverageAbove);
   const T t = cover * (T(1) - share);
   const T r = saturate(roughness);
-  const T a = std::max(r * r - T(SUBSTRATE_COAT_TOP_SPREAD) * cover * coatTopAlpha(c.coatFloor), kMinAlpha<T>);
+  const T a = std::max(r * r - T(SUBSTRATE_COAT_TOP_SPREAD) * cover * closureCoatTopAlpha(c), kMinAlpha<T>);
   const T a2 = a * a;
   auto inner = [](T mu) {
     const T inside = std::sqrt(T(1) - (T(1) - mu * mu) * T(SUBSTRATE_COAT_INV_ETA2));
