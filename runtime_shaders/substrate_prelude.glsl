@@ -46,6 +46,7 @@
 // and storage images: words in layers of an array, or a colour at a pixel.
 #define SUBSTRATE_TEXTURE_SAMPLE(t, s, uv) texture(t, uv)
 #define SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, lod) textureLod(t, uv, lod)
+#define SUBSTRATE_TEXTURE_SAMPLE_GRAD(t, s, uv, dx, dy) textureGrad(t, uv, dx, dy)
 #define SUBSTRATE_IMAGE_LOAD_LAYER(img, p, layer) imageLoad(img, ivec3(int((p).x), int((p).y), int(layer))).x
 #define SUBSTRATE_IMAGE_STORE_LAYER(img, p, layer, v) imageStore(img, ivec3(int((p).x), int((p).y), int(layer)), uvec4((v), 0u, 0u, 0u))
 #define SUBSTRATE_IMAGE_STORE(img, p, v) imageStore(img, ivec2(int((p).x), int((p).y)), v)

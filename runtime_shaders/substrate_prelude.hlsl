@@ -18,6 +18,7 @@
 // Textures and storage images (see substrate_prelude.glsl).
 #define SUBSTRATE_TEXTURE_SAMPLE(t, s, uv) t.Sample(s, uv)
 #define SUBSTRATE_TEXTURE_SAMPLE_LEVEL(t, s, uv, lod) t.SampleLevel(s, uv, lod)
+#define SUBSTRATE_TEXTURE_SAMPLE_GRAD(t, s, uv, dx, dy) t.SampleGrad(s, uv, dx, dy)
 #define SUBSTRATE_IMAGE_LOAD_LAYER(img, p, layer) img[uint3((p).x, (p).y, layer)]
 #define SUBSTRATE_IMAGE_STORE_LAYER(img, p, layer, v) img[uint3((p).x, (p).y, layer)] = (v)
 #define SUBSTRATE_IMAGE_STORE(img, p, v) img[(p)] = (v)

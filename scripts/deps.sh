@@ -8,6 +8,7 @@ PACKAGES=(
   nlohmann-json3-dev libfmt-dev libcli11-dev libgtest-dev libbenchmark-dev
   glslang-dev glslang-tools spirv-tools
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools libpng-dev
+  libjpeg62-turbo-dev   # texture images: JPEG (PNG is libpng's)
   clang-14 libclang-rt-14-dev llvm-14   # scripts/fuzz.sh: libFuzzer, ASan/UBSan runtimes, llvm-symbolizer
   libpugixml-dev
   libxxhash-dev

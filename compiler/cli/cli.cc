@@ -19,6 +19,7 @@
 
 #include "accuracy/accuracy.h"
 #include "batch/batch.h"
+#include "format/json_document.h"
 #include "cli/cli_options.h"
 #include "cli/command_outputs.h"
 #include "cli/messages.h"
@@ -543,6 +544,58 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
 
 // ----- preview -----------------------------------------------------------------
 
+/// --texture NAME=PATH and --search-path DIR: the images a render binds.
+struct TextureFlags {
+  std::vector<std::string> textures;  // NAME=PATH
+  std::vector<std::string> searchPaths;
+};
+
+void addTextureOptions(CLI::App* c, TextureFlags& f) {
+  c->add_option("--texture", f.textures,
+                "Bind the image PATH (PNG or JPEG) to texture input NAME, instead of the input's own file "
+                "(repeatable; an input with neither is bound to a neutral texel)")
+      ->type_name("NAME=PATH")
+      ->check([](const std::string& v) {
+        const std::size_t eq = v.find('=');
+        return eq == std::string::npos || eq == 0 || eq + 1 == v.size() ? std::string("expected NAME=PATH, got " + v)
+                                                                          : std::string();
+      });
+  c->add_option("--search-path", f.searchPaths,
+                "A directory a texture's relative file is looked for in when it is not beside the material file "
+                "(repeatable, in order)")
+      ->type_name("DIR");
+}
+
+/// The sources of `s`'s textures from the flags; kExitUsage (with the message)
+/// for a texture input named twice.
+int textureSources(const TextureFlags& f, const import::MaterialSource& s, preview::TextureSources* out,
+                   std::ostream& err) {
+  out->baseDir = s.baseDir;
+  out->searchPaths = f.searchPaths;
+  for (const std::string& t : f.textures) {
+    const std::size_t eq = t.find('=');
+    if (!out->overrides.emplace(t.substr(0, eq), t.substr(eq + 1)).second)
+      return printError(err, kExitUsage, fmt::format("--texture binds {} twice", t.substr(0, eq)));
+  }
+  return kExitOk;
+}
+
+/// Binds `m`'s textures (preview::bindTextures) from the flags, its notes and
+/// errors located in `s` and printed; every image read is an input of
+/// `outputs`. kExitBadInput when an image cannot be used.
+int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, const Material& m, const ReadLimits& read,
+                       CommandOutputs& outputs, preview::BoundTextures* out, std::ostream& err) {
+  preview::TextureSources sources;
+  if (int status = textureSources(f, s, &sources, err); status != kExitOk) return status;
+  Diagnostics diags(s.displayName);
+  if (!s.imported) parseJsonDocument(s.text, read, diags);  // only for the locator: it compiled already
+  const bool ok = preview::bindTextures(m, sources, out, diags);
+  err << diags.formatAll();
+  for (const auto& [name, path] : out->sources)
+    if (path != "neutral") outputs.input(path);
+  return ok ? kExitOk : kExitBadInput;
+}
+
 struct PreviewArgs {
   MaterialInput in;
   std::string output;
@@ -554,6 +607,7 @@ struct PreviewArgs {
   std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
   double exposure = 0;
   std::string precision = "float";
+  TextureFlags textures;
 };
 
 void addPreviewOptions(CLI::App* c, PreviewArgs& a) {
@@ -573,6 +627,7 @@ void addPreviewOptions(CLI::App* c, PreviewArgs& a) {
       ->transform(cli::inRange(-16.0, 16.0, "stops"))->capture_default_str();
   addMaxInputSize(c, a.compile);
   addPrecisionOption(c, a.precision);
+  addTextureOptions(c, a.textures);
 }
 
 /// What preview renders: the material, or (--sweep) each of its simplification steps.
@@ -603,8 +658,10 @@ int previewSteps(const PreviewArgs& a, const import::MaterialSource& s, const Co
 /// spheres labelled with their bytes and closures; nullopt, with the
 /// internal error printed, when a render fails.
 std::optional<preview::Image> renderPreview(const PreviewArgs& a, gpu::Context& ctx,
-                                            const std::vector<sweep::Step>& steps, std::ostream& err) {
+                                            const std::vector<sweep::Step>& steps,
+                                            const preview::BoundTextures& textures, std::ostream& err) {
   preview::RenderOptions ro;
+  ro.textures = &textures;
   ro.size = a.size;
   ro.environment = a.environment;
   ro.target = a.target == "hlsl" ? Target::Hlsl : Target::Glsl;
@@ -639,9 +696,14 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   if (!sources) return status;  // its includes are checked too, before rendering
   std::vector<sweep::Step> steps;
   if (int failed = previewSteps(a, sources->front(), o, steps, err); failed != kExitOk) return failed;
+  preview::BoundTextures textures;
+  if (int failed = bindRenderTextures(a.textures, sources->front(), steps.front().result.material, o.read, outputs,
+                                      &textures, err);
+      failed != kExitOk)
+    return failed;
   auto ctx = openGpu(a.precision, "preview renders on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
-  std::optional<preview::Image> image = renderPreview(a, *ctx, steps, err);
+  std::optional<preview::Image> image = renderPreview(a, *ctx, steps, textures, err);
   if (!image) return kExitInternal;
   preview::Srgb8 srgb = preview::encodeSrgb8(*image);
   if (srgb.nanCount > 0) return printInternalError(err, fmt::format("{} pixels of the preview are NaN", srgb.nanCount));
@@ -1040,8 +1102,9 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     if (int status = pickImported(a.in.material, *inputs, materials, sourceOf, err); status != kExitOk) return status;
   std::vector<OutputFile> files;
   for (std::size_t i = 0; i < materials.size(); ++i) {
+    import::rebaseImageFiles(materials[i], std::filesystem::path(sourceOf[i]).parent_path().string(), a.outDir);
     const import::ImportedMaterial& m = materials[i];
-    const import::MaterialSource source{sourceOf[i] + "[" + m.name + "]", m.text, true};
+    const import::MaterialSource source{sourceOf[i] + "[" + m.name + "]", m.text, true, ""};
     Diagnostics compileDiags(source.displayName);
     if (!compileText(source.displayName, m.text, CompileOptions{}, compileDiags)) {
       err << compileDiags.formatAll();

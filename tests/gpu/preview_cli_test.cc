@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -175,6 +176,100 @@ TEST(Preview, AnUnknownEnvironmentIsAUsageError) {
   CliRun r = cli({"preview", example("row12_simple.json"), "-o", (workDir() / "x.png").string(), "--env", "moon"});
   EXPECT_EQ(r.status, 2);
   EXPECT_NE(r.err.find("moon"), std::string::npos) << r.err;
+}
+
+// ---------------------------------------------------------------- real textures (issue 20)
+
+/// Writes a w x h PNG of one colour.
+void solidPng(const fs::path& path, unsigned char r, unsigned char g, unsigned char b, int size = 4) {
+  std::vector<unsigned char> texels;
+  for (int i = 0; i < size * size; ++i) texels.insert(texels.end(), {r, g, b});
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  image.width = image.height = static_cast<png_uint_32>(size);
+  image.format = PNG_FORMAT_RGB;
+  ASSERT_TRUE(png_image_write_to_file(&image, path.c_str(), 0, texels.data(), 0, nullptr));
+}
+
+/// A glTF whose one material's base colour is the texture `image`.
+void texturedGltf(const fs::path& path, const std::string& image) {
+  std::ofstream(path) << R"({"asset": {"version": "2.0"}, "images": [{"uri": ")" << image
+                      << R"("}], "textures": [{"source": 0}], "materials": [{"name": "Painted",
+     "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0, "roughnessFactor": 0.8}}]})";
+}
+
+/// The centre pixel of a preview.
+std::array<int, 3> centreOf(const fs::path& png) {
+  Png img;
+  EXPECT_TRUE(readPng(png, &img));
+  const unsigned char* p = &img.rgba[(static_cast<std::size_t>(img.height / 2) * img.width + img.width / 2) * 4];
+  return {p[0], p[1], p[2]};
+}
+
+/// A .gltf beside a solid green PNG previews green (it previewed a lavender
+/// checker), in both languages alike; --texture binds another image instead.
+TEST(PreviewTextures, AGltfBesideASolidGreenPngPreviewsGreenAndTextureBindsAnother) {
+  const fs::path dir = workDir() / "gltf_green";
+  fs::create_directories(dir);
+  solidPng(dir / "green.png", 0, 200, 0);
+  solidPng(dir / "red.png", 220, 0, 0);
+  texturedGltf(dir / "painted.gltf", "green.png");
+  CliRun r = cli({"preview", (dir / "painted.gltf").string(), "-o", (dir / "g.png").string(), "--size", "32"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::array<int, 3> green = centreOf(dir / "g.png");
+  EXPECT_GT(green[1], green[0] + 60) << green[0] << " " << green[1] << " " << green[2];
+  EXPECT_GT(green[1], green[2] + 60) << green[0] << " " << green[1] << " " << green[2];
+  ASSERT_EQ(cli({"preview", (dir / "painted.gltf").string(), "-o", (dir / "h.png").string(), "--size", "32", "--target",
+                 "hlsl"})
+                .status,
+            0);
+  EXPECT_EQ(bytesOf(dir / "g.png"), bytesOf(dir / "h.png")) << "GLSL and HLSL bind the same image";
+  r = cli({"preview", (dir / "painted.gltf").string(), "-o", (dir / "r.png").string(), "--size", "32", "--texture",
+           "baseColorTexture=" + (dir / "red.png").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::array<int, 3> red = centreOf(dir / "r.png");
+  EXPECT_GT(red[0], red[1] + 60) << red[0] << " " << red[1] << " " << red[2];
+}
+
+/// A black and a white image give different pictures (the checker made them byte-identical).
+TEST(PreviewTextures, BlackAndWhiteImagesGiveDifferentPictures) {
+  const fs::path dir = workDir() / "black_white";
+  fs::create_directories(dir);
+  solidPng(dir / "black.png", 0, 0, 0);
+  solidPng(dir / "white.png", 255, 255, 255);
+  texturedGltf(dir / "piece.gltf", "black.png");
+  ASSERT_EQ(cli({"preview", (dir / "piece.gltf").string(), "-o", (dir / "b.png").string(), "--size", "32"}).status, 0);
+  ASSERT_EQ(cli({"preview", (dir / "piece.gltf").string(), "-o", (dir / "w.png").string(), "--size", "32", "--texture",
+                 "baseColorTexture=" + (dir / "white.png").string()})
+                .status,
+            0);
+  const std::array<int, 3> black = centreOf(dir / "b.png"), white = centreOf(dir / "w.png");
+  EXPECT_GT(white[0], black[0] + 100) << black[0] << " " << white[0];
+}
+
+/// A material whose image is missing is an error naming the file and where it
+/// is asked for; nothing is written.
+TEST(PreviewTextures, AMissingImageIsALocatedErrorAndNothingIsWritten) {
+  const fs::path dir = workDir() / "missing_image";
+  fs::create_directories(dir);
+  texturedGltf(dir / "lost.gltf", "lost.png");
+  const fs::path material = dir / "native.json";
+  std::ofstream(material) << R"({"format": "substrate-material/1", "name": "native",
+  "inputs": {"albedo": {"type": "texture2d", "colorspace": "srgb", "file": "textures/albedo.png"}},
+  "nodes": {"a": {"kind": "texture", "texture": "$albedo"}, "root": {"kind": "slab", "diffuse_albedo": "a"}},
+  "output": "root"})";
+  CliRun r = cli({"preview", material.string(), "-o", (dir / "n.png").string(), "--size", "16"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("native.json:2:76: error: texture input \"albedo\": cannot use the image \"textures/albedo.png\""),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("no such file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "n.png"));
+  // A glTF's missing image is the importer's error, at the glTF pointer.
+  r = cli({"preview", (dir / "lost.gltf").string(), "-o", (dir / "l.png").string(), "--size", "16"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("lost.png"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "l.png"));
 }
 
 }  // namespace

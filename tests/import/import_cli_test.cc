@@ -11,6 +11,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
 
@@ -52,6 +53,28 @@ TEST(ImportCli, WritesOneFilePerMaterialThatCompiles) {
   // What was written is an ordinary material: report reads it back.
   CliRun back = cli({"report", (out / "gold.json").string()});
   EXPECT_EQ(back.status, 0) << back.err;
+}
+
+/// An imported texture keeps its image as the input's `file` (issue 20), made
+/// relative to where the material is written, so that the written material
+/// finds the image the source document named.
+TEST(ImportCli, ATexturesImageIsTheInputsFileRelativeToTheWrittenMaterial) {
+  const fs::path src = scratch("textured_source"), out = scratch("textured_out") / "materials";
+  fs::create_directories(src / "maps");
+  std::ofstream(src / "scene.gltf") << R"({"asset": {"version": "2.0"},
+    "images": [{"uri": "maps/bricks%20red.png"}, {"uri": "data:image/png;base64,iVBORw0KGgo="}],
+    "textures": [{"source": 0}, {"source": 1}],
+    "materials": [{"name": "Wall", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+                   "metallicRoughnessTexture": {"index": 1}}}]})";
+  std::ofstream(src / "maps/bricks red.png") << "not decoded by import";
+  CliRun r = cli({"import", (src / "scene.gltf").string(), "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(out / "Wall.json");
+  const nlohmann::json wall = nlohmann::json::parse(in);
+  EXPECT_EQ(wall["inputs"]["baseColorTexture"]["file"], "../../textured_source/maps/bricks red.png");
+  EXPECT_EQ(wall["inputs"]["baseColorTexture"]["colorspace"], "srgb");
+  EXPECT_FALSE(wall["inputs"]["metallicRoughnessTexture"].contains("file")) << "an embedded image has no file";
+  EXPECT_TRUE(fs::exists(out / wall["inputs"]["baseColorTexture"]["file"].get<std::string>()));
 }
 
 TEST(ImportCli, MaterialChoosesOneAndAnUnknownNameListsThem) {

@@ -80,6 +80,10 @@ void Diagnostics::warning(std::string pointer, std::string message) {
   pointed(Severity::Warning, std::move(pointer), std::move(message));
 }
 
+void Diagnostics::note(std::string pointer, std::string message) {
+  pointed(Severity::Note, std::move(pointer), std::move(message));
+}
+
 void Diagnostics::fail(std::string message) {
   Diagnostic d;
   d.file = file_;

@@ -64,6 +64,7 @@ class Diagnostics {
   /// locator when there is one.
   void error(std::string pointer, std::string message);
   void warning(std::string pointer, std::string message);
+  void note(std::string pointer, std::string message);  // information, never a failure
   void warningAt(int line, int column, std::string message);
   /// An error located nowhere in a document: a tool or a Vulkan call failed ("GPU harness:
   /// vkCreateDevice failed: ..."). Prints like any unlocated diagnostic (`file: error: msg`).

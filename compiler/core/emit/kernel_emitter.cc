@@ -16,6 +16,10 @@ std::string includes(const Material& m, const StorageLayout& L, const Syntax& sy
                      Precision precision) {
   std::string s(syn.header);
   s += "#define SUBSTRATE_TEXTURE_LOD0 1  // no implicit derivatives in a compute shader\n";
+  // The preview filters its (mipmapped) textures over the pixel's footprint in uv0.
+  if (mode == KernelMode::Preview)
+    s += "#define SUBSTRATE_SAMPLE(t, s, uv) SUBSTRATE_TEXTURE_SAMPLE_GRAD(t, s, uv, g.uvDerivatives.xy, "
+         "g.uvDerivatives.zw)\n";
   s += precisionDefine(precision);
   // The closures lit come straight from <name>_evaluate (unit normals), except
   // in Deferred, which lights what the generic unpacker decoded.

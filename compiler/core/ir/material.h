@@ -30,6 +30,12 @@ struct Input {
   std::array<double, 4> defaultValue{0, 0, 0, 0};
   std::optional<std::array<double, 4>> min, max;  // per component
   std::string pointer;
+  // texture2d only: the image a renderer binds when nobody binds another
+  // (`file`, as written: relative to the material file; "" for none), and
+  // whether its RGB is sRGB-encoded (`"colorspace": "srgb"`; else linear).
+  std::string file;
+  bool srgb = false;
+  std::string description;  // `description`, as written (an importer's names the source)
 };
 
 /// Slab pins, in the format's order. Every pin always has a value (absent

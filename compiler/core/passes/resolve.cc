@@ -662,12 +662,23 @@ void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string
   std::string kp = p + "/" + pointerToken(key);
   if (key == "type" || key == "description") {
     if (key == "description" && !k->is_string()) d_.error(kp, "expected a string");
+    else if (key == "description") in.description = k->get<std::string>();
     return;
   }
   if (key == "colorspace") {
     if (in.type != VType::Texture) d_.error(kp, "\"colorspace\" applies to texture2d inputs only");
     else if (!k->is_string() || (k->get<std::string>() != "srgb" && k->get<std::string>() != "linear"))
       d_.error(kp, fmt::format("expected \"srgb\" or \"linear\", got {}", kindOfJson(*k)));
+    else in.srgb = k->get<std::string>() == "srgb";
+    return;
+  }
+  if (key == "file") {
+    if (in.type != VType::Texture) d_.error(kp, "\"file\" applies to texture2d inputs only (an image to bind)");
+    else if (!k->is_string() || k->get<std::string>().empty())
+      d_.error(kp, fmt::format("expected an image path (a non-empty string), got {}", kindOfJson(*k)));
+    else if (k->get<std::string>().find('\0') != std::string::npos)
+      d_.error(kp, "an image path holding a NUL character");
+    else in.file = k->get<std::string>();
     return;
   }
   if (key == "min" || key == "max") {
@@ -694,7 +705,8 @@ void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string
   }
   if (key == "default") {
     if (in.type == VType::Texture) {
-      d_.error(kp, "a texture2d input has no default (it is bound at run time)");
+      d_.error(kp, "a texture2d input has no default (it is bound at run time; "
+                   "\"file\" names an image to bind when none is)");
       ok = false;
       return;
     }
@@ -713,7 +725,8 @@ void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string
     }
     return;
   }
-  d_.error(kp, fmt::format("unknown input key {} (expected type, default, min, max, description)",
+  d_.error(kp, fmt::format("unknown input key {} (expected type, default, min, max, description; "
+                           "texture2d: colorspace, file)",
                            quoteForDiagnostic(key)));
 }
 

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "import/gltf_pbr.h"
+#include "import/gltf_resources.h"
 
 namespace substratec::import {
 
@@ -106,6 +107,7 @@ class MaterialReader {
   Value normalFrom(const Json& parent, const char* key, const std::string& ptr);
   Value uvOf(const Json& info, const std::string& ptr);
   std::string imageDescription(int texture, const std::string& ptr);
+  std::string imageFile(int texture) const;
 
   const Json& doc_;
   const Json& m_;
@@ -187,6 +189,23 @@ Value MaterialReader::color(const Json& parent, const char* key, const std::stri
   if (kind == Kind::Switch && std::all_of(v->begin(), v->end(), [neutral](double x) { return x == neutral; }))
     return literal(*v);
   return w_.colorInput(key, *v, what);
+}
+
+/// The image file of texture `texture` as a path relative to the document (its
+/// percent-decoded URI), or "" when its image is embedded (a data: URI or a
+/// buffer view) or not a file (imageDescription reports a bad source).
+std::string MaterialReader::imageFile(int texture) const {
+  const Json& t = doc_["textures"][texture];
+  int source = t.contains("source") ? smallIndex(t, "source") : -1;
+  if (auto e = t.find("extensions"); e != t.end() && e->is_object())
+    for (const auto& [name, ext] : e->items())
+      if (ext.is_object() && ext.contains("source") && ext["source"].is_number_integer()) source = smallIndex(ext, "source");
+  const Json images = doc_.value("images", Json::array());
+  if (source < 0 || !images.is_array() || source >= static_cast<int>(images.size()) || !images[source].is_object())
+    return "";
+  const Json& img = images[source];
+  if (!img.contains("uri") || !img["uri"].is_string() || img["uri"].get<std::string>().rfind("data:", 0) == 0) return "";
+  return uriPath(img["uri"].get<std::string>()).value_or("");
 }
 
 std::string MaterialReader::imageDescription(int texture, const std::string& ptr) {
@@ -282,7 +301,7 @@ Value MaterialReader::sample(const Json& parent, const char* key, const std::str
     return Value();
   }
   Value& input = inputs_[{texture, srgb}];
-  if (input.is_null()) input = w_.textureInput(key, srgb, imageDescription(texture, ptr));
+  if (input.is_null()) input = w_.textureInput(key, srgb, imageDescription(texture, ptr), imageFile(texture));
   const Value uv = uvOf(*info, ptr);
   Value& node = samples_[input.get<std::string>() + "|" + uv.dump()];
   if (node.is_null()) node = w_.node(input.get<std::string>().substr(1) + "_sample", textureSample(input, uv));

@@ -47,21 +47,6 @@ Readable dataUri(const std::string& uri) {
   return {true, n * 3 / 4, ""};
 }
 
-/// A relative URI as a path (percent-decoded), or nullopt when it is not one.
-std::optional<std::string> uriPath(const std::string& uri) {
-  if (uri.find("://") != std::string::npos) return std::nullopt;
-  std::string out;
-  for (std::size_t i = 0; i < uri.size(); ++i) {
-    if (uri[i] == '%' && i + 2 < uri.size() && hexDigit(uri[i + 1]) >= 0 && hexDigit(uri[i + 2]) >= 0) {
-      out += static_cast<char>(hexDigit(uri[i + 1]) * 16 + hexDigit(uri[i + 2]));
-      i += 2;
-    } else {
-      out += uri[i];
-    }
-  }
-  if (out.find('\0') != std::string::npos) return std::nullopt;
-  return out;
-}
 
 Readable file(const std::string& path) {
   struct stat st;
@@ -261,6 +246,22 @@ bool checkGltfResources(const Json& doc, const std::string& baseDir, std::option
     for (std::size_t i = 0; i < images->size(); ++i) check.image((*images)[i], i, views, buffers, sampled);
   }
   return check.finish();
+}
+
+/// A relative URI as a path (percent-decoded), or nullopt when it is not one.
+std::optional<std::string> uriPath(const std::string& uri) {
+  if (uri.find("://") != std::string::npos) return std::nullopt;
+  std::string out;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '%' && i + 2 < uri.size() && hexDigit(uri[i + 1]) >= 0 && hexDigit(uri[i + 2]) >= 0) {
+      out += static_cast<char>(hexDigit(uri[i + 1]) * 16 + hexDigit(uri[i + 2]));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  if (out.find('\0') != std::string::npos) return std::nullopt;
+  return out;
 }
 
 }  // namespace substratec::import

@@ -30,4 +30,8 @@ inline constexpr int kMaxResourceWarnings = 32;
 bool checkGltfResources(const Json& doc, const std::string& baseDir, std::optional<std::size_t> glbBinBytes,
                         Diagnostics& diags);
 
+/// A relative URI as a path (percent-decoded), or nullopt when it is not one
+/// (a scheme such as data: or http:).
+std::optional<std::string> uriPath(const std::string& uri);
+
 }  // namespace substratec::import

@@ -110,6 +110,11 @@ const ImportedMaterial* pickMaterial(const std::vector<ImportedMaterial>& all, c
   return nullptr;
 }
 
+namespace {
+/// The directory of `path` ("" for one in the working directory).
+std::string baseDirOf(const std::string& path) { return std::filesystem::path(path).parent_path().string(); }
+}  // namespace
+
 std::optional<std::vector<MaterialSource>> loadMaterialSources(const std::string& path, const std::string& material,
                                                                bool all, const ReadLimits& limits,
                                                                Diagnostics& diags) {
@@ -121,18 +126,18 @@ std::optional<std::vector<MaterialSource>> loadMaterialSources(const std::string
     }
     auto text = readSourceFile(path, limits, diags);
     if (!text) return std::nullopt;
-    out.push_back({path, std::move(*text), false});
+    out.push_back({path, std::move(*text), false, baseDirOf(path)});
     return out;
   }
   auto imported = importFile(path, limits, diags);
   if (!imported) return std::nullopt;
   if (all && material.empty()) {
-    for (auto& m : *imported) out.push_back({path + "[" + m.name + "]", std::move(m.text), true});
+    for (auto& m : *imported) out.push_back({path + "[" + m.name + "]", std::move(m.text), true, baseDirOf(path)});
     return out;
   }
   const ImportedMaterial* m = pickMaterial(*imported, material, diags);
   if (!m) return std::nullopt;
-  out.push_back({path + "[" + m->name + "]", m->text, true});
+  out.push_back({path + "[" + m->name + "]", m->text, true, baseDirOf(path)});
   return out;
 }
 
@@ -223,6 +228,24 @@ void renameMaterial(ImportedMaterial& m, const std::string& name) {
   doc["name"] = name;
   m.text = doc.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
   m.name = name;
+}
+
+void rebaseImageFiles(ImportedMaterial& m, const std::string& fromDir, const std::string& toDir) {
+  namespace fs = std::filesystem;
+  Json doc = Json::parse(m.text);
+  if (!doc.contains("inputs") || !doc["inputs"].is_object()) return;
+  bool changed = false;
+  std::error_code ec;
+  const fs::path from = fs::absolute(fromDir.empty() ? "." : fromDir, ec).lexically_normal();
+  const fs::path to = fs::absolute(toDir.empty() ? "." : toDir, ec).lexically_normal();
+  for (auto& [name, input] : doc["inputs"].items()) {
+    if (!input.is_object() || !input.contains("file") || !input["file"].is_string()) continue;
+    const fs::path file(input["file"].get<std::string>());
+    if (file.is_absolute()) continue;
+    input["file"] = (from / file).lexically_normal().lexically_relative(to).generic_string();
+    changed = true;
+  }
+  if (changed) m.text = doc.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
 }  // namespace substratec::import

@@ -71,11 +71,18 @@ Replace replaceCheck(const std::string& path, const std::string& text, const std
 /// Gives `m` the identifier `name`, in the text too (the document's "name").
 void renameMaterial(ImportedMaterial& m, const std::string& name);
 
+/// An imported material's texture `file`s, which are relative to the
+/// document it came from (`fromDir`), made relative to `toDir` (where the
+/// material is written); absolute ones are kept. Lexical on absolute paths:
+/// nothing needs to exist.
+void rebaseImageFiles(ImportedMaterial& m, const std::string& fromDir, const std::string& toDir);
+
 /// One material to compile: the text and how diagnostics call it.
 struct MaterialSource {
   std::string displayName;  // the file, or "file[material]" for an imported one
   std::string text;
   bool imported = false;    // a compile error in it is the importer's (an internal error)
+  std::string baseDir;      // the directory its texture inputs' `file`s are relative to (the file's)
 };
 
 /// The material(s) `path` holds: a substrate-material/1 file as it is, or its

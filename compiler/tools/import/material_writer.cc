@@ -148,8 +148,10 @@ Value MaterialWriter::vec3Input(std::string_view name, const std::vector<double>
   return describedInput(name, std::move(b), description);
 }
 
-Value MaterialWriter::textureInput(std::string_view name, bool srgb, const std::string& description) {
+Value MaterialWriter::textureInput(std::string_view name, bool srgb, const std::string& description,
+                                   const std::string& file) {
   Json b = {{"type", "texture2d"}, {"colorspace", srgb ? "srgb" : "linear"}};
+  if (!file.empty()) b["file"] = file;
   return describedInput(name, std::move(b), description);
 }
 

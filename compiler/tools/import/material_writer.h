@@ -104,7 +104,7 @@ class MaterialWriter {
   Value colorInput(std::string_view name, const std::vector<double>& rgb, const std::string& description);
   Value vec2Input(std::string_view name, double x, double y, const std::string& description);
   Value vec3Input(std::string_view name, const std::vector<double>& xyz, const std::string& description);
-  Value textureInput(std::string_view name, bool srgb, const std::string& description);
+  Value textureInput(std::string_view name, bool srgb, const std::string& description, const std::string& file = "");
 
   /// A named node (value or Substrate); returns its id as a reference.
   Value node(std::string_view wantedId, Json body);

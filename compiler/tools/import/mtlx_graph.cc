@@ -392,7 +392,8 @@ Value MtlxValues::textureOf(pugi::xml_node node, const std::string& file, bool s
   if (it != textures_.end()) return it->second;
   std::string stem = std::filesystem::path(file).stem().string();
   if (stem.empty()) stem = str(node, "name");
-  const Value t = w_.textureInput(stem, srgb, fmt::format("{}: file '{}{}'", doc_.describe(node), doc_.filePrefix(node), file));
+  const std::string path = doc_.filePrefix(node) + file;
+  const Value t = w_.textureInput(stem, srgb, fmt::format("{}: file '{}'", doc_.describe(node), path), path);
   textures_[key] = t;
   return t;
 }

@@ -21,7 +21,6 @@ namespace {
 
 using namespace kernel;
 
-constexpr int kTextureSize = 64;
 
 /// The environment's cube maps, built once per name in a process (a sweep
 /// renders many tiles under the same light).
@@ -75,20 +74,6 @@ const Light kLights[kPreviewLights] = {
 
 }  // namespace
 
-std::vector<float> previewTexture(int size) {
-  std::vector<float> t(static_cast<std::size_t>(size) * size * 4);
-  for (int y = 0; y < size; ++y)
-    for (int x = 0; x < size; ++x) {
-      const int cell = size / 8 > 0 ? size / 8 : 1;
-      const float v = ((x / cell + y / cell) % 2) ? 0.65f : 0.35f;
-      float* p = &t[(static_cast<std::size_t>(y) * size + x) * 4];
-      p[0] = p[1] = v;
-      p[2] = 0.5f + 0.5f * v;  // a normal map reads it as a gentle tilt
-      p[3] = 1.0f;
-    }
-  return t;
-}
-
 gpu::ComputePipeline* PipelineCache::get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, Diagnostics& diags) {
   auto it = pipelines_.find(spirv);
   if (it != pipelines_.end()) return it->second.get();
@@ -132,6 +117,7 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
       params[(2 + kPreviewLights + l) * 4 + c] = static_cast<float>(kLights[l].radiance[c]);
     }
 
+  const std::vector<gpu::TextureRole> roles = gpu::textureRoles(r.material);
   gpu::Resources res;
   for (const gpu::DescriptorBinding& b : pipeline->reflection().bindings) {
     const auto key = std::make_pair(b.set, b.binding);
@@ -155,12 +141,13 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
       res[key] = gpu::BufferResource{gpu::inputBlockBytes(r.material, gpu::blockMembers(v.spirv, 1, 0), {}), false};
     } else if (b.set == 1 && b.kind == gpu::DescriptorKind::Sampler) {
       res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::Repeat};
-    } else if (b.set == 1) {
-      gpu::ImageResource img;
-      img.width = img.height = kTextureSize;
-      img.mips = {previewTexture(kTextureSize)};
-      img.filter = gpu::Filter::Linear;
-      res[key] = img;
+    } else if (b.set == 1) {  // a texture: its bound image, or its neutral texel
+      const int input = gpu::inputOfResource(r.material, b.name);
+      const std::string name = input >= 0 ? r.material.inputs[input].name : "";
+      const gpu::ImageResource* image = nullptr;
+      if (o.textures)
+        if (auto it = o.textures->images.find(name); it != o.textures->images.end()) image = &it->second;
+      res[key] = image ? *image : solidTexture(gpu::neutralTexel(input >= 0 ? roles[input] : gpu::TextureRole::Colour));
     }
   }
   const uint32_t groups = static_cast<uint32_t>((o.size + 7) / 8);

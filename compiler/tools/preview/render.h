@@ -14,6 +14,7 @@
 #include "gpu/harness.h"
 #include "pipeline/pipeline.h"
 #include "preview/image.h"
+#include "preview/textures.h"
 
 namespace substratec::preview {
 
@@ -37,16 +38,14 @@ struct RenderOptions {
   Precision precision = Precision::Float;    // of the runtime's lighting (needs shaderFloat16 for Half)
   double exposure = 0;                       // stops, for the tone map
   PipelineCache* pipelines = nullptr;        // reuse pipelines across calls (null: build one per call)
+  /// The material's textures by input name (bindTextures); an input it does
+  /// not hold (or every input, when null) gets its neutral texel.
+  const BoundTextures* textures = nullptr;
 };
 
 /// Renders `r` (linear HDR, background = the environment). False, with errors
 /// reported, on a kernel that does not validate (a compiler bug) or a failed dispatch.
 bool renderSphere(gpu::Context& gpu, const CompileResult& r, const RenderOptions& options, Image* out,
                   Diagnostics& diags);
-
-/// The procedural texture bound to every texture input of a preview: a soft
-/// 8 x 8 checker around mid grey (a mask, a colour or a normal map all show
-/// their effect without dominating), `size` x `size` RGBA.
-std::vector<float> previewTexture(int size);
 
 }  // namespace substratec::preview

@@ -1,0 +1,55 @@
+// The images a rendered material's textures are bound to: an image the user
+// names (--texture NAME=PATH), else the input's own `file`, else the input's
+// neutral texel (gpu::neutralTexel, by the texture's role) with a note. Images
+// are decoded (image/decode.h), colour-decoded by the input's colour space and
+// mipmapped; a missing or undecodable image is an error at the input's
+// pointer, never a silent placeholder.
+#pragma once
+#include <map>
+#include <string>
+#include <vector>
+
+#include "diag/diagnostics.h"
+#include "gpu/harness.h"
+#include "ir/material.h"
+
+namespace substratec::preview {
+
+/// Where a material's texture images come from.
+struct TextureSources {
+  /// The directory a `file` is relative to: the material file's ("" for the
+  /// working directory). An imported material's files are relative to the
+  /// document it was imported from.
+  std::string baseDir;
+  /// Further directories a relative `file` is looked for in, in order, when it
+  /// is not under baseDir (--search-path, as MaterialX's tools resolve images).
+  std::vector<std::string> searchPaths;
+  /// --texture NAME=PATH: PATH (relative to the working directory) for input NAME.
+  std::map<std::string, std::string> overrides;
+};
+
+/// A material's textures by input name, ready to bind: linear RGBA32F with
+/// their full mip chains, filtered linearly (trilinear) and repeated.
+struct BoundTextures {
+  std::map<std::string, gpu::ImageResource> images;
+  std::map<std::string, std::string> sources;  // input -> the image's path, or "neutral"
+};
+
+/// The path `file` resolves to: `file` when it is absolute, baseDir/file when
+/// it exists, else the first that exists of searchPaths[i]/file and then
+/// searchPaths[i]/tail for the tails of `file` without its leading folders,
+/// longest first ("../../Images/a.jpg" is found as DIR/Images/a.jpg or
+/// DIR/a.jpg); else baseDir/file (which the caller reports as missing).
+std::string resolveImagePath(const std::string& file, const TextureSources& sources);
+
+/// Binds every texture input of `m` from `sources`. An input with no image
+/// gets a 1 x 1 texture of its neutral texel and a note saying so. False, with
+/// errors, when an override names no texture input of `m`, or an image cannot
+/// be read or decoded: at the input's `file` (its description, which names
+/// the glTF pointer or MaterialX element of an imported material, is quoted).
+bool bindTextures(const Material& m, const TextureSources& sources, BoundTextures* out, Diagnostics& diags);
+
+/// A 1 x 1 texture of `texel` (RGBA), for a binding that has no image.
+gpu::ImageResource solidTexture(const std::array<double, 4>& texel);
+
+}  // namespace substratec::preview
