@@ -587,12 +587,13 @@ int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, c
                        CommandOutputs& outputs, preview::BoundTextures* out, std::ostream& err) {
   preview::TextureSources sources;
   if (int status = textureSources(f, s, &sources, err); status != kExitOk) return status;
+  sources.embedded = &s.images;
   Diagnostics diags(s.displayName);
   if (!s.imported) parseJsonDocument(s.text, read, diags);  // only for the locator: it compiled already
   const bool ok = preview::bindTextures(m, sources, out, diags);
   err << diags.formatAll();
   for (const auto& [name, path] : out->sources)
-    if (path != "neutral") outputs.input(path);
+    if (path != "neutral" && path.rfind("embedded:", 0) != 0) outputs.input(path);
   return ok ? kExitOk : kExitBadInput;
 }
 
@@ -1101,18 +1102,31 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
   if (!a.in.material.empty())
     if (int status = pickImported(a.in.material, *inputs, materials, sourceOf, err); status != kExitOk) return status;
   std::vector<OutputFile> files;
+  std::vector<std::string> fileSource;  // the input each file comes from
   for (std::size_t i = 0; i < materials.size(); ++i) {
     import::rebaseImageFiles(materials[i], std::filesystem::path(sourceOf[i]).parent_path().string(), a.outDir);
     const import::ImportedMaterial& m = materials[i];
-    const import::MaterialSource source{sourceOf[i] + "[" + m.name + "]", m.text, true, ""};
+    const import::MaterialSource source{sourceOf[i] + "[" + m.name + "]", m.text, true, "", {}};
     Diagnostics compileDiags(source.displayName);
     if (!compileText(source.displayName, m.text, CompileOptions{}, compileDiags)) {
       err << compileDiags.formatAll();
       return compileFailure(source, err);
     }
     files.push_back({m.name + ".json", m.text});
+    fileSource.push_back(sourceOf[i]);
+    for (const auto& [file, bytes] : m.images) {  // embedded images, beside the materials that name them
+      auto same = std::find_if(files.begin(), files.end(), [&](const OutputFile& f) { return f.name == file; });
+      if (same != files.end() && same->contents != bytes)
+        return printError(err, kExitBadInput,
+                          fmt::format("{} and {} both embed an image written as {}: import them into different "
+                                      "directories",
+                                      fileSource[same - files.begin()], sourceOf[i], file));
+      if (same != files.end()) continue;
+      files.push_back({file, bytes});
+      fileSource.push_back(sourceOf[i]);
+    }
   }
-  if (int status = refuseForeign(a, files, sourceOf, outputs, err); status != kExitOk) return status;
+  if (int status = refuseForeign(a, files, fileSource, outputs, err); status != kExitOk) return status;
   return writeOutputs(outputs, a.outDir, files, "", {}, {}, out, err);
 }
 

@@ -231,6 +231,42 @@ TEST(PreviewTextures, AGltfBesideASolidGreenPngPreviewsGreenAndTextureBindsAnoth
   EXPECT_GT(red[0], red[1] + 60) << red[0] << " " << red[1] << " " << red[2];
 }
 
+/// A .glb whose base colour image (a solid blue PNG) is in its binary chunk
+/// previews blue: embedded images are decoded from the container's bytes.
+TEST(PreviewTextures, AGlbsEmbeddedImageIsDecodedFromItsBinaryChunk) {
+  const fs::path dir = workDir() / "glb_embedded";
+  fs::create_directories(dir);
+  std::vector<unsigned char> texels;
+  for (int i = 0; i < 16; ++i) texels.insert(texels.end(), {0, 0, 230});
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  image.width = image.height = 4;
+  image.format = PNG_FORMAT_RGB;
+  png_alloc_size_t size = 0;
+  ASSERT_TRUE(png_image_write_to_memory(&image, nullptr, &size, 0, texels.data(), 0, nullptr));
+  std::string bin(size, '\0');
+  ASSERT_TRUE(png_image_write_to_memory(&image, bin.data(), &size, 0, texels.data(), 0, nullptr));
+  std::string json = R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": )" + std::to_string(bin.size()) +
+                     R"(}], "bufferViews": [{"buffer": 0, "byteLength": )" + std::to_string(bin.size()) +
+                     R"(}], "images": [{"bufferView": 0, "mimeType": "image/png"}], "textures": [{"source": 0}],
+      "materials": [{"name": "Blue", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}, "metallicFactor": 0}}]})";
+  while (json.size() % 4) json += ' ';
+  while (bin.size() % 4) bin += '\0';
+  auto le32 = [](std::size_t v) {
+    std::string b(4, '\0');
+    for (int i = 0; i < 4; ++i) b[i] = static_cast<char>(v >> (8 * i));
+    return b;
+  };
+  std::ofstream(dir / "blue.glb", std::ios::binary)
+      << le32(0x46546C67) + le32(2) + le32(12 + 8 + json.size() + 8 + bin.size()) + le32(json.size()) +
+             le32(0x4E4F534A) + json + le32(bin.size()) + le32(0x004E4942) + bin;
+  CliRun r = cli({"preview", (dir / "blue.glb").string(), "-o", (dir / "b.png").string(), "--size", "32"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::array<int, 3> blue = centreOf(dir / "b.png");
+  EXPECT_GT(blue[2], blue[0] + 60) << blue[0] << " " << blue[1] << " " << blue[2];
+  EXPECT_GT(blue[2], blue[1] + 60) << blue[0] << " " << blue[1] << " " << blue[2];
+}
+
 /// A black and a white image give different pictures (the checker made them byte-identical).
 TEST(PreviewTextures, BlackAndWhiteImagesGiveDifferentPictures) {
   const fs::path dir = workDir() / "black_white";

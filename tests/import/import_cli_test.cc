@@ -73,8 +73,48 @@ TEST(ImportCli, ATexturesImageIsTheInputsFileRelativeToTheWrittenMaterial) {
   const nlohmann::json wall = nlohmann::json::parse(in);
   EXPECT_EQ(wall["inputs"]["baseColorTexture"]["file"], "../../textured_source/maps/bricks red.png");
   EXPECT_EQ(wall["inputs"]["baseColorTexture"]["colorspace"], "srgb");
-  EXPECT_FALSE(wall["inputs"]["metallicRoughnessTexture"].contains("file")) << "an embedded image has no file";
+  EXPECT_EQ(wall["inputs"]["metallicRoughnessTexture"]["file"], "scene_image1.png") << "an embedded image";
+  EXPECT_TRUE(fs::exists(out / "scene_image1.png"));
   EXPECT_TRUE(fs::exists(out / wall["inputs"]["baseColorTexture"]["file"].get<std::string>()));
+}
+
+/// A .glb whose JSON is `json` and whose binary chunk is `bin`.
+std::string glbOf(std::string json, std::string bin) {
+  while (json.size() % 4) json += ' ';
+  while (bin.size() % 4) bin += '\0';
+  auto le32 = [](std::uint32_t v) {
+    std::string b(4, '\0');
+    for (int i = 0; i < 4; ++i) b[i] = static_cast<char>(v >> (8 * i));
+    return b;
+  };
+  const std::uint32_t total = static_cast<std::uint32_t>(12 + 8 + json.size() + 8 + bin.size());
+  return le32(0x46546C67) + le32(2) + le32(total) + le32(static_cast<std::uint32_t>(json.size())) + le32(0x4E4F534A) +
+         json + le32(static_cast<std::uint32_t>(bin.size())) + le32(0x004E4942) + bin;
+}
+
+/// An image embedded in a .glb's binary chunk or in a data: URI is written
+/// beside the imported material, as the file its input names.
+TEST(ImportCli, AnEmbeddedImageIsWrittenBesideTheMaterialThatNamesIt) {
+  const fs::path src = scratch("embedded_source"), out = scratch("embedded_out");
+  fs::create_directories(src);
+  const std::string image = "\x89PNG\r\n\x1a\n-the-bytes-of-an-image";
+  std::ofstream(src / "crate.glb", std::ios::binary) << glbOf(
+      R"({"asset": {"version": "2.0"}, "buffers": [{"byteLength": )" + std::to_string(image.size()) +
+          R"(}], "bufferViews": [{"buffer": 0, "byteLength": )" + std::to_string(image.size()) +
+          R"(}], "images": [{"bufferView": 0, "mimeType": "image/png"}, {"uri": "data:image/jpeg;base64,/9j/4AAQ"}],
+          "textures": [{"source": 0}, {"source": 1}],
+          "materials": [{"name": "Crate", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}},
+                         "emissiveTexture": {"index": 1}, "emissiveFactor": [1, 1, 1]}]})",
+      image);
+  CliRun r = cli({"import", (src / "crate.glb").string(), "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(out / "Crate.json");
+  const nlohmann::json crate = nlohmann::json::parse(in);
+  EXPECT_EQ(crate["inputs"]["baseColorTexture"]["file"], "crate_image0.png");
+  EXPECT_EQ(crate["inputs"]["emissiveTexture"]["file"], "crate_image1.jpg");
+  std::ifstream png(out / "crate_image0.png", std::ios::binary), jpg(out / "crate_image1.jpg", std::ios::binary);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(png), {}), image);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(jpg), {}), std::string("\xFF\xD8\xFF\xE0\x00\x10", 6));
 }
 
 TEST(ImportCli, MaterialChoosesOneAndAnUnknownNameListsThem) {

@@ -32,6 +32,13 @@ std::optional<std::size_t> glbBinChunkSize(const std::string& b) {
   return std::nullopt;
 }
 
+std::optional<std::string> glbBinChunk(const std::string& b) {
+  const std::optional<std::size_t> size = glbBinChunkSize(b);
+  if (!size) return std::nullopt;
+  const std::size_t jsonLength = le32(b, 12);  // the first chunk's; glbBinChunkSize checked it fits
+  return b.substr(12 + 8 + jsonLength + 8, *size);
+}
+
 bool looksLikeGlb(const std::string& bytes) { return bytes.size() >= 4 && le32(bytes, 0) == kMagic; }
 
 std::optional<std::string> glbJsonChunk(const std::string& b, Diagnostics& diags) {

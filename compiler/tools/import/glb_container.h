@@ -20,6 +20,9 @@ std::optional<std::string> glbJsonChunk(const std::string& bytes, Diagnostics& d
 /// glbJsonChunk accepted, or nullopt when it has none.
 std::optional<std::size_t> glbBinChunkSize(const std::string& bytes);
 
+/// The binary chunk's bytes of a container glbJsonChunk accepted, or nullopt.
+std::optional<std::string> glbBinChunk(const std::string& bytes);
+
 /// True when `bytes` starts with the .glb magic.
 bool looksLikeGlb(const std::string& bytes);
 

@@ -1,6 +1,8 @@
 #include "import/gltf_import.h"
 
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <map>
 
 #include <fmt/format.h>
@@ -49,12 +51,29 @@ Value times(const Value& factor, const Value& texture) {
   return mul(factor, texture);
 }
 
+/// Where a document's embedded images come from, and the stem their file names take.
+struct EmbeddedSource {
+  const std::string* glbBin;  // a .glb's binary chunk (null: none)
+  std::string stem;
+};
+
+/// `stem` with characters other than letters, digits, '-', '_' and '.' as '_'
+/// ("image" when nothing is left): a file name in any file system.
+std::string sanitizeFileStem(std::string stem) {
+  for (char& c : stem)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  return stem.empty() || stem[0] == '.' ? "image" + stem : stem;
+}
+
 /// Reads one material into GltfPbr, writing its inputs and value nodes.
 class MaterialReader {
  public:
   MaterialReader(const Json& doc, const Json& material, std::string pointer, std::string label, Diagnostics& d,
-                 MaterialWriter& w)
-      : doc_(doc), m_(material), ptr_(std::move(pointer)), label_(std::move(label)), d_(d), w_(w) {}
+                 MaterialWriter& w, const EmbeddedSource& embedded)
+      : doc_(doc), m_(material), ptr_(std::move(pointer)), label_(std::move(label)), d_(d), w_(w), embedded_(embedded) {}
+
+  /// The embedded images the material's texture inputs name as their `file`.
+  std::map<std::string, std::string>& images() { return images_; }
 
   /// Reads the core material, then each extension by its reader.
   bool read(GltfPbr& g);
@@ -107,7 +126,7 @@ class MaterialReader {
   Value normalFrom(const Json& parent, const char* key, const std::string& ptr);
   Value uvOf(const Json& info, const std::string& ptr);
   std::string imageDescription(int texture, const std::string& ptr);
-  std::string imageFile(int texture) const;
+  std::string imageFile(int texture);
 
   const Json& doc_;
   const Json& m_;
@@ -116,6 +135,8 @@ class MaterialReader {
   MaterialWriter& w_;
   bool ok_ = true;
   std::map<std::pair<int, bool>, Value> inputs_;  // (texture index, sRGB) -> "$input"
+  const EmbeddedSource& embedded_;
+  std::map<std::string, std::string> images_;  // file name -> bytes, of embedded images
   std::map<std::string, Value> samples_;          // input + uv -> sample node
 };
 
@@ -191,10 +212,12 @@ Value MaterialReader::color(const Json& parent, const char* key, const std::stri
   return w_.colorInput(key, *v, what);
 }
 
-/// The image file of texture `texture` as a path relative to the document (its
-/// percent-decoded URI), or "" when its image is embedded (a data: URI or a
-/// buffer view) or not a file (imageDescription reports a bad source).
-std::string MaterialReader::imageFile(int texture) const {
+/// The image file of texture `texture`: a path relative to the document (its
+/// percent-decoded URI); for an embedded image (a data: URI or a buffer view)
+/// "<document stem>_image<N>.<ext>", its bytes kept in images_; "" when it has
+/// no image (imageDescription reports a bad source) or its bytes cannot be had
+/// (a warning).
+std::string MaterialReader::imageFile(int texture) {
   const Json& t = doc_["textures"][texture];
   int source = t.contains("source") ? smallIndex(t, "source") : -1;
   if (auto e = t.find("extensions"); e != t.end() && e->is_object())
@@ -204,7 +227,17 @@ std::string MaterialReader::imageFile(int texture) const {
   if (source < 0 || !images.is_array() || source >= static_cast<int>(images.size()) || !images[source].is_object())
     return "";
   const Json& img = images[source];
-  if (!img.contains("uri") || !img["uri"].is_string() || img["uri"].get<std::string>().rfind("data:", 0) == 0) return "";
+  std::string why;
+  if (auto e = embeddedImage(doc_, source, embedded_.glbBin, &why)) {
+    const std::string name = fmt::format("{}_image{}.{}", embedded_.stem, source, e->extension);
+    images_[name] = std::move(e->bytes);
+    return name;
+  }
+  if (!why.empty()) {
+    warn(fmt::format("/images/{}", source), fmt::format("the embedded image cannot be read: {}", why));
+    return "";
+  }
+  if (!img.contains("uri") || !img["uri"].is_string()) return "";
   return uriPath(img["uri"].get<std::string>()).value_or("");
 }
 
@@ -545,7 +578,7 @@ void MaterialReader::readDiffuseRoughness(const Json& ext, const std::string& xp
 }  // namespace
 
 bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostics& diags,
-                        std::vector<ImportedMaterial>* out) {
+                        std::vector<ImportedMaterial>* out, const std::string* glbBin) {
   if (!doc.is_object()) {
     diags.error("", "expected a glTF document (a JSON object)");
     return false;
@@ -562,6 +595,7 @@ bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostic
     }
   bool ok = true;
   NameSet used(/*caseInsensitive=*/true);
+  const EmbeddedSource embedded{glbBin, sanitizeFileStem(std::filesystem::path(fileName).stem().string())};
   for (std::size_t i = 0; i < mats->size(); ++i) {
     const std::string ptr = "/materials/" + std::to_string(i);
     const Json& m = (*mats)[i];
@@ -577,13 +611,13 @@ bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostic
     w.setDescription(fmt::format("Imported from {} materials[{}]{} (glTF 2.0 PBR).", fileName, i,
                                  sourceName.empty() ? "" : " " + quoteForDescription(sourceName)));
     GltfPbr g;
-    MaterialReader reader(doc, m, ptr, label, diags, w);
+    MaterialReader reader(doc, m, ptr, label, diags, w, embedded);
     if (!reader.read(g)) {
       ok = false;
       continue;
     }
     writeLayeredSurface(gltfPbrSurface(g, w), w);
-    out->push_back({sourceName, name, ptr, w.text()});
+    out->push_back({sourceName, name, ptr, w.text(), std::move(reader.images())});
   }
   return ok;
 }

@@ -17,8 +17,12 @@
 namespace substratec::import {
 
 /// Appends every material of `doc` to `out`. `fileName` (a file name, no
-/// directories) goes into each material's description. False on any error.
+/// directories) goes into each material's description. A texture's image is
+/// its input's `file`: a file's URI as a path, or for an image embedded in
+/// the document (a data: URI, or a bufferView of a data: buffer or of a
+/// .glb's binary chunk `glbBin`) "<fileName's stem>_image<N>.<ext>" with its
+/// bytes in ImportedMaterial::images. False on any error.
 bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostics& diags,
-                        std::vector<ImportedMaterial>* out);
+                        std::vector<ImportedMaterial>* out, const std::string* glbBin = nullptr);
 
 }  // namespace substratec::import

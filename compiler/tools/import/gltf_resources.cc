@@ -264,4 +264,84 @@ std::optional<std::string> uriPath(const std::string& uri) {
   return out;
 }
 
+std::optional<std::string> decodeDataUri(const std::string& uri, std::string* why) {
+  const std::size_t comma = uri.find(',');
+  if (uri.rfind("data:", 0) != 0 || comma == std::string::npos) {
+    *why = "not a data: URI";
+    return std::nullopt;
+  }
+  const Readable r = dataUri(uri);  // validates the alphabet and the length
+  if (!r.ok) {
+    *why = r.why;
+    return std::nullopt;
+  }
+  const std::string header = uri.substr(5, comma - 5);
+  if (header.size() < 7 || header.compare(header.size() - 7, 7, ";base64") != 0) {
+    *why = "a data: URI that is not base64";
+    return std::nullopt;
+  }
+  auto value = [](char c) -> int {
+    if (c >= 'A' && c <= 'Z') return c - 'A';
+    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+    if (c >= '0' && c <= '9') return c - '0' + 52;
+    return c == '+' ? 62 : c == '/' ? 63 : -1;  // '=' padding
+  };
+  std::string out;
+  out.reserve(r.bytes);
+  std::uint32_t bits = 0;
+  int count = 0;
+  for (std::size_t i = comma + 1; i < uri.size(); ++i) {
+    const int v = value(uri[i]);
+    if (v < 0) break;
+    bits = (bits << 6) | static_cast<std::uint32_t>(v);
+    if ((count += 6) >= 8) {
+      count -= 8;
+      out.push_back(static_cast<char>((bits >> count) & 0xFF));
+    }
+  }
+  return out;
+}
+
+std::optional<EmbeddedImage> embeddedImage(const Json& doc, int index, const std::string* glbBin, std::string* why) {
+  why->clear();
+  const Json* images = arrayOf(doc, "images");
+  if (!images || index < 0 || index >= static_cast<int>(images->size()) || !(*images)[index].is_object()) return std::nullopt;
+  const Json& img = (*images)[index];
+  std::string mime = img.contains("mimeType") && img["mimeType"].is_string() ? img["mimeType"].get<std::string>() : "";
+  std::optional<std::string> bytes;
+  if (img.contains("uri") && img["uri"].is_string()) {
+    const std::string& uri = img["uri"].get_ref<const std::string&>();
+    if (uri.rfind("data:", 0) != 0) return std::nullopt;  // a file
+    if (mime.empty()) mime = uri.substr(5, uri.find_first_of(";,") - 5);
+    bytes = decodeDataUri(uri, why);
+  } else if (auto v = indexIn(img, "bufferView", arrayOf(doc, "bufferViews")); v) {
+    const Json& view = doc["bufferViews"][*v];
+    const auto b = indexIn(view, "buffer", arrayOf(doc, "buffers"));
+    const std::uintmax_t offset = countOf(view, "byteOffset"), length = countOf(view, "byteLength");
+    std::optional<std::string> buffer;
+    if (b && doc["buffers"][*b].is_object() && doc["buffers"][*b].contains("uri")) {
+      const Json& uri = doc["buffers"][*b]["uri"];
+      if (uri.is_string() && uri.get<std::string>().rfind("data:", 0) == 0) buffer = decodeDataUri(uri.get<std::string>(), why);
+      else *why = "an image in a buffer file is not read (only a .glb's binary chunk and data: URIs)";
+    } else if (b && *b == 0 && glbBin) {
+      buffer = *glbBin;
+    } else {
+      *why = "its bufferView's buffer has no bytes here";
+    }
+    if (buffer && (offset > buffer->size() || length > buffer->size() - offset)) {
+      *why = fmt::format("its bufferView ({} bytes at {}) runs past its buffer's {} bytes", length, offset, buffer->size());
+      buffer.reset();
+    }
+    if (buffer) bytes = buffer->substr(static_cast<std::size_t>(offset), static_cast<std::size_t>(length));
+  } else {
+    return std::nullopt;
+  }
+  if (!bytes) {
+    if (why->empty()) *why = "its bytes cannot be read";
+    return std::nullopt;
+  }
+  const std::string extension = mime == "image/png" ? "png" : mime == "image/jpeg" ? "jpg" : "img";
+  return EmbeddedImage{std::move(*bytes), extension};
+}
+
 }  // namespace substratec::import

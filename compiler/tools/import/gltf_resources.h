@@ -30,6 +30,20 @@ inline constexpr int kMaxResourceWarnings = 32;
 bool checkGltfResources(const Json& doc, const std::string& baseDir, std::optional<std::size_t> glbBinBytes,
                         Diagnostics& diags);
 
+/// The bytes of a base64 data: URI (data:[<media type>];base64,<data>), or
+/// nullopt with `*why` when it is not one or is malformed.
+std::optional<std::string> decodeDataUri(const std::string& uri, std::string* why);
+
+/// The bytes of `doc`'s image `index` when it is embedded — a data: URI, or a
+/// bufferView of a .glb's binary chunk `glbBin` (null for none) or of a buffer
+/// given as a data: URI — and its file extension by its MIME type ("png",
+/// "jpg"; "img" for another). nullopt with `*why` when the image is a file
+/// (`*why` empty) or its bytes cannot be had.
+struct EmbeddedImage {
+  std::string bytes, extension;
+};
+std::optional<EmbeddedImage> embeddedImage(const Json& doc, int index, const std::string* glbBin, std::string* why);
+
 /// A relative URI as a path (percent-decoded), or nullopt when it is not one
 /// (a scheme such as data: or http:).
 std::optional<std::string> uriPath(const std::string& uri);

@@ -48,18 +48,20 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
   } else {
     std::string json = text;
     std::optional<std::size_t> binBytes;
+    std::optional<std::string> bin;
     const bool glb = kind == SourceKind::Glb || (kind == SourceKind::Gltf && looksLikeGlb(text));
     if (glb) {
       auto chunk = glbJsonChunk(text, diags);
       if (!chunk) return std::nullopt;
       json = std::move(*chunk);
       binBytes = glbBinChunkSize(text);
+      bin = glbBinChunk(text);
     }
     auto doc = parseJsonDocument(json, limits, diags);
     if (!doc) return std::nullopt;
     // A .glb's JSON chunk: its lines are not the file's, so its pointers stay unlocated.
     if (glb) diags.setLocator(nullptr);
-    ok = importGltfDocument(*doc, fileName, diags, &out);
+    ok = importGltfDocument(*doc, fileName, diags, &out, bin ? &*bin : nullptr);
     // The buffers and images a .gltf or .glb refers to (gltf_resources.h);
     // a .materials.json extract has none.
     if (kind != SourceKind::GltfMaterials) ok = checkGltfResources(*doc, baseDir, binBytes, diags) && ok;
@@ -126,18 +128,19 @@ std::optional<std::vector<MaterialSource>> loadMaterialSources(const std::string
     }
     auto text = readSourceFile(path, limits, diags);
     if (!text) return std::nullopt;
-    out.push_back({path, std::move(*text), false, baseDirOf(path)});
+    out.push_back({path, std::move(*text), false, baseDirOf(path), {}});
     return out;
   }
   auto imported = importFile(path, limits, diags);
   if (!imported) return std::nullopt;
   if (all && material.empty()) {
-    for (auto& m : *imported) out.push_back({path + "[" + m.name + "]", std::move(m.text), true, baseDirOf(path)});
+    for (auto& m : *imported)
+      out.push_back({path + "[" + m.name + "]", std::move(m.text), true, baseDirOf(path), std::move(m.images)});
     return out;
   }
   const ImportedMaterial* m = pickMaterial(*imported, material, diags);
   if (!m) return std::nullopt;
-  out.push_back({path + "[" + m->name + "]", m->text, true, baseDirOf(path)});
+  out.push_back({path + "[" + m->name + "]", m->text, true, baseDirOf(path), m->images});
   return out;
 }
 
@@ -241,7 +244,7 @@ void rebaseImageFiles(ImportedMaterial& m, const std::string& fromDir, const std
   for (auto& [name, input] : doc["inputs"].items()) {
     if (!input.is_object() || !input.contains("file") || !input["file"].is_string()) continue;
     const fs::path file(input["file"].get<std::string>());
-    if (file.is_absolute()) continue;
+    if (file.is_absolute() || m.images.count(file.string())) continue;  // embedded ones are written beside it
     input["file"] = (from / file).lexically_normal().lexically_relative(to).generic_string();
     changed = true;
   }

@@ -73,8 +73,8 @@ void renameMaterial(ImportedMaterial& m, const std::string& name);
 
 /// An imported material's texture `file`s, which are relative to the
 /// document it came from (`fromDir`), made relative to `toDir` (where the
-/// material is written); absolute ones are kept. Lexical on absolute paths:
-/// nothing needs to exist.
+/// material is written); absolute ones, and embedded images (written beside
+/// the material), are kept. Lexical on absolute paths: nothing needs to exist.
 void rebaseImageFiles(ImportedMaterial& m, const std::string& fromDir, const std::string& toDir);
 
 /// One material to compile: the text and how diagnostics call it.
@@ -83,6 +83,7 @@ struct MaterialSource {
   std::string text;
   bool imported = false;    // a compile error in it is the importer's (an internal error)
   std::string baseDir;      // the directory its texture inputs' `file`s are relative to (the file's)
+  std::map<std::string, std::string> images;  // embedded images by `file` (ImportedMaterial::images)
 };
 
 /// The material(s) `path` holds: a substrate-material/1 file as it is, or its

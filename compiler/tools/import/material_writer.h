@@ -7,6 +7,7 @@
 // readable. The result is text: it goes through the normal parser and
 // pipeline (compileText) like any hand-written material.
 #pragma once
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -75,6 +76,9 @@ struct ImportedMaterial {
   std::string name;        // a usable identifier, unique among the source's materials
   std::string location;    // where the source defines it (JSON pointer or "line N")
   std::string text;        // substrate-material/1 JSON
+  /// Images embedded in the source, by the file name its texture inputs give
+  /// them (`file`, relative to the material): bytes as stored (PNG, JPEG).
+  std::map<std::string, std::string> images;
 };
 
 /// A material identifier for `wanted` (sanitized; `fallback` when that is

@@ -120,7 +120,7 @@ bool importMaterialXDocument(const std::string& text, const std::string& fileNam
       continue;
     }
     writeLayeredSurface(s, w);
-    out->push_back({sourceName, name, fmt::format("line {}", line), w.text()});
+    out->push_back({sourceName, name, fmt::format("line {}", line), w.text(), {}});
   }
   return ok;
 }

@@ -27,10 +27,14 @@ std::string describeInput(const Input& in) {
   return s;
 }
 
-/// The decoded, mipmapped image at `path` into `*out`; false with `*why`.
-bool loadTexture(const std::string& path, bool srgb, gpu::ImageResource* out, std::string* why) {
+/// The decoded, mipmapped image at `path` (or, when `bytes` is not null, of
+/// those bytes) into `*out`; false with `*why`.
+bool loadTexture(const std::string& path, const std::string* bytes, bool srgb, gpu::ImageResource* out,
+                 std::string* why) {
   image::Rgba8 rgba;
-  if (!image::load(path, &rgba, why)) return false;
+  if (bytes ? !image::decode(reinterpret_cast<const std::uint8_t*>(bytes->data()), bytes->size(), &rgba, why)
+            : !image::load(path, &rgba, why))
+    return false;
   image::MipChain chain = image::mipChain(rgba, srgb);
   out->width = chain.widths[0];
   out->height = chain.heights[0];
@@ -92,9 +96,16 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
     const Input& in = m.inputs[i];
     if (in.type != VType::Texture) continue;
     std::string path, why;
+    const std::string* embedded = nullptr;
     const auto override = sources.overrides.find(in.name);
-    if (override != sources.overrides.end()) path = override->second;
-    else if (!in.file.empty()) path = resolveImagePath(in.file, sources);
+    if (override != sources.overrides.end()) {
+      path = override->second;
+    } else if (!in.file.empty() && sources.embedded && sources.embedded->count(in.file)) {
+      embedded = &sources.embedded->at(in.file);
+      path = "embedded:" + in.file;
+    } else if (!in.file.empty()) {
+      path = resolveImagePath(in.file, sources);
+    }
     if (path.empty()) {
       const std::array<double, 4> texel = gpu::neutralTexel(roles[i]);
       diags.note(in.pointer, fmt::format("{} has no image: bound to its neutral texel ({:g}, {:g}, {:g}, {:g}); "
@@ -105,7 +116,7 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
       continue;
     }
     gpu::ImageResource img;
-    if (!loadTexture(path, in.srgb, &img, &why)) {
+    if (!loadTexture(path, embedded, in.srgb, &img, &why)) {
       if (override != sources.overrides.end())
         diags.fail(fmt::format("--texture {}={}: cannot use the image: {}", in.name, path, why));
       else

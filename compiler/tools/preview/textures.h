@@ -26,13 +26,16 @@ struct TextureSources {
   std::vector<std::string> searchPaths;
   /// --texture NAME=PATH: PATH (relative to the working directory) for input NAME.
   std::map<std::string, std::string> overrides;
+  /// Images embedded in an imported document, by the `file` its inputs name
+  /// them with (import::MaterialSource::images); looked up before the disk.
+  const std::map<std::string, std::string>* embedded = nullptr;
 };
 
 /// A material's textures by input name, ready to bind: linear RGBA32F with
 /// their full mip chains, filtered linearly (trilinear) and repeated.
 struct BoundTextures {
   std::map<std::string, gpu::ImageResource> images;
-  std::map<std::string, std::string> sources;  // input -> the image's path, or "neutral"
+  std::map<std::string, std::string> sources;  // input -> the image's path, "embedded:<file>" or "neutral"
 };
 
 /// The path `file` resolves to: `file` when it is absolute, baseDir/file when
