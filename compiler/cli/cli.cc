@@ -588,12 +588,14 @@ int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, c
   preview::TextureSources sources;
   if (int status = textureSources(f, s, &sources, err); status != kExitOk) return status;
   sources.embedded = &s.images;
+  sources.imported = s.imported;
   Diagnostics diags(s.displayName);
   if (!s.imported) parseJsonDocument(s.text, read, diags);  // only for the locator: it compiled already
   const bool ok = preview::bindTextures(m, sources, out, diags);
   err << diags.formatAll();
   for (const auto& [name, path] : out->sources)
-    if (path != "neutral" && path.rfind("embedded:", 0) != 0) outputs.input(path);
+    if (path != "neutral" && path != "default specular profile" && path.rfind("embedded:", 0) != 0)
+      outputs.input(path);
   return ok ? kExitOk : kExitBadInput;
 }
 
@@ -624,7 +626,9 @@ void addPreviewOptions(CLI::App* c, PreviewArgs& a) {
   c->add_option("--target", a.target, "Which generated language renders: glsl or hlsl")
       ->check(CLI::IsMember({"glsl", "hlsl"}))->capture_default_str();
   addDiffuseOption(c, a.diffuse);
-  c->add_option("--exposure", a.exposure, "Exposure in stops before the tone curve")
+  c->add_option("--exposure", a.exposure,
+                "Exposure in stops on top of the calibrated one (0: a white Lambertian facing the camera is display "
+                "white before the tone curve)")
       ->transform(cli::inRange(-16.0, 16.0, "stops"))->capture_default_str();
   addMaxInputSize(c, a.compile);
   addPrecisionOption(c, a.precision);
@@ -678,7 +682,7 @@ std::optional<preview::Image> renderPreview(const PreviewArgs& a, gpu::Context& 
       printInternalError(err, failure.errorMessages());
       return std::nullopt;
     }
-    tiles.push_back(preview::tonemap(hdr, a.exposure));
+    tiles.push_back(preview::tonemap(hdr, a.exposure, preview::calibrationGains(a.environment)));
     const int closures = static_cast<int>(e.result.after.closures.size());
     labels.push_back(fmt::format("{}: {} B, {} cl", e.label, e.result.after.bytes(), closures));
   }

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cstdlib>
+#include <iostream>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -17,6 +19,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/cli.h"
+#include "sweep/sweep.h"
 
 namespace {
 
@@ -306,6 +309,92 @@ TEST(PreviewTextures, AMissingImageIsALocatedErrorAndNothingIsWritten) {
   EXPECT_EQ(r.status, 1);
   EXPECT_NE(r.err.find("lost.png"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "l.png"));
+}
+
+// ---------------------------------------------------------------- honest previews (issue 20)
+
+double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+
+/// A Lambertian of albedo (0.2, 0.4, 0.6) lands on sRGB(albedo) = (124, 170, 203)
+/// at the sphere's centre under every environment: the preview is calibrated
+/// (exposure and white balance) to the irradiance facing the camera, and the
+/// tone curve leaves colours in range alone. (It rendered (217, 226, 226).)
+TEST(PreviewCalibration, ALambertianLandsOnItsAlbedoAtTheCentreUnderEveryEnvironment) {
+  const fs::path dir = workDir() / "calibration";
+  fs::create_directories(dir);
+  std::ofstream(dir / "lambert.json") << R"({"format": "substrate-material/1", "name": "lambert",
+    "nodes": {"root": {"kind": "slab", "diffuse_albedo": [0.2, 0.4, 0.6], "f0": 0, "roughness": 1}}, "output": "root"})";
+  int measured = 0;
+  for (const char* env : {"studio", "sky", "white"}) {
+    const fs::path png = dir / (std::string(env) + ".png");
+    CliRun r = cli({"preview", (dir / "lambert.json").string(), "-o", png.string(), "--size", "64", "--env", env});
+    ASSERT_EQ(r.status, 0) << r.err;
+    const std::array<int, 3> centre = centreOf(png), want{124, 170, 203};
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre[c], want[c], 3) << env << " channel " << c;
+    ++measured;
+  }
+  EXPECT_EQ(measured, 3);
+}
+
+/// The ColorChecker example (its 24 published sRGB values as a matte chart)
+/// under the white furnace: each patch's mean colour over the middle of the
+/// patch, wherever it falls on the sphere, within ΔE2000 3 of its albedo.
+TEST(PreviewCalibration, TheColorCheckerUnderTheWhiteFurnaceIsWithinDeltaE3OfItsAlbedos) {
+  static const int kPatches[24][3] = {
+      {115, 82, 68},   {194, 150, 130}, {98, 122, 157},  {87, 108, 67},   {133, 128, 177}, {103, 189, 170},
+      {214, 126, 44},  {80, 91, 166},   {193, 90, 99},   {94, 60, 108},   {157, 188, 64},  {224, 163, 46},
+      {56, 61, 150},   {70, 148, 73},   {175, 54, 60},   {231, 199, 31},  {187, 86, 149},  {8, 133, 161},
+      {243, 243, 242}, {200, 200, 200}, {160, 160, 160}, {122, 122, 121}, {85, 85, 85},    {52, 52, 52}};
+  const int size = 256;
+  const fs::path png = workDir() / "color_checker.png";
+  CliRun r = cli({"preview", example("color_checker.json"), "-o", png.string(), "--size", std::to_string(size), "--env",
+                  "white"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  Png img;
+  ASSERT_TRUE(readPng(png, &img));
+  // Each pixel's hit on the sphere, as the preview kernel finds it (camera on
+  // +Z at 4.2, 30 degrees of field), its uv0 and the chart's uv (the example's
+  // (uv0 - (1, 0.5)) * 2 + 0.5).
+  std::array<std::array<double, 3>, 24> sum{};
+  std::array<int, 24> count{};
+  const double t = std::tan(15.0 * M_PI / 180.0);
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double nx = (x + 0.5) / size * 2 - 1, ny = (y + 0.5) / size * 2 - 1;
+      double d[3] = {nx * t, -ny * t, -1};
+      const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+      for (double& c : d) c /= len;
+      const double o[3] = {0, 0, 4.2};
+      const double b = o[0] * d[0] + o[1] * d[1] + o[2] * d[2], disc = b * b - (4.2 * 4.2 - 1);
+      if (disc < 0) continue;
+      const double hit = -b - std::sqrt(disc);
+      const double n[3] = {o[0] + hit * d[0], o[1] + hit * d[1], o[2] + hit * d[2]};
+      const double u0 = 2 * (0.5 + std::atan2(n[0], n[2]) / (2 * M_PI)), v0 = std::acos(std::clamp(n[1], -1.0, 1.0)) / M_PI;
+      const double u = (u0 - 1) * 2 + 0.5, v = (v0 - 0.5) * 2 + 0.5;
+      if (u < 0 || u >= 1 || v < 0 || v >= 1) continue;
+      const double pu = u * 6 - std::floor(u * 6), pv = v * 4 - std::floor(v * 4);
+      if (pu < 0.25 || pu > 0.75 || pv < 0.25 || pv > 0.75) continue;  // the middle of a patch
+      const int patch = static_cast<int>(v * 4) * 6 + static_cast<int>(u * 6);
+      const unsigned char* p = &img.rgba[(static_cast<std::size_t>(y) * size + x) * 4];
+      for (int c = 0; c < 3; ++c) sum[patch][c] += srgbToLinear(p[c] / 255.0);
+      ++count[patch];
+    }
+  double worst = 0;
+  int measured = 0;
+  for (int k = 0; k < 24; ++k) {
+    ASSERT_GE(count[k], 20) << "patch " << k + 1 << " has too few pixels to measure";
+    std::array<double, 3> got, want;
+    for (int c = 0; c < 3; ++c) {
+      got[c] = sum[k][c] / count[k];
+      want[c] = srgbToLinear(kPatches[k][c] / 255.0);
+    }
+    const double de = substratec::sweep::deltaE2000(got, want);
+    EXPECT_LE(de, 3.0) << "patch " << k + 1;
+    worst = std::max(worst, de);
+    ++measured;
+  }
+  EXPECT_EQ(measured, 24);
+  std::cout << "color checker under the white furnace: " << measured << " patches, worst ΔE2000 " << worst << "\n";
 }
 
 }  // namespace

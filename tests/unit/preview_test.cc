@@ -452,29 +452,39 @@ Image onePixel(float r, float g, float b, float a) {
   return img;
 }
 
-TEST(PreviewImage, TonemapIsAcesFittedAfterExposure) {
-  auto aces = [](double x) { return x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14); };
-  Image out = tonemap(onePixel(1.0f, 0.18f, 0.0f, 0.25f), 0.0);
-  EXPECT_NEAR(out.rgba[0], aces(1.0), 1e-6);
-  EXPECT_NEAR(out.rgba[0], 0.8, 0.01);
-  EXPECT_NEAR(out.rgba[1], aces(0.18), 1e-6);
+TEST(PreviewImage, TonemapLeavesColoursInRangeAloneAndShouldersTheRestTowardWhite) {
+  // Below a peak channel of 0.76: the colour itself (after exposure and gains).
+  Image out = tonemap(onePixel(0.7f, 0.18f, 0.0f, 0.25f), 0.0);
+  EXPECT_FLOAT_EQ(out.rgba[0], 0.7f);
+  EXPECT_FLOAT_EQ(out.rgba[1], 0.18f);
   EXPECT_EQ(out.rgba[2], 0.0f);
   EXPECT_EQ(out.rgba[3], 0.25f);  // alpha kept
-  // +1 stop doubles the input.
-  EXPECT_FLOAT_EQ(tonemap(onePixel(0.5f, 0.5f, 0.5f, 1), 1.0).rgba[0], out.rgba[0]);
-  EXPECT_FLOAT_EQ(tonemap(onePixel(4.0f, 4.0f, 4.0f, 1), -2.0).rgba[0], out.rgba[0]);
-  // Bounded, monotone, negative to 0, +inf to 1, NaN kept for the encoder to count.
+  // +1 stop doubles the input; a gain scales its channel.
+  EXPECT_FLOAT_EQ(tonemap(onePixel(0.35f, 0.09f, 0, 1), 1.0).rgba[0], 0.7f);
+  EXPECT_FLOAT_EQ(tonemap(onePixel(0.7f, 0.36f, 0, 1), 0.0, {1, 0.5, 1}).rgba[1], 0.18f);
+  // Above: Khronos PBR Neutral's shoulder, 1 − 0.24² / (peak − 0.52), and the
+  // pixel pulled toward white (grey stays grey).
+  const double peak = 2.0, newPeak = 1 - 0.24 * 0.24 / (peak - 0.52);
+  Image grey = tonemap(onePixel(2.0f, 2.0f, 2.0f, 1), 0.0);
+  EXPECT_NEAR(grey.rgba[0], newPeak, 1e-6);
+  EXPECT_NEAR(grey.rgba[2], newPeak, 1e-6);
+  Image red = tonemap(onePixel(2.0f, 0.0f, 0.0f, 1), 0.0);
+  EXPECT_NEAR(red.rgba[0], newPeak, 1e-6);
+  EXPECT_GT(red.rgba[1], 0.0f) << "desaturated toward white";
+  EXPECT_LT(red.rgba[1], red.rgba[0]);
+  // Bounded, monotone, negative to 0, +inf near 1, NaN kept for the encoder to count.
   Image edge = tonemap(onePixel(1e30f, -3.0f, INFINITY, NAN), 0.0);
   EXPECT_LE(edge.rgba[0], 1.0f);
   EXPECT_GT(edge.rgba[0], 0.99f);
-  EXPECT_EQ(edge.rgba[1], 0.0f);
-  EXPECT_EQ(edge.rgba[2], 1.0f);
+  EXPECT_GE(edge.rgba[1], 0.0f);
+  EXPECT_LE(edge.rgba[2], 1.0f);
   EXPECT_TRUE(std::isnan(edge.rgba[3]));  // alpha untouched
   EXPECT_TRUE(std::isnan(tonemap(onePixel(NAN, 0, 0, 1), 0.0).rgba[0]));
   float previous = -1.0f;
   for (float x = 0.0f; x < 100.0f; x = x * 1.1f + 0.001f) {
     float y = tonemap(onePixel(x, x, x, 1), 0.0).rgba[0];
     EXPECT_GE(y, previous) << x;
+    EXPECT_LE(y, 1.0f) << x;
     previous = y;
   }
 }

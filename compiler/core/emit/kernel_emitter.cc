@@ -10,6 +10,24 @@ namespace {
 
 using namespace kernel;
 
+/// The preview's specular profiles: each profile input as its own texture
+/// (set 1, binding kPreviewProfileBinding + k, named p_<input>; HLSL's sampler
+/// ps_<input> 16 above), read by SUBSTRATE_SPECULAR_PROFILE_SAMPLE, which the
+/// runtime otherwise leaves at white (an engine binds its profile atlas).
+std::string previewProfiles(const Material& m, const StorageLayout& L, const Syntax& syn) {
+  const std::vector<int> profiles = specularProfileInputs(m, L);
+  if (profiles.empty()) return "";
+  std::string s, body;
+  for (std::size_t k = 0; k < profiles.size(); ++k) {
+    const std::string& name = m.inputs[profiles[k]].name;
+    const int binding = kPreviewProfileBinding + static_cast<int>(k);
+    s += syn.texture(1, binding, false, "p_" + name) + syn.sampler(1, binding + 16, "ps_" + name);
+    body += fmt::format("  if (index == {}u) return SUBSTRATE_TEXTURE_SAMPLE_LEVEL(p_{}, ps_{}, uv, 0.0).rgb;\n", k, name, name);
+  }
+  s += "float3 substrate_preview_profile(uint index, float2 uv) {\n" + body + "  return SUBSTRATE_SPLAT3(1.0);\n}\n";
+  return s + "#define SUBSTRATE_SPECULAR_PROFILE_SAMPLE(index, uv) substrate_preview_profile(index, uv)\n";
+}
+
 /// Includes, in the order the entries use: the storage code before the
 /// material (compiles its pack function in), the unpacker and lighting after.
 std::string includes(const Material& m, const StorageLayout& L, const Syntax& syn, KernelMode mode,
@@ -30,6 +48,7 @@ std::string includes(const Material& m, const StorageLayout& L, const Syntax& sy
     s += "#include \"substrate_pack.h\"\n";
   }
   s += fmt::format("#include \"{}{}\"\n", m.name, syn.materialExtension);
+  if (mode == KernelMode::Preview) s += previewProfiles(m, L, syn);
   if (mode == KernelMode::Deferred) s += "#include \"substrate_unpack.h\"\n";
   s += "#include \"substrate_energy_lut.h\"\n#include \"substrate_bsdf.h\"\n#include \"substrate_lighting.h\"\n\n";
   return s;

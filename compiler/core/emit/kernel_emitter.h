@@ -78,6 +78,10 @@ inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6,
 /// The sphere has radius 1 at the origin, +Y up, the camera looks at the origin.
 inline constexpr int kPreviewLights = 3;
 inline constexpr int kPreviewParamVec4s = 2 + 2 * kPreviewLights;
+/// The preview's specular profiles (specularProfileInputs order): profile k is
+/// the texture p_<input> at set 1, binding kPreviewProfileBinding + k (HLSL's
+/// sampler ps_<input> at 16 more), above the material's own textures.
+inline constexpr int kPreviewProfileBinding = 40;
 }  // namespace kernel
 
 /// The kernel source; it includes "<name>.material.{glsl,hlsl}" and the runtime.

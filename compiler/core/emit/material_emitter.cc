@@ -142,6 +142,15 @@ std::string coatFloorDefine(const Material& m, const StorageLayout& layout) {
                      any && !stretched ? 1 : 0, stretched ? 1 : 0);
 }
 
+std::vector<int> specularProfileInputs(const Material& m, const StorageLayout& layout) {
+  std::vector<int> inputs;
+  for (const ClosureLayout& c : layout.closures) {
+    const int input = m.slabs[c.slab].specularProfileInput;
+    if (input >= 0 && std::find(inputs.begin(), inputs.end(), input) == inputs.end()) inputs.push_back(input);
+  }
+  return inputs;
+}
+
 bool translucentBlend(const Material& m) {
   return m.settings.blendMode == BlendMode::TranslucentGrey || m.settings.blendMode == BlendMode::TranslucentColored ||
          m.settings.blendMode == BlendMode::ColoredTransmittanceOnly;
@@ -418,11 +427,9 @@ void Emitter::collectNeeded() {
       need(s.pin(SlabPin::GlintUv));
     }
     if (f & kFeatEmissive) need(s.pin(SlabPin::Emissive));
-    if (s.specularProfileInput >= 0 && !profileIndex_.count(s.specularProfileInput)) {
-      int k = static_cast<int>(profileIndex_.size());
-      profileIndex_[s.specularProfileInput] = k;
-    }
   }
+  const std::vector<int> profiles = specularProfileInputs(m_, L_);
+  for (std::size_t k = 0; k < profiles.size(); ++k) profileIndex_[profiles[k]] = static_cast<int>(k);
   for (ValueId v = 0; v < m_.values.size(); ++v)
     if (needed_[v] && m_.values.node(v).op == Op::Sample) textures_.insert(m_.values.node(v).attr);
 }

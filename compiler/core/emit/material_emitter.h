@@ -65,6 +65,11 @@ std::string topRoughnessExpr(const StorageLayout& layout, const std::string& arr
 /// Shared by the entry, kernel and scene emitters.
 /// A material blended over the background through its transmittance (dual-source).
 bool translucentBlend(const Material& m);
+
+/// The texture inputs the closures of `layout` use as specular profiles, in
+/// profile-index order (first use among the closures): a closure's
+/// `specularProfile` is its input's position here + 1.
+std::vector<int> specularProfileInputs(const Material& m, const StorageLayout& layout);
 /// A closure of `layout` is emissive.
 bool anyEmissive(const Material& m, const StorageLayout& layout);
 /// What the background is multiplied by behind a translucent material (float3,

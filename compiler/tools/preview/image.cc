@@ -6,6 +6,7 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -21,14 +22,26 @@ Image::Image(int w, int h, std::array<float, 4> fill) : width(w), height(h) {
 
 namespace {
 
-/// Narkowicz's ACES fit on one channel (already exposed).
-float acesFitted(float x) {
-  if (std::isnan(x)) return x;
-  if (!(x > 0.0f)) return 0.0f;
-  if (std::isinf(x)) return 1.0f;
-  double v = x;
-  double y = (v * (2.51 * v + 0.03)) / (v * (2.43 * v + 0.59) + 0.14);
-  return static_cast<float>(y < 0.0 ? 0.0 : (y > 1.0 ? 1.0 : y));
+/// The shoulder of the Khronos PBR Neutral tone mapper (Khronos 3D Commerce,
+/// 2024) on one exposed pixel, in place: identity up to a peak channel of
+/// 0.76, then a hue-preserving shoulder that desaturates toward white. (PBR
+/// Neutral also subtracts up to 0.04 from every channel, the dielectric
+/// Fresnel a base colour gains under a white furnace; a preview keeps it, so
+/// that a Lambertian lands on its albedo and a dielectric shows its sheen.)
+/// NaN channels stay NaN; negatives count as 0 and +inf as 1e30.
+void neutralShoulder(float* rgb) {
+  constexpr double kStartCompression = 0.8 - 0.04, kDesaturation = 0.15;
+  double c[3];
+  for (int i = 0; i < 3; ++i) c[i] = std::isnan(rgb[i]) ? 0.0 : std::clamp(static_cast<double>(rgb[i]), 0.0, 1e30);
+  const double peak = std::max({c[0], c[1], c[2]});
+  if (peak >= kStartCompression) {
+    const double d = 1.0 - kStartCompression;
+    const double newPeak = 1.0 - d * d / (peak + d - kStartCompression);
+    const double g = 1.0 - 1.0 / (kDesaturation * (peak - newPeak) + 1.0);
+    for (double& v : c) v = (v * newPeak / peak) * (1.0 - g) + newPeak * g;
+  }
+  for (int i = 0; i < 3; ++i)
+    if (!std::isnan(rgb[i])) rgb[i] = static_cast<float>(std::clamp(c[i], 0.0, 1.0));
 }
 
 /// round(255 clamp(v)); `srgb` applies the OETF first.
@@ -46,11 +59,13 @@ bool fail(Diagnostics& diags, std::string message) {
 
 }  // namespace
 
-Image tonemap(const Image& hdr, double exposure) {
+Image tonemap(const Image& hdr, double exposure, const std::array<double, 3>& gains) {
   Image out = hdr;
-  const float scale = static_cast<float>(std::exp2(exposure));
-  for (size_t i = 0; i < out.rgba.size(); ++i)
-    if (i % 4 != 3) out.rgba[i] = acesFitted(out.rgba[i] * scale);
+  const double scale = std::exp2(exposure);
+  for (size_t p = 0; p + 3 < out.rgba.size(); p += 4) {
+    for (int c = 0; c < 3; ++c) out.rgba[p + c] = static_cast<float>(out.rgba[p + c] * (scale * gains[c]));
+    neutralShoulder(&out.rgba[p]);
+  }
   return out;
 }
 

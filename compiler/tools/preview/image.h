@@ -23,12 +23,15 @@ struct Image {
   const float* pixel(int x, int y) const { return rgba.data() + (static_cast<size_t>(y) * width + x) * 4; }
 };
 
-/// Display-referred linear RGB in [0, 1]: each channel times 2^exposure, then
-/// the ACES filmic fit of Narkowicz 2015, f(x) = x (2.51 x + 0.03) /
-/// (x (2.43 x + 0.59) + 0.14), per channel, clamped to [0, 1] (f(1) = 0.80,
-/// f(0.18) = 0.27). Negative values go to 0, +inf to 1; NaN stays NaN (so
-/// encodeSrgb8 can count it). Alpha is kept.
-Image tonemap(const Image& hdr, double exposure);
+/// Display-referred linear RGB in [0, 1]: each channel times 2^exposure and
+/// its gain (white balance), then the shoulder of the Khronos PBR Neutral tone
+/// mapper per pixel: below a peak channel of 0.76 nothing changes (so a
+/// colour in range comes out as itself); above, the peak goes to
+/// 1 − 0.24² / (peak − 0.52) and the pixel toward white by
+/// 1 − 1 / (0.15 (peak − new peak) + 1). Negative values count as 0, +inf as
+/// a huge value (→ 1); a NaN channel stays NaN (so encodeSrgb8 can count it).
+/// Alpha is kept. (docs/textures.md, "Honest previews")
+Image tonemap(const Image& hdr, double exposure, const std::array<double, 3>& gains = {1, 1, 1});
 
 /// 8-bit sRGB pixels and how many pixels had a NaN channel.
 struct Srgb8 {

@@ -72,7 +72,27 @@ const Light kLights[kPreviewLights] = {
     {unit({0.2, 0.5, -0.9}), {1.2, 1.2, 1.2}},
 };
 
+/// The lights of `environment`: the three above, except under "white", a
+/// furnace, which is its radiance 1 alone (every light black).
+Light previewLight(const std::string& environment, int l) {
+  Light light = kLights[l];
+  if (environment == "white") light.radiance = {0, 0, 0};
+  return light;
+}
+
 }  // namespace
+
+std::array<double, 3> calibrationGains(const std::string& environment) {
+  const std::array<double, 3> toCamera{0, 0, 1};
+  std::array<double, 3> e = sampleCube(environmentMaps(environment).irradiance, toCamera, 0.0);
+  for (int l = 0; l < kPreviewLights; ++l) {
+    const Light light = previewLight(environment, l);
+    const double cosine = std::max(0.0, light.direction[0] * toCamera[0] + light.direction[1] * toCamera[1] +
+                                            light.direction[2] * toCamera[2]);
+    for (int c = 0; c < 3; ++c) e[c] += cosine * light.radiance[c];
+  }
+  return {M_PI / std::max(e[0], 1e-9), M_PI / std::max(e[1], 1e-9), M_PI / std::max(e[2], 1e-9)};
+}
 
 gpu::ComputePipeline* PipelineCache::get(gpu::Context& gpu, const std::vector<uint32_t>& spirv, Diagnostics& diags) {
   auto it = pipelines_.find(spirv);
@@ -113,8 +133,9 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
   std::memcpy(&params[4], viewport, sizeof viewport);
   for (int l = 0; l < kPreviewLights; ++l)
     for (int c = 0; c < 3; ++c) {
-      params[(2 + l) * 4 + c] = static_cast<float>(kLights[l].direction[c]);
-      params[(2 + kPreviewLights + l) * 4 + c] = static_cast<float>(kLights[l].radiance[c]);
+      const Light light = previewLight(o.environment, l);
+      params[(2 + l) * 4 + c] = static_cast<float>(light.direction[c]);
+      params[(2 + kPreviewLights + l) * 4 + c] = static_cast<float>(light.radiance[c]);
     }
 
   const std::vector<gpu::TextureRole> roles = gpu::textureRoles(r.material);
@@ -140,7 +161,16 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
     } else if (b.set == 1 && b.binding == 0) {
       res[key] = gpu::BufferResource{gpu::inputBlockBytes(r.material, gpu::blockMembers(v.spirv, 1, 0), {}), false};
     } else if (b.set == 1 && b.kind == gpu::DescriptorKind::Sampler) {
-      res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::Repeat};
+      const bool profile = b.binding >= kPreviewProfileBinding + 16;  // a LUT: clamped
+      res[key] = gpu::SamplerResource{gpu::Filter::Linear, profile ? gpu::Address::ClampToEdge : gpu::Address::Repeat};
+    } else if (b.set == 1 && b.binding >= kPreviewProfileBinding) {  // a specular profile: p_<input>
+      const std::string name = b.name.rfind("p_", 0) == 0 ? b.name.substr(2) : b.name;
+      const gpu::ImageResource* image = nullptr;
+      if (o.textures)
+        if (auto it = o.textures->images.find(name); it != o.textures->images.end()) image = &it->second;
+      gpu::ImageResource lut = image ? *image : defaultSpecularProfile();
+      lut.address = gpu::Address::ClampToEdge;
+      res[key] = std::move(lut);
     } else if (b.set == 1) {  // a texture: its bound image, or its neutral texel
       const int input = gpu::inputOfResource(r.material, b.name);
       const std::string name = input >= 0 ? r.material.inputs[input].name : "";

@@ -43,6 +43,14 @@ struct RenderOptions {
   const BoundTextures* textures = nullptr;
 };
 
+/// The gains (exposure and white balance, per channel) that calibrate a render
+/// under `environment`: π / E_c for the irradiance E on a normal facing the
+/// camera (the environment's, plus its lights' at their cosines), so that a
+/// white Lambertian at the sphere's centre reflects radiance (1, 1, 1) and a
+/// Lambertian of albedo a reflects a, which the tone curve (tonemap) keeps
+/// below 0.76. (1, 1, 1) for "white" (radiance 1 everywhere, no lights).
+std::array<double, 3> calibrationGains(const std::string& environment);
+
 /// Renders `r` (linear HDR, background = the environment). False, with errors
 /// reported, on a kernel that does not validate (a compiler bug) or a failed dispatch.
 bool renderSphere(gpu::Context& gpu, const CompileResult& r, const RenderOptions& options, Image* out,

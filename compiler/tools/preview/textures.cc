@@ -1,5 +1,6 @@
 #include "preview/textures.h"
 
+#include <cmath>
 #include <filesystem>
 #include <set>
 #include <system_error>
@@ -21,9 +22,9 @@ bool pathExists(const fs::path& p) {
 }
 
 /// "texture input 'x'" and, for an imported material, what it came from.
-std::string describeInput(const Input& in) {
+std::string describeInput(const Input& in, bool imported) {
   std::string s = fmt::format("texture input {}", quoteForDiagnostic(in.name));
-  if (!in.description.empty()) s += fmt::format(" ({})", in.description);
+  if (imported && !in.description.empty()) s += fmt::format(" ({})", in.description);
   return s;
 }
 
@@ -77,6 +78,24 @@ gpu::ImageResource solidTexture(const std::array<double, 4>& texel) {
   return img;
 }
 
+gpu::ImageResource defaultSpecularProfile() {
+  constexpr int kSize = 32;
+  gpu::ImageResource img;
+  img.width = img.height = kSize;
+  std::vector<float> texels;
+  for (int y = 0; y < kSize; ++y)
+    for (int x = 0; x < kSize; ++x) {
+      const double noV = (x + 0.5) / kSize, noL = (y + 0.5) / kSize, m = (2.0 - noV - noL) / 2.0;
+      for (int c = 0; c < 3; ++c)
+        texels.push_back(static_cast<float>(1.0 - 0.6 * m * (0.5 - 0.5 * std::cos(2.0 * M_PI * (0.8 * m + c / 3.0)))));
+      texels.push_back(1.0f);
+    }
+  img.mips = {std::move(texels)};
+  img.filter = gpu::Filter::Linear;
+  img.address = gpu::Address::ClampToEdge;
+  return img;
+}
+
 bool bindTextures(const Material& m, const TextureSources& sources, BoundTextures* out, Diagnostics& diags) {
   bool ok = true;
   std::set<std::string> textureNames;
@@ -92,6 +111,9 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
       ok = false;
     }
   const std::vector<gpu::TextureRole> roles = gpu::textureRoles(m);
+  std::set<int> profiles;  // inputs some slab uses as its specular profile
+  for (const Slab& slab : m.slabs)
+    if (slab.specularProfileInput >= 0) profiles.insert(slab.specularProfileInput);
   for (std::size_t i = 0; i < m.inputs.size(); ++i) {
     const Input& in = m.inputs[i];
     if (in.type != VType::Texture) continue;
@@ -106,11 +128,19 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
     } else if (!in.file.empty()) {
       path = resolveImagePath(in.file, sources);
     }
+    if (path.empty() && profiles.count(static_cast<int>(i))) {
+      diags.note(in.pointer, fmt::format("{} has no image: bound to the default specular profile (a pearlescent hue "
+                                         "toward grazing); --texture {}=PATH binds one",
+                                         describeInput(in, sources.imported), in.name));
+      out->images[in.name] = defaultSpecularProfile();
+      out->sources[in.name] = "default specular profile";
+      continue;
+    }
     if (path.empty()) {
       const std::array<double, 4> texel = gpu::neutralTexel(roles[i]);
       diags.note(in.pointer, fmt::format("{} has no image: bound to its neutral texel ({:g}, {:g}, {:g}, {:g}); "
                                          "--texture {}=PATH binds one",
-                                         describeInput(in), texel[0], texel[1], texel[2], texel[3], in.name));
+                                         describeInput(in, sources.imported), texel[0], texel[1], texel[2], texel[3], in.name));
       out->images[in.name] = solidTexture(texel);
       out->sources[in.name] = "neutral";
       continue;
@@ -121,7 +151,7 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
         diags.fail(fmt::format("--texture {}={}: cannot use the image: {}", in.name, path, why));
       else
         diags.error(in.pointer + "/file",
-                    fmt::format("{}: cannot use the image {} ({}): {}{}", describeInput(in), quoteForDiagnostic(in.file),
+                    fmt::format("{}: cannot use the image {} ({}): {}{}", describeInput(in, sources.imported), quoteForDiagnostic(in.file),
                                 path, why, sources.searchPaths.empty() && why == "no such file"
                                                ? " (a relative path is looked for beside the material file, "
                                                  "then along --search-path)"

@@ -29,6 +29,9 @@ struct TextureSources {
   /// Images embedded in an imported document, by the `file` its inputs name
   /// them with (import::MaterialSource::images); looked up before the disk.
   const std::map<std::string, std::string>* embedded = nullptr;
+  /// The material was imported: its inputs' descriptions name their source
+  /// (the glTF texture and image, the MaterialX element), and messages quote them.
+  bool imported = false;
 };
 
 /// A material's textures by input name, ready to bind: linear RGBA32F with
@@ -54,5 +57,12 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
 
 /// A 1 x 1 texture of `texel` (RGBA), for a binding that has no image.
 gpu::ImageResource solidTexture(const std::array<double, 4>& texel);
+
+/// The specular profile a profile input without an image is bound to (so that
+/// a profile shows: white would be no profile at all): a 32 x 32 view/light
+/// LUT (u = NoV, v = NoL), white where both are 1 and shifting through a
+/// pearlescent hue toward grazing: with m = (2 − NoV − NoL) / 2,
+/// rgb = 1 − 0.6 m (0.5 − 0.5 cos(2π (0.8 m + (0, 1/3, 2/3)))).
+gpu::ImageResource defaultSpecularProfile();
 
 }  // namespace substratec::preview
