@@ -397,4 +397,37 @@ TEST(PreviewCalibration, TheColorCheckerUnderTheWhiteFurnaceIsWithinDeltaE3OfIts
   std::cout << "color checker under the white furnace: " << measured << " patches, worst ΔE2000 " << worst << "\n";
 }
 
+/// A specular profile takes effect in a preview: bound to its image, or with
+/// none to the default (pearlescent) profile, which differs from a white one
+/// (no profile). Here the base's index differs from its coat's, so it has a
+/// specular interface for the profile to tint.
+TEST(PreviewCalibration, ASpecularProfileTintsTheSpecularItIsBoundTo) {
+  const fs::path dir = workDir() / "profile";
+  fs::create_directories(dir);
+  solidPng(dir / "white.png", 255, 255, 255);
+  solidPng(dir / "black.png", 0, 0, 0);
+  std::ofstream(dir / "profiled.json") << R"({"format": "substrate-material/1", "name": "profiled",
+    "inputs": {"lut": {"type": "texture2d"}},
+    "nodes": {"base": {"kind": "slab", "diffuse_albedo": 0.2, "f0": 0.3, "roughness": 0.35, "specular_profile": "$lut"},
+              "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.1, "sss_mfp": 10},
+              "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.0001}},
+    "output": "root"})";
+  const std::string material = (dir / "profiled.json").string();
+  CliRun byDefault = cli({"preview", material, "-o", (dir / "d.png").string(), "--size", "48"});
+  ASSERT_EQ(byDefault.status, 0) << byDefault.err;
+  EXPECT_NE(byDefault.err.find("note: texture input \"lut\" has no image: bound to the default specular profile"),
+            std::string::npos)
+      << byDefault.err;
+  ASSERT_EQ(cli({"preview", material, "-o", (dir / "w.png").string(), "--size", "48", "--texture",
+                 "lut=" + (dir / "white.png").string()})
+                .status,
+            0);
+  ASSERT_EQ(cli({"preview", material, "-o", (dir / "b.png").string(), "--size", "48", "--texture",
+                 "lut=" + (dir / "black.png").string()})
+                .status,
+            0);
+  EXPECT_NE(bytesOf(dir / "d.png"), bytesOf(dir / "w.png")) << "the default profile is not white";
+  EXPECT_NE(bytesOf(dir / "b.png"), bytesOf(dir / "w.png")) << "a black profile removes the base's specular";
+}
+
 }  // namespace

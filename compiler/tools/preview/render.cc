@@ -80,6 +80,28 @@ Light previewLight(const std::string& environment, int l) {
   return light;
 }
 
+/// A set-1 texture or sampler binding of the preview kernel: a material
+/// texture's bound image or its neutral texel (repeated), a specular profile
+/// p_<input>'s image or the default profile (clamped), their samplers.
+gpu::Resource materialTexture(const Material& m, const std::vector<gpu::TextureRole>& roles,
+                              const BoundTextures* textures, const gpu::DescriptorBinding& b) {
+  const bool profile = b.binding >= kPreviewProfileBinding;
+  if (b.kind == gpu::DescriptorKind::Sampler)
+    return gpu::SamplerResource{gpu::Filter::Linear, profile ? gpu::Address::ClampToEdge : gpu::Address::Repeat};
+  const int input = profile ? -1 : gpu::inputOfResource(m, b.name);
+  const std::string name = profile ? (b.name.rfind("p_", 0) == 0 ? b.name.substr(2) : b.name)
+                                   : (input >= 0 ? m.inputs[input].name : "");
+  const gpu::ImageResource* image = nullptr;
+  if (textures)
+    if (auto it = textures->images.find(name); it != textures->images.end()) image = &it->second;
+  if (profile) {
+    gpu::ImageResource lut = image ? *image : defaultSpecularProfile();
+    lut.address = gpu::Address::ClampToEdge;
+    return lut;
+  }
+  return image ? *image : solidTexture(gpu::neutralTexel(input >= 0 ? roles[input] : gpu::TextureRole::Colour));
+}
+
 }  // namespace
 
 std::array<double, 3> calibrationGains(const std::string& environment) {
@@ -138,7 +160,7 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
       params[(2 + kPreviewLights + l) * 4 + c] = static_cast<float>(light.radiance[c]);
     }
 
-  const std::vector<gpu::TextureRole> roles = gpu::textureRoles(r.material);
+  const std::vector<gpu::TextureRole> roles = gpu::textureRoles(r.material);  // for unbound textures
   gpu::Resources res;
   for (const gpu::DescriptorBinding& b : pipeline->reflection().bindings) {
     const auto key = std::make_pair(b.set, b.binding);
@@ -160,24 +182,8 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
       res[key] = buf;
     } else if (b.set == 1 && b.binding == 0) {
       res[key] = gpu::BufferResource{gpu::inputBlockBytes(r.material, gpu::blockMembers(v.spirv, 1, 0), {}), false};
-    } else if (b.set == 1 && b.kind == gpu::DescriptorKind::Sampler) {
-      const bool profile = b.binding >= kPreviewProfileBinding + 16;  // a LUT: clamped
-      res[key] = gpu::SamplerResource{gpu::Filter::Linear, profile ? gpu::Address::ClampToEdge : gpu::Address::Repeat};
-    } else if (b.set == 1 && b.binding >= kPreviewProfileBinding) {  // a specular profile: p_<input>
-      const std::string name = b.name.rfind("p_", 0) == 0 ? b.name.substr(2) : b.name;
-      const gpu::ImageResource* image = nullptr;
-      if (o.textures)
-        if (auto it = o.textures->images.find(name); it != o.textures->images.end()) image = &it->second;
-      gpu::ImageResource lut = image ? *image : defaultSpecularProfile();
-      lut.address = gpu::Address::ClampToEdge;
-      res[key] = std::move(lut);
-    } else if (b.set == 1) {  // a texture: its bound image, or its neutral texel
-      const int input = gpu::inputOfResource(r.material, b.name);
-      const std::string name = input >= 0 ? r.material.inputs[input].name : "";
-      const gpu::ImageResource* image = nullptr;
-      if (o.textures)
-        if (auto it = o.textures->images.find(name); it != o.textures->images.end()) image = &it->second;
-      res[key] = image ? *image : solidTexture(gpu::neutralTexel(input >= 0 ? roles[input] : gpu::TextureRole::Colour));
+    } else if (b.set == 1) {
+      res[key] = materialTexture(r.material, roles, o.textures, b);
     }
   }
   const uint32_t groups = static_cast<uint32_t>((o.size + 7) / 8);
