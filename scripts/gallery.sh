@@ -13,7 +13,9 @@ mkdir -p "$OUT"
   echo
   echo "Every example in \`examples/\`, rendered by \`substratec preview FILE --size 128\` on lavapipe"
   echo "(the generated GLSL preview kernel: three lights and the procedural \"studio\" environment,"
-  echo "textures bound to a soft checker). Regenerate with \`scripts/gallery.sh\`."
+  echo "exposed and white-balanced so that a Lambertian lands on its albedo at the centre; each texture"
+  echo "bound to its input's \`file\` or, without one, to its neutral texel: docs/textures.md)."
+  echo "Regenerate with \`scripts/gallery.sh\`."
   echo
   echo "| | | | |"
   echo "|---|---|---|---|"
@@ -21,7 +23,7 @@ mkdir -p "$OUT"
   n=0
   for f in "$ROOT"/examples/*.json; do
     stem="$(basename "$f" .json)"
-    "$BIN" preview "$f" -o "$OUT/$stem.png" --size 128 >/dev/null
+    "$BIN" preview "$f" -o "$OUT/$stem.png" --size 128 >/dev/null 2>"$OUT/notes.tmp" || { cat "$OUT/notes.tmp" >&2; exit 1; }
     row="$row| ![$stem]($stem.png)<br>\`$stem\` "
     n=$((n + 1))
     if [ $((n % 4)) -eq 0 ]; then echo "$row|"; row=""; fi
@@ -37,5 +39,5 @@ mkdir -p "$OUT"
   echo "![worked_example_72 sweep](worked_example_72.sweep.png)"
 } > "$OUT/README.md.tmp"
 sed 's|](\([a-z0-9_.]*\.png\))|](gallery/\1)|g' "$OUT/README.md.tmp" > "$ROOT/docs/gallery.md"
-rm "$OUT/README.md.tmp"
+rm -f "$OUT/README.md.tmp" "$OUT/notes.tmp"
 echo "wrote $ROOT/docs/gallery.md and $(ls "$OUT" | wc -l) images"
