@@ -21,6 +21,7 @@
 #include "cli_util.h"
 #include "output/atomic_write.h"
 #include "output/file_identity.h"
+#include "preview/image.h"
 
 namespace fs = std::filesystem;
 using substratec::clitest::cli;
@@ -196,6 +197,22 @@ TEST(OutputsAreNotInputs, PreviewRefusesToWriteOverItsInput) {
   expectRefused({"preview", p.string(), "-o", p.string()}, dir, "output '" + p.string() + "' is an input");
   fs::create_symlink("p.json", dir / "p.png");
   expectRefused({"preview", p.string(), "-o", (dir / "p.png").string()}, dir, "(the same file)");
+}
+
+/// A texture's image is an input of the preview too (issue 20): an output
+/// over it, by --texture or by the input's own file, is refused before any
+/// rendering, and the image is left as it was.
+TEST(OutputsAreNotInputs, PreviewRefusesToWriteOverATexturesImage) {
+  const fs::path dir = freshDir("preview_texture");
+  fs::create_directories(dir);
+  substratec::Diagnostics d("albedo.png");
+  ASSERT_TRUE(substratec::preview::writePng((dir / "albedo.png").string(), 1, 1, {10, 20, 30, 255}, d)) << d.formatAll();
+  std::ofstream(dir / "t.json") << R"({"format": "substrate-material/1", "name": "t",
+    "inputs": {"albedo": {"type": "texture2d", "file": "albedo.png"}},
+    "nodes": {"a": {"kind": "texture", "texture": "$albedo"}, "root": {"kind": "slab", "diffuse_albedo": "a"}},
+    "output": "root"})";
+  const std::string image = (dir / "albedo.png").string();
+  expectRefused({"preview", (dir / "t.json").string(), "-o", image}, dir, "output '" + image + "' is an input");
 }
 
 TEST(OutputsAreNotInputs, SweepRefusesAPlotOverItsInput) {

@@ -706,6 +706,7 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
                                       &textures, err);
       failed != kExitOk)
     return failed;
+  if (int status = outputs.check(err); status != kExitOk) return status;  // an image is an input too
   auto ctx = openGpu(a.precision, "preview renders on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
   std::optional<preview::Image> image = renderPreview(a, *ctx, steps, textures, err);

@@ -226,7 +226,7 @@ void main(uint3 id : SV_DispatchThreadID) {
 }
 )");
   Resources res{{{0, 0}, texture4x4()},
-                {{0, 1}, SamplerResource{Filter::Nearest, Address::ClampToEdge}},
+                {{0, 1}, SamplerResource{Filter::Nearest, Address::ClampToEdge, std::nullopt}},
                 {{0, 2}, outputBuffer(16 * 4 * sizeof(float))}};
   ASSERT_TRUE(run(spirv, res, 1));
   EXPECT_EQ(valuesOf<float>(std::get<BufferResource>(res.at({0, 2})).data), std::get<ImageResource>(res.at({0, 0})).mips[0]);

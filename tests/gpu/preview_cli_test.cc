@@ -270,6 +270,41 @@ TEST(PreviewTextures, AGlbsEmbeddedImageIsDecodedFromItsBinaryChunk) {
   EXPECT_GT(blue[2], blue[1] + 60) << blue[0] << " " << blue[1] << " " << blue[2];
 }
 
+/// An input's `wrap` is how its image is addressed: repeat, clamp and mirror
+/// of a red-to-green image over three times its uv range give three pictures,
+/// in both languages alike (HLSL binds the input's own sampler).
+TEST(PreviewTextures, AnInputsWrapDecidesHowItsImageRepeats) {
+  const fs::path dir = workDir() / "wrap";
+  fs::create_directories(dir);
+  std::vector<unsigned char> texels;
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) texels.insert(texels.end(), {static_cast<unsigned char>(255 - 60 * x), static_cast<unsigned char>(60 * x), 0});
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  image.width = image.height = 4;
+  image.format = PNG_FORMAT_RGB;
+  ASSERT_TRUE(png_image_write_to_file(&image, (dir / "ramp.png").c_str(), 0, texels.data(), 0, nullptr));
+  std::vector<std::string> pictures;
+  for (const char* wrap : {"repeat", "clamp", "mirror"})
+    for (const char* target : {"glsl", "hlsl"}) {
+      const fs::path material = dir / (std::string(wrap) + ".json");
+      std::ofstream(material) << R"({"format": "substrate-material/1", "name": "wrapped",
+        "inputs": {"ramp": {"type": "texture2d", "file": "ramp.png", "wrap": ")" << wrap << R"("}},
+        "nodes": {"a": {"kind": "texture", "texture": "$ramp",
+                        "uv": {"kind": "multiply", "a": {"kind": "geometry", "attribute": "uv0"}, "b": 3}},
+                  "root": {"kind": "slab", "diffuse_albedo": "a", "f0": 0, "roughness": 1}},
+        "output": "root"})";
+      const fs::path png = dir / (std::string(wrap) + "." + target + ".png");
+      CliRun r = cli({"preview", material.string(), "-o", png.string(), "--size", "32", "--target", target});
+      ASSERT_EQ(r.status, 0) << r.err;
+      pictures.push_back(bytesOf(png));
+    }
+  for (int w = 0; w < 3; ++w) EXPECT_EQ(pictures[2 * w], pictures[2 * w + 1]) << "GLSL and HLSL, wrap " << w;
+  EXPECT_NE(pictures[0], pictures[2]) << "repeat and clamp";
+  EXPECT_NE(pictures[0], pictures[4]) << "repeat and mirror";
+  EXPECT_NE(pictures[2], pictures[4]) << "clamp and mirror";
+}
+
 /// A black and a white image give different pictures (the checker made them byte-identical).
 TEST(PreviewTextures, BlackAndWhiteImagesGiveDifferentPictures) {
   const fs::path dir = workDir() / "black_white";

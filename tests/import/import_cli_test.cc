@@ -63,7 +63,8 @@ TEST(ImportCli, ATexturesImageIsTheInputsFileRelativeToTheWrittenMaterial) {
   fs::create_directories(src / "maps");
   std::ofstream(src / "scene.gltf") << R"({"asset": {"version": "2.0"},
     "images": [{"uri": "maps/bricks%20red.png"}, {"uri": "data:image/png;base64,iVBORw0KGgo="}],
-    "textures": [{"source": 0}, {"source": 1}],
+    "samplers": [{"wrapS": 33071, "wrapT": 33648, "magFilter": 9728}],
+    "textures": [{"source": 0, "sampler": 0}, {"source": 1}],
     "materials": [{"name": "Wall", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
                    "metallicRoughnessTexture": {"index": 1}}}]})";
   std::ofstream(src / "maps/bricks red.png") << "not decoded by import";
@@ -73,6 +74,9 @@ TEST(ImportCli, ATexturesImageIsTheInputsFileRelativeToTheWrittenMaterial) {
   const nlohmann::json wall = nlohmann::json::parse(in);
   EXPECT_EQ(wall["inputs"]["baseColorTexture"]["file"], "../../textured_source/maps/bricks red.png");
   EXPECT_EQ(wall["inputs"]["baseColorTexture"]["colorspace"], "srgb");
+  EXPECT_EQ(wall["inputs"]["baseColorTexture"]["wrap"], nlohmann::json::array({"clamp", "mirror"})) << "its sampler";
+  EXPECT_EQ(wall["inputs"]["baseColorTexture"]["filter"], "nearest");
+  EXPECT_FALSE(wall["inputs"]["metallicRoughnessTexture"].contains("wrap")) << "no sampler: repeat";
   EXPECT_EQ(wall["inputs"]["metallicRoughnessTexture"]["file"], "scene_image1.png") << "an embedded image";
   EXPECT_TRUE(fs::exists(out / "scene_image1.png"));
   EXPECT_TRUE(fs::exists(out / wall["inputs"]["baseColorTexture"]["file"].get<std::string>()));

@@ -161,7 +161,7 @@ TEST(Resolve, UnknownSetting) {
 TEST(Resolve, UnknownInputKey) {
   EXPECT_EQ(diagnosticsOf(material(R"("root": {"kind": "slab", "roughness": "$r"})",
                                    R"({"r": {"type": "float", "default": 0.5, "maximum": 1}})")),
-            "test.json:1:110: error: unknown input key \"maximum\" (expected type, default, min, max, description; texture2d: colorspace, file) [/inputs/r/maximum]\n");
+            "test.json:1:110: error: unknown input key \"maximum\" (expected type, default, min, max, description; texture2d: colorspace, file, wrap, filter) [/inputs/r/maximum]\n");
 }
 
 TEST(Resolve, UnknownSlabPin) {

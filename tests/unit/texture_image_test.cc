@@ -271,6 +271,34 @@ TEST(TextureBinding, AMissingOrBrokenImageIsAnErrorAtTheInputsFile) {
       << d3.formatAll();
 }
 
+TEST(TextureBinding, AnInputsWrapAndFilterAreHowItsImageIsBound) {
+  Scratch s;
+  s.png("a.png", 1, 2, 3);
+  const Material m = textured(R"({"type": "texture2d", "file": "a.png", "wrap": ["clamp", "mirror"], "filter": "nearest"})");
+  EXPECT_EQ(m.inputs[0].wrapU, Wrap::Clamp);
+  EXPECT_EQ(m.inputs[0].wrapV, Wrap::Mirror);
+  EXPECT_TRUE(m.inputs[0].nearest);
+  preview::TextureSources sources;
+  sources.baseDir = s.dir.string();
+  preview::BoundTextures bound;
+  Diagnostics d("m.json");
+  ASSERT_TRUE(preview::bindTextures(m, sources, &bound, d)) << d.formatAll();
+  const gpu::ImageResource& img = bound.images.at("albedo");
+  EXPECT_EQ(img.address, gpu::Address::ClampToEdge);
+  EXPECT_EQ(img.addressV, gpu::Address::MirroredRepeat);
+  EXPECT_EQ(img.filter, gpu::Filter::Nearest);
+  // One mode for both axes; a bad mode is an error at its pointer.
+  const Material one = textured(R"({"type": "texture2d", "wrap": "mirror"})");
+  EXPECT_EQ(one.inputs[0].wrapU, Wrap::Mirror);
+  EXPECT_EQ(one.inputs[0].wrapV, Wrap::Mirror);
+  EXPECT_NE(test::diagnosticsOf(test::material(R"("a": {"kind": "texture", "texture": "$t"},
+      "root": {"kind": "slab", "diffuse_albedo": "a"})",
+                                               R"({"t": {"type": "texture2d", "wrap": "border"}})"))
+                .find("expected \"repeat\", \"clamp\" or \"mirror\", or an array of two (u, v), got \"border\" "
+                      "[/inputs/t/wrap]"),
+            std::string::npos);
+}
+
 TEST(TextureBinding, FileIsAStringOnATextureInputOnly) {
   EXPECT_NE(test::diagnosticsOf(test::material(R"("root": {"kind": "slab", "roughness": "$r"})",
                                                R"({"r": {"type": "float", "default": 0.5, "file": "r.png"}})"))

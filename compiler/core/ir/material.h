@@ -23,6 +23,9 @@ struct Settings {
   BlendMode blendMode = BlendMode::Opaque;
 };
 
+/// How a texture input's image is addressed outside [0, 1] (`"wrap"`).
+enum class Wrap : std::uint8_t { Repeat, Clamp, Mirror };
+
 struct Input {
   std::string name;
   VType type = VType::Float;
@@ -35,6 +38,8 @@ struct Input {
   // whether its RGB is sRGB-encoded (`"colorspace": "srgb"`; else linear).
   std::string file;
   bool srgb = false;
+  Wrap wrapU = Wrap::Repeat, wrapV = Wrap::Repeat;  // `"wrap"`: one mode, or [u, v]
+  bool nearest = false;                            // `"filter": "nearest"` (else linear, trilinear)
   std::string description;  // `description`, as written (an importer's names the source)
 };
 

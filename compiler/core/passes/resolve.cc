@@ -267,6 +267,7 @@ class Resolver {
   void readInputs(const Json& s, const std::string& ptr);
   void readInput(const std::string& name, const Json& v, const std::string& p);
   void readInputKey(Input& in, Json::const_iterator k, const std::string& p, bool& ok);
+  bool readTextureKey(Input& in, const std::string& key, const Json& value, const std::string& kp);
   void classifyNodes();
   void classifyAdds(const std::vector<std::string>& adds);
   int resolveValueNode(const std::string& id);
@@ -655,6 +656,63 @@ void Resolver::readInput(const std::string& name, const Json& v, const std::stri
   out_.inputs.push_back(std::move(in));
 }
 
+/// A texture2d input's own keys (colorspace, wrap, filter, file) into `in`;
+/// false for any other key. `kp` is the key's pointer.
+bool Resolver::readTextureKey(Input& in, const std::string& key, const Json& value, const std::string& kp) {
+  if (key == "colorspace") {
+    if (in.type != VType::Texture) d_.error(kp, "\"colorspace\" applies to texture2d inputs only");
+    else if (!value.is_string() || (value.get<std::string>() != "srgb" && value.get<std::string>() != "linear"))
+      d_.error(kp, fmt::format("expected \"srgb\" or \"linear\", got {}", kindOfJson(value)));
+    else in.srgb = value.get<std::string>() == "srgb";
+    return true;
+  }
+  if (key == "wrap" || key == "filter") {
+    if (in.type != VType::Texture) {
+      d_.error(kp, fmt::format("\"{}\" applies to texture2d inputs only", key));
+      return true;
+    }
+    if (key == "filter") {
+      if (!value.is_string() || (value.get<std::string>() != "linear" && value.get<std::string>() != "nearest"))
+        d_.error(kp, fmt::format("expected \"linear\" or \"nearest\", got {}", kindOfJson(value)));
+      else in.nearest = value.get<std::string>() == "nearest";
+      return true;
+    }
+    auto mode = [](const Json& j) -> std::optional<Wrap> {
+      if (!j.is_string()) return std::nullopt;
+      const std::string& s = j.get_ref<const std::string&>();
+      if (s == "repeat") return Wrap::Repeat;
+      if (s == "clamp") return Wrap::Clamp;
+      if (s == "mirror") return Wrap::Mirror;
+      return std::nullopt;
+    };
+    std::optional<Wrap> u, v;
+    if (value.is_array() && value.size() == 2) {
+      u = mode(value[0]);
+      v = mode(value[1]);
+    } else {
+      u = v = mode(value);
+    }
+    if (!u || !v) {
+      d_.error(kp, fmt::format("expected \"repeat\", \"clamp\" or \"mirror\", or an array of two (u, v), got {}",
+                               kindOfJson(value)));
+    } else {
+      in.wrapU = *u;
+      in.wrapV = *v;
+    }
+    return true;
+  }
+  if (key == "file") {
+    if (in.type != VType::Texture) d_.error(kp, "\"file\" applies to texture2d inputs only (an image to bind)");
+    else if (!value.is_string() || value.get<std::string>().empty())
+      d_.error(kp, fmt::format("expected an image path (a non-empty string), got {}", kindOfJson(value)));
+    else if (value.get<std::string>().find('\0') != std::string::npos)
+      d_.error(kp, "an image path holding a NUL character");
+    else in.file = value.get<std::string>();
+    return true;
+  }
+  return false;
+}
+
 /// Key `k` of input `in` (at pointer `p`) other than its type; `ok` turns
 /// false when the key makes the default unusable.
 void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string& p, bool& ok) {
@@ -665,22 +723,7 @@ void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string
     else if (key == "description") in.description = k->get<std::string>();
     return;
   }
-  if (key == "colorspace") {
-    if (in.type != VType::Texture) d_.error(kp, "\"colorspace\" applies to texture2d inputs only");
-    else if (!k->is_string() || (k->get<std::string>() != "srgb" && k->get<std::string>() != "linear"))
-      d_.error(kp, fmt::format("expected \"srgb\" or \"linear\", got {}", kindOfJson(*k)));
-    else in.srgb = k->get<std::string>() == "srgb";
-    return;
-  }
-  if (key == "file") {
-    if (in.type != VType::Texture) d_.error(kp, "\"file\" applies to texture2d inputs only (an image to bind)");
-    else if (!k->is_string() || k->get<std::string>().empty())
-      d_.error(kp, fmt::format("expected an image path (a non-empty string), got {}", kindOfJson(*k)));
-    else if (k->get<std::string>().find('\0') != std::string::npos)
-      d_.error(kp, "an image path holding a NUL character");
-    else in.file = k->get<std::string>();
-    return;
-  }
+  if (readTextureKey(in, key, *k, kp)) return;
   if (key == "min" || key == "max") {
     // A number bounds every component; an array bounds each component.
     auto& dst = key == "min" ? in.min : in.max;
@@ -726,7 +769,7 @@ void Resolver::readInputKey(Input& in, Json::const_iterator k, const std::string
     return;
   }
   d_.error(kp, fmt::format("unknown input key {} (expected type, default, min, max, description; "
-                           "texture2d: colorspace, file)",
+                           "texture2d: colorspace, file, wrap, filter)",
                            quoteForDiagnostic(key)));
 }
 

@@ -282,7 +282,8 @@ struct Context::Impl {
                    VkImageUsageFlags usage, VkImageViewType viewType, DispatchObjects& objs, VkImage* image,
                    VkImageView* view, Diagnostics& diags);
   /// A sampler (filter for min/mag/mips, one address mode for u/v/w, no LOD clamp) owned by `objs`.
-  bool createSampler(Filter filter, Address address, DispatchObjects& objs, VkSampler* sampler, Diagnostics& diags);
+  bool createSampler(Filter filter, Address address, Address addressV, DispatchObjects& objs, VkSampler* sampler,
+                     Diagnostics& diags);
   /// Destroys everything in `objs` (only once the device no longer uses it).
   void destroy(DispatchObjects& objs);
 
@@ -526,16 +527,21 @@ bool Context::Impl::createImage(VkFormat format, uint32_t width, uint32_t height
   return true;
 }
 
-bool Context::Impl::createSampler(Filter filter, Address address, DispatchObjects& objs, VkSampler* sampler,
-                                  Diagnostics& diags) {
+bool Context::Impl::createSampler(Filter filter, Address address, Address addressV, DispatchObjects& objs,
+                                  VkSampler* sampler, Diagnostics& diags) {
   const VkFilter f = filter == Filter::Linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
-  const VkSamplerAddressMode a =
-      address == Address::Repeat ? VK_SAMPLER_ADDRESS_MODE_REPEAT : VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  auto mode = [](Address a) {
+    return a == Address::Repeat           ? VK_SAMPLER_ADDRESS_MODE_REPEAT
+           : a == Address::MirroredRepeat ? VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT
+                                          : VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+  };
+  const VkSamplerAddressMode a = mode(address);
   VkSamplerCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO;
   info.magFilter = info.minFilter = f;
   info.mipmapMode = filter == Filter::Linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST;
-  info.addressModeU = info.addressModeV = info.addressModeW = a;
+  info.addressModeU = info.addressModeW = a;
+  info.addressModeV = mode(addressV);
   info.maxLod = VK_LOD_CLAMP_NONE;
   if (!succeeded(vk.vkCreateSampler(device, &info, nullptr, sampler), "vkCreateSampler", diags)) return false;
   objs.samplers.push_back(*sampler);
@@ -702,7 +708,7 @@ bool Context::Impl::bindResources(const ShaderReflection& refl, Resources& resou
       bound = bindImage(binding, *img, objs, b, w, failure);
     } else if (auto* smp = std::get_if<SamplerResource>(&resource)) {
       VkSampler sampler;
-      bound = createSampler(smp->filter, smp->address, objs, &sampler, failure);
+      bound = createSampler(smp->filter, smp->address, smp->addressV.value_or(smp->address), objs, &sampler, failure);
       if (bound) {
         b.imageInfos.push_back({sampler, VK_NULL_HANDLE, VK_IMAGE_LAYOUT_UNDEFINED});
         w.pImageInfo = &b.imageInfos.back();
@@ -786,7 +792,7 @@ bool Context::Impl::bindImage(const DescriptorBinding& binding, const ImageResou
   b.uploads.push_back(std::move(up));
   VkSampler sampler = VK_NULL_HANDLE;
   if (binding.kind == DescriptorKind::CombinedImageSampler &&
-      !createSampler(img.filter, img.address, objs, &sampler, diags))
+      !createSampler(img.filter, img.address, img.addressV.value_or(img.address), objs, &sampler, diags))
     return false;
   b.imageInfos.push_back({sampler, view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL});
   w.pImageInfo = &b.imageInfos.back();

@@ -15,6 +15,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <utility>
 #include <variant>
@@ -26,7 +27,7 @@
 namespace substratec::gpu {
 
 enum class Filter { Nearest, Linear };           // for magnification, minification and between mips
-enum class Address { Repeat, ClampToEdge };      // for all three coordinates
+enum class Address { Repeat, ClampToEdge, MirroredRepeat };
 enum class StorageFormat { R32Uint, R32G32B32A32Sfloat };
 
 /// A uniform or storage buffer (the descriptor type comes from reflection). Not output: `data` is
@@ -46,13 +47,15 @@ struct ImageResource {
   uint32_t layers = 1;
   std::vector<std::vector<float>> mips;  // mips[level]: 4 floats per texel, layer-major then row-major
   Filter filter = Filter::Nearest;       // ignored for a SampledImage binding (no sampler there)
-  Address address = Address::Repeat;
+  Address address = Address::Repeat;     // u and w (and v unless addressV says otherwise)
+  std::optional<Address> addressV;
 };
 
 /// A separate sampler (HLSL SamplerState) for a Sampler binding.
 struct SamplerResource {
   Filter filter = Filter::Nearest;
-  Address address = Address::Repeat;
+  Address address = Address::Repeat;  // u and w (and v unless addressV says otherwise)
+  std::optional<Address> addressV;
 };
 
 /// A storage image: cleared to NaN (float) or 0xFFFFFFFF (uint) before each dispatch, or, with

@@ -1,11 +1,13 @@
 #include "image/decode.h"
 
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
 #include <csetjmp>
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <system_error>
 
 #include <png.h>
@@ -188,8 +190,11 @@ MipChain mipChain(const Rgba8& img, bool srgb) {
         for (int c = 0; c < 4; ++c) {
           const std::uint32_t x0 = 2 * x, y0 = 2 * y;
           const std::uint32_t x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
-          auto at = [&](std::uint32_t xx, std::uint32_t yy) { return above[(static_cast<std::size_t>(yy) * w + xx) * 4 + c]; };
-          next[(static_cast<std::size_t>(y) * nw + x) * 4 + c] = 0.25f * (at(x0, y0) + at(x1, y0) + at(x0, y1) + at(x1, y1));
+          auto at = [&](std::uint32_t xx, std::uint32_t yy) {
+            return above[(static_cast<std::size_t>(yy) * w + xx) * 4 + c];
+          };
+          next[(static_cast<std::size_t>(y) * nw + x) * 4 + c] =
+              0.25f * (at(x0, y0) + at(x1, y0) + at(x0, y1) + at(x1, y1));
         }
     w = nw;
     h = nh;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -125,8 +126,10 @@ class MaterialReader {
   /// A tangent-space normal from a normal textureInfo (its `scale` an input).
   Value normalFrom(const Json& parent, const char* key, const std::string& ptr);
   Value uvOf(const Json& info, const std::string& ptr);
-  std::string imageDescription(int texture, const std::string& ptr);
+  std::string imageDescription(int texture);
   std::string imageFile(int texture);
+  /// Texture `texture`'s sampler as the format spells it: wrap u, wrap v, nearest.
+  std::tuple<std::string, std::string, bool> sampling(int texture) const;
 
   const Json& doc_;
   const Json& m_;
@@ -212,6 +215,18 @@ Value MaterialReader::color(const Json& parent, const char* key, const std::stri
   return w_.colorInput(key, *v, what);
 }
 
+std::tuple<std::string, std::string, bool> MaterialReader::sampling(int texture) const {
+  const Json& t = doc_["textures"][texture];
+  const Json samplers = doc_.value("samplers", Json::array());
+  const int si = t.contains("sampler") ? smallIndex(t, "sampler") : -1;
+  if (!samplers.is_array() || si < 0 || si >= static_cast<int>(samplers.size()) || !samplers[si].is_object())
+    return {"repeat", "repeat", false};
+  auto mode = [](int m) { return m == 33071 ? "clamp" : m == 33648 ? "mirror" : "repeat"; };
+  const Json& s = samplers[si];
+  return {mode(smallIndex(s, "wrapS", kRepeat)), mode(smallIndex(s, "wrapT", kRepeat)),
+          smallIndex(s, "magFilter", 9729) == 9728};  // NEAREST
+}
+
 /// The image file of texture `texture`: a path relative to the document (its
 /// percent-decoded URI); for an embedded image (a data: URI or a buffer view)
 /// "<document stem>_image<N>.<ext>", its bytes kept in images_; "" when it has
@@ -241,7 +256,7 @@ std::string MaterialReader::imageFile(int texture) {
   return uriPath(img["uri"].get<std::string>()).value_or("");
 }
 
-std::string MaterialReader::imageDescription(int texture, const std::string& ptr) {
+std::string MaterialReader::imageDescription(int texture) {
   const Json& t = doc_["textures"][texture];
   std::string out = fmt::format("textures[{}]", texture);
   int source = -1;
@@ -277,12 +292,7 @@ std::string MaterialReader::imageDescription(int texture, const std::string& ptr
     const int si = smallIndex(t, "sampler");
     if (samplers.is_array() && si >= 0 && si < static_cast<int>(samplers.size()) && samplers[si].is_object()) {
       const int ws = smallIndex(samplers[si], "wrapS", kRepeat), wt = smallIndex(samplers[si], "wrapT", kRepeat);
-      if (ws != kRepeat || wt != kRepeat) {
-        warn(ptr, fmt::format("textures[{}] samples with wrap {}/{}: a material does not choose its sampler "
-                              "(the renderer binds one); recorded in the input's description",
-                              texture, wrapName(ws), wrapName(wt)));
-        out += fmt::format(", wrap {}/{}", wrapName(ws), wrapName(wt));
-      }
+      if (ws != kRepeat || wt != kRepeat) out += fmt::format(", wrap {}/{}", wrapName(ws), wrapName(wt));
     }
   }
   return out;
@@ -334,7 +344,10 @@ Value MaterialReader::sample(const Json& parent, const char* key, const std::str
     return Value();
   }
   Value& input = inputs_[{texture, srgb}];
-  if (input.is_null()) input = w_.textureInput(key, srgb, imageDescription(texture, ptr), imageFile(texture));
+  if (input.is_null()) {
+    const auto [wrapU, wrapV, nearest] = sampling(texture);
+    input = w_.textureInput(key, srgb, imageDescription(texture), imageFile(texture), wrapU, wrapV, nearest);
+  }
   const Value uv = uvOf(*info, ptr);
   Value& node = samples_[input.get<std::string>() + "|" + uv.dump()];
   if (node.is_null()) node = w_.node(input.get<std::string>().substr(1) + "_sample", textureSample(input, uv));

@@ -149,9 +149,12 @@ Value MaterialWriter::vec3Input(std::string_view name, const std::vector<double>
 }
 
 Value MaterialWriter::textureInput(std::string_view name, bool srgb, const std::string& description,
-                                   const std::string& file) {
+                                   const std::string& file, const std::string& wrapU, const std::string& wrapV,
+                                   bool nearest) {
   Json b = {{"type", "texture2d"}, {"colorspace", srgb ? "srgb" : "linear"}};
   if (!file.empty()) b["file"] = file;
+  if (wrapU != "repeat" || wrapV != "repeat") b["wrap"] = wrapU == wrapV ? Json(wrapU) : Json::array({wrapU, wrapV});
+  if (nearest) b["filter"] = "nearest";
   return describedInput(name, std::move(b), description);
 }
 

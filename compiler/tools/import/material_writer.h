@@ -108,7 +108,10 @@ class MaterialWriter {
   Value colorInput(std::string_view name, const std::vector<double>& rgb, const std::string& description);
   Value vec2Input(std::string_view name, double x, double y, const std::string& description);
   Value vec3Input(std::string_view name, const std::vector<double>& xyz, const std::string& description);
-  Value textureInput(std::string_view name, bool srgb, const std::string& description, const std::string& file = "");
+  /// A texture input; `file` its image, `wrapU`/`wrapV` "repeat", "clamp" or
+  /// "mirror" (written only when not both repeat), `nearest` its filter.
+  Value textureInput(std::string_view name, bool srgb, const std::string& description, const std::string& file = "",
+                     const std::string& wrapU = "repeat", const std::string& wrapV = "repeat", bool nearest = false);
 
   /// A named node (value or Substrate); returns its id as a reference.
   Value node(std::string_view wantedId, Json body);

@@ -386,14 +386,15 @@ MtlxValues::Typed MtlxValues::nodeValue(pugi::xml_node node, const std::string& 
   return t;
 }
 
-Value MtlxValues::textureOf(pugi::xml_node node, const std::string& file, bool srgb) {
-  const std::string key = file + (srgb ? "|srgb" : "|linear");
+Value MtlxValues::textureOf(pugi::xml_node node, const std::string& file, bool srgb, const std::string& wrapU,
+                            const std::string& wrapV) {
+  const std::string key = file + (srgb ? "|srgb" : "|linear") + "|" + wrapU + "|" + wrapV;
   auto it = textures_.find(key);
   if (it != textures_.end()) return it->second;
   std::string stem = std::filesystem::path(file).stem().string();
   if (stem.empty()) stem = str(node, "name");
   const std::string path = doc_.filePrefix(node) + file;
-  const Value t = w_.textureInput(stem, srgb, fmt::format("{}: file '{}'", doc_.describe(node), path), path);
+  const Value t = w_.textureInput(stem, srgb, fmt::format("{}: file '{}'", doc_.describe(node), path), path, wrapU, wrapV);
   textures_[key] = t;
   return t;
 }
@@ -563,13 +564,21 @@ std::optional<Value> MtlxValues::Call::imageTexture() const {
   const bool srgb = cs == "srgb_texture" || cs == "srgb_displayp3";
   if (!cs.empty() && !srgb && cs != "lin_rec709" && cs != "raw" && cs != "none")
     self.warn(node, fmt::format("colour space '{}' of the file is read as linear Rec.709", cs));
-  for (const char* mode : {"uaddressmode", "vaddressmode"})
-    if (auto a = node.find_child_by_attribute("input", "name", mode)) {
+  std::string wrap[2] = {"repeat", "repeat"};  // MaterialX's periodic
+  for (int axis = 0; axis < 2; ++axis)
+    if (auto a = node.find_child_by_attribute("input", "name", axis == 0 ? "uaddressmode" : "vaddressmode")) {
       const std::string m = str(a, "value");
-      if (!m.empty() && m != "periodic")
-        self.warn(node, fmt::format("{} '{}': a material does not choose its sampler (the renderer binds one)", mode, m));
+      const char* name = axis == 0 ? "uaddressmode" : "vaddressmode";
+      if (m == "clamp" || m == "mirror") {
+        wrap[axis] = m;
+      } else if (m == "constant") {
+        wrap[axis] = "clamp";
+        self.warn(node, fmt::format("{} 'constant' (the default colour outside [0, 1]) is read as clamp", name));
+      } else if (!m.empty() && m != "periodic") {
+        self.warn(node, fmt::format("{} '{}' is not an address mode: read as periodic", name, m));
+      }
     }
-  return self.textureOf(node, file, srgb && (type != "float"));
+  return self.textureOf(node, file, srgb && (type != "float"), wrap[0], wrap[1]);
 }
 
 /// The texture coordinates: the texcoord input (null: uv0) through the

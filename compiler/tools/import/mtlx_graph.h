@@ -85,7 +85,8 @@ class MtlxValues {
   /// One node's computation; its rules (per node kind) are members (mtlx_graph.cc).
   struct Call;
   Typed bake(pugi::xml_node node, const std::string& kind, const std::string& type, const std::string& why);
-  Value textureOf(pugi::xml_node node, const std::string& file, bool srgb);
+  Value textureOf(pugi::xml_node node, const std::string& file, bool srgb, const std::string& wrapU = "repeat",
+                  const std::string& wrapV = "repeat");
   Value sampleOf(const Value& texture, const Value& uv);
   Value interfaceInput(pugi::xml_node graphInput, const std::string& name, const std::string& type);
   Value valueInput(const std::string& name, const std::string& type, const std::vector<double>& v,

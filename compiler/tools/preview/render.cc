@@ -86,9 +86,13 @@ Light previewLight(const std::string& environment, int l) {
 gpu::Resource materialTexture(const Material& m, const std::vector<gpu::TextureRole>& roles,
                               const BoundTextures* textures, const gpu::DescriptorBinding& b) {
   const bool profile = b.binding >= kPreviewProfileBinding;
-  if (b.kind == gpu::DescriptorKind::Sampler)
-    return gpu::SamplerResource{gpu::Filter::Linear, profile ? gpu::Address::ClampToEdge : gpu::Address::Repeat};
   const int input = profile ? -1 : gpu::inputOfResource(m, b.name);
+  if (b.kind == gpu::DescriptorKind::Sampler) {  // HLSL's: the input's wrap and filter
+    if (input < 0) return gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::ClampToEdge, std::nullopt};
+    const Input& in = m.inputs[input];
+    return gpu::SamplerResource{in.nearest ? gpu::Filter::Nearest : gpu::Filter::Linear, addressOf(in.wrapU),
+                                addressOf(in.wrapV)};
+  }
   const std::string name = profile ? (b.name.rfind("p_", 0) == 0 ? b.name.substr(2) : b.name)
                                    : (input >= 0 ? m.inputs[input].name : "");
   const gpu::ImageResource* image = nullptr;
@@ -171,7 +175,7 @@ bool renderSphere(gpu::Context& ctx, const CompileResult& r, const RenderOptions
     } else if (b.set == 0 && b.binding == 2) {
       res[key] = cubeResource(maps.irradiance);
     } else if (b.set == 0 && b.binding == 3) {
-      res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::ClampToEdge};
+      res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::ClampToEdge, std::nullopt};
     } else if (b.set == 0 && b.binding == 5) {
       auto lut = energyLutTables();
       res[key] = gpu::BufferResource{bytesOf(std::vector<float>(lut.begin(), lut.end())), false};

@@ -69,6 +69,15 @@ std::string resolveImagePath(const std::string& file, const TextureSources& sour
   return first.lexically_normal().string();
 }
 
+gpu::Address addressOf(Wrap wrap) {
+  switch (wrap) {
+    case Wrap::Clamp: return gpu::Address::ClampToEdge;
+    case Wrap::Mirror: return gpu::Address::MirroredRepeat;
+    case Wrap::Repeat: break;
+  }
+  return gpu::Address::Repeat;
+}
+
 gpu::ImageResource solidTexture(const std::array<double, 4>& texel) {
   gpu::ImageResource img;
   img.width = img.height = 1;
@@ -106,8 +115,8 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
       std::string names;
       for (const std::string& n : textureNames) names += (names.empty() ? "" : ", ") + n;
       diags.fail(fmt::format("--texture {}={}: the material has no texture input {} ({})", name, path,
-                                  quoteForDiagnostic(name),
-                                  names.empty() ? "it has no texture inputs" : "its texture inputs: " + names));
+                             quoteForDiagnostic(name),
+                             names.empty() ? "it has no texture inputs" : "its texture inputs: " + names));
       ok = false;
     }
   const std::vector<gpu::TextureRole> roles = gpu::textureRoles(m);
@@ -138,9 +147,10 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
     }
     if (path.empty()) {
       const std::array<double, 4> texel = gpu::neutralTexel(roles[i]);
-      diags.note(in.pointer, fmt::format("{} has no image: bound to its neutral texel ({:g}, {:g}, {:g}, {:g}); "
-                                         "--texture {}=PATH binds one",
-                                         describeInput(in, sources.imported), texel[0], texel[1], texel[2], texel[3], in.name));
+      diags.note(in.pointer,
+                 fmt::format("{} has no image: bound to its neutral texel ({:g}, {:g}, {:g}, {:g}); "
+                             "--texture {}=PATH binds one",
+                             describeInput(in, sources.imported), texel[0], texel[1], texel[2], texel[3], in.name));
       out->images[in.name] = solidTexture(texel);
       out->sources[in.name] = "neutral";
       continue;
@@ -151,14 +161,18 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
         diags.fail(fmt::format("--texture {}={}: cannot use the image: {}", in.name, path, why));
       else
         diags.error(in.pointer + "/file",
-                    fmt::format("{}: cannot use the image {} ({}): {}{}", describeInput(in, sources.imported), quoteForDiagnostic(in.file),
-                                path, why, sources.searchPaths.empty() && why == "no such file"
-                                               ? " (a relative path is looked for beside the material file, "
-                                                 "then along --search-path)"
-                                               : ""));
+                    fmt::format("{}: cannot use the image {} ({}): {}{}", describeInput(in, sources.imported),
+                                quoteForDiagnostic(in.file), path, why,
+                                sources.searchPaths.empty() && why == "no such file"
+                                    ? " (a relative path is looked for beside the material file, "
+                                      "then along --search-path)"
+                                    : ""));
       ok = false;
       continue;
     }
+    img.address = addressOf(in.wrapU);
+    img.addressV = addressOf(in.wrapV);
+    img.filter = in.nearest ? gpu::Filter::Nearest : gpu::Filter::Linear;
     out->images[in.name] = std::move(img);
     out->sources[in.name] = path;
   }

@@ -35,7 +35,8 @@ struct TextureSources {
 };
 
 /// A material's textures by input name, ready to bind: linear RGBA32F with
-/// their full mip chains, filtered linearly (trilinear) and repeated.
+/// their full mip chains, addressed and filtered as the input says (`wrap`,
+/// `filter`: repeat and trilinear by default).
 struct BoundTextures {
   std::map<std::string, gpu::ImageResource> images;
   std::map<std::string, std::string> sources;  // input -> the image's path, "embedded:<file>" or "neutral"
@@ -54,6 +55,9 @@ std::string resolveImagePath(const std::string& file, const TextureSources& sour
 /// be read or decoded: at the input's `file` (its description, which names
 /// the glTF pointer or MaterialX element of an imported material, is quoted).
 bool bindTextures(const Material& m, const TextureSources& sources, BoundTextures* out, Diagnostics& diags);
+
+/// The harness's address mode of a texture input's `wrap`.
+gpu::Address addressOf(Wrap wrap);
 
 /// A 1 x 1 texture of `texel` (RGBA), for a binding that has no image.
 gpu::ImageResource solidTexture(const std::array<double, 4>& texel);
