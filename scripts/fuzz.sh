@@ -8,7 +8,9 @@
 # same files as ../shared/corpus — with .glb containers made from a few of its
 # glTF extracts, examples/scenes and tests/import/fuzz_regressions;
 # fuzz/mtlx.dict, gltf.dict, scene.dict) for IMPORT_SECONDS each (default 30:
-# CI's budget, 3 x 30 s on top of 2 x 60 s).
+# CI's budget, 3 x 30 s on top of 2 x 60 s); image_fuzzer (the PNG and JPEG
+# decoders; seeds examples/textures/*.png and fuzz/image_seeds) for
+# IMPORT_SECONDS too.
 # Fails if any target finds a crash, a leak, a timeout (> 10 s per input) or
 # an out-of-memory (> 2 GiB); the input is kept in build-asan/fuzz/artifacts/.
 # Prints the executions each target ran. docs/robustness.md describes it.
@@ -23,7 +25,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 SECONDS_EACH="${1:-60}"
 IMPORT_SECONDS="${IMPORT_SECONDS:-30}"
-TARGETS="${FUZZ_TARGETS:-parser_fuzzer pipeline_fuzzer mtlx_fuzzer gltf_fuzzer manifest_fuzzer}"
+TARGETS="${FUZZ_TARGETS:-parser_fuzzer pipeline_fuzzer mtlx_fuzzer gltf_fuzzer manifest_fuzzer image_fuzzer}"
 BUILD=build-asan/fuzz
 
 cmake --preset asan >/dev/null
@@ -79,12 +81,16 @@ for f in examples/scenes/*.json tests/import/fuzz_regressions/*.scene.json; do
   if [ -f "$f" ]; then cp "$f" "$SEEDS/manifest_fuzzer/$(basename "$f")"; fi
 done
 
+mkdir -p "$SEEDS/image_fuzzer"
+cp examples/textures/*.png fuzz/image_seeds/* "$SEEDS/image_fuzzer/"
+
 status=0
 for t in $TARGETS; do
   case "$t" in
     mtlx_fuzzer) dict=fuzz/mtlx.dict; secs="$IMPORT_SECONDS" ;;
     gltf_fuzzer) dict=fuzz/gltf.dict; secs="$IMPORT_SECONDS" ;;
     manifest_fuzzer) dict=fuzz/scene.dict; secs="$IMPORT_SECONDS" ;;
+    image_fuzzer) dict=""; secs="$IMPORT_SECONDS" ;;
     *) dict=fuzz/substrate.dict; secs="$SECONDS_EACH" ;;
   esac
   corpus="$BUILD/corpus/$t"
@@ -92,7 +98,7 @@ for t in $TARGETS; do
   log="$BUILD/$t.log"
   echo "fuzz: $t for ${secs}s (log: $log)"
   set +e
-  build-asan/bin/$t -max_total_time="$secs" -dict="$dict" -timeout=10 -rss_limit_mb=2048 \
+  build-asan/bin/$t -max_total_time="$secs" ${dict:+-dict="$dict"} -timeout=10 -rss_limit_mb=2048 \
     -max_len=16384 -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/$t-" \
     "$corpus" "$SEEDS/$t" >"$log" 2>&1
   rc=$?
