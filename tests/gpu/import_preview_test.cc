@@ -1,7 +1,7 @@
 // Issue 10: every material of the import corpora (tests/import/corpus)
 // renders a preview on lavapipe, through one context: a 32 x 32 sphere with
-// the preview's procedural texture bound to every texture input (what
-// `substratec preview` does with an imported file), without a NaN. Each
+// every texture input at its neutral texel (what `substratec preview` binds
+// to a texture without an image; the corpus extracts carry none), without a NaN. Each
 // material is compiled under one name, so materials that differ only in their
 // inputs' values share a kernel and its pipeline (preview::PipelineCache):
 // lavapipe builds each of the corpus' distinct kernels once.

@@ -21,7 +21,6 @@ namespace {
 
 using namespace kernel;
 
-
 /// The environment's cube maps, built once per name in a process (a sweep
 /// renders many tiles under the same light).
 struct EnvironmentMaps {
