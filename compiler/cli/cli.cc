@@ -593,9 +593,7 @@ int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, c
   if (!s.imported) parseJsonDocument(s.text, read, diags);  // only for the locator: it compiled already
   const bool ok = preview::bindTextures(m, sources, out, diags);
   err << diags.formatAll();
-  for (const auto& [name, path] : out->sources)
-    if (path != "neutral" && path != "default specular profile" && path.rfind("embedded:", 0) != 0)
-      outputs.input(path);
+  for (const std::string& path : out->files) outputs.input(path);
   return ok ? kExitOk : kExitBadInput;
 }
 

@@ -128,6 +128,10 @@ class MaterialReader {
   Value uvOf(const Json& info, const std::string& ptr);
   std::string imageDescription(int texture);
   std::string imageFile(int texture);
+  /// Texture `texture`'s image index (its own `source`, or an extension's,
+  /// e.g. KHR_texture_basisu; -1 for none) and " (<extension>)" for each
+  /// extension that gives one.
+  std::pair<int, std::string> imageSource(int texture) const;
   /// Texture `texture`'s sampler as the format spells it: wrap u, wrap v, nearest.
   std::tuple<std::string, std::string, bool> sampling(int texture) const;
 
@@ -233,11 +237,7 @@ std::tuple<std::string, std::string, bool> MaterialReader::sampling(int texture)
 /// no image (imageDescription reports a bad source) or its bytes cannot be had
 /// (a warning).
 std::string MaterialReader::imageFile(int texture) {
-  const Json& t = doc_["textures"][texture];
-  int source = t.contains("source") ? smallIndex(t, "source") : -1;
-  if (auto e = t.find("extensions"); e != t.end() && e->is_object())
-    for (const auto& [name, ext] : e->items())
-      if (ext.is_object() && ext.contains("source") && ext["source"].is_number_integer()) source = smallIndex(ext, "source");
+  const int source = imageSource(texture).first;
   const Json images = doc_.value("images", Json::array());
   if (source < 0 || !images.is_array() || source >= static_cast<int>(images.size()) || !images[source].is_object())
     return "";
@@ -256,17 +256,22 @@ std::string MaterialReader::imageFile(int texture) {
   return uriPath(img["uri"].get<std::string>()).value_or("");
 }
 
-std::string MaterialReader::imageDescription(int texture) {
+std::pair<int, std::string> MaterialReader::imageSource(int texture) const {
   const Json& t = doc_["textures"][texture];
-  std::string out = fmt::format("textures[{}]", texture);
-  int source = -1;
-  if (t.contains("source")) source = smallIndex(t, "source");
+  std::pair<int, std::string> out{t.contains("source") ? smallIndex(t, "source") : -1, ""};
   if (auto e = t.find("extensions"); e != t.end() && e->is_object())
     for (const auto& [name, ext] : e->items())
       if (ext.is_object() && ext.contains("source") && ext["source"].is_number_integer()) {
-        source = smallIndex(ext, "source");
-        out += " (" + name + ")";
+        out.first = smallIndex(ext, "source");
+        out.second += " (" + name + ")";
       }
+  return out;
+}
+
+std::string MaterialReader::imageDescription(int texture) {
+  const Json& t = doc_["textures"][texture];
+  const auto [source, extensions] = imageSource(texture);
+  std::string out = fmt::format("textures[{}]{}", texture, extensions);
   const Json images = doc_.value("images", Json::array());
   if (source < 0 || !images.is_array() || source >= static_cast<int>(images.size()) || !images[source].is_object()) {
     error(fmt::format("/textures/{}/source", texture),

@@ -175,6 +175,7 @@ bool bindTextures(const Material& m, const TextureSources& sources, BoundTexture
     img.filter = in.nearest ? gpu::Filter::Nearest : gpu::Filter::Linear;
     out->images[in.name] = std::move(img);
     out->sources[in.name] = path;
+    if (!embedded) out->files.insert(path);
   }
   return ok;
 }

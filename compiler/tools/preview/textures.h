@@ -6,6 +6,7 @@
 // pointer, never a silent placeholder.
 #pragma once
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,7 @@ struct TextureSources {
 struct BoundTextures {
   std::map<std::string, gpu::ImageResource> images;
   std::map<std::string, std::string> sources;  // input -> the image's path, "embedded:<file>" or "neutral"
+  std::set<std::string> files;                 // every image file read from disk (inputs of the command)
 };
 
 /// The path `file` resolves to: `file` when it is absolute, baseDir/file when
