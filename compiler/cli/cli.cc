@@ -1117,15 +1117,16 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
     }
     files.push_back({m.name + ".json", m.text});
     fileSource.push_back(sourceOf[i]);
-    for (const auto& [file, bytes] : m.images) {  // embedded images, beside the materials that name them
+    for (const auto& image : m.images) {  // embedded images, beside the materials that name them
+      const std::string& file = image.first;
       auto same = std::find_if(files.begin(), files.end(), [&](const OutputFile& f) { return f.name == file; });
-      if (same != files.end() && same->contents != bytes)
+      if (same != files.end() && same->contents != image.second)
         return printError(err, kExitBadInput,
                           fmt::format("{} and {} both embed an image written as {}: import them into different "
                                       "directories",
                                       fileSource[same - files.begin()], sourceOf[i], file));
       if (same != files.end()) continue;
-      files.push_back({file, bytes});
+      files.push_back({file, image.second});
       fileSource.push_back(sourceOf[i]);
     }
   }
