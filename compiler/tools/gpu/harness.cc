@@ -11,23 +11,17 @@
 #include <mutex>
 #include <type_traits>
 
+#include "gpu/harness_internal.h"
 #include "gpu/vulkan_loader.h"
 
 namespace substratec::gpu {
 
-/// Validation messages, appended by the debug-utils callback (any thread).
-/// Outside the anonymous namespace: Context::Impl, which has external linkage,
-/// holds one (GCC's -Wsubobject-linkage warned on every build).
-struct ValidationMessageLog {
-  std::mutex mutex;
-  std::vector<std::string> messages;
-};
+using namespace harness_detail;
 
 namespace {
 
 constexpr const char* kLavapipeIcd = "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json";
 constexpr const char* kValidationLayer = "VK_LAYER_KHRONOS_validation";
-constexpr uint32_t kQuietNan = 0x7fc00000u;
 constexpr uint32_t kExecutionModelGLCompute = 5;
 
 /// The VK_EXT_debug_utils callback: records warnings and errors into the ValidationMessageLog.
@@ -64,110 +58,6 @@ std::string driverHint() {
          ", VK_ICD_FILENAMES=" + (icds ? icds : "<unset>") + "; Debian: mesa-vulkan-drivers)";
 }
 
-/// Reports `message` as an error; false (for `return fail(...)`).
-bool fail(Diagnostics& diags, std::string message) {
-  diags.fail(std::move(message));
-  return false;
-}
-
-/// Reports "<call> failed: <VkResult>" unless `result` is VK_SUCCESS.
-bool succeeded(VkResult result, const std::string& call, Diagnostics& diags) {
-  if (result == VK_SUCCESS) return true;
-  diags.fail(call + " failed: " + vkResultName(result));
-  return false;
-}
-
-VkDescriptorType descriptorType(DescriptorKind kind) {
-  switch (kind) {
-    case DescriptorKind::UniformBuffer: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    case DescriptorKind::StorageBuffer: return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    case DescriptorKind::CombinedImageSampler: return VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    case DescriptorKind::SampledImage: return VK_DESCRIPTOR_TYPE_SAMPLED_IMAGE;
-    case DescriptorKind::StorageImage: return VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    case DescriptorKind::Sampler: return VK_DESCRIPTOR_TYPE_SAMPLER;
-  }
-  return VK_DESCRIPTOR_TYPE_MAX_ENUM;
-}
-
-/// "set 0 binding 2 ('tex', CombinedImageSampler)" for error messages.
-std::string describe(const DescriptorBinding& b) {
-  return "set " + std::to_string(b.set) + " binding " + std::to_string(b.binding) + " ('" + b.name + "', " +
-         descriptorKindName(b.kind) + ")";
-}
-
-/// Index of the Resource alternative a descriptor kind needs.
-size_t resourceIndexFor(DescriptorKind kind) {
-  switch (kind) {
-    case DescriptorKind::UniformBuffer:
-    case DescriptorKind::StorageBuffer: return 0;
-    case DescriptorKind::CombinedImageSampler:
-    case DescriptorKind::SampledImage: return 1;
-    case DescriptorKind::Sampler: return 2;
-    case DescriptorKind::StorageImage: return 3;
-  }
-  return 0;
-}
-
-constexpr const char* kResourceNames[] = {"BufferResource", "ImageResource", "SamplerResource", "StorageImageResource"};
-
-/// The Vulkan objects of one dispatch, destroyed together.
-struct DispatchObjects {
-  std::vector<VkBuffer> buffers;
-  std::vector<VkImage> images;
-  std::vector<VkImageView> views;
-  std::vector<VkSampler> samplers;
-  std::vector<VkDeviceMemory> memories;
-  VkDescriptorPool descriptorPool = VK_NULL_HANDLE;
-  VkCommandBuffer commandBuffer = VK_NULL_HANDLE;
-  VkFence fence = VK_NULL_HANDLE;
-  VkQueryPool timestamps = VK_NULL_HANDLE;  // two timestamps around the dispatch, when timed
-};
-
-/// An image to fill before the dispatch: from a staging buffer, or cleared.
-struct ImageUpload {
-  VkImage image;
-  uint32_t layers, mipLevels;
-  VkImageLayout finalLayout;
-  VkBuffer staging = VK_NULL_HANDLE;  // null: clear with `clear`
-  std::vector<VkBufferImageCopy> regions{};
-  VkClearColorValue clear{};
-};
-
-/// A copy from mapped memory back into a resource after the dispatch.
-struct Readback {
-  std::vector<std::byte>* target;
-  const void* mapped;
-  size_t size;
-  VkImage image = VK_NULL_HANDLE;  // non-null: first copy the image into `buffer`
-  VkBuffer buffer = VK_NULL_HANDLE;
-  VkBufferImageCopy region{};
-};
-
-/// What one dispatch binds, fills and reads back. The info vectors are reserved for every binding up
-/// front and never reallocate: the writes point into them.
-struct Bindings {
-  std::vector<VkDescriptorSet> sets;  // index = set number
-  std::vector<VkDescriptorBufferInfo> bufferInfos;
-  std::vector<VkDescriptorImageInfo> imageInfos;
-  std::vector<VkWriteDescriptorSet> writes;
-  std::vector<ImageUpload> uploads;
-  std::vector<Readback> readbacks;
-};
-
-/// A layout transition of all `mips` and `layers` of a colour image.
-VkImageMemoryBarrier imageBarrier(VkImage image, uint32_t layers, uint32_t mips, VkImageLayout from, VkImageLayout to,
-                                  VkAccessFlags srcAccess, VkAccessFlags dstAccess) {
-  VkImageMemoryBarrier barrier{};
-  barrier.sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER;
-  barrier.srcAccessMask = srcAccess;
-  barrier.dstAccessMask = dstAccess;
-  barrier.oldLayout = from;
-  barrier.newLayout = to;
-  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  barrier.image = image;
-  barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mips, 0, layers};
-  return barrier;
-}
 
 /// Every binding of `refl` has a resource of its kind in `resources`, and every resource is used;
 /// otherwise false, reporting the first mismatch.
@@ -200,126 +90,6 @@ bool resourcesMatch(const ShaderReflection& refl, const Resources& resources, Di
 
 }  // namespace
 
-struct Context::Impl {
-  VulkanFunctions vk;
-  Options options;
-  std::unique_ptr<ValidationMessageLog> log = std::make_unique<ValidationMessageLog>();  // the messenger's user data
-  VkInstance instance = VK_NULL_HANDLE;
-  VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
-  VkPhysicalDevice physical = VK_NULL_HANDLE;
-  VkPhysicalDeviceMemoryProperties memory{};
-  VkDevice device = VK_NULL_HANDLE;
-  uint32_t queueFamily = 0;
-  VkQueue queue = VK_NULL_HANDLE;
-  VkCommandPool commandPool = VK_NULL_HANDLE;
-  std::string deviceName, driverInfo;
-  double timestampPeriodNs = 1;  // VkPhysicalDeviceLimits::timestampPeriod
-  bool shaderFloat16 = false;    // enabled on the device (VkPhysicalDeviceVulkan12Features)
-  bool lost = false;  // a fence wait timed out or the device was lost: leak, never wait
-  VkFence lostFence = VK_NULL_HANDLE;  // the fence of the dispatch that timed out (leaked with it)
-
-  ~Impl() {
-    if (lost) {  // objects may still be in use by the device; leaking them (and the log) is the only safe choice
-      // One more bounded wait (60 s) for the work that timed out: a process
-      // that exits while lavapipe's threads still run it crashes in their
-      // teardown. Work that never finishes is leaked all the same.
-      if (lostFence) (void)vk.vkWaitForFences(device, 1, &lostFence, VK_TRUE, 60'000'000'000ull);
-      (void)log.release();
-      return;
-    }
-    if (device) {
-      vk.vkDeviceWaitIdle(device);
-      if (commandPool) vk.vkDestroyCommandPool(device, commandPool, nullptr);
-      vk.vkDestroyDevice(device, nullptr);
-    }
-    if (messenger) vk.vkDestroyDebugUtilsMessengerEXT(instance, messenger, nullptr);
-    if (instance) vk.vkDestroyInstance(instance, nullptr);
-  }
-
-  size_t messageCount() {
-    std::lock_guard<std::mutex> lock(log->mutex);
-    return log->messages.size();
-  }
-
-  /// Reports the messages recorded since `start` as one error ("the validation layer reported N
-  /// message(s) during <during>:", a line each); false if there were any.
-  bool noMessagesSince(size_t start, const std::string& during, Diagnostics& diags) {
-    std::lock_guard<std::mutex> lock(log->mutex);
-    if (log->messages.size() <= start) return true;
-    std::string text = "the validation layer reported " + std::to_string(log->messages.size() - start) +
-                       " message(s) during " + during + ":";
-    for (size_t i = start; i < log->messages.size(); ++i) text += "\n  " + log->messages[i];
-    diags.fail(std::move(text));
-    return false;
-  }
-
-  /// Loads libvulkan, pins lavapipe, creates the instance with the validation layer and the messenger.
-  bool createInstance(Diagnostics& diags);
-  /// Picks lavapipe, creates the device with one compute queue (and shaderFloat16 when it has it) and the
-  /// command pool.
-  bool createDevice(Diagnostics& diags);
-  /// Allocates memory for `req` (host-visible + coherent and mapped when `hostVisible`), owned by `objs`.
-  bool allocate(const VkMemoryRequirements& req, bool hostVisible, DispatchObjects& objs, VkDeviceMemory* out,
-                void** mapped, Diagnostics& diags);
-  /// Gives `object` (a VkBuffer or VkImage) memory of its own, owned by `objs`: host-visible, coherent
-  /// and mapped into `*mapped` when `mapped` is set.
-  template <class Object>
-  bool bindMemory(Object object, DispatchObjects& objs, void** mapped, Diagnostics& diags) {
-    constexpr bool isBuffer = std::is_same_v<Object, VkBuffer>;
-    VkMemoryRequirements req;
-    if constexpr (isBuffer) vk.vkGetBufferMemoryRequirements(device, object, &req);
-    else vk.vkGetImageMemoryRequirements(device, object, &req);
-    VkDeviceMemory mem;
-    if (!allocate(req, mapped != nullptr, objs, &mem, mapped, diags)) return false;
-    if constexpr (isBuffer) return succeeded(vk.vkBindBufferMemory(device, object, mem, 0), "vkBindBufferMemory", diags);
-    else return succeeded(vk.vkBindImageMemory(device, object, mem, 0), "vkBindImageMemory", diags);
-  }
-  /// A host-visible, mapped buffer owned by `objs`.
-  bool createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, DispatchObjects& objs, VkBuffer* buffer,
-                    void** mapped, Diagnostics& diags);
-  /// An optimal-tiling 2D image (cube-compatible when `cube`) with its memory and one view, owned by `objs`.
-  bool createImage(VkFormat format, uint32_t width, uint32_t height, uint32_t layers, uint32_t mips, bool cube,
-                   VkImageUsageFlags usage, VkImageViewType viewType, DispatchObjects& objs, VkImage* image,
-                   VkImageView* view, Diagnostics& diags);
-  /// A sampler (filter for min/mag/mips, one address mode for u/v/w, no LOD clamp) owned by `objs`.
-  bool createSampler(Filter filter, Address address, Address addressV, DispatchObjects& objs, VkSampler* sampler,
-                     Diagnostics& diags);
-  /// Destroys everything in `objs` (only once the device no longer uses it).
-  void destroy(DispatchObjects& objs);
-
-  // The steps of one dispatch, in order (Context::dispatch runs them; each sets `*why` on failure).
-  /// The descriptor pool and one set per layout of `p` (empty layouts included) into `b.sets`.
-  bool allocateSets(const ComputePipeline::Impl& p, const ShaderReflection& refl, DispatchObjects& objs, Bindings& b,
-                    Diagnostics& diags);
-  /// Creates and fills the Vulkan object of every binding and writes the descriptor sets; `*why` names the binding.
-  bool bindResources(const ShaderReflection& refl, Resources& resources, DispatchObjects& objs, Bindings& b,
-                     Diagnostics& diags);
-  /// A uniform or storage buffer: uploaded, NaN-filled or both read back (BufferResource's contract).
-  bool bindBuffer(const DescriptorBinding& binding, BufferResource& buf, DispatchObjects& objs, Bindings& b,
-                  VkWriteDescriptorSet& w, Diagnostics& diags);
-  /// A sampled texture with all its mips staged for upload (and its sampler when combined).
-  bool bindImage(const DescriptorBinding& binding, const ImageResource& img, DispatchObjects& objs, Bindings& b,
-                 VkWriteDescriptorSet& w, Diagnostics& diags);
-  /// A storage image: cleared or staged for upload, and copied out for read-back.
-  bool bindStorageImage(const DescriptorBinding& binding, StorageImageResource& si, DispatchObjects& objs, Bindings& b,
-                        VkWriteDescriptorSet& w, Diagnostics& diags);
-  /// One command buffer: fill images, dispatch (between timestamps when `timed`), copy storage images out,
-  /// make everything host-visible.
-  bool record(const ComputePipeline::Impl& p, const Bindings& b, const uint32_t groups[3], bool timed,
-              DispatchObjects& objs, Diagnostics& diags);
-  /// Submits `objs.commandBuffer` and waits for its fence (at most Options::fenceTimeoutNs; after that the
-  /// Context is lost).
-  bool submitAndWait(DispatchObjects& objs, Diagnostics& diags);
-  /// Copies the outputs into their resources, and the dispatch's time into `*dispatchNs` when timed.
-  bool readBack(const Bindings& b, DispatchObjects& objs, double* dispatchNs, Diagnostics& diags);
-};
-
-struct ComputePipeline::Impl {
-  Context::Impl* context = nullptr;
-  std::vector<VkDescriptorSetLayout> setLayouts;  // index = set number
-  VkPipelineLayout layout = VK_NULL_HANDLE;
-  VkPipeline pipeline = VK_NULL_HANDLE;
-};
 
 bool Context::Impl::createInstance(Diagnostics& diags) {
   if (!loadGlobalFunctions(&vk, diags)) return false;
@@ -424,13 +194,25 @@ bool Context::Impl::createDevice(Diagnostics& diags) {
   vk.vkGetPhysicalDeviceQueueFamilyProperties(physical, &count, nullptr);
   std::vector<VkQueueFamilyProperties> families(count);
   vk.vkGetPhysicalDeviceQueueFamilyProperties(physical, &count, families.data());
+  // One queue for everything: compute dispatches and raster passes (raster.cc).
+  constexpr VkQueueFlags kNeed = VK_QUEUE_COMPUTE_BIT | VK_QUEUE_GRAPHICS_BIT;
   auto family = std::find_if(families.begin(), families.end(),
-                             [](const VkQueueFamilyProperties& f) { return f.queueFlags & VK_QUEUE_COMPUTE_BIT; });
+                             [](const VkQueueFamilyProperties& f) { return (f.queueFlags & kNeed) == kNeed; });
   if (family == families.end()) {
-    diags.fail("lavapipe reports no compute queue family");
+    diags.fail("lavapipe reports no queue family with both graphics and compute");
     return false;
   }
   queueFamily = static_cast<uint32_t>(family - families.begin());
+  if (!createLogicalDevice(diags)) return false;
+  if (!loadDeviceFunctions(&vk, device, diags)) return false;
+  vk.vkGetDeviceQueue(device, queueFamily, 0, &queue);
+  VkCommandPoolCreateInfo poolInfo{};
+  poolInfo.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
+  poolInfo.queueFamilyIndex = queueFamily;
+  return succeeded(vk.vkCreateCommandPool(device, &poolInfo, nullptr, &commandPool), "vkCreateCommandPool", diags);
+}
+
+bool Context::Impl::createLogicalDevice(Diagnostics& diags) {
   const float priority = 1.0f;
   VkDeviceQueueCreateInfo queueInfo{};
   queueInfo.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
@@ -447,21 +229,28 @@ bool Context::Impl::createDevice(Diagnostics& diags) {
   features.pNext = &has12;
   vk.vkGetPhysicalDeviceFeatures2(physical, &features);
   shaderFloat16 = has12.shaderFloat16 == VK_TRUE;
+  // For raster passes (raster.cc): base passes store material-buffer words
+  // from fragment shaders, and translucent forward passes blend with a second
+  // colour output (dual-source), and a base pass writes only the attachments
+  // it has outputs for (independent blend state). Enabled when the device has them.
+  fragmentStores = features.features.fragmentStoresAndAtomics == VK_TRUE;
+  dualSourceBlend = features.features.dualSrcBlend == VK_TRUE;
+  independentBlend = features.features.independentBlend == VK_TRUE;  // base passes write some attachments only
   VkPhysicalDeviceVulkan12Features enable12{};
   enable12.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES;
   enable12.shaderFloat16 = shaderFloat16 ? VK_TRUE : VK_FALSE;
+  VkPhysicalDeviceFeatures2 enable{};
+  enable.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+  enable.pNext = &enable12;
+  enable.features.fragmentStoresAndAtomics = fragmentStores ? VK_TRUE : VK_FALSE;
+  enable.features.dualSrcBlend = dualSourceBlend ? VK_TRUE : VK_FALSE;
+  enable.features.independentBlend = independentBlend ? VK_TRUE : VK_FALSE;
   VkDeviceCreateInfo info{};
   info.sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO;
-  info.pNext = &enable12;
+  info.pNext = &enable;
   info.queueCreateInfoCount = 1;
   info.pQueueCreateInfos = &queueInfo;
-  if (!succeeded(vk.vkCreateDevice(physical, &info, nullptr, &device), "vkCreateDevice (lavapipe)", diags)) return false;
-  if (!loadDeviceFunctions(&vk, device, diags)) return false;
-  vk.vkGetDeviceQueue(device, queueFamily, 0, &queue);
-  VkCommandPoolCreateInfo poolInfo{};
-  poolInfo.sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO;
-  poolInfo.queueFamilyIndex = queueFamily;
-  return succeeded(vk.vkCreateCommandPool(device, &poolInfo, nullptr, &commandPool), "vkCreateCommandPool", diags);
+  return succeeded(vk.vkCreateDevice(physical, &info, nullptr, &device), "vkCreateDevice (lavapipe)", diags);
 }
 
 bool Context::Impl::allocate(const VkMemoryRequirements& req, bool hostVisible, DispatchObjects& objs,
@@ -552,7 +341,9 @@ void Context::Impl::destroy(DispatchObjects& objs) {
   if (objs.fence) vk.vkDestroyFence(device, objs.fence, nullptr);
   if (objs.timestamps) vk.vkDestroyQueryPool(device, objs.timestamps, nullptr);
   if (objs.commandBuffer) vk.vkFreeCommandBuffers(device, commandPool, 1, &objs.commandBuffer);
-  if (objs.descriptorPool) vk.vkDestroyDescriptorPool(device, objs.descriptorPool, nullptr);
+  for (VkFramebuffer f : objs.framebuffers) vk.vkDestroyFramebuffer(device, f, nullptr);
+  for (VkRenderPass r : objs.renderPasses) vk.vkDestroyRenderPass(device, r, nullptr);
+  for (VkDescriptorPool pool : objs.descriptorPools) vk.vkDestroyDescriptorPool(device, pool, nullptr);
   for (VkSampler s : objs.samplers) vk.vkDestroySampler(device, s, nullptr);
   for (VkImageView v : objs.views) vk.vkDestroyImageView(device, v, nullptr);
   for (VkImage i : objs.images) vk.vkDestroyImage(device, i, nullptr);
@@ -664,9 +455,9 @@ std::unique_ptr<ComputePipeline> Context::createPipeline(const std::vector<uint3
   return pipeline;
 }
 
-bool Context::Impl::allocateSets(const ComputePipeline::Impl& p, const ShaderReflection& refl, DispatchObjects& objs,
-                                 Bindings& b, Diagnostics& diags) {
-  b.sets.assign(p.setLayouts.size(), VK_NULL_HANDLE);
+bool Context::Impl::allocateSets(const std::vector<VkDescriptorSetLayout>& setLayouts, const ShaderReflection& refl,
+                                 DispatchObjects& objs, Bindings& b, Diagnostics& diags) {
+  b.sets.assign(setLayouts.size(), VK_NULL_HANDLE);
   if (b.sets.empty()) return true;
   std::map<VkDescriptorType, uint32_t> typeCounts;
   for (const DescriptorBinding& binding : refl.bindings) ++typeCounts[descriptorType(binding.kind)];
@@ -677,29 +468,38 @@ bool Context::Impl::allocateSets(const ComputePipeline::Impl& p, const ShaderRef
   poolInfo.maxSets = static_cast<uint32_t>(b.sets.size());
   poolInfo.poolSizeCount = static_cast<uint32_t>(sizes.size());
   poolInfo.pPoolSizes = sizes.data();
-  if (!succeeded(vk.vkCreateDescriptorPool(device, &poolInfo, nullptr, &objs.descriptorPool), "vkCreateDescriptorPool",
-                 diags))
+  VkDescriptorPool pool;
+  if (!succeeded(vk.vkCreateDescriptorPool(device, &poolInfo, nullptr, &pool), "vkCreateDescriptorPool", diags))
     return false;
+  objs.descriptorPools.push_back(pool);
   VkDescriptorSetAllocateInfo alloc{};
   alloc.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
-  alloc.descriptorPool = objs.descriptorPool;
+  alloc.descriptorPool = pool;
   alloc.descriptorSetCount = static_cast<uint32_t>(b.sets.size());
-  alloc.pSetLayouts = p.setLayouts.data();
+  alloc.pSetLayouts = setLayouts.data();
   return succeeded(vk.vkAllocateDescriptorSets(device, &alloc, b.sets.data()), "vkAllocateDescriptorSets", diags);
 }
 
 bool Context::Impl::bindResources(const ShaderReflection& refl, Resources& resources, DispatchObjects& objs,
-                                  Bindings& b, Diagnostics& diags) {
+                                  Bindings& b, Diagnostics& diags,
+                                  const std::map<std::pair<uint32_t, uint32_t>, VkDescriptorImageInfo>* shared) {
   b.bufferInfos.reserve(refl.bindings.size());
   b.imageInfos.reserve(refl.bindings.size());
   for (const DescriptorBinding& binding : refl.bindings) {
-    Resource& resource = resources.at({binding.set, binding.binding});
     VkWriteDescriptorSet w{};
     w.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     w.dstSet = b.sets[binding.set];
     w.dstBinding = binding.binding;
     w.descriptorCount = 1;
     w.descriptorType = descriptorType(binding.kind);
+    if (shared) {
+      if (auto it = shared->find({binding.set, binding.binding}); it != shared->end()) {
+        w.pImageInfo = &it->second;
+        b.writes.push_back(w);
+        continue;
+      }
+    }
+    Resource& resource = resources.at({binding.set, binding.binding});
     Diagnostics failure(diags.file());  // the binding's failure, reported below naming the binding
     bool bound = true;
     if (auto* buf = std::get_if<BufferResource>(&resource)) {
@@ -963,7 +763,7 @@ bool Context::dispatch(const ComputePipeline& pipeline, Resources& resources, ui
   Bindings bindings;
   const uint32_t groups[3] = {groupsX, groupsY, groupsZ};
   Diagnostics failure(diags.file());  // the failed step's, reported below as the dispatch's
-  const bool ran = c.allocateSets(p, refl, objs, bindings, failure) &&
+  const bool ran = c.allocateSets(p.setLayouts, refl, objs, bindings, failure) &&
                    c.bindResources(refl, resources, objs, bindings, failure) &&
                    c.record(p, bindings, groups, dispatchNs != nullptr, objs, failure) &&
                    c.submitAndWait(objs, failure) && c.readBack(bindings, objs, dispatchNs, failure);

@@ -87,7 +87,19 @@ namespace substratec::gpu {
   X(vkDestroyQueryPool)                   \
   X(vkCmdResetQueryPool)                  \
   X(vkCmdWriteTimestamp)                  \
-  X(vkGetQueryPoolResults)
+  X(vkGetQueryPoolResults)               \
+  X(vkCreateGraphicsPipelines)            \
+  X(vkCreateRenderPass)                   \
+  X(vkDestroyRenderPass)                  \
+  X(vkCreateFramebuffer)                  \
+  X(vkDestroyFramebuffer)                 \
+  X(vkCmdBeginRenderPass)                 \
+  X(vkCmdEndRenderPass)                   \
+  X(vkCmdBindVertexBuffers)               \
+  X(vkCmdBindIndexBuffer)                 \
+  X(vkCmdSetViewport)                     \
+  X(vkCmdSetScissor)                      \
+  X(vkCmdDrawIndexed)
 
 /// The function-pointer table; a null member means "not loaded yet".
 struct VulkanFunctions {
