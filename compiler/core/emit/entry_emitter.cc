@@ -39,7 +39,10 @@ std::string resourcesAndMain(const Syntax& syn, bool environment, const std::vec
                                    "  float4 lightRadiance;   // rgb\n"
                                    "  float4 envParams;       // x: mip count of the prefiltered environment\n");
   if (environment) s += environmentResources(syn);
-  s += more + "\n" + syn.fragmentInterface(interpolants(), outputs) + "\n" + syn.fragmentMain();
+  // A pass that stores to an image (the base pass's material buffer) tests
+  // depth first: a hidden fragment must not store its words over the visible one's.
+  s += more + "\n" + syn.fragmentInterface(interpolants(), outputs) + "\n" +
+       (more.empty() ? "" : syn.earlyFragmentTests()) + syn.fragmentMain();
   return s;
 }
 

@@ -134,6 +134,10 @@ std::string Syntax::fragmentMain() const {
   return isGlsl(*this) ? "void main() {\n" : "PSOutput main(PSInput i) {\n  PSOutput o;\n";
 }
 
+std::string Syntax::earlyFragmentTests() const {
+  return isGlsl(*this) ? "layout(early_fragment_tests) in;\n" : "[earlydepthstencil]\n";
+}
+
 std::string Syntax::fragmentEnd() const { return isGlsl(*this) ? "}\n" : "  return o;\n}\n"; }
 
 std::string Syntax::input(std::string_view n) const {

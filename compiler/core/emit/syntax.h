@@ -72,6 +72,11 @@ struct Syntax {
   std::string fragmentInterface(const std::vector<StageVar>& inputs, const std::vector<StageVar>& outputs) const;
   /// `main`'s signature and opening brace (HLSL: declares the output struct `o`).
   std::string fragmentMain() const;
+  /// The fragment entry's early-fragment-tests request, placed right before
+  /// fragmentMain(): depth and stencil are tested before the shader runs, so a
+  /// fragment that is hidden never runs and never stores (a base pass that
+  /// writes the material buffer needs it; docs/render.md).
+  std::string earlyFragmentTests() const;
   /// `main`'s closing lines (HLSL: returns `o`).
   std::string fragmentEnd() const;
   std::string input(std::string_view name) const;   // an interpolant

@@ -24,6 +24,29 @@ std::string materialFile(const CompileResult& r, const Syntax& syn, const EmitOp
   return material;
 }
 
+/// The files an entry includes, served from memory: the runtime and `g`'s files.
+std::map<std::string, std::string_view> memoryFiles(const Generated& g) {
+  std::map<std::string, std::string_view> files;
+  for (const RuntimeFile& f : runtimeFiles()) files.emplace(std::string(f.name), f.text);
+  for (const OutputFile& f : g.files) files.emplace(f.name, f.contents);
+  return files;
+}
+
+/// Whether a generated file is an entry shader, and its language and stage by its extension.
+bool isEntry(const std::string& name) {
+  return name.ends_with(".frag") || name.ends_with(".ps.hlsl") || name.ends_with(".comp") || name.ends_with(".cs.hlsl");
+}
+ShaderSource entrySource(const OutputFile& f, const std::map<std::string, std::string_view>& files, Precision precision) {
+  ShaderSource src;
+  src.name = f.name;
+  src.text = f.contents;
+  src.language = f.name.ends_with(".frag") || f.name.ends_with(".comp") ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
+  src.stage = f.name.ends_with(".comp") || f.name.ends_with(".cs.hlsl") ? ShaderStage::Compute : ShaderStage::Fragment;
+  src.memoryFiles = files;
+  src.hlsl16BitTypes = precision == Precision::Half;
+  return src;
+}
+
 }  // namespace
 
 Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
@@ -44,30 +67,17 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
 void validateGenerated(Generated& g, const ValidateOptions& options, std::size_t threads) {
   // The entries include the material files and the runtime by name: both are
   // served from memory, so nothing touches the disk.
-  std::map<std::string, std::string_view> files;
-  for (const RuntimeFile& f : runtimeFiles()) files.emplace(std::string(f.name), f.text);
-  for (const OutputFile& f : g.files) files.emplace(f.name, f.contents);
-
+  const std::map<std::string, std::string_view> files = memoryFiles(g);
   std::vector<const OutputFile*> entries;
   for (const OutputFile& f : g.files)
-    if (f.name.ends_with(".frag") || f.name.ends_with(".ps.hlsl") || f.name.ends_with(".comp") ||
-        f.name.ends_with(".cs.hlsl"))
-      entries.push_back(&f);
+    if (isEntry(f.name)) entries.push_back(&f);
 
   // Entries are independent (glslang and SPIRV-Tools are thread-safe per
   // compilation); results are kept by index, so the outcome does not depend
   // on scheduling.
   std::vector<ShaderValidation> results(entries.size());
   parallelFor(entries.size(), threads, [&](std::size_t i) {
-    const OutputFile& f = *entries[i];
-    ShaderSource src;
-    src.name = f.name;
-    src.text = f.contents;
-    src.language = f.name.ends_with(".frag") || f.name.ends_with(".comp") ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
-    src.stage = f.name.ends_with(".comp") || f.name.ends_with(".cs.hlsl") ? ShaderStage::Compute : ShaderStage::Fragment;
-    src.memoryFiles = files;
-    src.hlsl16BitTypes = g.precision == Precision::Half;
-    results[i] = compileAndValidate(src, options);
+    results[i] = compileAndValidate(entrySource(*entries[i], files, g.precision), options);
   });
 
   for (std::size_t i = 0; i < entries.size(); ++i) {
@@ -79,6 +89,18 @@ void validateGenerated(Generated& g, const ValidateOptions& options, std::size_t
     }
     g.entries.push_back({entries[i]->name, v.instructionCount, v.optimizedInstructionCount, std::move(v.optimized)});
   }
+}
+
+ShaderValidation compileGeneratedEntry(const Generated& g, const std::string& file) {
+  for (const OutputFile& f : g.files) {
+    if (f.name != file || !isEntry(f.name)) continue;
+    ShaderValidation v = compileAndValidate(entrySource(f, memoryFiles(g), g.precision));
+    if (!v.ok) v.log = fmt::format("{}\n{}\n{}", f.name, numberLines(f.contents), v.log);
+    return v;
+  }
+  ShaderValidation missing;
+  missing.log = "no entry shader '" + file + "' among the generated files";
+  return missing;
 }
 
 ShaderValidation compileKernel(const CompileResult& r, Target target, KernelMode mode, const EmitOptions& emit) {

@@ -44,6 +44,11 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o);
 /// Fills `entries`, `valid`, `failure` (the first failing entry in file order).
 void validateGenerated(Generated& g, const ValidateOptions& options = {}, std::size_t threads = 0);
 
+/// Compiles the entry shader `file` of `g` as validateGenerated does and keeps
+/// its SPIR-V (what `render` draws with). `ok` false, with the numbered source
+/// and the log (or "no entry shader ..."), otherwise.
+ShaderValidation compileGeneratedEntry(const Generated& g, const std::string& file);
+
 /// Compiles one compute kernel of the material (emit/kernel_emitter.h) for
 /// `target` to validated SPIR-V, against the material file generated with
 /// `emit` and the embedded runtime. `ok` false with the numbered kernel source
