@@ -117,7 +117,7 @@ TEST(CliUsage, AnUnknownCommandIsNamedAndTheCommandsListed) {
     EXPECT_NE(r.err.find(args.empty() ? "a command is required" : "unknown command \"" + args[0] + "\""),
               std::string::npos)
         << r.err;
-    EXPECT_NE(r.err.find("(the commands: report, compile, preview, sweep, accuracy, stability, import, scene)"), std::string::npos)
+    EXPECT_NE(r.err.find("(the commands: report, compile, preview, render, sweep, accuracy, stability, import, scene)"), std::string::npos)
         << r.err;
   }
   EXPECT_EQ(cli({"--version"}).status, 0);  // an option first is not a command

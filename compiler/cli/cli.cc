@@ -27,6 +27,7 @@
 #include "gpu/harness.h"
 #include "gpu/sample_run.h"
 #include "import/import.h"
+#include "mesh/gltf_mesh.h"
 #include "output/atomic_write.h"
 #include "output/depfile.h"
 #include "pipeline/pass_registry.h"
@@ -34,6 +35,8 @@
 #include "preview/contact_sheet.h"
 #include "preview/environment.h"
 #include "preview/render.h"
+#include "render/materials.h"
+#include "render/render.h"
 #include "report/report.h"
 #include "scene/scene.h"
 #include "stability/stability.h"
@@ -721,6 +724,207 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   return kExitOk;
 }
 
+// ----- render ------------------------------------------------------------------
+
+struct RenderArgs {
+  std::string model;
+  std::string material;  // --material FILE[:NAME]: every primitive with it
+  std::string output;
+  CompileFlags compile;
+  std::string size = "512x512";
+  std::string camera;  // "": the document's first camera, else one that frames the scene; N; "frame"
+  bool forward = false;
+  std::string target = "glsl";
+  std::string environment = preview::kDefaultEnvironment;
+  std::string diffuse{diffuseModelName(kDefaultDiffuseModel)};
+  double exposure = 0;
+  bool timings = false;
+  TextureFlags textures;
+};
+
+void addRenderOptions(CLI::App* c, RenderArgs& a) {
+  c->add_option("model", a.model, "glTF 2.0 scene (.gltf or .glb)")->required();
+  c->add_option("--material", a.material,
+                "Draw every primitive with this material instead of the document's own: FILE, or FILE:NAME for one "
+                "material of a .gltf, .glb, .materials.json or .mtlx file")
+      ->type_name("FILE[:NAME]");
+  addOutput(c, a.output, "PNG file to write");
+  addBudgetOptions(c, a.compile);
+  c->add_option("--size", a.size, "Image size in pixels, WxH (16 to 4096 a side)")->capture_default_str();
+  c->add_option("--camera", a.camera,
+                "The document's camera N (0-based, in node order), or 'frame' for one that frames the scene "
+                "(default: the document's first camera, else 'frame')");
+  c->add_flag("--forward", a.forward, "Draw opaque materials with their forward pass instead of the deferred path");
+  c->add_option("--target", a.target, "Which generated language renders: glsl or hlsl")
+      ->check(CLI::IsMember({"glsl", "hlsl"}))->capture_default_str();
+  c->add_option("--env", a.environment, "Procedural environment")->check(CLI::IsMember(preview::environmentNames()))
+      ->capture_default_str();
+  addDiffuseOption(c, a.diffuse);
+  c->add_option("--exposure", a.exposure, "Exposure in stops on top of the calibrated one")
+      ->transform(cli::inRange(-16.0, 16.0, "stops"))->capture_default_str();
+  c->add_flag("--timings", a.timings, "Print each pass's GPU time (timestamp queries) after the output's path");
+  addMaxInputSize(c, a.compile);
+  addTextureOptions(c, a.textures);
+}
+
+/// "WxH" -> width and height; kExitUsage (with the message) otherwise.
+int parseImageSize(const std::string& text, int* width, int* height, std::ostream& err) {
+  const std::size_t x = text.find('x');
+  try {
+    std::size_t used = 0;
+    if (x != std::string::npos && x > 0) {
+      *width = std::stoi(text.substr(0, x), &used);
+      const bool whole = used == x;
+      *height = std::stoi(text.substr(x + 1), &used);
+      if (whole && used == text.size() - x - 1 && *width >= 16 && *height >= 16 && *width <= 4096 && *height <= 4096)
+        return kExitOk;
+    }
+  } catch (const std::exception&) {
+  }
+  return printError(err, kExitUsage, fmt::format("--size: expected WxH with 16 to 4096 pixels a side, got '{}'", text));
+}
+
+/// The materials of the render: --material's, or the document's (and glTF's default).
+std::optional<render::SceneSources> renderSources(const RenderArgs& a, const mesh::Scene& scene, const ReadLimits& read,
+                                                  CommandOutputs& outputs, std::ostream& err, int& status) {
+  if (!a.material.empty()) {
+    MaterialInput in{a.material, ""};
+    const std::size_t colon = a.material.rfind(':');
+    if (colon != std::string::npos && colon > 0 && import::sourceKindOf(a.material.substr(0, colon)) !=
+                                                       import::SourceKind::Substrate) {
+      in.file = a.material.substr(0, colon);
+      in.material = a.material.substr(colon + 1);
+    }
+    auto sources = loadFile(in, false, read, outputs, err, status);
+    if (!sources) return std::nullopt;
+    return render::oneMaterialSources(std::move(sources->front()), scene);
+  }
+  Diagnostics diags(a.model);
+  auto sources = render::gltfSceneSources(a.model, scene, read, diags);
+  err << diags.formatAll();
+  if (!sources) status = kExitBadInput;
+  return sources;
+}
+
+/// The camera --camera asks for: kExitUsage for a camera the document does not have.
+int renderCamera(const RenderArgs& a, const mesh::Scene& scene, int width, int height, mesh::Camera* out,
+                 std::ostream& err) {
+  if (a.camera == "frame" || (a.camera.empty() && scene.cameras.empty())) {
+    *out = mesh::framingCamera(scene, static_cast<double>(width) / height);
+    return kExitOk;
+  }
+  std::size_t n = 0;
+  if (!a.camera.empty()) {
+    std::size_t used = 0;
+    try {
+      n = std::stoul(a.camera, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != a.camera.size() || n >= scene.cameras.size())
+      return printError(err, kExitUsage,
+                        fmt::format("--camera {}: {} has {} camera(s); give 0 to {} or 'frame'", a.camera, a.model,
+                                    scene.cameras.size(), scene.cameras.empty() ? 0 : scene.cameras.size() - 1));
+  }
+  *out = scene.cameras[n];
+  return kExitOk;
+}
+
+/// Compiles each source and binds its textures; the materials' results in `results` (kept alive).
+int compileRenderMaterials(const RenderArgs& a, const render::SceneSources& s, const CompileOptions& o,
+                           CommandOutputs& outputs, std::vector<CompileResult>* results,
+                           std::vector<preview::BoundTextures>* textures, std::ostream& err) {
+  results->resize(s.sources.size());
+  textures->resize(s.sources.size());
+  for (std::size_t i = 0; i < s.sources.size(); ++i) {
+    const import::MaterialSource& src = s.sources[i];
+    Diagnostics diags(src.displayName);
+    auto r = compileText(src.displayName, src.text, o, diags);
+    err << diags.formatAll();
+    if (!r) return compileFailure(src, err);
+    (*results)[i] = std::move(*r);
+    // --texture NAME=PATH binds every material's input NAME; a NAME no material has is an error below.
+    TextureFlags flags{{}, a.textures.searchPaths};
+    for (const std::string& t : a.textures.textures)
+      for (const Input& in : (*results)[i].material.inputs)
+        if (in.name == t.substr(0, t.find('='))) flags.textures.push_back(t);
+    if (int failed = bindRenderTextures(flags, src, (*results)[i].material, o.read, outputs, &(*textures)[i], err);
+        failed != kExitOk)
+      return failed;
+  }
+  for (const std::string& t : a.textures.textures) {
+    const std::string name = t.substr(0, t.find('='));
+    bool used = false;
+    for (const CompileResult& r : *results)
+      for (const Input& in : r.material.inputs) used = used || (in.name == name && in.type == VType::Texture);
+    if (!used) return printError(err, kExitUsage, fmt::format("--texture {}: no material of the render has a texture input of that name", name));
+  }
+  return kExitOk;
+}
+
+/// Draws a glTF scene with the emitted shaders on lavapipe (docs/render.md) and writes an sRGB PNG.
+int runRender(const RenderArgs& a, std::ostream& out, std::ostream& err) {
+  const CompileOptions o = toCompileOptions(a.compile);
+  int width = 0, height = 0;
+  if (int status = parseImageSize(a.size, &width, &height, err); status != kExitOk) return status;
+  CommandOutputs outputs(out);
+  outputs.namedFile(a.output);
+  outputs.input(a.model);
+  if (int status = outputs.check(err); status != kExitOk) return status;
+  Diagnostics meshDiags(a.model);
+  mesh::MeshLimits limits;
+  limits.maxFileBytes = std::max<std::size_t>(limits.maxFileBytes, o.read.maxInputBytes);
+  auto scene = mesh::loadGltfScene(a.model, limits, meshDiags);
+  err << meshDiags.formatAll();
+  if (!scene) return kExitBadInput;
+  for (const std::string& f : scene->files) outputs.input(f);
+  int status = kExitOk;
+  auto sources = renderSources(a, *scene, o.read, outputs, err, status);
+  if (!sources) return status;
+  std::vector<CompileResult> results;
+  std::vector<preview::BoundTextures> textures;
+  if (int failed = compileRenderMaterials(a, *sources, o, outputs, &results, &textures, err); failed != kExitOk)
+    return failed;
+  mesh::Camera camera;
+  if (int failed = renderCamera(a, *scene, width, height, &camera, err); failed != kExitOk) return failed;
+  if (int failed = outputs.check(err); failed != kExitOk) return failed;
+  auto ctx = openGpu("float", "render draws on Vulkan (Mesa lavapipe)", err);
+  if (!ctx) return kExitBadInput;
+  std::vector<render::SceneMaterial> materials;
+  for (std::size_t i = 0; i < results.size(); ++i) materials.push_back({&results[i], &textures[i]});
+  render::RenderOptions ro;
+  ro.width = width;
+  ro.height = height;
+  ro.forward = a.forward;
+  ro.target = a.target == "hlsl" ? Target::Hlsl : Target::Glsl;
+  ro.environment = a.environment;
+  ro.diffuseModel = diffuseModelOf(a.diffuse);
+  render::RenderResult result;
+  Diagnostics failure(a.model);
+  if (!render::renderScene(*ctx, *scene, materials, sources->primitiveMaterial, camera, ro, &result, failure))
+    return printInternalError(err, failure.errorMessages());
+  const std::array<double, 3> toCamera{-camera.forward[0], -camera.forward[1], -camera.forward[2]};
+  const preview::Image image =
+      preview::tonemap(result.hdr, a.exposure, render::renderCalibrationGains(a.environment, toCamera));
+  preview::Srgb8 srgb = preview::encodeSrgb8(image);
+  if (srgb.nanCount > 0) return printInternalError(err, fmt::format("{} pixels of the render are NaN", srgb.nanCount));
+  std::vector<uint8_t> png;
+  if (!preview::encodePng(image.width, image.height, srgb.rgba, png, failure))
+    return printInternalError(err, "cannot encode the PNG: " + failure.errorMessages());
+  if (int failed = outputs.commit({{a.output, std::string(png.begin(), png.end())}}, err); failed != kExitOk)
+    return failed;
+  out << a.output << "\n";
+  if (a.timings) {
+    const render::RenderStats& st = result.stats;
+    out << fmt::format("{} draws, {} of {} pixels covered; GPU ms: opaque {:.3f}, classify {:.3f}, lighting {:.3f}, "
+                       "forward {:.3f} (tiles: {} simple, {} single, {} complex, {} special)\n",
+                       st.draws, st.coveredPixels, std::size_t(width) * height, st.opaqueNs * 1e-6,
+                       st.classifyNs * 1e-6, st.lightingNs * 1e-6, st.forwardNs * 1e-6, st.tiles[0], st.tiles[1],
+                       st.tiles[2], st.tiles[3]);
+  }
+  return kExitOk;
+}
+
 // ----- sweep -------------------------------------------------------------------
 
 struct SweepArgs {
@@ -1269,6 +1473,10 @@ int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream
               runCompile),
       command(app, "preview", "Render the material on a sphere (Vulkan, Mesa lavapipe) into a PNG", addPreviewOptions,
               runPreview),
+      command(app, "render",
+              "Draw a glTF scene with the emitted shaders in raster passes (Vulkan, Mesa lavapipe) into a PNG "
+              "(docs/render.md)",
+              addRenderOptions, runRender),
       command(app, "sweep", "Cost against error at the full budget and at each simplification step", addSweepOptions,
               runSweep),
       command(app, "accuracy",

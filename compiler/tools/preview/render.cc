@@ -21,11 +21,28 @@ namespace {
 
 using namespace kernel;
 
-/// The environment's cube maps, built once per name in a process (a sweep
-/// renders many tiles under the same light).
-struct EnvironmentMaps {
-  CubeMap prefiltered, irradiance;
+template <class T>
+std::vector<std::byte> bytesOf(const std::vector<T>& v) {
+  std::vector<std::byte> b(v.size() * sizeof(T));
+  std::memcpy(b.data(), v.data(), b.size());
+  return b;
+}
+
+std::array<double, 3> unit(std::array<double, 3> v) {
+  const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  return {v[0] / l, v[1] / l, v[2] / l};
+}
+/// The three preview lights: a warm key from the upper left, a cool fill from
+/// the right and a rim from behind (unit directions toward the light, +Y up,
+/// the camera on +Z).
+const Light kLights[kPreviewLights] = {
+    {unit({-0.6, 0.7, 0.6}), {2.6, 2.4, 2.1}},
+    {unit({0.8, 0.1, 0.5}), {0.5, 0.6, 0.75}},
+    {unit({0.2, 0.5, -0.9}), {1.2, 1.2, 1.2}},
 };
+
+}  // namespace
+
 const EnvironmentMaps& environmentMaps(const std::string& name) {
   static std::mutex mutex;
   static std::map<std::string, EnvironmentMaps> cache;
@@ -48,40 +65,12 @@ gpu::ImageResource cubeResource(const CubeMap& map) {
   return img;
 }
 
-template <class T>
-std::vector<std::byte> bytesOf(const std::vector<T>& v) {
-  std::vector<std::byte> b(v.size() * sizeof(T));
-  std::memcpy(b.data(), v.data(), b.size());
-  return b;
-}
-
-/// The three preview lights: a warm key from the upper left, a cool fill from
-/// the right and a rim from behind (unit directions toward the light, +Y up,
-/// the camera on +Z).
-struct Light {
-  std::array<double, 3> direction, radiance;
-};
-std::array<double, 3> unit(std::array<double, 3> v) {
-  const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  return {v[0] / l, v[1] / l, v[2] / l};
-}
-const Light kLights[kPreviewLights] = {
-    {unit({-0.6, 0.7, 0.6}), {2.6, 2.4, 2.1}},
-    {unit({0.8, 0.1, 0.5}), {0.5, 0.6, 0.75}},
-    {unit({0.2, 0.5, -0.9}), {1.2, 1.2, 1.2}},
-};
-
-/// The lights of `environment`: the three above, except under "white", a
-/// furnace, which is its radiance 1 alone (every light black).
 Light previewLight(const std::string& environment, int l) {
   Light light = kLights[l];
   if (environment == "white") light.radiance = {0, 0, 0};
   return light;
 }
 
-/// A set-1 texture or sampler binding of the preview kernel: a material
-/// texture's bound image or its neutral texel (repeated), a specular profile
-/// p_<input>'s image or the default profile (clamped), their samplers.
 gpu::Resource materialTexture(const Material& m, const std::vector<gpu::TextureRole>& roles,
                               const BoundTextures* textures, const gpu::DescriptorBinding& b) {
   const bool profile = b.binding >= kPreviewProfileBinding;
@@ -104,8 +93,6 @@ gpu::Resource materialTexture(const Material& m, const std::vector<gpu::TextureR
   }
   return image ? *image : solidTexture(gpu::neutralTexel(input >= 0 ? roles[input] : gpu::TextureRole::Colour));
 }
-
-}  // namespace
 
 std::array<double, 3> calibrationGains(const std::string& environment) {
   const std::array<double, 3> toCamera{0, 0, 1};

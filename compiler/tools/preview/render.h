@@ -12,7 +12,9 @@
 #include "emit/material_emitter.h"
 #include "emit/syntax.h"
 #include "gpu/harness.h"
+#include "gpu/sample_run.h"
 #include "pipeline/pipeline.h"
+#include "preview/cubemap.h"
 #include "preview/image.h"
 #include "preview/textures.h"
 
@@ -29,6 +31,33 @@ class PipelineCache {
  private:
   std::map<std::vector<uint32_t>, std::unique_ptr<gpu::ComputePipeline>> pipelines_;
 };
+
+/// A light of the preview (and of `render`): a unit direction toward it and its radiance.
+struct Light {
+  std::array<double, 3> direction, radiance;
+};
+
+/// The lights of `environment`, l < kPreviewLights (emit/kernel_emitter.h): a
+/// warm key from the upper left (l = 0, the one light of `render`), a cool
+/// fill from the right and a rim from behind; under "white", a furnace, every
+/// light is black (its radiance 1 alone).
+Light previewLight(const std::string& environment, int l);
+
+/// The split-sum cube maps of an environment, built once per name in a
+/// process (a sweep renders many tiles under the same light).
+struct EnvironmentMaps {
+  CubeMap prefiltered, irradiance;
+};
+const EnvironmentMaps& environmentMaps(const std::string& name);
+/// A cube map as a sampled texture (linear, clamped).
+gpu::ImageResource cubeResource(const CubeMap& map);
+
+/// A set-1 texture or sampler binding of a material's shaders (the preview
+/// kernel, the base and forward passes): a texture input's bound image or its
+/// neutral texel by role (repeated), a specular profile p_<input>'s image or
+/// the default profile (clamped), and HLSL's samplers by the input's wrap and filter.
+gpu::Resource materialTexture(const Material& m, const std::vector<gpu::TextureRole>& roles,
+                              const BoundTextures* textures, const gpu::DescriptorBinding& b);
 
 struct RenderOptions {
   int size = 256;                            // pixels, square
