@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # `substratec render` of a mesh at 512 x 512 on lavapipe (issue 20; docs/performance.md,
-# "render"): each pass's GPU time from timestamp queries (`--timings`), the wall time and
-# the peak memory (GNU time's maximum resident set) of the whole command, deferred and
-# forward, GLSL and HLSL. Works from any directory.
+# "render"): each pass's time (`--timings`: the GPU timestamps of the raster passes, the
+# host wall time of every submission — lavapipe's timestamps do not enclose a compute
+# dispatch), the wall time and the peak memory (GNU time's maximum resident set) of the
+# whole command, deferred and forward, GLSL and HLSL. Works from any directory.
 #
 #   RENDER_MESH      [../shared/corpus/assets/materialx/Geometry/shaderball.glb] the glTF/.glb drawn
 #   RENDER_MATERIAL  [examples/car_paint.json]  drawn on every primitive (--material)
@@ -28,8 +29,8 @@ trap 'rm -rf "$out"' EXIT
 echo "machine: $(nproc) cores, $(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | xargs), load $(cut -d' ' -f1-3 /proc/loadavg), $(git -C "$root" rev-parse --short HEAD 2>/dev/null || echo '?')"
 echo "mesh: $(basename "$mesh"), material: $(basename "$material"), $size"
 echo
-echo "| path | target | GPU ms: opaque | classify | lighting | forward | wall s (median of $runs) | peak RSS MiB |"
-echo "|---|---|---:|---:|---:|---:|---:|---:|"
+echo "| path | target | opaque GPU ms | opaque wall ms | classify wall ms | lighting wall ms | forward wall ms | command wall s (median of $runs) | peak RSS MiB |"
+echo "|---|---|---:|---:|---:|---:|---:|---:|---:|"
 for path in deferred forward; do
   for target in glsl hlsl; do
     flags=(--target "$target")
@@ -46,11 +47,14 @@ for path in deferred forward; do
       read -r wall kb < "$out/time"
       walls+=("$wall")
       rss=$(( kb > rss ? kb : rss ))
-      line="$(grep 'GPU ms' "$out/stdout")"
+      gpu="$(grep '^GPU ms' "$out/stdout")"
+      line="$(grep '^wall ms' "$out/stdout")"
     done
     median="$(printf '%s\n' "${walls[@]}" | sort -g | sed -n "$(( (runs + 1) / 2 ))p")"
-    # "... GPU ms: opaque A, classify B, lighting C, forward D (tiles: ...)" (the last run's)
-    read -r opaque classify lighting forward < <(echo "$line" | sed -E 's/.*opaque ([0-9.]+), classify ([0-9.]+), lighting ([0-9.]+), forward ([0-9.]+).*/\1 \2 \3 \4/')
-    echo "| $path | $target | $opaque | $classify | $lighting | $forward | $median | $(( rss / 1024 )) |"
+    # "... ms (...): opaque A, classify B, lighting C, forward D" (the last run's)
+    fields='s/.*opaque ([0-9.]+), classify ([0-9.]+), lighting ([0-9.]+), forward ([0-9.]+).*/\1 \2 \3 \4/'
+    read -r gpuOpaque _ < <(echo "$gpu" | sed -E "$fields")
+    read -r opaque classify lighting forward < <(echo "$line" | sed -E "$fields")
+    echo "| $path | $target | $gpuOpaque | $opaque | $classify | $lighting | $forward | $median | $(( rss / 1024 )) |"
   done
 done

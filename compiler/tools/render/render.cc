@@ -1,6 +1,7 @@
 #include "render/render.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -37,6 +38,15 @@ std::vector<std::byte> bytesOf(const T* data, std::size_t count) {
   std::vector<std::byte> b(count * sizeof(T));
   if (count) std::memcpy(b.data(), data, b.size());
   return b;
+}
+
+/// Runs `submit` and adds its host wall time to `*ns`.
+template <class F>
+bool timed(double* ns, F&& submit) {
+  const auto start = std::chrono::steady_clock::now();
+  const bool ok = submit();
+  *ns += std::chrono::duration<double, std::nano>(std::chrono::steady_clock::now() - start).count();
+  return ok;
 }
 
 /// How a material is drawn: into the G-buffer, or forward after the lighting.
@@ -327,7 +337,7 @@ bool Frame::gbufferPass(std::vector<gpu::ColorAttachment>* gbuffer, std::vector<
     draws.push_back({pipe, &list.geometry[p], std::move(res)});
   }
   stats.draws += static_cast<int>(opaque.size());
-  if (!ctx.render(pass, draws, diags, &stats.opaqueNs)) return false;
+  if (!timed(&stats.opaqueWallNs, [&] { return ctx.render(pass, draws, diags, &stats.opaqueNs); })) return false;
   *gbuffer = std::move(pass.colors);
   depth = std::move(pass.depth);
   if (slices > 0) *materialBuffer = std::move(std::get<gpu::StorageImageResource>(pass.shared.at({0, 4})).data);
@@ -421,7 +431,10 @@ bool Frame::lightTiles(const std::vector<gpu::ColorAttachment>& gbuffer, const s
   };
   auto classifier = computePipeline(tileClassificationFileName(shape, syn), emitTileClassification(shape, syn));
   Tiles tiles;
-  if (!classifier || !classify(ctx, *classifier, lighting, gbufferImage, &tiles, &stats.classifyNs, diags)) return false;
+  if (!classifier || !timed(&stats.classifyWallNs, [&] {
+        return classify(ctx, *classifier, lighting, gbufferImage, &tiles, &stats.classifyNs, diags);
+      }))
+    return false;
   const uint32_t tilesX = (W + kSceneTileSize - 1) / kSceneTileSize, tileCount = tilesX * ((H + kSceneTileSize - 1) / kSceneTileSize);
   color.assign(std::size_t{W} * H * 4, 0.0f);
   for (const SceneLightingClass& k : shape.classes) {
@@ -433,7 +446,9 @@ bool Frame::lightTiles(const std::vector<gpu::ColorAttachment>& gbuffer, const s
     gpu::Resources res =
         lightingResources(*light, lighting, tileCount, gbufferImage, materialImage ? &*materialImage : nullptr, tiles);
     double ns = 0;
-    if (!ctx.dispatch(*light, res, static_cast<uint32_t>(list.size()), 1, 1, diags, &ns)) return false;
+    if (!timed(&stats.lightingWallNs,
+               [&] { return ctx.dispatch(*light, res, static_cast<uint32_t>(list.size()), 1, 1, diags, &ns); }))
+      return false;
     stats.lightingNs += ns;
     const auto& lit = std::get<gpu::StorageImageResource>(res.at({0, 8})).data;
     for (uint32_t word : list)  // copy this class's tiles out of its target
@@ -477,7 +492,9 @@ bool Frame::forwardOpaque(Diagnostics& diags) {
     draws.push_back({pipe, &list.geometry[p], drawResources(*pipe, list.shaders[mi].forward, materials[mi], lighting)});
   }
   stats.draws += static_cast<int>(draws.size());
-  if (!draws.empty() && !ctx.render(pass, draws, diags, &stats.opaqueNs)) return false;
+  if (!draws.empty() &&
+      !timed(&stats.opaqueWallNs, [&] { return ctx.render(pass, draws, diags, &stats.opaqueNs); }))
+    return false;
   const std::size_t texels = std::size_t{pass.width} * pass.height;
   color.assign(texels * 4, 0.0f);
   depth.assign(texels, 1.0f);
@@ -536,7 +553,7 @@ bool Frame::forwardAfter(Diagnostics& diags) {
     draws.push_back({pipe, &list.geometry[p], drawResources(*pipe, list.shaders[mi].forward, materials[mi], lighting)});
   }
   stats.draws += static_cast<int>(draws.size());
-  if (!ctx.render(pass, draws, diags, &stats.forwardNs)) return false;
+  if (!timed(&stats.forwardWallNs, [&] { return ctx.render(pass, draws, diags, &stats.forwardNs); })) return false;
   std::memcpy(color.data(), pass.colors[0].data.data(), color.size() * sizeof(float));
   depth = std::move(pass.depth);
   for (std::size_t i = 3; i < color.size(); i += 4) color[i] = 1.0f;

@@ -52,13 +52,18 @@ struct RenderOptions {
   DiffuseModel diffuseModel = kDefaultDiffuseModel;
 };
 
-/// What the passes cost (timestamp queries around each pass's GPU work:
-/// uploads and read-backs excluded) and what they drew.
+/// What the passes cost and what they drew. Two clocks: timestamp queries
+/// around each pass's GPU work (uploads and read-backs excluded), and the
+/// host's wall time of each submission (uploads, the work, read-backs; no
+/// shader or pipeline compilation). On lavapipe the timestamps around a
+/// compute dispatch do not enclose its execution (a 512 x 512 lighting
+/// dispatch reads 0.07 ms): read the wall times for classify and lighting.
 struct RenderStats {
   double opaqueNs = 0;       // deferred: pre-pass + base pass; forward: the opaque forward pass
   double classifyNs = 0;     // deferred: tile classification
   double lightingNs = 0;     // deferred: every tile class's lighting
   double forwardNs = 0;      // the forward pass after lighting (masked, translucent), when it has draws
+  double opaqueWallNs = 0, classifyWallNs = 0, lightingWallNs = 0, forwardWallNs = 0;  // the same, host wall time
   int draws = 0;             // primitives drawn (a pre-pass draw not counted)
   std::array<std::size_t, 4> tiles{};  // deferred: tiles per class (simple, single, complex, special)
   std::size_t coveredPixels = 0;       // pixels some primitive covers
