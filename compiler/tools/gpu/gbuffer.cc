@@ -66,7 +66,9 @@ std::vector<std::byte> bytesOf(const std::vector<uint32_t>& w) {
   return b;
 }
 
-BufferResource frameBlock(const SceneFrame& f) {
+}  // namespace
+
+BufferResource sceneFrameBlock(const SceneFrame& f) {
   std::vector<float> v;
   auto push = [&](const std::array<double, 3>& a, double w) {
     for (double c : a) v.push_back(static_cast<float>(c));
@@ -77,7 +79,7 @@ BufferResource frameBlock(const SceneFrame& f) {
   push(f.up, 0);
   push(f.light, 0);
   push(f.radiance, 0);
-  push({1, 0, 0}, 0);  // envParams: one mip (the environment is constant)
+  push({f.envMips, 0, 0}, 0);  // envParams
   BufferResource b;
   b.data.resize(v.size() * 4 + 16);
   std::memcpy(b.data.data(), v.data(), v.size() * 4);
@@ -85,6 +87,8 @@ BufferResource frameBlock(const SceneFrame& f) {
   std::memcpy(b.data.data() + v.size() * 4, viewport, 16);
   return b;
 }
+
+namespace {
 
 ImageResource constantCube(const std::array<double, 3>& c) {
   ImageResource img;
@@ -189,9 +193,14 @@ StorageImageResource Gbuffer::materialBufferImage() const {
 
 bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFrame& f, const Gbuffer& gbuffer,
                    TileLists* out, Diagnostics& diags) {
+  return classifyTiles(ctx, classify, f, gbuffer.gbufferImage(), out, diags);
+}
+
+bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFrame& f,
+                   const StorageImageResource& gbufferImage, TileLists* out, Diagnostics& diags, double* ns) {
   Resources res;
-  res[{0, 0}] = frameBlock(f);
-  res[{0, 6}] = gbuffer.gbufferImage();
+  res[{0, 0}] = sceneFrameBlock(f);
+  res[{0, 6}] = gbufferImage;
   BufferResource tiles;
   tiles.data.resize(std::size_t{4} * f.tiles() * 4);
   tiles.output = true;
@@ -202,7 +211,7 @@ bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFra
   args.data = bytesOf(init);
   args.output = args.initialized = true;
   res[{0, 9}] = args;
-  if (!ctx.dispatch(classify, res, f.tilesX(), f.tilesY(), 1, diags)) return false;
+  if (!ctx.dispatch(classify, res, f.tilesX(), f.tilesY(), 1, diags, ns)) return false;
   std::vector<uint32_t> counts(16);
   std::memcpy(counts.data(), std::get<BufferResource>(res[{0, 9}]).data.data(), 64);
   out->raw.resize(std::size_t{4} * f.tiles());
@@ -227,7 +236,7 @@ Resources lightingResources(const ComputePipeline& lighting, const SceneFrame& f
   for (const DescriptorBinding& b : lighting.reflection().bindings) {
     const auto key = std::make_pair(b.set, b.binding);
     switch (b.binding) {
-      case 0: res[key] = frameBlock(f); break;
+      case 0: res[key] = sceneFrameBlock(f); break;
       case 1: res[key] = constantCube(f.prefiltered); break;
       case 2: res[key] = constantCube(f.irradiance); break;
       case 3: res[key] = SamplerResource{}; break;

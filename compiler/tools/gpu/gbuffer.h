@@ -26,6 +26,7 @@ struct SceneFrame {
   std::array<double, 3> radiance{2.0, 1.8, 1.6};
   std::array<double, 3> prefiltered{0.6, 0.5, 0.4};  // every direction and mip
   std::array<double, 3> irradiance{1.2, 1.0, 0.8};
+  double envMips = 1;  // mip levels of the prefiltered environment (envParams.x; 1: the constant one above)
 
   uint32_t tilesX() const { return (width + kSceneTileSize - 1) / kSceneTileSize; }
   uint32_t tilesY() const { return (height + kSceneTileSize - 1) / kSceneTileSize; }
@@ -73,9 +74,16 @@ struct TileLists {
   std::vector<uint32_t> raw;  // the list buffer as written (what the lighting reads)
 };
 
+/// SubstrateSceneFrame (emit/scene_emitter.h) for `f`; viewport.z = f.tiles().
+BufferResource sceneFrameBlock(const SceneFrame& f);
+
 /// Runs a classification pipeline over `gbuffer`; false, with errors reported, on failure.
 bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFrame& f, const Gbuffer& gbuffer,
                    TileLists* out, Diagnostics& diags);
+/// The same over a G-buffer image (4 layers of r32ui: words 0-2, the top-layer word); with `ns`, the
+/// dispatch's timestamps (Context::dispatch).
+bool classifyTiles(Context& ctx, const ComputePipeline& classify, const SceneFrame& f,
+                   const StorageImageResource& gbufferImage, TileLists* out, Diagnostics& diags, double* ns = nullptr);
 
 /// The resources of one lighting dispatch (its reflection says which it uses);
 /// the colour target (binding 8) is an RGBA32F output of the frame's size.

@@ -94,10 +94,10 @@ gpu::Resource materialTexture(const Material& m, const std::vector<gpu::TextureR
   return image ? *image : solidTexture(gpu::neutralTexel(input >= 0 ? roles[input] : gpu::TextureRole::Colour));
 }
 
-std::array<double, 3> calibrationGains(const std::string& environment) {
-  const std::array<double, 3> toCamera{0, 0, 1};
+std::array<double, 3> calibrationGains(const std::string& environment, int lights,
+                                       const std::array<double, 3>& toCamera) {
   std::array<double, 3> e = sampleCube(environmentMaps(environment).irradiance, toCamera, 0.0);
-  for (int l = 0; l < kPreviewLights; ++l) {
+  for (int l = 0; l < std::min(lights, kPreviewLights); ++l) {
     const Light light = previewLight(environment, l);
     const double cosine = std::max(0.0, light.direction[0] * toCamera[0] + light.direction[1] * toCamera[1] +
                                             light.direction[2] * toCamera[2]);

@@ -78,7 +78,10 @@ struct RenderOptions {
 /// white Lambertian at the sphere's centre reflects radiance (1, 1, 1) and a
 /// Lambertian of albedo a reflects a, which the tone curve (tonemap) keeps
 /// below 0.76. (1, 1, 1) for "white" (radiance 1 everywhere, no lights).
-std::array<double, 3> calibrationGains(const std::string& environment);
+/// `lights` and `towardCamera` generalize it: the first `lights` preview
+/// lights (`render` has the key light alone) and the normal that faces the camera.
+std::array<double, 3> calibrationGains(const std::string& environment, int lights = kernel::kPreviewLights,
+                                       const std::array<double, 3>& towardCamera = {0, 0, 1});
 
 /// Renders `r` (linear HDR, background = the environment). False, with errors
 /// reported, on a kernel that does not validate (a compiler bug) or a failed dispatch.

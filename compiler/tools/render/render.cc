@@ -14,6 +14,7 @@
 #include "emit/material_emitter.h"
 #include "emit/scene_emitter.h"
 #include "gpu/block_layout.h"
+#include "gpu/gbuffer.h"
 #include "gpu/sample_run.h"
 #include "pipeline/generate.h"
 #include "preview/render.h"
@@ -163,18 +164,19 @@ gpu::BufferResource viewBlock(const Lighting& l) {
   return {bytesOf(f, 16), false, false};
 }
 
-/// SubstrateSceneFrame of the classification and lighting (6 float4, uint4).
-gpu::BufferResource sceneFrame(const Lighting& l, uint32_t tiles) {
-  float f[28] = {};
-  const std::array<double, 3>* vectors[5] = {&l.view.forward, &l.view.right, &l.view.up, &l.light.direction,
-                                             &l.light.radiance};
-  for (int v = 0; v < 5; ++v)
-    for (int c = 0; c < 3; ++c) f[v * 4 + c] = static_cast<float>((*vectors[v])[c]);
-  f[3] = static_cast<float>(l.view.tanHalfFov);
-  f[20] = static_cast<float>(l.maps->prefiltered.mipCount());
-  const uint32_t viewport[4] = {static_cast<uint32_t>(l.width), static_cast<uint32_t>(l.height), tiles, 0};
-  std::memcpy(&f[24], viewport, sizeof viewport);
-  return {bytesOf(f, 28), false, false};
+/// The scene lighting's frame (gpu/gbuffer.h: SubstrateSceneFrame) for this view and light.
+gpu::SceneFrame sceneFrame(const Lighting& l) {
+  gpu::SceneFrame f;
+  f.width = static_cast<uint32_t>(l.width);
+  f.height = static_cast<uint32_t>(l.height);
+  f.forward = l.view.forward;
+  f.right = l.view.right;
+  f.up = l.view.up;
+  f.tanHalfFov = l.view.tanHalfFov;
+  f.light = l.light.direction;
+  f.radiance = l.light.radiance;
+  f.envMips = l.maps->prefiltered.mipCount();
+  return f;
 }
 
 gpu::BufferResource energyTables() {
@@ -247,12 +249,7 @@ struct DrawList {
 
 std::array<double, 3> renderCalibrationGains(const std::string& environment,
                                              const std::array<double, 3>& towardCamera) {
-  std::array<double, 3> e = preview::sampleCube(preview::environmentMaps(environment).irradiance, towardCamera, 0.0);
-  const preview::Light light = preview::previewLight(environment, 0);
-  const double cosine = std::max(0.0, light.direction[0] * towardCamera[0] + light.direction[1] * towardCamera[1] +
-                                          light.direction[2] * towardCamera[2]);
-  for (int c = 0; c < 3; ++c) e[c] += cosine * light.radiance[c];
-  return {M_PI / std::max(e[0], 1e-9), M_PI / std::max(e[1], 1e-9), M_PI / std::max(e[2], 1e-9)};
+  return preview::calibrationGains(environment, 1, towardCamera);  // the key light alone
 }
 
 namespace {
@@ -344,61 +341,22 @@ bool Frame::gbufferPass(std::vector<gpu::ColorAttachment>* gbuffer, std::vector<
   return true;
 }
 
-/// The classes' tile lists as classification left them: per class, tile words (x | y << 16).
-struct Tiles {
-  std::array<std::vector<uint32_t>, 4> lists;
-  std::vector<std::byte> raw;  // the list buffer (what the lighting reads)
-};
-
-/// Runs the tile classification over `gbufferImage`; false, with errors reported, on failure.
-bool classify(gpu::Context& ctx, const gpu::ComputePipeline& pipeline, const Lighting& l,
-              const gpu::StorageImageResource& gbufferImage, Tiles* out, double* ns, Diagnostics& diags) {
-  const uint32_t tilesX = (l.width + kSceneTileSize - 1) / kSceneTileSize;
-  const uint32_t tilesY = (l.height + kSceneTileSize - 1) / kSceneTileSize;
-  const uint32_t tiles = tilesX * tilesY;
-  gpu::Resources res;
-  res[{0, 0}] = sceneFrame(l, tiles);
-  res[{0, 6}] = gbufferImage;
-  gpu::BufferResource list;
-  list.data.resize(std::size_t{4} * tiles * sizeof(uint32_t));
-  list.output = true;
-  res[{0, 7}] = list;
-  std::vector<uint32_t> args;
-  for (int c = 0; c < 4; ++c) args.insert(args.end(), {0u, 1u, 1u, 0u});
-  gpu::BufferResource argBuffer{bytesOf(args.data(), args.size()), true, true};
-  res[{0, 9}] = argBuffer;
-  if (!ctx.dispatch(pipeline, res, tilesX, tilesY, 1, diags, ns)) return false;
-  uint32_t counts[16];
-  std::memcpy(counts, std::get<gpu::BufferResource>(res[{0, 9}]).data.data(), sizeof counts);
-  out->raw = std::get<gpu::BufferResource>(res[{0, 7}]).data;
-  for (int c = 0; c < 4; ++c) {
-    if (counts[c * 4] > tiles)
-      return diags.fail(fmt::format("internal compiler error: classification listed {} tiles of {}", counts[c * 4],
-                                    tiles)),
-             false;
-    out->lists[c].resize(counts[c * 4]);
-    std::memcpy(out->lists[c].data(), out->raw.data() + (static_cast<std::size_t>(c) * tiles) * sizeof(uint32_t),
-                counts[c * 4] * sizeof(uint32_t));
-  }
-  return true;
-}
-
 /// The resources of one class's lighting dispatch, by its reflection.
-gpu::Resources lightingResources(const gpu::ComputePipeline& p, const Lighting& l, uint32_t tiles,
+gpu::Resources lightingResources(const gpu::ComputePipeline& p, const Lighting& l,
                                  const gpu::StorageImageResource& gbufferImage,
-                                 const gpu::StorageImageResource* materialImage, const Tiles& lists) {
+                                 const gpu::StorageImageResource* materialImage, const gpu::TileLists& lists) {
   gpu::Resources res;
   for (const gpu::DescriptorBinding& b : p.reflection().bindings) {
     const auto key = std::make_pair(b.set, b.binding);
     switch (b.binding) {
-      case 0: res[key] = sceneFrame(l, tiles); break;
+      case 0: res[key] = gpu::sceneFrameBlock(sceneFrame(l)); break;
       case 1: res[key] = preview::cubeResource(l.maps->prefiltered); break;
       case 2: res[key] = preview::cubeResource(l.maps->irradiance); break;
       case 3: res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::ClampToEdge, std::nullopt}; break;
       case 4: if (materialImage) res[key] = *materialImage; break;
       case 5: res[key] = energyTables(); break;
       case 6: res[key] = gbufferImage; break;
-      case 7: res[key] = gpu::BufferResource{lists.raw, false, false}; break;
+      case 7: res[key] = gpu::BufferResource{bytesOf(lists.raw.data(), lists.raw.size()), false, false}; break;
       case 8:
         res[key] = gpu::StorageImageResource{static_cast<uint32_t>(l.width), static_cast<uint32_t>(l.height), 1,
                                              gpu::StorageFormat::R32G32B32A32Sfloat, {}, false};
@@ -430,31 +388,33 @@ bool Frame::lightTiles(const std::vector<gpu::ColorAttachment>& gbuffer, const s
     return spirv.empty() ? nullptr : ctx.createPipeline(spirv, diags);
   };
   auto classifier = computePipeline(tileClassificationFileName(shape, syn), emitTileClassification(shape, syn));
-  Tiles tiles;
+  const gpu::SceneFrame frame = sceneFrame(lighting);
+  gpu::TileLists tiles;
   if (!classifier || !timed(&stats.classifyWallNs, [&] {
-        return classify(ctx, *classifier, lighting, gbufferImage, &tiles, &stats.classifyNs, diags);
+        return gpu::classifyTiles(ctx, *classifier, frame, gbufferImage, &tiles, diags, &stats.classifyNs);
       }))
     return false;
-  const uint32_t tilesX = (W + kSceneTileSize - 1) / kSceneTileSize, tileCount = tilesX * ((H + kSceneTileSize - 1) / kSceneTileSize);
   color.assign(std::size_t{W} * H * 4, 0.0f);
   for (const SceneLightingClass& k : shape.classes) {
-    const auto& list = tiles.lists[static_cast<int>(k.cls)];
+    const auto& list = tiles.tiles[static_cast<int>(k.cls)];  // tile ids: ty * tilesX + tx
     stats.tiles[static_cast<int>(k.cls)] = list.size();
     if (list.empty()) continue;
     auto light = computePipeline(sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn));
     if (!light) return false;
     gpu::Resources res =
-        lightingResources(*light, lighting, tileCount, gbufferImage, materialImage ? &*materialImage : nullptr, tiles);
+        lightingResources(*light, lighting, gbufferImage, materialImage ? &*materialImage : nullptr, tiles);
     double ns = 0;
     if (!timed(&stats.lightingWallNs,
                [&] { return ctx.dispatch(*light, res, static_cast<uint32_t>(list.size()), 1, 1, diags, &ns); }))
       return false;
     stats.lightingNs += ns;
     const auto& lit = std::get<gpu::StorageImageResource>(res.at({0, 8})).data;
-    for (uint32_t word : list)  // copy this class's tiles out of its target
-      for (uint32_t y = (word >> 16) * kSceneTileSize; y < std::min(H, ((word >> 16) + 1) * kSceneTileSize); ++y)
-        for (uint32_t x = (word & 0xffffu) * kSceneTileSize; x < std::min(W, ((word & 0xffffu) + 1) * kSceneTileSize); ++x)
+    for (uint32_t tile : list) {  // copy this class's tiles out of its target
+      const uint32_t x0 = (tile % frame.tilesX()) * kSceneTileSize, y0 = (tile / frame.tilesX()) * kSceneTileSize;
+      for (uint32_t y = y0; y < std::min(H, y0 + kSceneTileSize); ++y)
+        for (uint32_t x = x0; x < std::min(W, x0 + kSceneTileSize); ++x)
           std::memcpy(&color[(std::size_t{y} * W + x) * 4], lit.data() + (std::size_t{y} * W + x) * 16, 16);
+    }
   }
   return true;
 }
