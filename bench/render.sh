@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # `substratec render` of a mesh at 512 x 512 on lavapipe (issue 20; docs/performance.md,
 # "render"): each pass's time (`--timings`: the GPU timestamps of the raster passes, the
-# host wall time of every submission — lavapipe's timestamps do not enclose a compute
-# dispatch), the wall time and the peak memory (GNU time's maximum resident set) of the
+# host wall time of every submission — the timestamps of render's compute dispatches read
+# implausibly low, docs/performance.md says more), the wall time and the peak memory (GNU time's maximum resident set) of the
 # whole command, deferred and forward, GLSL and HLSL. Works from any directory.
 #
 #   RENDER_MESH      [../shared/corpus/assets/materialx/Geometry/shaderball.glb] the glTF/.glb drawn

@@ -55,9 +55,9 @@ struct RenderOptions {
 /// What the passes cost and what they drew. Two clocks: timestamp queries
 /// around each pass's GPU work (uploads and read-backs excluded), and the
 /// host's wall time of each submission (uploads, the work, read-backs; no
-/// shader or pipeline compilation). On lavapipe the timestamps around a
-/// compute dispatch do not enclose its execution (a 512 x 512 lighting
-/// dispatch reads 0.07 ms): read the wall times for classify and lighting.
+/// shader or pipeline compilation). The timestamps of render's 512 x 512
+/// lighting dispatch read 0.07 ms, which cannot be (not understood yet,
+/// docs/performance.md "render"): read the wall times for classify and lighting.
 struct RenderStats {
   double opaqueNs = 0;       // deferred: pre-pass + base pass; forward: the opaque forward pass
   double classifyNs = 0;     // deferred: tile classification
