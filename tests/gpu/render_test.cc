@@ -22,6 +22,7 @@
 
 #include "batch/batch.h"
 #include "cli/cli.h"
+#include "import/gltf_resources.h"
 #include "material_fixture.h"
 #include "mesh/gltf_mesh.h"
 #include "pipeline/pipeline.h"
@@ -349,6 +350,19 @@ TEST(RenderCli, BadInputIsALocatedErrorAndNothingIsWritten) {
   r = cli({"render", scenePath().string(), "-o", scenePath().string()});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(readBytes(scenePath()), sceneGltf());
+  // The output over an external buffer the document reads: an input too.
+  doc = nlohmann::json::parse(sceneGltf());
+  std::string why;
+  const std::string bin = import::decodeDataUri(doc["buffers"][0]["uri"].get<std::string>(), &why).value();
+  const fs::path buffer = workDir() / "external.bin";
+  std::ofstream(buffer, std::ios::binary) << bin;
+  doc["buffers"][0]["uri"] = "external.bin";
+  doc["buffers"][0]["byteLength"] = bin.size();
+  const fs::path external = workDir() / "external_buffer.gltf";
+  std::ofstream(external) << doc.dump();
+  r = cli({"render", external.string(), "-o", buffer.string()});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(readBytes(buffer), bin);
 }
 
 }  // namespace

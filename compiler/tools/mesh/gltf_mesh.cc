@@ -581,6 +581,7 @@ const std::string* Loader::loadBuffer(const Json& b, std::size_t index, const st
     bytes = import::decodeDataUri(uri, &why);
   } else if (auto path = import::uriPath(uri)) {
     const std::string full = (std::filesystem::path(baseDir_) / *path).string();
+    scene_.files.push_back(full);  // an input of the command, read or not
     bytes = readWholeFile(full, limits_.maxFileBytes, why);
     if (!bytes) why = fmt::format("cannot read {}: {}", quoteForDiagnostic(full, 200), why);
   } else {
@@ -1135,7 +1136,9 @@ std::optional<Scene> loadGltfScene(const std::string& path, const MeshLimits& li
   auto bytes = readSourceFile(path, documentLimits(limits), diags);
   if (!bytes) return std::nullopt;
   std::string dir = std::filesystem::path(path).parent_path().string();
-  return loadGltfSceneFromBytes(*bytes, dir.empty() ? "." : dir, limits, diags);
+  auto scene = loadGltfSceneFromBytes(*bytes, dir.empty() ? "." : dir, limits, diags);
+  if (scene) scene->files.insert(scene->files.begin(), path);
+  return scene;
 }
 
 Camera framingCamera(const Scene& scene, double aspect) {
