@@ -3,16 +3,40 @@
 // signature): every input ends in an image within the limits whose texel
 // count matches its size, then a mip chain whose levels halve down to 1 x 1,
 // or in a refusal that says why; never a crash, a leak or an exception.
+// The same bytes through image::decodeRadiance (Radiance HDR by stb_image,
+// behind the pixel-stream check that keeps it from looping forever): an image
+// within the limits of finite radiance >= 0, or a refusal that says why.
 #include <cstddef>
 #include <cstdint>
 #include <cstdlib>
 #include <string>
 
+#include <cmath>
+
 #include "image/decode.h"
+#include "image/radiance.h"
 
 using namespace substratec;
 
+namespace {
+
+void radiance(const std::uint8_t* data, std::size_t size) {
+  image::RgbF img;
+  std::string why;
+  if (!image::decodeRadiance(data, size, &img, &why)) {
+    if (why.empty()) std::abort();
+    return;
+  }
+  if (img.width == 0 || img.height == 0 || std::uint64_t{img.width} * img.height > image::kMaxImageTexels) std::abort();
+  if (img.rgb.size() != std::size_t{img.width} * img.height * 3) std::abort();
+  for (float v : img.rgb)
+    if (!std::isfinite(v) || v < 0) std::abort();
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  radiance(data, size);
   image::Rgba8 img;
   std::string why;
   if (!image::decode(data, size, &img, &why)) {

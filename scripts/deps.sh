@@ -9,6 +9,7 @@ PACKAGES=(
   glslang-dev glslang-tools spirv-tools
   libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools libpng-dev
   libjpeg62-turbo-dev   # texture images: JPEG (PNG is libpng's)
+  libstb-dev            # Radiance HDR environments (stb_image's header)
   clang-14 libclang-rt-14-dev llvm-14   # scripts/fuzz.sh: libFuzzer, ASan/UBSan runtimes, llvm-symbolizer
   libpugixml-dev
   libxxhash-dev

@@ -8,6 +8,7 @@
 // name goes through cli/messages.h.
 #include "cli/cli.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <map>
@@ -600,6 +601,41 @@ int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, c
   return ok ? kExitOk : kExitBadInput;
 }
 
+/// --env: a procedural environment by name, or a Radiance file (lat-long).
+void addEnvironmentOption(CLI::App* c, std::string& environment) {
+  std::string names;
+  for (const std::string& n : preview::environmentNames()) names += n + ", ";
+  c->add_option("--env", environment,
+                "Environment: " + names + "or FILE.hdr (a Radiance image in the lat-long layout, docs/render.md)")
+      ->check(CLI::Validator(
+          [](std::string& v) -> std::string {
+            const auto known = preview::environmentNames();
+            if (std::find(known.begin(), known.end(), v) != known.end() || preview::isEnvironmentFile(v)) return "";
+            std::string list;
+            for (const std::string& n : known) list += n + ", ";
+            return "expected " + list + "or a .hdr file, got '" + v + "'";
+          },
+          "ENV"))
+      ->capture_default_str();
+}
+
+/// An --env file is an input of the command, read and decoded (its cube maps
+/// built and kept for the render) before anything is rendered: a file that
+/// cannot be is an error at its path, exit 1.
+int checkEnvironment(const std::string& environment, CommandOutputs& outputs, std::ostream& err) {
+  if (!preview::isEnvironmentFile(environment)) return kExitOk;
+  outputs.input(environment);
+  if (int status = outputs.check(err); status != kExitOk) return status;
+  try {
+    (void)preview::environmentMaps(environment);
+  } catch (const std::runtime_error& e) {
+    err << environment << ": error: cannot use the environment: "
+        << std::string_view(e.what()).substr(environment.size() + 2) << "\n";
+    return kExitBadInput;
+  }
+  return kExitOk;
+}
+
 struct PreviewArgs {
   MaterialInput in;
   std::string output;
@@ -620,8 +656,7 @@ void addPreviewOptions(CLI::App* c, PreviewArgs& a) {
   addBudgetOptions(c, a.compile);
   c->add_option("--size", a.size, "Image width and height in pixels")->transform(cli::inRange(16, 2048, "pixels"))
       ->capture_default_str();
-  c->add_option("--env", a.environment, "Procedural environment")->check(CLI::IsMember(preview::environmentNames()))
-      ->capture_default_str();
+  addEnvironmentOption(c, a.environment);
   c->add_flag("--sweep", a.sweep,
               "A contact sheet: the material at each simplification step, labelled with bytes and closures");
   c->add_option("--target", a.target, "Which generated language renders: glsl or hlsl")
@@ -708,6 +743,7 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
       failed != kExitOk)
     return failed;
   if (int status = outputs.check(err); status != kExitOk) return status;  // an image is an input too
+  if (int failed = checkEnvironment(a.environment, outputs, err); failed != kExitOk) return failed;
   auto ctx = openGpu(a.precision, "preview renders on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
   std::optional<preview::Image> image = renderPreview(a, *ctx, steps, textures, err);
@@ -757,8 +793,7 @@ void addRenderOptions(CLI::App* c, RenderArgs& a) {
   c->add_flag("--forward", a.forward, "Draw opaque materials with their forward pass instead of the deferred path");
   c->add_option("--target", a.target, "Which generated language renders: glsl or hlsl")
       ->check(CLI::IsMember({"glsl", "hlsl"}))->capture_default_str();
-  c->add_option("--env", a.environment, "Procedural environment")->check(CLI::IsMember(preview::environmentNames()))
-      ->capture_default_str();
+  addEnvironmentOption(c, a.environment);
   addDiffuseOption(c, a.diffuse);
   c->add_option("--exposure", a.exposure, "Exposure in stops on top of the calibrated one")
       ->transform(cli::inRange(-16.0, 16.0, "stops"))->capture_default_str();
@@ -889,6 +924,7 @@ int runRender(const RenderArgs& a, std::ostream& out, std::ostream& err) {
   mesh::Camera camera;
   if (int failed = renderCamera(a, *scene, width, height, &camera, err); failed != kExitOk) return failed;
   if (int failed = outputs.check(err); failed != kExitOk) return failed;
+  if (int failed = checkEnvironment(a.environment, outputs, err); failed != kExitOk) return failed;
   auto ctx = openGpu("float", "render draws on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
   std::vector<render::SceneMaterial> materials;

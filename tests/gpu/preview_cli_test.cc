@@ -20,6 +20,7 @@
 
 #include "cli/cli.h"
 #include "sweep/sweep.h"
+#include "../radiance_writer.h"
 
 namespace {
 
@@ -369,6 +370,61 @@ TEST(PreviewCalibration, ALambertianLandsOnItsAlbedoAtTheCentreUnderEveryEnviron
     ++measured;
   }
   EXPECT_EQ(measured, 3);
+}
+
+// ---------------------------------------------------------------- --env FILE.hdr (issue 20)
+
+/// A Radiance image of radiance 1 everywhere lights exactly as the white
+/// furnace does (same cube maps, no lights): the same bytes.
+TEST(PreviewEnvironment, AConstantRadianceImageIsTheWhiteFurnace) {
+  const fs::path dir = workDir() / "env_constant";
+  fs::create_directories(dir);
+  std::ofstream(dir / "one.hdr", std::ios::binary) << substratec::testutil::constantRadianceFile(64, 32, 1, 1, 1, true);
+  CliRun a = cli({"preview", example("car_paint.json"), "-o", (dir / "a.png").string(), "--size", "48", "--env",
+                  (dir / "one.hdr").string()});
+  ASSERT_EQ(a.status, 0) << a.err;
+  CliRun b = cli({"preview", example("car_paint.json"), "-o", (dir / "b.png").string(), "--size", "48", "--env", "white"});
+  ASSERT_EQ(b.status, 0) << b.err;
+  EXPECT_EQ(bytesOf(dir / "a.png"), bytesOf(dir / "b.png"));
+}
+
+/// Under an image environment (a bright blue sky over a dark warm ground,
+/// the image the whole lighting) a Lambertian still lands on its albedo at
+/// the centre: the calibration divides by the irradiance the image gives.
+TEST(PreviewEnvironment, ALambertianLandsOnItsAlbedoUnderAnImage) {
+  const fs::path dir = workDir() / "env_sky";
+  fs::create_directories(dir);
+  std::vector<float> rgb;
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) rgb.insert(rgb.end(), y < 16 ? std::initializer_list<float>{0.5f, 1, 2} : std::initializer_list<float>{0.25f, 0.125f, 0.0625f});
+  std::ofstream(dir / "sky.hdr", std::ios::binary) << substratec::testutil::radianceFile(64, 32, rgb);
+  std::ofstream(dir / "lambert.json") << R"({"format": "substrate-material/1", "name": "lambert",
+    "nodes": {"root": {"kind": "slab", "diffuse_albedo": [0.2, 0.4, 0.6], "f0": 0, "roughness": 1}}, "output": "root"})";
+  const fs::path png = dir / "lambert.png";
+  CliRun r = cli({"preview", (dir / "lambert.json").string(), "-o", png.string(), "--size", "64", "--env",
+                  (dir / "sky.hdr").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::array<int, 3> centre = centreOf(png), want{124, 170, 203};
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre[c], want[c], 3) << "channel " << c;
+}
+
+/// A missing or broken environment file is an error at its path (exit 1),
+/// and an output over it is refused: nothing is written.
+TEST(PreviewEnvironment, AMissingOrBrokenImageIsAnErrorAtItsPathAndNothingIsWritten) {
+  const fs::path dir = workDir() / "env_bad";
+  fs::create_directories(dir);
+  const fs::path png = dir / "x.png", broken = dir / "broken.hdr";
+  std::ofstream(broken, std::ios::binary) << substratec::testutil::constantRadianceFile(16, 4, 1, 1, 1, true).substr(0, 60);
+  for (const fs::path& env : {dir / "missing.hdr", broken}) {
+    CliRun r = cli({"preview", example("row12_simple.json"), "-o", png.string(), "--env", env.string()});
+    EXPECT_EQ(r.status, 1) << r.err;
+    EXPECT_EQ(r.err.rfind(env.string() + ": error: cannot use the environment: ", 0), 0u) << r.err;
+    EXPECT_FALSE(fs::exists(png));
+  }
+  const std::string before = bytesOf(broken);
+  CliRun r = cli({"preview", example("row12_simple.json"), "-o", broken.string(), "--env", broken.string()});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(bytesOf(broken), before);
 }
 
 /// The ColorChecker example (its 24 published sRGB values as a matte chart)

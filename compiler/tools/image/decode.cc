@@ -25,7 +25,8 @@ bool isPng(const std::uint8_t* b, std::size_t n) {
 
 bool isJpeg(const std::uint8_t* b, std::size_t n) { return n >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF; }
 
-/// False, with `*why`, for a size decode refuses.
+}  // namespace
+
 bool sizeAllowed(std::uint64_t w, std::uint64_t h, std::string* why) {
   if (w == 0 || h == 0) {
     *why = "an image of zero texels";
@@ -38,6 +39,8 @@ bool sizeAllowed(std::uint64_t w, std::uint64_t h, std::string* why) {
   }
   return true;
 }
+
+namespace {
 
 /// PNG through libpng's simplified API: any PNG (palette, grey, 16-bit,
 /// interlaced) read as 8-bit RGBA.
@@ -143,7 +146,7 @@ bool decode(const std::uint8_t* bytes, std::size_t size, Rgba8* out, std::string
   return false;
 }
 
-bool load(const std::string& path, Rgba8* out, std::string* why) {
+bool readImageFile(const std::string& path, std::vector<std::uint8_t>* bytes, std::string* why) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) {
     *why = std::filesystem::exists(path, ec) ? "not a regular file" : "no such file";
@@ -160,12 +163,17 @@ bool load(const std::string& path, Rgba8* out, std::string* why) {
     return false;
   }
   std::ifstream in(path, std::ios::binary);
-  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(size));
-  if (!in || !in.read(reinterpret_cast<char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()))) {
+  bytes->assign(static_cast<std::size_t>(size), 0);
+  if (!in || !in.read(reinterpret_cast<char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()))) {
     *why = std::string("cannot read it (") + std::strerror(errno) + ")";
     return false;
   }
-  return decode(bytes.data(), bytes.size(), out, why);
+  return true;
+}
+
+bool load(const std::string& path, Rgba8* out, std::string* why) {
+  std::vector<std::uint8_t> bytes;
+  return readImageFile(path, &bytes, why) && decode(bytes.data(), bytes.size(), out, why);
 }
 
 double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }

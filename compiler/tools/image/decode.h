@@ -18,6 +18,10 @@ inline constexpr std::uint64_t kMaxImageTexels = std::uint64_t{1} << 24;
 /// The largest image file read (bytes).
 inline constexpr std::size_t kMaxImageFileBytes = std::size_t{256} << 20;
 
+/// True for a size the decoders accept (1 to kMaxImageSide a side, at most
+/// kMaxImageTexels); false, with `*why` saying so, otherwise.
+bool sizeAllowed(std::uint64_t width, std::uint64_t height, std::string* why);
+
 /// 8-bit RGBA texels as stored in the file (sRGB-encoded or not, as the file
 /// is), row-major, top row first. Grey, grey + alpha, palette and RGB images
 /// are expanded to RGBA (alpha 255 where the file has none); 16-bit PNG
@@ -31,6 +35,11 @@ struct Rgba8 {
 /// `*why` saying what is wrong (not an image, a format other than PNG or JPEG,
 /// a truncated or corrupt stream, too large), on failure.
 bool decode(const std::uint8_t* bytes, std::size_t size, Rgba8* out, std::string* why);
+
+/// Reads the file at `path` whole (at most kMaxImageFileBytes). False, with
+/// `*why` (no such file, not a regular file, too large, the system's reason),
+/// on failure.
+bool readImageFile(const std::string& path, std::vector<std::uint8_t>* bytes, std::string* why);
 
 /// Reads and decodes the image file at `path`. False, with `*why` (the
 /// system's reason or decode's), on failure.

@@ -3,10 +3,14 @@
 // finite and non-negative everywhere, the sun's centre included.
 #include "preview/environment.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <stdexcept>
 
+#include "image/radiance.h"
 #include "preview/preview_math.h"
 
 namespace substratec::preview {
@@ -104,7 +108,67 @@ Vec3 skyRadiance(const Vec3& d) {
 
 Vec3 whiteRadiance(const Vec3&) { return {1.0, 1.0, 1.0}; }
 
+/// `img` box-averaged by integer factors until it is at most
+/// kMaxLatLongWidth wide (and its height at most half that): the cube maps
+/// sample the environment every 0.006 rad or so, which then still visits
+/// every texel, so a sun smaller than a texel keeps its energy.
+image::RgbF reduceLatLong(image::RgbF img) {
+  const std::uint32_t fx = (img.width + kMaxLatLongWidth - 1) / kMaxLatLongWidth;
+  const std::uint32_t fy = (img.height + kMaxLatLongWidth / 2 - 1) / (kMaxLatLongWidth / 2);
+  const std::uint32_t f = std::max(fx, fy);
+  if (f <= 1) return img;
+  image::RgbF out;
+  out.width = std::max<std::uint32_t>(1, img.width / f);
+  out.height = std::max<std::uint32_t>(1, img.height / f);
+  out.rgb.assign(std::size_t{out.width} * out.height * 3, 0.0f);
+  for (std::uint32_t y = 0; y < out.height; ++y)
+    for (std::uint32_t x = 0; x < out.width; ++x)
+      for (int c = 0; c < 3; ++c) {
+        double sum = 0;
+        std::uint32_t n = 0;
+        for (std::uint32_t sy = y * f; sy < std::min(img.height, (y + 1) * f); ++sy)
+          for (std::uint32_t sx = x * f; sx < std::min(img.width, (x + 1) * f); ++sx, ++n)
+            sum += img.rgb[(std::size_t{sy} * img.width + sx) * 3 + c];
+        out.rgb[(std::size_t{y} * out.width + x) * 3 + c] = static_cast<float>(sum / std::max<std::uint32_t>(n, 1));
+      }
+  return out;
+}
+
 }  // namespace
+
+bool isEnvironmentFile(const std::string& name) {
+  if (name.size() < 5) return false;
+  std::string ext = name.substr(name.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".hdr";
+}
+
+std::array<double, 2> latLongCoordinates(const std::array<double, 3>& d) {
+  const double u = std::atan2(d[0], -d[2]) / (2 * std::numbers::pi) + 0.5;
+  const double v = std::acos(std::clamp(d[1], -1.0, 1.0)) / std::numbers::pi;
+  return {u, v};
+}
+
+Environment latLongEnvironment(const std::string& name, image::RgbF img) {
+  auto map = std::make_shared<const image::RgbF>(reduceLatLong(std::move(img)));
+  return Environment(name, [map](const Vec3& d) -> Vec3 {
+    // Bilinear between texel centres: repeating around the horizon, clamped at the poles.
+    const auto [u, v] = latLongCoordinates(d);
+    const double w = map->width, h = map->height;
+    const double x = u * w - 0.5, y = std::clamp(v * h - 0.5, 0.0, h - 1);
+    const double x0 = std::floor(x), y0 = std::floor(y), tx = x - x0, ty = y - y0;
+    auto at = [&](double xx, double yy, int c) {
+      const auto ix = static_cast<std::size_t>((static_cast<long long>(xx) % map->width + map->width) % map->width);
+      const auto iy = static_cast<std::size_t>(std::min(yy, h - 1));
+      return static_cast<double>(map->rgb[(iy * map->width + ix) * 3 + c]);
+    };
+    Vec3 L{};
+    for (int c = 0; c < 3; ++c)
+      L[c] = (at(x0, y0, c) * (1 - tx) + at(x0 + 1, y0, c) * tx) * (1 - ty) +
+             (at(x0, y0 + 1, c) * (1 - tx) + at(x0 + 1, y0 + 1, c) * tx) * ty;
+    return L;
+  });
+}
 
 std::vector<std::string> environmentNames() { return {"studio", "sky", "white"}; }
 
@@ -112,6 +176,12 @@ Environment makeEnvironment(const std::string& name) {
   if (name == "studio") return Environment(name, studioRadiance);
   if (name == "sky") return Environment(name, skyRadiance, {{kSunDirection, kSunAngularRadius * 1.05}});
   if (name == "white") return Environment(name, whiteRadiance);
+  if (isEnvironmentFile(name)) {
+    image::RgbF img;
+    std::string why;
+    if (!image::loadRadiance(name, &img, &why)) throw std::runtime_error(name + ": " + why);
+    return latLongEnvironment(name, std::move(img));
+  }
   std::string known;
   for (const std::string& n : environmentNames()) known += (known.empty() ? "" : ", ") + n;
   throw std::invalid_argument("unknown environment '" + name + "' (known: " + known + ")");

@@ -2,12 +2,16 @@
 // functions of a world-space direction (+Y up), so that nothing has to be
 // downloaded or shipped. "studio" (the default): soft boxes in a dark room;
 // "sky": a clear sky with a sun; "white": radiance 1 everywhere (furnace).
+// Or an image: a Radiance HDR file in the lat-long layout (--env FILE.hdr).
 #pragma once
 #include <array>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "image/radiance.h"
 
 namespace substratec::preview {
 
@@ -41,12 +45,31 @@ class Environment {
   std::vector<Hotspot> hotspots_;
 };
 
-/// The names makeEnvironment accepts, default first.
+/// The names of the procedural environments, default first.
 std::vector<std::string> environmentNames();
 
-/// The environment called `name`; throws std::invalid_argument naming the
-/// known environments for any other name.
+/// True for an environment given as a file rather than a name: a path that
+/// ends in ".hdr" (any case).
+bool isEnvironmentFile(const std::string& name);
+
+/// The environment called `name`, or (isEnvironmentFile) read from that
+/// Radiance file; throws std::invalid_argument naming the known environments
+/// for any other name, std::runtime_error ("PATH: why") for a file that
+/// cannot be read or decoded.
 Environment makeEnvironment(const std::string& name);
+
+/// Lat-long images wider than this are box-averaged down to it first.
+inline constexpr std::uint32_t kMaxLatLongWidth = 512;
+
+/// The (u, v) in [0, 1] of direction `d` in a lat-long image, MaterialX's
+/// convention (its viewer's and shaders' mx_latlong_projection): v = 0 is
+/// straight up (+Y, the image's top row), v = 1 straight down; u = 0.5 is
+/// -Z (looking away from a camera on +Z), u grows toward +X.
+std::array<double, 2> latLongCoordinates(const std::array<double, 3>& d);
+
+/// The environment of a lat-long radiance image (linear, finite, >= 0),
+/// sampled bilinearly between texel centres (repeating in u, clamped in v).
+Environment latLongEnvironment(const std::string& name, image::RgbF img);
 
 /// Unit direction toward the sun of the "sky" environment, and the angular
 /// radius of its disc in radians (tests keep away from it).

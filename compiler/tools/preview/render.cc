@@ -67,7 +67,8 @@ gpu::ImageResource cubeResource(const CubeMap& map) {
 
 Light previewLight(const std::string& environment, int l) {
   Light light = kLights[l];
-  if (environment == "white") light.radiance = {0, 0, 0};
+  // The furnace has no lights; an image environment is the whole lighting.
+  if (environment == "white" || isEnvironmentFile(environment)) light.radiance = {0, 0, 0};
   return light;
 }
 
