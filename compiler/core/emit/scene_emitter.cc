@@ -97,6 +97,7 @@ SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialSh
       const bool full = rank(m.layoutClass) <= rank(c);
       if (!full && !m.runtimeSimple) continue;
       k.materials.push_back(m.name);
+      k.metalnessMix = k.metalnessMix || m.metalnessMix;
       if (!full) continue;
       k.features |= m.storedFeatures;
       k.maxClosures = std::max(k.maxClosures, m.closures);
@@ -138,9 +139,13 @@ std::string sceneUseDefines(const SceneLightingClass& k) {
   // Nor which closures under layers wrap or have a fuzz.
   s += fmt::format("#define SUBSTRATE_USE_WRAP_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
   s += fmt::format("#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
-  // The stream does not say which closures are metalness mixes: every
-  // conductor-like F0 is read as one (the runtime's default).
-  s += "#define SUBSTRATE_USE_METALNESS_MIX 1\n";
+  // The stream does not say which closures are metalness mixes, so a class
+  // that lights some material with a metalness slab reads every conductor-like
+  // F0 as one (the runtime's default); a class that lights none reads none,
+  // as those materials' own shaders do. (It read them all: a thin film's or a
+  // coat's coloured F0 over a diffuse was lit 7-25 % brighter deferred than
+  // forward, RenderCorpus on open_pbr_pearl; docs/scenes.md.)
+  s += fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}\n", k.metalnessMix ? 1 : 0);
   return s;
 }
 

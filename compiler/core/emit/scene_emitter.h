@@ -52,6 +52,7 @@ struct SceneMaterialShape {
   std::uint16_t storedFeatures = 0; // kFeat* bits its closures store
   int closures = 1;
   int words = 2;
+  bool metalnessMix = false;        // its shaders read conductor-like F0 as a metalness mix (Material::metalnessMix)
 };
 
 /// One lighting shader: the pixels of tiles of `cls`, which may hold any class up to it.
@@ -61,6 +62,7 @@ struct SceneLightingClass {
   int maxClosures = 1;
   int maxWords = 2;
   std::vector<std::string> materials;  // those materials (names, scene order)
+  bool metalnessMix = false;           // some of them is a metalness mix (SUBSTRATE_USE_METALNESS_MIX)
 };
 
 struct SceneShape {

@@ -25,6 +25,7 @@ MaterialSummary summarize(const CompileResult& r) {
   s.budgetBytes = r.budgetBytes;
   s.maxClosures = r.maxClosures;
   s.simplificationSteps = static_cast<int>(r.steps.size());
+  s.metalnessMix = r.material.metalnessMix;
   return s;
 }
 
@@ -39,7 +40,8 @@ nlohmann::ordered_json summaryJson(const MaterialSummary& s) {
           {"runtime_simple", s.runtimeSimple},
           {"budget_bytes", s.budgetBytes},
           {"max_closures", s.maxClosures},
-          {"simplification_steps", s.simplificationSteps}};
+          {"simplification_steps", s.simplificationSteps},
+          {"metalness_mix", s.metalnessMix}};
 }
 
 std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) {
@@ -59,6 +61,7 @@ std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) 
     s.budgetBytes = j.at("budget_bytes").get<int>();
     s.maxClosures = j.at("max_closures").get<int>();
     s.simplificationSteps = j.at("simplification_steps").get<int>();
+    s.metalnessMix = j.at("metalness_mix").get<bool>();
     if (!known || s.name.empty() || s.words < 1 || s.closures < 1 || s.closures > 8) return std::nullopt;
     return s;
   } catch (const nlohmann::json::exception&) {

@@ -33,9 +33,10 @@ struct MaterialSummary {
   int budgetBytes = 0;
   int maxClosures = 0;
   int simplificationSteps = 0;
+  bool metalnessMix = false;         // Material::metalnessMix
 
   SceneMaterialShape shape() const {
-    return {name, layoutClass, runtimeSimple, storedFeatures, closures, words};
+    return {name, layoutClass, runtimeSimple, storedFeatures, closures, words, metalnessMix};
   }
 };
 
