@@ -72,7 +72,7 @@ TEST(CliUsage, HelpStatesUnitsChoicesAndDefaults) {
     EXPECT_NE(compile.find(expected), std::string::npos) << expected << "\n" << compile;
   const std::string preview = cli({"preview", "--help"}).out;
   for (const char* expected : {"--size INT:in [16, 2048] pixels=256", "--exposure FLOAT:in [-16, 16] stops=0",
-                               "--env TEXT:{studio,sky,white}=studio"})
+                               "--env TEXT:{studio,sky,white}|FILE.hdr=studio"})
     EXPECT_NE(preview.find(expected), std::string::npos) << expected << "\n" << preview;
 }
 

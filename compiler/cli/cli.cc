@@ -604,9 +604,9 @@ int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, c
 /// --env: a procedural environment by name, or a Radiance file (lat-long).
 void addEnvironmentOption(CLI::App* c, std::string& environment) {
   std::string names;
-  for (const std::string& n : preview::environmentNames()) names += n + ", ";
+  for (const std::string& n : preview::environmentNames()) names += n + ",";
   c->add_option("--env", environment,
-                "Environment: " + names + "or FILE.hdr (a Radiance image in the lat-long layout, docs/render.md)")
+                "Environment: a procedural one, or a Radiance image in the lat-long layout (docs/render.md)")
       ->check(CLI::Validator(
           [](std::string& v) -> std::string {
             const auto known = preview::environmentNames();
@@ -615,7 +615,7 @@ void addEnvironmentOption(CLI::App* c, std::string& environment) {
             for (const std::string& n : known) list += n + ", ";
             return "expected " + list + "or a .hdr file, got '" + v + "'";
           },
-          "ENV"))
+          "{" + names.substr(0, names.size() - 1) + "}|FILE.hdr"))
       ->capture_default_str();
 }
 
@@ -776,6 +776,7 @@ struct RenderArgs {
   double exposure = 0;
   bool timings = false;
   TextureFlags textures;
+  std::string platform;  // --platform: a built-in platform's budget and features
 };
 
 void addRenderOptions(CLI::App* c, RenderArgs& a) {
@@ -790,6 +791,9 @@ void addRenderOptions(CLI::App* c, RenderArgs& a) {
   c->add_option("--camera", a.camera,
                 "The document's camera N (0-based, in node order), or 'frame' for one that frames the scene "
                 "(default: the document's first camera, else 'frame')");
+  c->add_option("--platform", a.platform,
+                "Simplify every material for this platform (built in: " + PlatformTable::builtin().names() +
+                    "; docs/scenes.md)");
   c->add_flag("--forward", a.forward, "Draw opaque materials with their forward pass instead of the deferred path");
   c->add_option("--target", a.target, "Which generated language renders: glsl or hlsl")
       ->check(CLI::IsMember({"glsl", "hlsl"}))->capture_default_str();
@@ -900,7 +904,14 @@ int compileRenderMaterials(const RenderArgs& a, const render::SceneSources& s, c
 
 /// Draws a glTF scene with the emitted shaders on lavapipe (docs/render.md) and writes an sRGB PNG.
 int runRender(const RenderArgs& a, std::ostream& out, std::ostream& err) {
-  const CompileOptions o = toCompileOptions(a.compile);
+  CompileOptions o = toCompileOptions(a.compile);
+  if (!a.platform.empty()) {
+    const Platform* p = PlatformTable::builtin().find(a.platform);
+    if (!p)
+      return printError(err, kExitUsage, fmt::format("unknown platform {} (known: {})", quoteForDiagnostic(a.platform),
+                                                     PlatformTable::builtin().names()));
+    o.platform = *p;
+  }
   int width = 0, height = 0;
   if (int status = parseImageSize(a.size, &width, &height, err); status != kExitOk) return status;
   CommandOutputs outputs(out);
