@@ -62,13 +62,13 @@ if [ "$SANITIZERS" != 0 ]; then
   # part on 2026-12-04; docs/robustness.md, "CI". SUBSTRATEC_ASAN_EXCLUDE
   # replaces the list (a regex matching nothing, e.g. '^$', runs them all, and
   # then the three examples are not run again).
-  # DeepTrees, LayeringEnergy and RenderEveryExample are more of the same:
+  # DeepTrees, LayeringEnergy, RenderEveryExample and RenderCorpus are more of the same:
   # lavapipe compiling kernels for many materials (the render suite's other
   # tests, with its raster host code, stay in). unit_tests:Furnace is Monte
   # Carlo numerics, 4x slower under the sanitizers (372 s of this stage on
   # 2026-12-05, 98 s in stage 1); the reference's host code it runs is run by
   # the Accuracy and RandomWalk suites here too.
-  heavy_gpu='^gpu_tests:(Stability(/EveryExample)?:[0-9]+|Examples/MaterialOnGpu:[0-9]+|ImportCorpusPreview|DeepTrees|LayeringEnergy|RenderEveryExample)$'
+  heavy_gpu='^gpu_tests:(Stability(/EveryExample)?:[0-9]+|Examples/MaterialOnGpu:[0-9]+|ImportCorpusPreview|DeepTrees|LayeringEnergy|RenderEveryExample|RenderCorpus)$'
   heavy="${heavy_gpu}|^unit_tests:Furnace$"
   exclude="${SUBSTRATEC_ASAN_EXCLUDE-$heavy}"
   status=0

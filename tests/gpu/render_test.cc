@@ -244,6 +244,11 @@ TEST(RenderCli, BadInputIsALocatedErrorAndNothingIsWritten) {
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_NE(r.err.find("missing.bin"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(png));
+  // A platform nobody defined.
+  r = cli({"render", scenePath().string(), "-o", png.string(), "--platform", "moon"});
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("unknown platform \"moon\" (known: mobile, console, pc-high)"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
   // A camera the document does not have.
   r = cli({"render", scenePath().string(), "-o", png.string(), "--camera", "3"});
   EXPECT_EQ(r.status, 2) << r.err;
