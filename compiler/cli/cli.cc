@@ -906,10 +906,11 @@ int compileRenderMaterials(const RenderArgs& a, const render::SceneSources& s, c
 int runRender(const RenderArgs& a, std::ostream& out, std::ostream& err) {
   CompileOptions o = toCompileOptions(a.compile);
   if (!a.platform.empty()) {
-    const Platform* p = PlatformTable::builtin().find(a.platform);
+    const PlatformTable table = PlatformTable::builtin();  // find() points into it
+    const Platform* p = table.find(a.platform);
     if (!p)
       return printError(err, kExitUsage, fmt::format("unknown platform {} (known: {})", quoteForDiagnostic(a.platform),
-                                                     PlatformTable::builtin().names()));
+                                                     table.names()));
     o.platform = *p;
   }
   int width = 0, height = 0;

@@ -222,6 +222,12 @@ TEST(RenderCli, DrawsTheDocumentsMaterialsIntoAPng) {
   EXPECT_NE(r.out.find("GPU ms"), std::string::npos) << r.out;
   const std::string bytes = readBytes(png);
   EXPECT_EQ(bytes.substr(1, 3), "PNG");
+  // For a platform: its budget and features (a coat over SSS on mobile: one closure, no SSS).
+  const fs::path mobile = workDir() / "mobile.png";
+  const CliRun m = cli({"render", scenePath().string(), "--material", (kSource / "examples/skin_coated.json").string(),
+                        "--platform", "mobile", "-o", mobile.string(), "--size", "32x32"});
+  ASSERT_EQ(m.status, 0) << m.err;
+  EXPECT_EQ(readBytes(mobile).substr(1, 3), "PNG");
 }
 
 TEST(RenderCli, BadInputIsALocatedErrorAndNothingIsWritten) {
