@@ -6,6 +6,7 @@
 // The scene is generated here: a UV sphere over a ground quad, written as a
 // .gltf with its buffer in a data: URI (no tangents: the loader generates
 // them), each primitive with its own material.
+#include <png.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -276,6 +277,131 @@ TEST(RenderCli, BadInputIsALocatedErrorAndNothingIsWritten) {
   r = cli({"render", external.string(), "-o", buffer.string()});
   EXPECT_EQ(r.status, 2) << r.err;
   EXPECT_EQ(readBytes(buffer), bin);
+}
+
+// ----- glTF texture coordinates in the raster pipeline --------------------------
+
+/// Decodes a PNG file to 8-bit RGBA.
+bool decodePngFile(const fs::path& path, int* width, int* height, std::vector<unsigned char>* rgba) {
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) return false;
+  image.format = PNG_FORMAT_RGBA;
+  rgba->assign(PNG_IMAGE_SIZE(image), 0);
+  *width = static_cast<int>(image.width);
+  *height = static_cast<int>(image.height);
+  return png_image_finish_read(&image, nullptr, rgba->data(), 0, nullptr) != 0;
+}
+
+/// Three quads in a row, facing the camera, each its own material over one
+/// 2 x 1 image (left texel red, right texel green; nearest, clamped): the
+/// first reads uv0 as it is, the second through KHR_texture_transform
+/// (scale (0.5, 1), offset (0.5, 0): u from 0.5 to 1, all green), the third
+/// reads TEXCOORD_1, which is (0.25, 0.5) at every vertex (all red).
+std::string texCoordGltf() {
+  using J = nlohmann::json;
+  const float positions[] = {-0.5f, -0.5f, 0, 0.5f, -0.5f, 0, 0.5f, 0.5f, 0, -0.5f, 0.5f, 0};
+  const float normals[] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
+  const float uv0[] = {0, 1, 1, 1, 1, 0, 0, 0};
+  const float uv1[] = {0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f, 0.25f, 0.5f};
+  const uint32_t indices[] = {0, 1, 2, 0, 2, 3};
+  std::string buffer;
+  J views = J::array(), accessors = J::array();
+  auto add = [&](const void* data, std::size_t bytes, std::size_t count, int type, const char* kind) {
+    views.push_back({{"buffer", 0}, {"byteOffset", buffer.size()}, {"byteLength", bytes}});
+    buffer.append(static_cast<const char*>(data), bytes);
+    accessors.push_back({{"bufferView", views.size() - 1}, {"componentType", type}, {"count", count}, {"type", kind}});
+  };
+  add(positions, sizeof positions, 4, 5126, "VEC3");
+  accessors.back()["min"] = {-0.5, -0.5, 0};
+  accessors.back()["max"] = {0.5, 0.5, 0};
+  add(normals, sizeof normals, 4, 5126, "VEC3");
+  add(uv0, sizeof uv0, 4, 5126, "VEC2");
+  add(uv1, sizeof uv1, 4, 5126, "VEC2");
+  add(indices, sizeof indices, 6, 5125, "SCALAR");
+  J meshes = J::array(), nodes = J::array();
+  for (int m = 0; m < 3; ++m) {
+    meshes.push_back({{"primitives", {{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}, {"TEXCOORD_0", 2}, {"TEXCOORD_1", 3}}},
+                                       {"indices", 4}, {"material", m}}}}});
+    nodes.push_back({{"mesh", m}, {"translation", {1.1 * (m - 1), 0.0, 0.0}}});
+  }
+  nodes.push_back({{"camera", 0}, {"translation", {0.0, 0.0, 3.0}}});
+  auto textured = [](const char* name, J info) {
+    return J{{"name", name},
+             {"pbrMetallicRoughness", {{"baseColorTexture", info}, {"metallicFactor", 0.0}, {"roughnessFactor", 1.0}}}};
+  };
+  J doc = {{"asset", {{"version", "2.0"}}},
+           {"extensionsUsed", {"KHR_texture_transform"}},
+           {"scene", 0},
+           {"scenes", {{{"nodes", {0, 1, 2, 3}}}}},
+           {"nodes", nodes},
+           {"cameras", {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"aspectRatio", 3.0}, {"znear", 0.05}}}}}},
+           {"meshes", meshes},
+           {"materials",
+            {textured("plain", {{"index", 0}}),
+             textured("transformed",
+                      {{"index", 0},
+                       {"extensions", {{"KHR_texture_transform", {{"offset", {0.5, 0.0}}, {"scale", {0.5, 1.0}}}}}}}),
+             textured("second_set", {{"index", 0}, {"texCoord", 1}})}},
+           {"textures", {{{"source", 0}, {"sampler", 0}}}},
+           {"samplers", {{{"magFilter", 9728}, {"minFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}}},
+           {"images", {{{"uri", "halves.png"}}}},
+           {"accessors", accessors},
+           {"bufferViews", views},
+           {"buffers", {{{"byteLength", buffer.size()},
+                         {"uri", "data:application/octet-stream;base64," + base64(buffer)}}}}};
+  return doc.dump();
+}
+
+// What the importer makes of a glTF texture's coordinates (KHR_texture_transform,
+// texCoord) reaches the raster pipeline: the vertex stage passes uv0 and uv1,
+// the base pass and the forward pass read them through the material's uv math.
+TEST(RenderCli, TextureTransformsAndTheSecondUvSetReachTheRasterPipeline) {
+  const fs::path dir = workDir() / "texcoords";
+  fs::create_directories(dir);
+  const unsigned char halves[] = {255, 0, 0, 0, 255, 0};
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  image.width = 2;
+  image.height = 1;
+  image.format = PNG_FORMAT_RGB;
+  ASSERT_TRUE(png_image_write_to_file(&image, (dir / "halves.png").c_str(), 0, halves, 0, nullptr));
+  std::ofstream(dir / "quads.gltf") << texCoordGltf();
+  std::size_t checked = 0;
+  for (const char* path : {"deferred", "forward"}) {
+    SCOPED_TRACE(path);
+    const fs::path png = dir / (std::string(path) + ".png");
+    std::vector<std::string> args = {"render", (dir / "quads.gltf").string(), "-o", png.string(), "--size", "192x64",
+                                     "--env", "white"};
+    if (std::string(path) == "forward") args.push_back("--forward");
+    const CliRun r = cli(args);
+    ASSERT_EQ(r.status, 0) << r.err;
+    int w = 0, h = 0;
+    std::vector<unsigned char> rgba;
+    ASSERT_TRUE(decodePngFile(png, &w, &h, &rgba));
+    // Pixel column of world x on the row through the quads' centres.
+    const double halfWidth = 3.0 * std::tan(0.4) * 3.0;
+    auto at = [&](double x) {
+      const int px = static_cast<int>((x / halfWidth * 0.5 + 0.5) * w);
+      return &rgba[(static_cast<std::size_t>(h / 2) * w + px) * 4];
+    };
+    auto red = [](const unsigned char* p) { return p[0] > p[1] + 100 && p[0] > p[2] + 100; };
+    auto green = [](const unsigned char* p) { return p[1] > p[0] + 100 && p[1] > p[2] + 100; };
+    const struct {
+      double x;
+      bool wantRed;
+      const char* what;
+    } probes[] = {{-1.35, true, "uv0, left half: red"},    {-0.85, false, "uv0, right half: green"},
+                  {-0.25, false, "transformed, left: green"}, {0.25, false, "transformed, right: green"},
+                  {0.85, true, "TEXCOORD_1: red"},         {1.35, true, "TEXCOORD_1: red"}};
+    for (const auto& probe : probes) {
+      const unsigned char* p = at(probe.x);
+      EXPECT_TRUE(probe.wantRed ? red(p) : green(p))
+          << probe.what << ": (" << int(p[0]) << ", " << int(p[1]) << ", " << int(p[2]) << ")";
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 12u);
 }
 
 }  // namespace
