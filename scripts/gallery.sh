@@ -87,7 +87,7 @@ EOF
   echo "# Gallery"
   echo
   echo "Every example in \`examples/\`, rendered by \`substratec preview FILE --size 128\` on lavapipe"
-  echo "(the generated GLSL preview kernel: three lights and the procedural \"studio\" environment,"
+  echo "(the generated GLSL preview kernel: render's key light and the procedural \"studio\" environment,"
   echo "exposed and white-balanced so that a Lambertian lands on its albedo at the centre; each texture"
   echo "bound to its input's \`file\` or, without one, to its neutral texel: docs/textures.md)."
   echo "Regenerate with \`scripts/gallery.sh\`."

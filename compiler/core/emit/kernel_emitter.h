@@ -28,7 +28,7 @@ namespace substratec {
 enum class KernelMode {
   Forward,   // evaluate, then light the closures inline (the forward pass)
   Deferred,  // evaluate, pack into the uint stream, unpack generically, then light (base pass + deferred lighting)
-  Preview,   // a sphere, three lights and a split-sum environment, one RGBA float4 per pixel
+  Preview,   // a sphere, the key light and a split-sum environment, one RGBA float4 per pixel
   Throughput,  // cost: each invocation hashes its own shading point, evaluates, lights it (one light and a
                // constant split-sum environment) and writes one float4 (results[i]): no input buffer to read
 };
@@ -74,9 +74,11 @@ inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6,
 /// Preview parameters (set 0, binding 0, std140 / cbuffer, float4 each):
 ///   camera: xyz eye position, w tan(vertical half field of view)
 ///   viewport: x width, y height (pixels), z mip count of envPrefiltered, w exposure (unused by the kernel)
-///   lightDirection[3] (xyz, unit, toward the light), lightRadiance[3] (rgb)
+///   lightDirection[kPreviewLights] (xyz, unit, toward the light), lightRadiance[kPreviewLights] (rgb)
 /// The sphere has radius 1 at the origin, +Y up, the camera looks at the origin.
-inline constexpr int kPreviewLights = 3;
+/// One light, `render`'s (issue 20, part 4: preview lights as render does;
+/// it had a fill and a rim light too).
+inline constexpr int kPreviewLights = 1;
 inline constexpr int kPreviewParamVec4s = 2 + 2 * kPreviewLights;
 /// The preview's specular profiles (specularProfileInputs order): profile k is
 /// the texture p_<input> at set 1, binding kPreviewProfileBinding + k (HLSL's

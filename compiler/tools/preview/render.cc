@@ -32,13 +32,12 @@ std::array<double, 3> unit(std::array<double, 3> v) {
   const double l = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
   return {v[0] / l, v[1] / l, v[2] / l};
 }
-/// The three preview lights: a warm key from the upper left, a cool fill from
-/// the right and a rim from behind (unit directions toward the light, +Y up,
-/// the camera on +Z).
+/// The preview's light, render's: a warm key from the upper left (the unit
+/// direction toward the light, +Y up, the camera on +Z). The preview had a
+/// cool fill from the right and a rim from behind too, until it was made to
+/// light as `render` does (issue 20, part 4).
 const Light kLights[kPreviewLights] = {
     {unit({-0.6, 0.7, 0.6}), {2.6, 2.4, 2.1}},
-    {unit({0.8, 0.1, 0.5}), {0.5, 0.6, 0.75}},
-    {unit({0.2, 0.5, -0.9}), {1.2, 1.2, 1.2}},
 };
 
 }  // namespace

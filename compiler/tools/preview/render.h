@@ -37,11 +37,10 @@ struct Light {
   std::array<double, 3> direction, radiance;
 };
 
-/// The lights of `environment`, l < kPreviewLights (emit/kernel_emitter.h): a
-/// warm key from the upper left (l = 0, the one light of `render`), a cool
-/// fill from the right and a rim from behind; under "white", a furnace, every
-/// light is black (its radiance 1 alone), and under an image environment
-/// (isEnvironmentFile) too: the image is the whole lighting.
+/// The lights of `environment`, l < kPreviewLights (emit/kernel_emitter.h):
+/// one, a warm key from the upper left, which `render` lights with too; under
+/// "white", a furnace, it is black (the radiance 1 alone), and under an image
+/// environment (isEnvironmentFile) too: the image is the whole lighting.
 Light previewLight(const std::string& environment, int l);
 
 /// The split-sum cube maps of an environment, built once per name in a
