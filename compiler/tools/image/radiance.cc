@@ -3,7 +3,6 @@
 #include <climits>
 #include <cmath>
 #include <memory>
-#include <string_view>
 
 #include "image/decode.h"
 #include "image/stb_image_hdr.h"
@@ -11,6 +10,27 @@
 namespace substratec::image {
 
 namespace {
+
+/// Moves `pos` past one header line as stb_image's stbi__hdr_gettoken reads
+/// it (up to '\n'; at most 1023 bytes kept, the rest skipped to the '\n'),
+/// and says whether stb_image reads it as empty: its first byte is '\n' or
+/// '\0', or the data ends after it. (A line of NULs ends the header: the
+/// fuzzer's first timeout, fuzz/image_seeds/nul_header.hdr.)
+bool stbHeaderLine(const std::uint8_t* b, std::size_t size, std::size_t& pos) {
+  auto get8 = [&]() -> std::uint8_t { return pos < size ? b[pos++] : 0; };
+  std::uint8_t c = get8();
+  const bool empty = c == 0 || c == '\n' || pos >= size;
+  std::size_t len = 0;
+  while (pos < size && c != '\n') {
+    if (++len == 1023) {
+      while (pos < size && get8() != '\n') {
+      }
+      break;
+    }
+    c = get8();
+  }
+  return empty;
+}
 
 /// stb_image's run-length decoder loops forever on a run of length 0, and a
 /// truncated file reads as one (its reader returns 0 past the end): found by
@@ -21,11 +41,13 @@ namespace {
 /// length 0 or that ends early is refused. What else stb_image finds corrupt
 /// (a scanline of another width, a span past the scanline) it refuses itself.
 bool checkPixelStream(const std::uint8_t* b, std::size_t size, std::size_t w, std::size_t h, std::string* why) {
-  const std::string_view text(reinterpret_cast<const char*>(b), size);
-  const std::size_t blank = text.find("\n\n");
-  const std::size_t resolutionEnd = blank == std::string_view::npos ? blank : text.find('\n', blank + 2);
-  if (resolutionEnd == std::string_view::npos) return true;  // stb_image refuses the header
-  std::size_t pos = resolutionEnd + 1;
+  // Where stb_image's pixels start: the signature line, header lines up to
+  // the first one it reads as empty, the resolution line (stbi__hdr_load).
+  std::size_t pos = 0;
+  stbHeaderLine(b, size, pos);
+  for (std::size_t line = 0; line < size && !stbHeaderLine(b, size, pos); ++line) {
+  }
+  stbHeaderLine(b, size, pos);
   auto truncated = [&] {
     *why = "a truncated Radiance image (its pixels end early)";
     return false;
