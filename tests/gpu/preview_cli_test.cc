@@ -21,6 +21,7 @@
 #include "cli/cli.h"
 #include "sweep/sweep.h"
 #include "../radiance_writer.h"
+#include "png_files.h"
 
 namespace {
 
@@ -55,22 +56,9 @@ fs::path workDir() {
 
 std::string example(const char* name) { return (kSource / "examples" / name).string(); }
 
-struct Png {
-  int width = 0, height = 0;
-  std::vector<unsigned char> rgba;
-};
-
-/// Reads a PNG back with libpng (false when it is not one).
-bool readPng(const fs::path& path, Png* out) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&image, path.c_str())) return false;
-  image.format = PNG_FORMAT_RGBA;
-  out->width = static_cast<int>(image.width);
-  out->height = static_cast<int>(image.height);
-  out->rgba.resize(PNG_IMAGE_SIZE(image));
-  return png_image_finish_read(&image, nullptr, out->rgba.data(), 0, nullptr) != 0;
-}
+using substratec::testutil::Png;
+using substratec::testutil::readPng;
+using substratec::testutil::solidPng;
 
 std::string bytesOf(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -184,16 +172,6 @@ TEST(Preview, AnUnknownEnvironmentIsAUsageError) {
 
 // ---------------------------------------------------------------- real textures (issue 20)
 
-/// Writes a w x h PNG of one colour.
-void solidPng(const fs::path& path, unsigned char r, unsigned char g, unsigned char b, int size = 4) {
-  std::vector<unsigned char> texels;
-  for (int i = 0; i < size * size; ++i) texels.insert(texels.end(), {r, g, b});
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  image.width = image.height = static_cast<png_uint_32>(size);
-  image.format = PNG_FORMAT_RGB;
-  ASSERT_TRUE(png_image_write_to_file(&image, path.c_str(), 0, texels.data(), 0, nullptr));
-}
 
 /// A glTF whose one material's base colour is the texture `image`.
 void texturedGltf(const fs::path& path, const std::string& image) {

@@ -23,7 +23,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <png.h>
 
 #include "../import/corpus.h"
 #include "cli/cli.h"
@@ -34,6 +33,7 @@
 #include "pipeline/pipeline.h"
 #include "preview/textures.h"
 #include "render/render.h"
+#include "png_files.h"
 #include "render_scene.h"
 
 namespace substratec::gputest {
@@ -242,17 +242,6 @@ TEST_F(RenderCorpus, EveryMaterialXMaterialOnTheBallDeferredMatchesForward) {
 
 // ---- real textures -------------------------------------------------------------
 
-/// Writes a 4 x 4 PNG of one 8-bit RGB colour.
-void solidRgbPng(const fs::path& path, const std::array<int, 3>& rgb) {
-  std::vector<unsigned char> texels;
-  for (int i = 0; i < 16; ++i)
-    for (int c : rgb) texels.push_back(static_cast<unsigned char>(c));
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  image.width = image.height = 4;
-  image.format = PNG_FORMAT_RGB;
-  ASSERT_TRUE(png_image_write_to_file(&image, path.c_str(), 0, texels.data(), 0, nullptr));
-}
 
 /// The mean linear colour of the covered pixels.
 std::array<double, 3> meanColour(const render::RenderResult& r) {
@@ -338,7 +327,8 @@ TEST_F(RenderCorpus, TheTexturedMaterialsShowTheirImagesAgainstTheirDecodedMeanC
         code[c] = best;
       }
       const fs::path png = corpusWorkDir() / (in.name + "_mean.png");
-      solidRgbPng(png, code);
+      testutil::solidPng(png, static_cast<unsigned char>(code[0]), static_cast<unsigned char>(code[1]),
+                         static_cast<unsigned char>(code[2]));
       solid.overrides[in.name] = png.string();
       ++textures;
     }

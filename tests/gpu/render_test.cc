@@ -28,6 +28,7 @@
 #include "mesh/gltf_mesh.h"
 #include "pipeline/pipeline.h"
 #include "render/render.h"
+#include "png_files.h"
 #include "render_scene.h"
 
 namespace substratec::gputest {
@@ -281,17 +282,6 @@ TEST(RenderCli, BadInputIsALocatedErrorAndNothingIsWritten) {
 
 // ----- glTF texture coordinates in the raster pipeline --------------------------
 
-/// Decodes a PNG file to 8-bit RGBA.
-bool decodePngFile(const fs::path& path, int* width, int* height, std::vector<unsigned char>* rgba) {
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&image, path.c_str())) return false;
-  image.format = PNG_FORMAT_RGBA;
-  rgba->assign(PNG_IMAGE_SIZE(image), 0);
-  *width = static_cast<int>(image.width);
-  *height = static_cast<int>(image.height);
-  return png_image_finish_read(&image, nullptr, rgba->data(), 0, nullptr) != 0;
-}
 
 /// Three quads in a row, facing the camera, each its own material over one
 /// 2 x 1 image (left texel red, right texel green; nearest, clamped): the
@@ -376,9 +366,10 @@ TEST(RenderCli, TextureTransformsAndTheSecondUvSetReachTheRasterPipeline) {
     if (std::string(path) == "forward") args.push_back("--forward");
     const CliRun r = cli(args);
     ASSERT_EQ(r.status, 0) << r.err;
-    int w = 0, h = 0;
-    std::vector<unsigned char> rgba;
-    ASSERT_TRUE(decodePngFile(png, &w, &h, &rgba));
+    testutil::Png picture;
+    ASSERT_TRUE(testutil::readPng(png, &picture));
+    const int w = picture.width, h = picture.height;
+    const std::vector<unsigned char>& rgba = picture.rgba;
     // Pixel column of world x on the row through the quads' centres.
     const double halfWidth = 3.0 * std::tan(0.4) * 3.0;
     auto at = [&](double x) {
