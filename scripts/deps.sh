@@ -13,6 +13,7 @@ PACKAGES=(
   clang-14 libclang-rt-14-dev llvm-14   # scripts/fuzz.sh: libFuzzer, ASan/UBSan runtimes, llvm-symbolizer
   libpugixml-dev
   libxxhash-dev
+  bazel-bootstrap       # tests/bazel_example: the persistent worker under Debian's Bazel 4 (a headless JDK with it)
 )
 
 missing=()

@@ -22,6 +22,7 @@
 #include "batch/batch.h"
 #include "format/json_document.h"
 #include "cli/cli_options.h"
+#include "cli/argument_files.h"
 #include "cli/command_outputs.h"
 #include "cli/messages.h"
 #include "pipeline/generate.h"
@@ -1512,7 +1513,10 @@ std::optional<int> parse(CLI::App& app, const std::vector<std::string>& args, st
 
 }  // namespace
 
-int runCli(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+int runCli(const std::vector<std::string>& commandLine, std::ostream& out, std::ostream& err) {
+  const std::optional<std::vector<std::string>> expanded = expandArgumentFiles(commandLine, err);
+  if (!expanded) return kExitUsage;
+  const std::vector<std::string>& args = *expanded;
   CLI::App app{"substratec: compiles Substrate material graphs (substrate-material/1) into priced, simplified, "
                "flattened shaders",
                "substratec"};
