@@ -92,6 +92,22 @@ TEST(ShaderValidate, TrivialGlslFragmentShaderValidates) {
   EXPECT_EQ(v.optimizedInstructionCount, spirvInstructionCount(v.optimized));
 }
 
+TEST(ShaderValidate, SaysWhereItsTimeWentPhaseByPhase) {
+  for (const ShaderSource& src : {glsl("trivial.frag", kTrivialFrag), hlsl("pixel.hlsl", kHlslPixel)}) {
+    const ShaderValidation v = compileAndValidate(src);
+    ASSERT_TRUE(v.ok) << v.log;
+    EXPECT_GT(v.timings.parseMs, 0.0) << src.name;
+    EXPECT_GT(v.timings.linkMs, 0.0) << src.name;
+    EXPECT_GT(v.timings.spirvMs, 0.0) << src.name;
+    EXPECT_GT(v.timings.validateMs, 0.0) << src.name;
+  }
+  // A shader that does not parse spends nothing in the later phases.
+  const ShaderValidation bad = compileAndValidate(glsl("bad.frag", "#version 450\nvoid main() { oops }\n"));
+  ASSERT_FALSE(bad.ok);
+  EXPECT_GT(bad.timings.parseMs, 0.0);
+  EXPECT_EQ(bad.timings.linkMs + bad.timings.spirvMs + bad.timings.validateMs, 0.0);
+}
+
 TEST(ShaderValidate, OptimizedCopyOnlyOnRequest) {
   ShaderValidation v = compileAndValidate(glsl("trivial.frag", kTrivialFrag));
   ASSERT_TRUE(v.ok) << v.log;

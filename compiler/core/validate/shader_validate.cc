@@ -9,6 +9,7 @@
 #include <spirv-tools/optimizer.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -200,10 +201,22 @@ std::size_t spirvInstructionCount(const std::vector<uint32_t>& words) {
 
 namespace {
 
+/// Milliseconds since `start`, and `start` moved to now (the phases of ShaderValidation::timings).
+double lap(std::chrono::steady_clock::time_point& start) {
+  const auto now = std::chrono::steady_clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - start).count();
+  start = now;
+  return ms;
+}
+
 /// SPIR-V from a linked program, into result.spirv; for HLSL legalized when
 /// spirv-val rejects the raw module. False (the log says why) when it fails.
+/// `validated`: the module kept is the raw HLSL one spirv-val has just
+/// accepted, with the options validateSpirvModule would use (no need to again).
 bool spirvFromProgram(glslang::TProgram& program, EShLanguage stage, bool hlsl, const ShaderSource& src,
-                      ShaderValidation& result) {
+                      ShaderValidation& result, bool& validated) {
+  validated = false;
+  auto clock = std::chrono::steady_clock::now();
   // glslang's GLSL front end declares storage buffers in the StorageBuffer
   // class for SPIR-V >= 1.3, but its HLSL front end (12.0) keeps the
   // Uniform + BufferBlock form that SPIR-V 1.4 removed, which spirv-val rejects
@@ -218,28 +231,37 @@ bool spirvFromProgram(glslang::TProgram& program, EShLanguage stage, bool hlsl, 
   glslang::GlslangToSpv(*program.getIntermediate(stage), result.spirv, &logger, &spvOptions);
   const std::string spvLog = logger.getAllMessages();
   appendLog(result.log, spvLog);
+  result.timings.spirvMs += lap(clock);
   if (containsLine(spvLog, "error") || result.spirv.empty()) return false;
 
   // HLSL: glslang's raw output is often not valid Vulkan SPIR-V (e.g. structs
   // holding textures and samplers) until its legalization passes run; they
   // cost more than everything else here, so they run only when spirv-val
   // rejects the raw module. Either way the module kept is one spirv-val accepts.
-  if (hlsl && !spirvValid(result.spirv, nullptr, src.name, "spirv-val")) {
+  if (hlsl) {
+    validated = spirvValid(result.spirv, nullptr, src.name, "spirv-val");
+    result.timings.validateMs += lap(clock);
+  }
+  if (hlsl && !validated) {
     std::vector<uint32_t> legalized;
     spv::SpvBuildLogger legalizeLogger;
     spvOptions.disableOptimizer = false;  // glslang runs legalization only with its optimizer on
     glslang::GlslangToSpv(*program.getIntermediate(stage), legalized, &legalizeLogger, &spvOptions);
     const std::string legalizeLog = legalizeLogger.getAllMessages();
     if (legalizeLog != spvLog) appendLog(result.log, legalizeLog);
+    result.timings.spirvMs += lap(clock);
     if (containsLine(legalizeLog, "error") || legalized.empty()) return false;
     result.spirv = std::move(legalized);
   }
   return true;
 }
 
-/// Checks the module's one entry point and runs spirv-val (and, when asked,
-/// spirv-opt and spirv-val again) on result.spirv; sets result.ok when all pass.
-void validateSpirvModule(const ShaderSource& src, const ValidateOptions& options, ShaderValidation& result) {
+/// Checks the module's one entry point and runs spirv-val (unless `validated`:
+/// spirvFromProgram has), and, when asked, spirv-opt and spirv-val again, on
+/// result.spirv; sets result.ok when all pass.
+void validateSpirvModule(const ShaderSource& src, const ValidateOptions& options, bool validated,
+                         ShaderValidation& result) {
+  auto clock = std::chrono::steady_clock::now();
   const std::vector<std::string> entries = entryPointNames(result.spirv);
   if (entries.size() != 1 || entries.front() != src.entryPoint) {
     appendLog(result.log, fmt::format("{}: expected exactly one entry point \"{}\", the module has {}", src.name,
@@ -247,7 +269,9 @@ void validateSpirvModule(const ShaderSource& src, const ValidateOptions& options
     return;
   }
 
-  if (!spirvValid(result.spirv, &result.log, src.name, "spirv-val")) return;
+  const bool valid = validated || spirvValid(result.spirv, &result.log, src.name, "spirv-val");
+  result.timings.validateMs += lap(clock);
+  if (!valid) return;
   result.instructionCount = spirvInstructionCount(result.spirv);
 
   if (options.optimize) {
@@ -297,16 +321,19 @@ ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptio
   if (hlsl && src.hlsl16BitTypes) messages |= EShMsgHlslEnable16BitTypes;
   const auto msgs = static_cast<EShMessages>(messages);
 
+  auto clock = std::chrono::steady_clock::now();
   FileIncluder includer(src.includeDirs, src.memoryFiles);
   const bool parsed = shader.parse(GetDefaultResources(), /*defaultVersion=*/hlsl ? 100 : 450,
                                    /*forwardCompatible=*/false, msgs, includer);
   appendLog(result.log, shader.getInfoLog());
   appendLog(result.log, shader.getInfoDebugLog());
+  result.timings.parseMs = lap(clock);
   if (!parsed) return result;
 
   glslang::TProgram program;
   program.addShader(&shader);
   const bool linked = program.link(msgs);
+  result.timings.linkMs = lap(clock);
   const std::string linkLog = program.getInfoLog();
   appendLog(result.log, linkLog);
   appendLog(result.log, program.getInfoDebugLog());
@@ -320,8 +347,9 @@ ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptio
     return result;
   }
 
-  if (!spirvFromProgram(program, stage, hlsl, src, result)) return result;
-  validateSpirvModule(src, options, result);
+  bool validated = false;
+  if (!spirvFromProgram(program, stage, hlsl, src, result, validated)) return result;
+  validateSpirvModule(src, options, validated, result);
   return result;
 }
 

@@ -58,6 +58,13 @@ struct ShaderValidation {
   std::size_t instructionCount = 0;           // of `spirv`
   std::vector<uint32_t> optimized;            // ValidateOptions::optimize: after the performance passes
   std::size_t optimizedInstructionCount = 0;  // of `optimized` (0 without ValidateOptions::optimize)
+  /// Where the time went, wall-clock milliseconds on the calling thread (bench/compile_bench's
+  /// ValidatePhases): glslang's front end with the preprocessor (and, the first time a process
+  /// parses a language, its built-in symbol tables), its linker, SPIR-V generation (HLSL:
+  /// legalization too, when it runs), and spirv-val (without the optimizer's run).
+  struct Timings {
+    double parseMs = 0, linkMs = 0, spirvMs = 0, validateMs = 0;
+  } timings;
 };
 
 /// Compiles (GLSL -> SPIR-V 1.5 / Vulkan 1.2, HLSL through glslang's HLSL front end), links,
