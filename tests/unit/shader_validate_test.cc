@@ -176,9 +176,26 @@ float4 main(float2 uv : TEXCOORD0) : SV_Target0 {
   return fetch(m, uv);
 }
 )"));
-  // Valid only because legalization ran: the raw module is rejected.
+  // Valid only because legalization ran: the raw module is rejected. The module kept is the
+  // legalized one, and spirv-val accepts it on its own.
   ASSERT_TRUE(v.ok) << v.log;
   EXPECT_EQ(v.instructionCount, spirvInstructionCount(v.spirv));
+  std::string log;
+  EXPECT_TRUE(spirvValidates(v.spirv, &log)) << log;
+}
+
+TEST(ShaderValidate, EveryModuleKeptIsOneSpirvValAcceptsWhetherOrNotLegalizationRan) {
+  // An HLSL module spirv-val accepts raw is kept without a second validation (it is the same
+  // module); one it rejects is legalized and validated again. Either way what is kept validates.
+  for (const ShaderSource& src : {hlsl("pixel.hlsl", kHlslPixel), glsl("trivial.frag", kTrivialFrag)}) {
+    const ShaderValidation v = compileAndValidate(src);
+    ASSERT_TRUE(v.ok) << v.log;
+    std::string log;
+    EXPECT_TRUE(spirvValidates(v.spirv, &log)) << src.name << ": " << log;
+  }
+  std::string log;
+  EXPECT_FALSE(spirvValidates({0x07230203u, 0x00010500u, 0, 1, 0, 0x00ffffffu}, &log));  // a broken module
+  EXPECT_NE(log, "");
 }
 
 TEST(ShaderValidate, HlslStorageBuffersUseTheStorageBufferClass) {

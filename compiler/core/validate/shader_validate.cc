@@ -187,6 +187,10 @@ bool spirvValid(const std::vector<uint32_t>& words, std::string* log, const std:
 
 }  // namespace
 
+bool spirvValidates(const std::vector<uint32_t>& words, std::string* log) {
+  return spirvValid(words, log, "module", "spirv-val");
+}
+
 std::size_t spirvInstructionCount(const std::vector<uint32_t>& words) {
   if (words.size() < 5) return 0;
   std::size_t n = 0;

@@ -78,6 +78,10 @@ struct ShaderValidation {
 /// `spirv` is then the legalized module.
 ShaderValidation compileAndValidate(const ShaderSource& src, const ValidateOptions& options = {});
 
+/// Runs spirv-val (Vulkan 1.2 rules) on a module, as compileAndValidate does: true when it is
+/// valid; otherwise false, with the validator's messages appended to `log` when given.
+bool spirvValidates(const std::vector<uint32_t>& words, std::string* log = nullptr);
+
 /// Counts the instructions of a SPIR-V module (0 if the header is missing or a word count is bad).
 std::size_t spirvInstructionCount(const std::vector<uint32_t>& words);
 
