@@ -20,54 +20,22 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
+#include "cli_util.h"
 #include "output/atomic_write.h"
 
 namespace fs = std::filesystem;
 using substratec::runCli;
+using substratec::clitest::binary;
+using substratec::clitest::cli;
+using substratec::clitest::slurp;
+using CliRun = substratec::clitest::CliResult;
 
 namespace {
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
-struct CliRun {
-  int status;
-  std::string out, err;
-};
-
-CliRun cli(std::vector<std::string> args) {
-  std::ostringstream out, err;
-  int status = runCli(args, out, err);
-  return {status, out.str(), err.str()};
-}
-
-/// Runs the built binary in a child process (stdout captured, stderr to a file).
-CliRun binary(const std::string& args) {
-  fs::create_directories(SUBSTRATEC_WORK_DIR);
-  std::string errFile = std::string(SUBSTRATEC_WORK_DIR) + "/stderr.txt";
-  std::string cmd = std::string(SUBSTRATEC_BINARY) + " " + args + " 2>" + errFile;
-  CliRun r{-1, "", ""};
-  FILE* p = popen(cmd.c_str(), "r");
-  if (!p) return r;
-  char buf[4096];
-  std::size_t n;
-  while ((n = fread(buf, 1, sizeof buf, p)) > 0) r.out.append(buf, n);
-  int st = pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
-  std::ifstream e(errFile);
-  std::ostringstream s;
-  s << e.rdbuf();
-  r.err = s.str();
-  return r;
-}
-
 std::string example(const char* name) { return (kSource / "examples" / name).string(); }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 /// One child process of the built binary, measured on its own (wait4).
 struct Spawned {

@@ -162,14 +162,9 @@ TEST(WorkerProcess, StartedAsBazelStartsItTheBinaryWritesOnlyResponsesOnItsStand
   std::ofstream(requests) << requestLine({example("car_paint.json"), "-o", (dir / "out").string()}, 0)
                           << "oops\n"
                           << requestLine({example("row12_simple.json"), "-o", (dir / "out").string()}, 0);
-  const std::string cmd = std::string(SUBSTRATEC_BINARY) + " compile --persistent_worker < " + requests.string() +
-                          " 2>" + (dir / "stderr.txt").string();
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::string out;
-  char buf[4096];
-  for (std::size_t n; (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
-  EXPECT_EQ(pclose(p), 0);
+  const CliResult run = binary("compile --persistent_worker < " + requests.string());
+  EXPECT_EQ(run.status, 0);
+  const std::string& out = run.out;
   std::istringstream lines(out);
   std::vector<int> codes;
   for (std::string line; std::getline(lines, line);) {
@@ -179,7 +174,7 @@ TEST(WorkerProcess, StartedAsBazelStartsItTheBinaryWritesOnlyResponsesOnItsStand
   }
   EXPECT_EQ(codes, (std::vector<int>{0, kExitUsage, 0}));
   EXPECT_EQ(filesOf(dir / "out").size(), 14u);
-  EXPECT_EQ(slurp(dir / "stderr.txt"), "");
+  EXPECT_EQ(run.err, "");
 }
 
 TEST(ArgumentFiles, AnAtFileStandsForTheArgumentsItHoldsOnePerLine) {

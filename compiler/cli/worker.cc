@@ -6,6 +6,7 @@
 #include <exception>
 #include <functional>
 #include <istream>
+#include <limits>
 #include <mutex>
 #include <ostream>
 #include <sstream>
@@ -16,16 +17,19 @@
 
 #include "cli/cli.h"
 #include "cli/messages.h"
+#include "util/parallel.h"
 
 namespace substratec {
 namespace {
 
 using json = nlohmann::json;
 
-/// A field by its JSON name or its protobuf name (proto3's JSON mapping accepts
-/// both: Bazel writes `requestId`, a hand-written request may say `request_id`).
-const json* field(const json& object, const char* jsonName, const char* protoName) {
+/// A field by its JSON name or, when that differs, its protobuf name (proto3's JSON
+/// mapping accepts both: Bazel writes `requestId`, a hand-written request may say
+/// `request_id`).
+const json* field(const json& object, const char* jsonName, const char* protoName = nullptr) {
   if (auto it = object.find(jsonName); it != object.end()) return &*it;
+  if (!protoName) return nullptr;
   if (auto it = object.find(protoName); it != object.end()) return &*it;
   return nullptr;
 }
@@ -168,7 +172,7 @@ std::optional<WorkRequest> parseWorkRequest(const std::string& text, std::string
     r.requestId = id->get<int>();
     *requestId = r.requestId;
   }
-  if (const json* args = field(j, "arguments", "arguments")) {
+  if (const json* args = field(j, "arguments")) {
     if (!args->is_array()) {
       *error = "arguments must be an array of strings";
       return std::nullopt;
@@ -181,7 +185,7 @@ std::optional<WorkRequest> parseWorkRequest(const std::string& text, std::string
       r.arguments.push_back((*args)[i].get<std::string>());
     }
   }
-  if (const json* cancel = field(j, "cancel", "cancel")) r.cancel = cancel->is_boolean() && cancel->get<bool>();
+  if (const json* cancel = field(j, "cancel")) r.cancel = cancel->is_boolean() && cancel->get<bool>();
   const json* sandbox = field(j, "sandboxDir", "sandbox_dir");
   if (sandbox && !(sandbox->is_string() && sandbox->get<std::string>().empty())) {
     *error = "sandboxDir is not supported (substratec does not declare supports-multiplex-sandboxing)";
@@ -201,10 +205,9 @@ std::string workResponseLine(int exitCode, const std::string& output, int reques
 
 int runWorker(const std::vector<std::string>& prefix, std::istream& in, std::ostream& out,
               const WorkerOptions& options) {
-  const std::size_t threads =
-      options.threads ? options.threads : std::max<std::size_t>(1, std::thread::hardware_concurrency());
   Responder responder(out);
-  RequestPool pool(threads);
+  // Multiplex requests may all arrive at once: as many threads as asked (0: the machine's).
+  RequestPool pool(workerCount(std::numeric_limits<std::size_t>::max(), options.threads));
   std::string text;
   bool tooLong = false;
   for (std::size_t number = 1; readRequest(in, text, options.maxRequestBytes, tooLong); ++number) {
