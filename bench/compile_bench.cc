@@ -28,8 +28,6 @@
 #include "format/json_document.h"
 #include "pipeline/generate.h"
 #include "pipeline/pipeline.h"
-#include "validate/runtime_files.h"
-#include "validate/runtime_pruning.h"
 
 namespace fs = std::filesystem;
 using namespace substratec;
@@ -134,15 +132,15 @@ void BM_GenerateAndValidate(benchmark::State& state, const Example* ex, bool opt
 // per material: glslang's front end (parse_ms), its linker (link_ms), SPIR-V
 // generation (spirv_ms) and spirv-val (val_ms). CPU time per material is the
 // benchmark's time (one thread).
-void BM_ValidatePhases(benchmark::State& state, const Example* ex, bool pruned) {
+void BM_ValidatePhases(benchmark::State& state, const Example* ex) {
   Diagnostics diags(ex->path);
   auto result = compileText(ex->path, ex->text, CompileOptions{}, diags);
   ShaderValidation::Timings sum;
   for (auto _ : state) {
     Generated g = generateFiles(*result, GenerateOptions{});
-    for (const ShaderSource& src : entrySources(g)) {
-      ShaderValidation v =
-          pruned ? compileAndValidate(withPrunedRuntime(src, pruneRuntime(src, runtimeFiles()))) : compileAndValidate(src);
+    for (const OutputFile& f : g.files) {
+      if (!f.name.ends_with(".frag") && !f.name.ends_with(".ps.hlsl")) continue;
+      ShaderValidation v = compileGeneratedEntry(g, f.name);
       if (!v.ok) state.SkipWithError("generated code does not validate");
       sum.parseMs += v.timings.parseMs;
       sum.linkMs += v.timings.linkMs;
@@ -156,26 +154,6 @@ void BM_ValidatePhases(benchmark::State& state, const Example* ex, bool pruned) 
   state.counters["link_ms"] = sum.linkMs / n;
   state.counters["spirv_ms"] = sum.spirvMs / n;
   state.counters["val_ms"] = sum.validateMs / n;
-}
-
-// What deciding what to prune costs (pruneRuntime on the material's four
-// entries), and how much of the runtime's function definitions it removes.
-void BM_PruneRuntime(benchmark::State& state, const Example* ex) {
-  Diagnostics diags(ex->path);
-  auto result = compileText(ex->path, ex->text, CompileOptions{}, diags);
-  const Generated g = generateFiles(*result, GenerateOptions{});
-  const std::vector<ShaderSource> sources = entrySources(g);
-  std::size_t definitions = 0, removed = 0;
-  for (auto _ : state) {
-    definitions = removed = 0;
-    for (const ShaderSource& src : sources) {
-      const RuntimePruning p = pruneRuntime(src, runtimeFiles());
-      definitions += p.definitions;
-      removed += p.removed;
-      benchmark::DoNotOptimize(p);
-    }
-  }
-  state.counters["removed_pct"] = definitions ? 100.0 * static_cast<double>(removed) / static_cast<double>(definitions) : 0;
 }
 
 void BM_ParseOnly(benchmark::State& state, const Example* ex) {
@@ -281,14 +259,8 @@ int main(int argc, char** argv) {
         ->UseRealTime()
         ->MeasureProcessCPUTime();
   for (const Example& ex : list)
-    benchmark::RegisterBenchmark(("ValidatePhases/" + ex.stem).c_str(), BM_ValidatePhases, &ex, false)
+    benchmark::RegisterBenchmark(("ValidatePhases/" + ex.stem).c_str(), BM_ValidatePhases, &ex)
         ->Unit(benchmark::kMillisecond);
-  for (const Example& ex : list)
-    benchmark::RegisterBenchmark(("ValidatePhasesPruned/" + ex.stem).c_str(), BM_ValidatePhases, &ex, true)
-        ->Unit(benchmark::kMillisecond);
-  for (const Example& ex : list)
-    benchmark::RegisterBenchmark(("PruneRuntime/" + ex.stem).c_str(), BM_PruneRuntime, &ex)
-        ->Unit(benchmark::kMicrosecond);
   for (const Example& ex : list)
     benchmark::RegisterBenchmark(("GenerateValidateOptimize/" + ex.stem).c_str(), BM_GenerateAndValidate, &ex, true)
         ->Unit(benchmark::kMillisecond)

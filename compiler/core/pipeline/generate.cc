@@ -10,7 +10,6 @@
 #include "emit/layout_json.h"
 #include "util/parallel.h"
 #include "validate/runtime_files.h"
-#include "validate/runtime_pruning.h"
 #include "validate/shader_validate.h"
 
 namespace substratec {
@@ -65,18 +64,10 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
   return g;
 }
 
-std::vector<ShaderSource> entrySources(const Generated& g) {
+void validateGenerated(Generated& g, const ValidateOptions& options, std::size_t threads) {
   // The entries include the material files and the runtime by name: both are
   // served from memory, so nothing touches the disk.
   const std::map<std::string, std::string_view> files = memoryFiles(g);
-  std::vector<ShaderSource> sources;
-  for (const OutputFile& f : g.files)
-    if (isEntry(f.name)) sources.push_back(entrySource(f, files, g.precision));
-  return sources;
-}
-
-void validateGenerated(Generated& g, const ValidateOptions& options, std::size_t threads) {
-  const std::vector<ShaderSource> sources = entrySources(g);
   std::vector<const OutputFile*> entries;
   for (const OutputFile& f : g.files)
     if (isEntry(f.name)) entries.push_back(&f);
@@ -86,7 +77,7 @@ void validateGenerated(Generated& g, const ValidateOptions& options, std::size_t
   // on scheduling.
   std::vector<ShaderValidation> results(entries.size());
   parallelFor(entries.size(), threads, [&](std::size_t i) {
-    results[i] = compileAndValidateShared(sources[i], runtimeFiles(), options);
+    results[i] = compileAndValidate(entrySource(*entries[i], files, g.precision), options);
   });
 
   for (std::size_t i = 0; i < entries.size(); ++i) {

@@ -38,18 +38,11 @@ struct Generated {
 Generated generateFiles(const CompileResult& r, const GenerateOptions& o);
 
 /// Compiles every entry shader in-process against the generated files and the
-/// embedded runtime (all in memory), runs spirv-val and counts instructions
-/// (compileAndValidateShared: the runtime's uncalled functions are not parsed
-/// once an entry of the same runtime configuration compiled it whole);
+/// embedded runtime (all in memory), runs spirv-val and counts instructions;
 /// with `options.optimize` also after SPIRV-Tools' performance passes.
 /// Entries compile in parallel on up to `threads` threads (0: the machine's).
 /// Fills `entries`, `valid`, `failure` (the first failing entry in file order).
 void validateGenerated(Generated& g, const ValidateOptions& options = {}, std::size_t threads = 0);
-
-/// The entry shaders of `g` as validateGenerated compiles them, in file order:
-/// `g`'s files and the embedded runtime served from memory (the sources refer to
-/// `g`'s texts: `g` must outlive them).
-std::vector<ShaderSource> entrySources(const Generated& g);
 
 /// Compiles the entry shader `file` of `g` as validateGenerated does and keeps
 /// its SPIR-V (what `render` draws with). `ok` false, with the numbered source
