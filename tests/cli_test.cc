@@ -470,6 +470,34 @@ TEST(Cli, WriteFilesAtomicallyWritesAllOrNothing) {
   fs::remove_all(dir);
 }
 
+// What Ninja's restat needs: a file that already holds the bytes is left as it
+// is (same inode, same modification time); a changed one, or a link in its
+// place, is replaced.
+TEST(Cli, WriteFilesAtomicallyLeavesAFileThatHoldsTheBytesAsItIs) {
+  using substratec::writeFilesAtomically;
+  const fs::path dir = fs::path(SUBSTRATEC_WORK_DIR) / ("restat." + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  ASSERT_EQ(writeFilesAtomically(dir.string(), {{"same.txt", "S"}, {"changed.txt", "C"}, {"linked.txt", "L"}}), "");
+  const auto old = fs::file_time_type::clock::now() - std::chrono::hours(1);
+  for (const char* f : {"same.txt", "changed.txt"}) fs::last_write_time(dir / f, old);
+  fs::remove(dir / "linked.txt");
+  std::ofstream(dir / "target.txt") << "L";
+  fs::create_symlink("target.txt", dir / "linked.txt");
+  struct stat before {};
+  ASSERT_EQ(::stat((dir / "same.txt").c_str(), &before), 0);
+
+  ASSERT_EQ(writeFilesAtomically(dir.string(), {{"same.txt", "S"}, {"changed.txt", "C2"}, {"linked.txt", "L"}}), "");
+  struct stat after {};
+  ASSERT_EQ(::stat((dir / "same.txt").c_str(), &after), 0);
+  EXPECT_EQ(after.st_ino, before.st_ino);
+  EXPECT_EQ(fs::last_write_time(dir / "same.txt"), old);
+  EXPECT_EQ(slurp(dir / "changed.txt"), "C2");
+  EXPECT_GT(fs::last_write_time(dir / "changed.txt"), old);
+  EXPECT_FALSE(fs::is_symlink(dir / "linked.txt"));
+  EXPECT_EQ(slurp(dir / "linked.txt"), "L");
+  fs::remove_all(dir);
+}
+
 // preview -o and sweep --plot of a broken material: exit 1 before any
 // rendering, and the file already there is untouched (no GPU needed).
 TEST(Cli, PreviewAndSweepOfABrokenMaterialLeaveTheirOutputAsItWas) {

@@ -98,10 +98,37 @@ std::string writeFilesAtomically(const std::string& dirName, const std::vector<O
   return writePathsAtomically(paths);
 }
 
-std::string writePathsAtomically(const std::vector<OutputPath>& files) {
-  for (const auto& f : files)
+namespace {
+
+/// Whether `path` is a regular file (not a link to one) holding exactly `contents`.
+bool holdsExactly(const fs::path& path, const std::string& contents) {
+  struct stat st;
+  if (::lstat(path.c_str(), &st) != 0 || !S_ISREG(st.st_mode) || st.st_size != static_cast<off_t>(contents.size()))
+    return false;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) return false;
+  std::string existing(contents.size(), '\0');
+  std::size_t got = 0;
+  while (got < existing.size()) {
+    const ssize_t n = ::read(fd, existing.data() + got, existing.size() - got);
+    if (n <= 0) break;
+    got += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  return got == contents.size() && existing == contents;
+}
+
+}  // namespace
+
+std::string writePathsAtomically(const std::vector<OutputPath>& all) {
+  for (const auto& f : all)
     if (!isPlainFileName(fs::path(f.path).filename().string()))
       return fmt::format("refusing to write the output '{}'", f.path);
+  // A destination that already holds these bytes is left as it is (its
+  // modification time kept): see the header.
+  std::vector<OutputPath> files;
+  for (const auto& f : all)
+    if (!holdsExactly(f.path, f.contents)) files.push_back(f);
 
   std::vector<fs::path> created;  // the directories this call creates, shallowest first
   std::vector<fs::path> temps(files.size()), backups(files.size());

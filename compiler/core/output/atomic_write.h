@@ -33,6 +33,11 @@ std::string outputPathsIn(const std::string& dir, const std::vector<OutputFile>&
 
 /// The same across directories: every file of a command (its outputs, its
 /// depfile, its --cache entries, a plot) is committed together, or none is.
+/// A destination that is already a regular file holding exactly the bytes to
+/// write is not written again: its modification time stays, so a build system
+/// that re-stats outputs after a command (Ninja's `restat`, which CMake sets
+/// on every custom command) does not rebuild what depends on an output the
+/// command left unchanged. (writeFilesAtomically goes through this too.)
 /// All temporaries are written (every directory created) before the first
 /// rename, so a destination that cannot be written fails the whole set with
 /// nothing changed anywhere. Returns "" on success, else an error message.
