@@ -3,11 +3,20 @@
 #   substrate_add_materials(TARGET <name> MATERIALS <file>...
 #                           [TARGETS glsl hlsl] [PLATFORM <name>] [PLATFORMS <file>]
 #                           [DIFFUSE lambert|chan2018|chan2024|eon] [CACHE <dir>]
-#                           [OUTPUT_DIRECTORY <dir>] [SUBSTRATEC <path>])
+#                           [OUTPUT_DIRECTORY <dir>] [SUBSTRATEC <path>]
+#                           [MATERIALS_PER_COMMAND <n>])
 #
-# One custom command per material runs `substratec compile` with --depfile, so
-# Ninja (and Make) rebuild exactly the materials whose file (or the PLATFORMS
-# file, or the compiler) changed. <name> is a custom target (made if it does
+# The materials are compiled by custom commands of up to MATERIALS_PER_COMMAND
+# materials each (default 32), `substratec compile FILE... --cache DIR` with
+# --depfile, so Ninja (and Make) rerun exactly the commands holding a material
+# whose file (or the PLATFORMS file, or the compiler) changed. A rerun command
+# takes its other materials from the content-hash cache (CACHE, default
+# ${CMAKE_CURRENT_BINARY_DIR}/substratec_cache/<name>) and leaves their outputs
+# untouched, so Ninja's restat rebuilds nothing that depends on them: editing
+# one material recompiles one. A command pays glslang's start-up (about 0.2 s)
+# once for all its materials instead of once each (docs/performance.md, "CMake:
+# materials per command"); MATERIALS_PER_COMMAND 1 gives a command per material
+# (no cache unless CACHE is given). <name> is a custom target (made if it does
 # not exist, else made to depend on the materials) over every output. The
 # outputs (docs/codegen.md) go into OUTPUT_DIRECTORY (default
 # ${CMAKE_CURRENT_BINARY_DIR}/<name>) and are listed in the target's
@@ -68,7 +77,8 @@ macro(_substratec_common_options)
 endmacro()
 
 function(substrate_add_materials)
-  cmake_parse_arguments(PARSE_ARGV 0 arg "" "TARGET;PLATFORM;PLATFORMS;DIFFUSE;CACHE;OUTPUT_DIRECTORY;SUBSTRATEC"
+  cmake_parse_arguments(PARSE_ARGV 0 arg ""
+                        "TARGET;PLATFORM;PLATFORMS;DIFFUSE;CACHE;OUTPUT_DIRECTORY;SUBSTRATEC;MATERIALS_PER_COMMAND"
                         "MATERIALS;TARGETS")
   if(arg_UNPARSED_ARGUMENTS)
     message(FATAL_ERROR "substrate_add_materials: unknown arguments: ${arg_UNPARSED_ARGUMENTS}")
@@ -79,11 +89,29 @@ function(substrate_add_materials)
   if(NOT arg_MATERIALS)
     message(FATAL_ERROR "substrate_add_materials(${arg_TARGET}): MATERIALS <file>... is required")
   endif()
+  if(NOT DEFINED arg_MATERIALS_PER_COMMAND)
+    set(arg_MATERIALS_PER_COMMAND 32)
+  endif()
+  if(NOT arg_MATERIALS_PER_COMMAND MATCHES "^[1-9][0-9]*$")
+    message(FATAL_ERROR "substrate_add_materials(${arg_TARGET}): MATERIALS_PER_COMMAND takes a positive "
+                        "integer, not '${arg_MATERIALS_PER_COMMAND}'")
+  endif()
+  list(LENGTH arg_MATERIALS materialCount)
+  # A command of several materials needs the cache to recompile only what changed.
+  if(NOT arg_CACHE AND arg_MATERIALS_PER_COMMAND GREATER 1 AND materialCount GREATER 1)
+    set(arg_CACHE "${CMAKE_CURRENT_BINARY_DIR}/substratec_cache/${arg_TARGET}")
+  endif()
   _substratec_common_options()
 
   set(allOutputs "")
   set(depDir "${CMAKE_CURRENT_BINARY_DIR}/substratec_depfiles/${arg_TARGET}")
+  set(chunkFiles "")
+  set(chunkOutputs "")
+  set(chunkNames "")
+  set(chunkCount 0)
+  set(index 0)
   foreach(material IN LISTS arg_MATERIALS)
+    math(EXPR index "${index} + 1")
     cmake_path(ABSOLUTE_PATH material BASE_DIRECTORY "${CMAKE_CURRENT_SOURCE_DIR}" NORMALIZE OUTPUT_VARIABLE file)
     if(NOT EXISTS "${file}")
       message(FATAL_ERROR "substrate_add_materials(${arg_TARGET}): ${material}: no such file")
@@ -95,25 +123,40 @@ function(substrate_add_materials)
                           "(substratec compile ${material} says why)")
     endif()
     # In the order substratec writes them: its depfile's first target is this list's first.
-    set(outputs "")
     if(glsl)
-      list(APPEND outputs "${arg_OUTPUT_DIRECTORY}/${name}.material.glsl" "${arg_OUTPUT_DIRECTORY}/${name}.basepass.frag"
-           "${arg_OUTPUT_DIRECTORY}/${name}.forward.frag")
+      list(APPEND chunkOutputs "${arg_OUTPUT_DIRECTORY}/${name}.material.glsl"
+           "${arg_OUTPUT_DIRECTORY}/${name}.basepass.frag" "${arg_OUTPUT_DIRECTORY}/${name}.forward.frag")
     endif()
     if(hlsl)
-      list(APPEND outputs "${arg_OUTPUT_DIRECTORY}/${name}.material.hlsl"
+      list(APPEND chunkOutputs "${arg_OUTPUT_DIRECTORY}/${name}.material.hlsl"
            "${arg_OUTPUT_DIRECTORY}/${name}.basepass.ps.hlsl" "${arg_OUTPUT_DIRECTORY}/${name}.forward.ps.hlsl")
     endif()
-    list(APPEND outputs "${arg_OUTPUT_DIRECTORY}/${name}.layout.json")
-    set(depfile "${depDir}/${name}.d")
-    add_custom_command(
-      OUTPUT ${outputs}
-      COMMAND ${compiler} compile "${file}" -o "${arg_OUTPUT_DIRECTORY}" ${options} --depfile "${depfile}"
-      DEPENDS "${file}" ${compiler} ${extraDeps}
-      DEPFILE "${depfile}"
-      COMMENT "substratec: ${material} -> ${name}"
-      VERBATIM)
-    list(APPEND allOutputs ${outputs})
+    list(APPEND chunkOutputs "${arg_OUTPUT_DIRECTORY}/${name}.layout.json")
+    list(APPEND chunkFiles "${file}")
+    list(APPEND chunkNames "${name}")
+    list(LENGTH chunkFiles inChunk)
+    if(inChunk EQUAL arg_MATERIALS_PER_COMMAND OR index EQUAL materialCount)
+      if(inChunk EQUAL 1)
+        set(depfile "${depDir}/${name}.d")
+        set(comment "substratec: ${material} -> ${name}")
+      else()
+        math(EXPR chunkCount "${chunkCount} + 1")
+        set(depfile "${depDir}/${arg_TARGET}.${chunkCount}.d")
+        list(JOIN chunkNames " " listed)
+        set(comment "substratec: ${inChunk} materials -> ${listed}")
+      endif()
+      add_custom_command(
+        OUTPUT ${chunkOutputs}
+        COMMAND ${compiler} compile ${chunkFiles} -o "${arg_OUTPUT_DIRECTORY}" ${options} --depfile "${depfile}"
+        DEPENDS ${chunkFiles} ${compiler} ${extraDeps}
+        DEPFILE "${depfile}"
+        COMMENT "${comment}"
+        VERBATIM)
+      list(APPEND allOutputs ${chunkOutputs})
+      set(chunkFiles "")
+      set(chunkOutputs "")
+      set(chunkNames "")
+    endif()
   endforeach()
 
   if(TARGET ${arg_TARGET})

@@ -1,8 +1,11 @@
 # ctest's cmake_consumer: installs substratec into a temporary prefix, builds
 # tests/cmake_consumer against the installed package with Ninja, and checks
 # that the build is incremental: nothing to do after a build; touching one
-# material reruns its command and the scene listing it, no other (ninja -n and
-# -d explain); the scene learns its materials from its depfile only.
+# material reruns the command holding it and the scene listing it, no other
+# (ninja -n and -d explain); editing one material of a two-material command
+# recompiles it alone (one new cache entry) and leaves the other's outputs
+# untouched, so nothing that consumes them reruns (restat); the scene learns
+# its materials from its depfile only.
 #
 #   cmake -DBUILD_DIR=<substratec build> -DSOURCE_DIR=<tests/cmake_consumer>
 #         -DWORK_DIR=<scratch> -DNINJA=<ninja> -P check.cmake
@@ -68,19 +71,64 @@ endif()
 if(NOT EXISTS "${out}/yard_lighting/scene.json" OR NOT EXISTS "${out}/yard_lighting/yard.lighting_simple.comp")
   message(FATAL_ERROR "the scene was not built:\n${built}")
 endif()
-# Touching a material reruns its own command and the scene that lists it (a
-# dependency only the scene's depfile declares), nothing else.
+# Touching a material reruns the command holding it (brick and chrome share
+# one) and the scene that lists it (a dependency only the scene's depfile
+# declares), nothing else. A dry run also plans what consumes chrome's
+# shaders (it cannot know the command will leave them as they are); the real
+# run does not run it (restat).
 file(TOUCH "${WORK_DIR}/src/materials/brick.json")
 run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" -n -d explain OUTPUT plan)
 string(REGEX MATCHALL "\\[[0-9]+/[0-9]+\\][^\n]*" steps "${plan}")
 list(LENGTH steps count)
-if(NOT count EQUAL 2 OR NOT steps MATCHES "brick.json -> brick" OR NOT steps MATCHES "scene scene.json")
-  message(FATAL_ERROR "touching brick.json should rerun brick's command and the scene; ninja plans ${count}:\n${plan}")
+if(NOT count EQUAL 3 OR NOT steps MATCHES "2 materials -> brick chrome" OR NOT steps MATCHES "scene scene.json")
+  message(FATAL_ERROR "touching brick.json should rerun the command of brick and chrome, and the scene; ninja plans ${count}:\n${plan}")
 endif()
-if(plan MATCHES "-> chrome|-> felt")
+if(plan MATCHES "-> felt")
   message(FATAL_ERROR "touching brick.json reruns another material:\n${plan}")
 endif()
 run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" OUTPUT rebuilt)
+if(rebuilt MATCHES "consume chrome" OR NOT rebuilt MATCHES "2 materials -> brick chrome")
+  message(FATAL_ERROR "touching brick.json should rerun its command and not what consumes chrome's shaders:\n${rebuilt}")
+endif()
+
+# Editing brick recompiles brick alone: one new cache entry; chrome's outputs
+# keep their old modification time, so what consumes them does not rerun.
+set(cache "${out}/substratec_cache/mobile_shaders")
+file(GLOB entriesBefore "${cache}/*")
+list(LENGTH entriesBefore entriesBefore)
+file(GLOB chromeOutputs "${out}/mobile_shaders/chrome.*")
+run(COMMAND touch -d "@1000000000" ${chromeOutputs} "${out}/chrome_forward_copy.frag")
+file(READ "${out}/mobile_shaders/brick.material.glsl" brickBefore)
+file(READ "${WORK_DIR}/src/materials/brick.json" brick)
+string(REPLACE "\"roughness\": 0.8" "\"roughness\": 0.7" edited "${brick}")
+if(edited STREQUAL brick)
+  message(FATAL_ERROR "check.cmake: cannot edit brick.json's roughness")
+endif()
+file(WRITE "${WORK_DIR}/src/materials/brick.json" "${edited}")
+run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" OUTPUT rebuilt)
+file(GLOB entriesAfter "${cache}/*")
+list(LENGTH entriesAfter entriesAfter)
+math(EXPR added "${entriesAfter} - ${entriesBefore}")
+if(NOT added EQUAL 1)
+  message(FATAL_ERROR "editing brick.json should add one cache entry (one material compiled), added ${added}:\n${rebuilt}")
+endif()
+file(READ "${out}/mobile_shaders/brick.material.glsl" brickAfter)
+if(brickAfter STREQUAL brickBefore)
+  message(FATAL_ERROR "brick's shaders did not change with its roughness")
+endif()
+foreach(f IN LISTS chromeOutputs ITEMS "${out}/chrome_forward_copy.frag")
+  file(TIMESTAMP "${f}" year "%Y" UTC)
+  if(NOT year STREQUAL "2001")
+    message(FATAL_ERROR "editing brick.json rewrote ${f} (${year}):\n${rebuilt}")
+  endif()
+endforeach()
+if(rebuilt MATCHES "consume chrome")
+  message(FATAL_ERROR "editing brick.json reran what consumes chrome's shaders:\n${rebuilt}")
+endif()
+run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" -n OUTPUT settled)
+if(NOT settled MATCHES "no work to do")
+  message(FATAL_ERROR "not settled after editing brick.json:\n${settled}")
+endif()
 # Felt alone: one command.
 file(TOUCH "${WORK_DIR}/src/materials/felt.json")
 run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" -n OUTPUT plan)
@@ -94,4 +142,4 @@ run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" -n OUTPUT settled)
 if(NOT settled MATCHES "no work to do")
   message(FATAL_ERROR "not settled after the rebuild:\n${settled}")
 endif()
-message(STATUS "cmake_consumer: installed, built, and touching one material rebuilt only it")
+message(STATUS "cmake_consumer: installed, built, and editing one material recompiled only it")
