@@ -126,9 +126,9 @@ std::string writePathsAtomically(const std::vector<OutputPath>& all) {
       return fmt::format("refusing to write the output '{}'", f.path);
   // A destination that already holds these bytes is left as it is (its
   // modification time kept): see the header.
-  std::vector<OutputPath> files;
+  std::vector<const OutputPath*> files;
   for (const auto& f : all)
-    if (!holdsExactly(f.path, f.contents)) files.push_back(f);
+    if (!holdsExactly(f.path, f.contents)) files.push_back(&f);
 
   std::vector<fs::path> created;  // the directories this call creates, shallowest first
   std::vector<fs::path> temps(files.size()), backups(files.size());
@@ -139,7 +139,7 @@ std::string writePathsAtomically(const std::vector<OutputPath>& all) {
   auto rollback = [&](std::string message) {
     std::error_code ignored;
     for (std::size_t i = renamed; i-- > 0;) {
-      const fs::path dest = files[i].path;
+      const fs::path dest = files[i]->path;
       if (!backups[i].empty()) fs::rename(backups[i], dest, ignored);
       else if (!existed[i]) fs::remove(dest, ignored);
     }
@@ -155,16 +155,16 @@ std::string writePathsAtomically(const std::vector<OutputPath>& all) {
   // destination (same file system). Any destination that cannot be written
   // fails here, before anything is renamed.
   for (const auto& f : files)
-    if (std::string error = makeDirectory(f.path, created); !error.empty()) return rollback(error);
+    if (std::string error = makeDirectory(f->path, created); !error.empty()) return rollback(error);
   for (std::size_t i = 0; i < files.size(); ++i) {
-    std::string error = writeTemporary(files[i].path, files[i].contents, &temps[i]);
+    std::string error = writeTemporary(files[i]->path, files[i]->contents, &temps[i]);
     if (!error.empty()) return rollback(error);
   }
   // Phase 2: keep a hard link to every file about to be replaced (so a failure
   // half way can put it back), then rename each temporary into place (atomic
   // per file on POSIX).
   for (std::size_t i = 0; i < files.size(); ++i) {
-    const fs::path dest = files[i].path;
+    const fs::path dest = files[i]->path;
     struct stat st;
     if (::lstat(dest.c_str(), &st) != 0) continue;  // nothing to replace
     existed[i] = true;
@@ -180,7 +180,7 @@ std::string writePathsAtomically(const std::vector<OutputPath>& all) {
   }
   std::error_code ec;
   for (std::size_t i = 0; i < files.size(); ++i) {
-    const fs::path dest = files[i].path;
+    const fs::path dest = files[i]->path;
     fs::rename(temps[i], dest, ec);
     if (ec) return rollback(fmt::format("cannot rename into '{}': {}", dest.string(), ec.message()));
     temps[i].clear();
