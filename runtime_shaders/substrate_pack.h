@@ -34,6 +34,9 @@
 #define SUBSTRATE_MAX_BASES 8
 
 #define SUBSTRATE_HEADER_MULTI 0x8000u
+// Bit 14 of a single-closure header: the pixel holds no closure (an unlit
+// material: it emits, the base pass added that, and nothing is lit).
+#define SUBSTRATE_HEADER_NO_CLOSURE 0x4000u
 
 // Field widths in bits (docs/storage.md, "Field table").
 #define SUBSTRATE_BITS_HEADER 16u
@@ -330,6 +333,11 @@ float3 substrate_tangent_angle_decode(uint code, float3 N) {
 // WEIGHT (2-8; bit 9, coverage above, is reserved), SSS type (10-11).
 uint substrate_material_header_single(uint layoutClass, uint features, uint sssType) {
   return (layoutClass & 3u) | ((features & 0x7fu) << 2u) | ((sssType & 3u) << 10u);
+}
+
+// The header of a pixel with no closure (an unlit material): SIMPLE, bit 14 set.
+uint substrate_material_header_unlit() {
+  return SUBSTRATE_HEADER_NO_CLOSURE;
 }
 
 // Multi-closure header: class (0-1), closure count - 1 (2-4), basis count

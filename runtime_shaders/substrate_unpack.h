@@ -5,6 +5,14 @@
 #ifndef SUBSTRATE_UNPACK_H
 #define SUBSTRATE_UNPACK_H 1
 
+// 1: a pixel may hold the no-closure header of an unlit material (bit 14,
+// docs/storage.md, "No closure"): the unpackers read it as nothing to light.
+// A scene's lighting whose materials all have closures defines it 0 and
+// compiles the test out (scene_emitter.cc).
+#ifndef SUBSTRATE_USE_NO_CLOSURE
+#define SUBSTRATE_USE_NO_CLOSURE 1
+#endif
+
 // The fields of one closure that follow its header bits, from stream bit
 // `pos` (advanced past them), into `c` (initialized by the caller): albedo,
 // F0, roughness, then weight, top transmittance, coverage above and the
@@ -121,6 +129,11 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
   }
   uint header = words[0] & 0xffffu;
   bool multi = (header & SUBSTRATE_HEADER_MULTI) != 0u;
+#if SUBSTRATE_USE_NO_CLOSURE
+  if (!multi && (header & SUBSTRATE_HEADER_NO_CLOSURE) != 0u) {
+    return 0u;  // an unlit pixel: nothing to light
+  }
+#endif
   uint count = 1u;
   uint basisCount = 1u;
   if (multi) {
@@ -254,6 +267,11 @@ void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLa
   uint feats = (header >> 2u) & 0x7fu;
   uint pos = SUBSTRATE_BITS_HEADER;
   substrate_unpack_closure_fields(words, pos, feats, (header >> 10u) & 3u, true, c);
+#if SUBSTRATE_USE_NO_CLOSURE
+  if ((header & SUBSTRATE_HEADER_NO_CLOSURE) != 0u) {
+    c.weight = 0.0;  // an unlit pixel: its closure is not lit (substrate_closure_visible)
+  }
+#endif
   float topRoughness;
   substrate_dq_top_layer(topLayer, c.N, topRoughness);
   float3 b0;
@@ -267,12 +285,17 @@ void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLa
 
 // A pixel in the SIMPLE layout (class bits 0): the header is known, so the
 // three fields are read at their fixed offsets (16, 36, 56); the normal is the
-// top-layer word's. Only for pixels known to be SIMPLE (a SIMPLE tile).
+// top-layer word's. Only for pixels known to be SIMPLE (a SIMPLE tile), which
+// include unlit pixels (no closure: weight 0).
 void substrate_unpack_simple(uint words[SUBSTRATE_MAX_WORDS], uint topLayer, out SubstrateClosure c) {
   substrate_closure_init(c);
   c.diffuseAlbedo = substrate_dq_color20(SUBSTRATE_READ_BITS(words, 16u, SUBSTRATE_BITS_COLOR));
   c.f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, 36u, SUBSTRATE_BITS_COLOR));
   c.roughness = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, 56u, SUBSTRATE_BITS_ROUGHNESS), 8u);
+#if SUBSTRATE_USE_NO_CLOSURE
+  // An unlit pixel (header bit 14) is SIMPLE too: weight 0, so it is not lit.
+  c.weight = (words[0] & SUBSTRATE_HEADER_NO_CLOSURE) != 0u ? 0.0 : 1.0;
+#endif
   float topRoughness;
   substrate_dq_top_layer(topLayer, c.N, topRoughness);
 }

@@ -146,6 +146,7 @@ Shaded<T> shade(const CompileResult& r, const Sample& s, const reference::InputV
   Shaded<T> out;
   out.material = reference::evaluateMaterial<T>(r, s.geometry, in, sampleTexture);
   lightInto(out, out.material.closures, s, diffuseModel);
+  add(out.emissive, out.material.emission);  // the unlit nodes' (the forward kernel's `emission`)
   return out;
 }
 template Shaded<float> shade<float>(const CompileResult&, const Sample&, const reference::InputValues&, int);

@@ -173,6 +173,7 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   s += "    environment += viewT * substrate_env_split_sum(closures[k], g.V, prefiltered, irradiance);\n";
   if (mode == KernelMode::Forward && anyEmissive(m, L)) s += "    emissive += viewT * closures[k].emissive;\n";
   s += "  }\n";
+  if (mode == KernelMode::Forward && unlitEmission(m)) s += "  emissive += emission;  // the unlit nodes'\n";
   s += fmt::format("  results[base + {}u] = float({});\n", kResultCount, count);
   s += fmt::format("  results[base + {}u] = coverage;\n", kResultCoverage);
   s += fmt::format("  results[base + {}u] = {};\n  results[base + 3u] = 0.0;\n", kResultLayoutClass,
@@ -274,6 +275,7 @@ std::string previewLighting(const Material& m, const StorageLayout& L) {
                    materialUpper(m), kPreviewLights);
   if (anyEmissive(m, L)) s += "    color += viewT * closures[k].emissive;\n";
   s += "  }\n";
+  if (unlitEmission(m)) s += "  color += emission;  // the unlit nodes'\n";
   switch (m.settings.blendMode) {
     case BlendMode::Masked:
       s += "  if (coverage < 0.5) color = background;\n";

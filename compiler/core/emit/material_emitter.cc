@@ -162,6 +162,8 @@ bool anyEmissive(const Material& m, const StorageLayout& L) {
   return false;
 }
 
+bool basePassEmissive(const Material& m, const StorageLayout& L) { return anyEmissive(m, L) || unlitEmission(m); }
+
 std::string backgroundThroughput(const Material& m) {
   if (m.settings.blendMode == BlendMode::TranslucentGrey)
     return "SUBSTRATE_SPLAT3(1.0 - coverage + coverage * dot(transmittance, SUBSTRATE_SPLAT3(1.0 / 3.0)))";
@@ -180,11 +182,27 @@ std::string lightClosureCode(const std::string& c, const std::string& view, cons
       indent, c, view);
 }
 
+bool unlitEmission(const Material& m) {
+  if (m.root < 0) return false;
+  for (int n : analyzeTree(m).preorder) {
+    const TreeNode& node = m.nodes[n];
+    if (node.op == TreeOp::Slab && m.slabs[node.slab].kind == BsdfKind::Unlit &&
+        (m.slabs[node.slab].features & kFeatEmissive))
+      return true;
+  }
+  return false;
+}
+
+std::string closureArraySize(const Material& m) {
+  return m.root >= 0 && analyzeTree(m).slabOrder.empty() ? "1" : materialUpper(m) + "_CLOSURE_COUNT";
+}
+
 std::string evaluateCall(const Material& m) {
+  const bool emission = unlitEmission(m);
   return fmt::format(
-      "  SubstrateClosure closures[{}_CLOSURE_COUNT];\n  float coverage;\n  float3 transmittance;\n"
-      "  {}_evaluate(g, closures, coverage, transmittance);\n",
-      materialUpper(m), m.name);
+      "  SubstrateClosure closures[{}];\n  float coverage;\n  float3 transmittance;\n{}"
+      "  {}_evaluate(g, closures, coverage, transmittance{});\n",
+      closureArraySize(m), emission ? "  float3 emission;\n" : "", m.name, emission ? ", emission" : "");
 }
 
 namespace {
@@ -217,7 +235,11 @@ class Emitter {
   void emitClosures();
   void emitCoatFloor();
   void emitCoatInterface();
+  std::string pathWeight(int node, const std::string& id, std::vector<std::pair<int, int>>& layers);
   std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
+  void emitEmission();
+  void emitNoClosureSlot();
+  int firstUnlit() const;  // the first unlit leaf in pre-order, or -1
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
   bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
@@ -428,6 +450,15 @@ void Emitter::collectNeeded() {
     }
     if (f & kFeatEmissive) need(s.pin(SlabPin::Emissive));
   }
+  for (int n : t_.preorder) {  // unlit leaves: what they let through and emit
+    const TreeNode& node = m_.nodes[n];
+    if (node.op != TreeOp::Slab || m_.slabs[node.slab].kind != BsdfKind::Unlit) continue;
+    const Slab& s = m_.slabs[node.slab];
+    need(s.pin(SlabPin::Transmittance));
+    if (s.coverage != kNoValue) need(s.coverage);
+    if (s.features & kFeatEmissive) need(s.pin(SlabPin::Emissive));
+    if (L_.closures.empty()) need(s.pin(SlabPin::Normal));  // the no-closure slot's (emitNoClosureSlot)
+  }
   const std::vector<int> profiles = specularProfileInputs(m_, L_);
   for (std::size_t k = 0; k < profiles.size(); ++k) profileIndex_[profiles[k]] = static_cast<int>(k);
   for (ValueId v = 0; v < m_.values.size(); ++v)
@@ -480,6 +511,12 @@ void Emitter::emitTree() {
     if (node.op != TreeOp::Slab) continue;
     const Slab& s = m_.slabs[node.slab];
     std::string c = s.coverage == kNoValue ? "1.0" : expr(s.coverage);
+    if (s.kind == BsdfKind::Unlit) {  // no closure: it covers, lets through its transmittance, emits (emitEmission)
+      line(fmt::format("// unlit '{}' (Id={})", node.id, t_.reportId[n]));
+      line(fmt::format("float C_{} = {};", node.id, c));
+      line(fmt::format("float3 T_{} = {};", node.id, expr(s.pin(SlabPin::Transmittance))));
+      continue;
+    }
     int v = verticalOfTop(n);
     std::string t;
     double d = m_.settings.surfaceThickness;
@@ -546,14 +583,12 @@ std::string Emitter::operatorCall(const TreeNode& node, const std::string& prefi
   }
 }
 
-/// The walk from closure `cl`'s slab (tree node `node`, id `id`) up to the
-/// root: returns its mix/coverage weight (an expression, "" for 1) and, for a
-/// closure under layers, emits what the layers above do to it (ca_, ta_, va_).
-std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string& id) {
-  const Slab& s = m_.slabs[cl.slab];
-  // The walk up to the root: mix/coverage weights, and the layers above.
+/// The walk from BSDF leaf `node` (id `id`) up to the root: its mix/coverage
+/// weight (an expression, "" for 1); `layers` gets (vertical, its top) for
+/// each vertical whose base holds it, bottom-up.
+std::string Emitter::pathWeight(int node, const std::string& id, std::vector<std::pair<int, int>>& layers) {
+  const Slab& s = m_.slabs[m_.nodes[node].slab];
   std::string weight = s.coverage == kNoValue ? "" : fmt::format("C_{}", id);
-  std::vector<std::pair<int, int>> layers;  // (vertical, its top) for each vertical above, bottom-up
   for (int x = node, p = t_.parent[node]; p >= 0; x = p, p = t_.parent[p]) {
     const TreeNode& op = m_.nodes[p];
     std::string f;
@@ -576,6 +611,15 @@ std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string
     }
     if (!f.empty()) weight += (weight.empty() ? "" : " * ") + f;
   }
+  return weight;
+}
+
+/// The walk from closure `cl`'s slab (tree node `node`, id `id`) up to the
+/// root: returns its mix/coverage weight (an expression, "" for 1) and, for a
+/// closure under layers, emits what the layers above do to it (ca_, ta_, va_).
+std::string Emitter::walkUp(const ClosureLayout& cl, int node, const std::string& id) {
+  std::vector<std::pair<int, int>> layers;  // (vertical, its top) for each vertical above, bottom-up
+  const std::string weight = pathWeight(node, id, layers);
   if (!cl.isTop) {
     line(fmt::format("float ca_{0} = 0.0; float3 ta_{0} = {1}; float va_{0} = 0.0;", id, vec3(1, 1, 1)));
     // From the root down. The top's interfaces transmit 1 - F0 at normal
@@ -680,6 +724,49 @@ void Emitter::emitClosures() {
   }
 }
 
+int Emitter::firstUnlit() const {
+  for (int n : t_.preorder)
+    if (m_.nodes[n].op == TreeOp::Slab && m_.slabs[m_.nodes[n].slab].kind == BsdfKind::Unlit) return n;
+  return -1;
+}
+
+/// A material with no closure (only unlit leaves): its one slot
+/// (closureArraySize) is neutral with weight 0, so nothing lights it, and
+/// holds what the top-layer word stores: the first unlit's normal and a
+/// roughness of 1.
+void Emitter::emitNoClosureSlot() {
+  if (!L_.closures.empty()) return;
+  const int n = firstUnlit();
+  line("");
+  line("// No closure (an unlit material): one neutral slot of weight 0, for the top-layer word.");
+  line("substrate_closure_init(closures[0]);");
+  line("closures[0].weight = 0.0;");
+  line("closures[0].roughness = 1.0;");
+  line(fmt::format("closures[0].N = substrate_tangent_to_world({}, g.N, g.T);",
+                   expr(m_.slabs[m_.nodes[n].slab].pin(SlabPin::Normal))));
+}
+
+/// `emission`: what the unlit leaves emit, each weighted by the mixes and
+/// coverage weights on its way to the root (unlitEmission; an unlit is never
+/// under a layer, build_tree).
+void Emitter::emitEmission() {
+  if (!unlitEmission(m_)) return;
+  line("");
+  line("// What the unlit nodes emit toward the viewer (light-independent).");
+  std::string sum;
+  for (int n : t_.preorder) {
+    const TreeNode& node = m_.nodes[n];
+    if (node.op != TreeOp::Slab) continue;
+    const Slab& s = m_.slabs[node.slab];
+    if (s.kind != BsdfKind::Unlit || !(s.features & kFeatEmissive)) continue;
+    std::vector<std::pair<int, int>> layers;
+    const std::string weight = pathWeight(n, node.id, layers);
+    const std::string e = expr(s.pin(SlabPin::Emissive));
+    sum += (sum.empty() ? "" : " + ") + (weight.empty() ? e : fmt::format("({}) * {}", weight, e));
+  }
+  line(fmt::format("emission = {};", sum));
+}
+
 /// What the layers' top lets through at grazing angles, for every closure
 /// under one interface when one closure, one GGX lobe, is on top (coatFloorClosures;
 /// the others keep 0, substrate_closure_init), as the deferred unpacker derives it:
@@ -755,9 +842,9 @@ std::string Emitter::run() {
   emitResources();
   line("");
   line(fmt::format("// Evaluates the material at one shading point into its closures (fully unrolled)."));
-  line(fmt::format("void {0}_evaluate(SubstrateGeometry g, out SubstrateClosure closures[{1}_CLOSURE_COUNT], "
-                   "out float coverage, out float3 transmittance) {{",
-                   m_.name, upper));
+  line(fmt::format("void {0}_evaluate(SubstrateGeometry g, out SubstrateClosure closures[{1}], "
+                   "out float coverage, out float3 transmittance{2}) {{",
+                   m_.name, closureArraySize(m_), unlitEmission(m_) ? ", out float3 emission" : ""));
   indent_ = "  ";
   line("float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in "
        "tangent space");
@@ -766,6 +853,8 @@ std::string Emitter::run() {
   emitClosures();
   emitCoatFloor();
   emitCoatInterface();
+  emitNoClosureSlot();
+  emitEmission();
   line("");
   line(fmt::format("coverage = C_{};", m_.nodes[m_.root].id));
   line(fmt::format("transmittance = T_{};", m_.nodes[m_.root].id));
@@ -783,6 +872,7 @@ std::string topRoughnessExpr(const StorageLayout& layout, const std::string& arr
   for (std::size_t i = 0; i < layout.closures.size(); ++i)
     if (layout.closures[i].isTop) tops.push_back(i);
   if (tops.size() == 1) return fmt::format("saturate({}[{}].roughness)", arr, tops[0]);  // its weight cancels
+  if (tops.empty()) return fmt::format("saturate({}[0].roughness)", arr);  // no closure: the neutral slot's
   std::string rsum, wsum;
   for (std::size_t i : tops) {
     const std::string c = fmt::format("{}[{}]", arr, i);

@@ -4,7 +4,7 @@
 //
 // Output (docs/codegen.md): resources (the inputs' uniform block / constant
 // buffer and the textures), then `<name>_evaluate(g, closures, coverage,
-// transmittance)`: the value DAG as locals, each slab's coverage and
+// transmittance[, emission])`: the value DAG as locals, each slab's coverage and
 // transmittance, the operators bottom-up by distance from leaves, and each
 // slab's walk up to the root producing its closure — all unrolled for this
 // static topology (no loops, no recursion). Then `<name>_pack`, the packing
@@ -72,6 +72,9 @@ bool translucentBlend(const Material& m);
 std::vector<int> specularProfileInputs(const Material& m, const StorageLayout& layout);
 /// A closure of `layout` is emissive.
 bool anyEmissive(const Material& m, const StorageLayout& layout);
+/// The base pass writes its emissive output (location 4): a closure is
+/// emissive or an unlit node emits (unlitEmission).
+bool basePassEmissive(const Material& m, const StorageLayout& layout);
 /// What the background is multiplied by behind a translucent material (float3,
 /// from `coverage` and `transmittance`).
 std::string backgroundThroughput(const Material& m);
@@ -80,9 +83,23 @@ std::string backgroundThroughput(const Material& m);
 /// (SUBSTRATE_ENV_PREFILTERED / _IRRADIANCE, mip count frame.envParams.x).
 std::string lightClosureCode(const std::string& c, const std::string& view, const std::string& indent);
 
-/// Declares `closures`, `coverage` and `transmittance` and evaluates the
-/// material into them at the SubstrateGeometry `g` (an entry's or kernel's body).
+/// Declares `closures`, `coverage` and `transmittance` (and `emission` when
+/// unlitEmission) and evaluates the material into them at the
+/// SubstrateGeometry `g` (an entry's or kernel's body).
 std::string evaluateCall(const Material& m);
+
+/// The material's tree holds an unlit node that emits (its emissive is not
+/// the constant 0): `<name>_evaluate` then also returns `emission`, what the
+/// unlit nodes emit toward the viewer, weighted by the operators above them
+/// (light-independent: the forward pass adds it to the colour, the base pass
+/// to its emissive output).
+bool unlitEmission(const Material& m);
+
+/// The size of the closures' array in declarations and signatures:
+/// `<NAME>_CLOSURE_COUNT`, or 1 for a material with no closure (only unlit
+/// nodes): its one slot is neutral with weight 0 (nothing lights it), and
+/// holds the normal and roughness the top-layer word stores.
+std::string closureArraySize(const Material& m);
 
 /// Names used across emitted files.
 std::string materialUpper(const Material& m);  // NAME in macros

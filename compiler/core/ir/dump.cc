@@ -21,7 +21,7 @@ std::string dumpMaterial(const Material& m) {
   for (int n : info.preorder) {
     const TreeNode& node = m.nodes[n];
     std::string line(static_cast<std::size_t>(info.depth[n]) * 2, ' ');
-    line += fmt::format("{} {}", treeOpName(node.op), node.id);
+    line += fmt::format("{} {}", nodeOpName(m, node), node.id);
     switch (node.op) {
       case TreeOp::Horizontal: line += " mix=" + renderValue(m, node.a); break;
       case TreeOp::Vertical: line += " thickness=" + renderValue(m, node.a); break;
@@ -36,6 +36,7 @@ std::string dumpMaterial(const Material& m) {
     const Slab& s = m.slabs[node.slab];
     std::string pad(static_cast<std::size_t>(info.depth[n]) * 2 + 4, ' ');
     for (int p = 0; p < kSlabPinCount; ++p) {
+      if (!bsdfTakesPin(s.kind, static_cast<SlabPin>(p))) continue;
       const SlabPinInfo& pi = slabPinInfo(static_cast<SlabPin>(p));
       ValueId v = s.pins[p];
       bool isDefault = pi.geometryDefault >= 0

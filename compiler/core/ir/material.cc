@@ -9,19 +9,20 @@ std::string_view blendModeName(BlendMode m) { return enumName(kBlendModeNames, m
 namespace {
 constexpr double kInf = 1e300;
 constexpr int kNoGeo = -1;
-// name, type, color, default, geometry default, lo, hi
+constexpr std::uint8_t kBoth = kPinOfSlab | kPinOfUnlit;
+// name, type, color, default, geometry default, lo, hi, kinds
 const SlabPinInfo kPins[kSlabPinCount] = {
     {"diffuse_albedo", VType::Vec3, true, 0.18, kNoGeo, 0, 1},
     {"f0", VType::Vec3, true, 0.04, kNoGeo, 0, 1},
     {"f90", VType::Vec3, true, 1.0, kNoGeo, 0, 1},
     {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
     {"anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
-    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1},
+    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kBoth},
     {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1},
     {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
     {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf},
     {"sss_phase_anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
-    {"emissive", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
+    {"emissive", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kBoth},
     {"second_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
     {"second_roughness_weight", VType::Float, false, 0.0, kNoGeo, 0, 1},
     {"fuzz_amount", VType::Float, false, 0.0, kNoGeo, 0, 1},
@@ -29,6 +30,8 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     {"fuzz_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
     {"glint_value", VType::Float, false, 1.0, kNoGeo, 0, 1},
     {"glint_uv", VType::Vec2, false, 0.0, static_cast<int>(GeometryAttr::Uv0), -kInf, kInf},
+    // The unlit's: what it lets through from behind (or below), along the normal.
+    {"transmittance", VType::Vec3, true, 1.0, kNoGeo, 0, 1, kPinOfUnlit},
 };
 }  // namespace
 
@@ -40,6 +43,12 @@ std::optional<SlabPin> slabPinByName(std::string_view name) {
   return std::nullopt;
 }
 
+bool bsdfTakesPin(BsdfKind k, SlabPin p) {
+  return (kPins[static_cast<int>(p)].kinds & (k == BsdfKind::Unlit ? kPinOfUnlit : kPinOfSlab)) != 0;
+}
+
+std::string_view bsdfKindName(BsdfKind k) { return k == BsdfKind::Unlit ? "unlit" : "slab"; }
+
 std::string_view sssTypeName(SssType t) { return enumName(kSssTypeNames, t, "none"); }
 
 std::string_view featureName(int bit) {
@@ -49,6 +58,11 @@ std::string_view featureName(int bit) {
 }
 
 std::string_view treeOpName(TreeOp op) { return enumName(kTreeOpNames, op, "?"); }
+
+std::string_view nodeOpName(const Material& m, const TreeNode& n) {
+  if (n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Unlit) return "UNLIT";
+  return treeOpName(n.op);
+}
 
 int Material::inputIndex(std::string_view n) const {
   for (std::size_t i = 0; i < inputs.size(); ++i)

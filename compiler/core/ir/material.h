@@ -48,9 +48,18 @@ struct Input {
 enum class SlabPin : std::uint8_t {
   DiffuseAlbedo, F0, F90, Roughness, Anisotropy, Normal, Tangent, SssMfp, SssMfpScale,
   SssPhaseAnisotropy, Emissive, SecondRoughness, SecondRoughnessWeight, FuzzAmount, FuzzColor,
-  FuzzRoughness, GlintValue, GlintUv, Count_
+  FuzzRoughness, GlintValue, GlintUv, Transmittance, Count_
 };
 inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
+
+/// The kinds of BSDF leaf (docs/format.md, "BSDF nodes"): the slab, and the
+/// unlit BSDF, which emits and lets through but reflects nothing, so it is no
+/// closure: it stores nothing per pixel and the lighting never sees it.
+enum class BsdfKind : std::uint8_t { Slab, Unlit };
+std::string_view bsdfKindName(BsdfKind k);  // "slab", "unlit": the node kind in materials
+
+/// BsdfKind bits: which kinds of BSDF node take a pin.
+inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2;
 
 struct SlabPinInfo {
   std::string_view name;
@@ -59,9 +68,13 @@ struct SlabPinInfo {
   double defaultValue; // for constant defaults (geometry defaults use `geometryDefault`)
   int geometryDefault; // -1 or a GeometryAttr
   double lo, hi;       // legal range of literal values
+  std::uint8_t kinds = kPinOfSlab;  // the BSDF kinds that take it (kPinOf*)
 };
 const SlabPinInfo& slabPinInfo(SlabPin p);
 std::optional<SlabPin> slabPinByName(std::string_view name);
+/// Whether a BSDF of kind `k` takes pin `p` (an unlit's other pins keep their
+/// defaults and nothing reads them).
+bool bsdfTakesPin(BsdfKind k, SlabPin p);
 
 std::string_view sssTypeName(SssType t);
 
@@ -94,6 +107,7 @@ struct MetalnessSource {
 };
 
 struct Slab {
+  BsdfKind kind = BsdfKind::Slab;  // an unlit leaf is no closure (tree_info: not in slabOrder)
   std::string id;       // source node id (with instance suffix when instanced twice)
   std::string pointer;  // JSON pointer of the slab node
   std::array<ValueId, kSlabPinCount> pins{};
@@ -126,6 +140,10 @@ struct TreeNode {
   std::string id;       // source node id (instance-suffixed), for names and reports
   std::string pointer;  // JSON pointer of the source node
 };
+
+/// The name of tree node `n` in reports and dumps: its operator's
+/// (treeOpName), "UNLIT" for an unlit leaf.
+std::string_view nodeOpName(const struct Material& m, const TreeNode& n);
 
 struct Basis {
   ValueId normal = kNoValue;

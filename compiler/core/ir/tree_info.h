@@ -24,10 +24,11 @@ struct TreeInfo {
   std::vector<bool> unitCoverage;       // any node: the subtree's coverage is statically 1
   std::vector<bool> holdsFuzz;          // any node: the subtree holds a slab with fuzz (fuzzyLayer)
   std::vector<int> interfaces;   // any node: the most interfaces a path down through the subtree
-                                 // crosses (slab 1, vertical top + base, other operators the larger side)
+                                 // crosses (slab 1, unlit 0, vertical top + base, other operators the larger side)
   std::vector<int> interfacesAbove;  // slabs: the interfaces of the tops of the verticals whose base
                                      // holds the slab, summed (0 on top): what the light crosses to it
-  std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order)
+  std::vector<int> slabOrder;    // slab indices in pre-order (the BSDF / closure order); not the
+                                 // unlit leaves, which are no closures (slabNode still has them)
   std::vector<int> bsdfId;       // slab index -> position in slabOrder
   std::vector<int> slabNode;     // slab index -> its tree node (-1 if not in the tree)
   std::vector<int> layerVertical;  // node -> the nearest vertical whose top layer holds it, through

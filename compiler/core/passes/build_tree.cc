@@ -4,6 +4,8 @@
 
 #include <fmt/format.h>
 
+#include "ir/tree_info.h"
+
 namespace substratec {
 
 namespace {
@@ -52,6 +54,7 @@ class TreeBuilder {
     m_.nodes.push_back(node);
     if (src.op == TreeOp::Slab) {
       Slab slab;
+      slab.kind = src.kind;
       slab.id = m_.nodes[index].id;
       slab.pointer = src.pointer;
       for (int p = 0; p < kSlabPinCount; ++p) {
@@ -143,6 +146,30 @@ class TreeBuilder {
   std::unordered_map<std::string, int> seen_;
 };
 
+/// An unlit leaf may sit anywhere but in a vertical (its top layer or its
+/// base): it has no interface nor medium to layer matter under, and light
+/// emitted under a layer would have to cross that layer's interface, which
+/// the unlit path does not model. One error per unlit node (at its pointer),
+/// naming the vertical.
+void checkUnlitPlacement(const Material& m, Diagnostics& diags) {
+  const TreeInfo t = analyzeTree(m);
+  std::unordered_set<std::string> reported;
+  for (int n : t.preorder) {
+    const TreeNode& node = m.nodes[n];
+    if (node.op != TreeOp::Slab || m.slabs[node.slab].kind != BsdfKind::Unlit) continue;
+    for (int x = n, p = t.parent[n]; p >= 0; x = p, p = t.parent[p]) {
+      if (m.nodes[p].op != TreeOp::Vertical) continue;
+      if (reported.insert(node.pointer).second)
+        diags.error(node.pointer,
+                    fmt::format("unlit '{}' is in the {} of vertical '{}': an unlit BSDF cannot be layered (it has no "
+                                "interface or medium to layer under, and its emission cannot cross a layer); mix it "
+                                "with a horizontal, add or coverage_weight instead, or use a slab's emissive",
+                                node.id, m.nodes[p].left == x ? "top layer" : "base", m.nodes[p].id));
+      break;
+    }
+  }
+}
+
 }  // namespace
 
 bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Material& m, Diagnostics& diags,
@@ -178,6 +205,7 @@ bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Materia
   }
   TreeBuilder builder(doc, table, m, diags);
   m.root = builder.instance(doc.output);
+  checkUnlitPlacement(m, diags);
   return !diags.hasErrors();
 }
 

@@ -12,6 +12,10 @@ void analyzeFeatures(Material& m) {
     Slab& s = m.slabs[m.nodes[node].slab];
     std::uint16_t f = 0;
     auto used = [&](SlabPin p, double neutral) { return !v.isConstEqual(s.pin(p), neutral); };
+    if (s.kind == BsdfKind::Unlit) {  // an unlit only emits (and lets through, which costs nothing)
+      s.features = used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0;
+      continue;
+    }
     if (used(SlabPin::F90, 1.0)) f |= kFeatF90;
     if (used(SlabPin::Anisotropy, 0.0)) f |= kFeatAnisotropy;
     bool hasMfp = used(SlabPin::SssMfp, 0.0) && used(SlabPin::SssMfpScale, 0.0);

@@ -115,7 +115,7 @@ const OpSpec* findOpSpec(const std::string& kind) {
 }
 
 std::optional<TreeOp> substrateKind(const std::string& kind) {
-  if (kind == "slab") return TreeOp::Slab;
+  if (kind == "slab" || kind == "unlit") return TreeOp::Slab;  // BSDF leaves (SNode::kind)
   if (kind == "horizontal") return TreeOp::Horizontal;
   if (kind == "vertical") return TreeOp::Vertical;
   if (kind == "coverage_weight") return TreeOp::CoverageWeight;
@@ -519,7 +519,7 @@ void Resolver::checkOutput() {
         d_.error("/output", fmt::format("unknown node {}", quoteForDiagnostic(outputId_)));
     } else if (isValueKindName(outputId_)) {
       d_.error("/output", fmt::format("{} is a value node; the output must be a Substrate node "
-                                      "(slab, horizontal, vertical, add, coverage_weight, select)",
+                                      "(slab, unlit, horizontal, vertical, add, coverage_weight, select)",
                                       quoteForDiagnostic(outputId_)));
     } else if (isSubstrateName(outputId_)) {
       out_.output = namedSubstrate_[outputId_];
@@ -1340,13 +1340,25 @@ void Resolver::fillOperatorNode(int index, const Json& j, const std::string& ptr
 }
 
 void Resolver::fillSlabNode(int index, const Json& j, const std::string& ptr, SNode& node) {
+  node.kind = j["kind"].get<std::string>() == "unlit" ? BsdfKind::Unlit : BsdfKind::Slab;
+  const bool unlit = node.kind == BsdfKind::Unlit;
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string& k = it.key();
-    if (k == "kind" || k == "comment" || k == "sss_type" || k == "specular_profile") continue;
-    if (!slabPinByName(k))
-      d_.error(ptr + "/" + pointerToken(k), fmt::format("unknown slab pin {}", quoteForDiagnostic(k)));
+    if (k == "kind" || k == "comment" || (!unlit && (k == "sss_type" || k == "specular_profile"))) continue;
+    const std::optional<SlabPin> p = slabPinByName(k);
+    if (!p || !bsdfTakesPin(node.kind, *p))
+      d_.error(ptr + "/" + pointerToken(k),
+               unlit ? fmt::format("unknown pin {} for an unlit node (pins: emissive, transmittance, normal)",
+                                   quoteForDiagnostic(k))
+                     : fmt::format("unknown slab pin {}", quoteForDiagnostic(k)));
   }
-  for (int p = 0; p < kSlabPinCount; ++p) readSlabPin(index, j, ptr, p, node.slabPins[p]);
+  // A pin the kind does not take keeps its default (an unlit's slab pins: nothing reads them).
+  for (int p = 0; p < kSlabPinCount; ++p)
+    if (bsdfTakesPin(node.kind, static_cast<SlabPin>(p)))
+      readSlabPin(index, j, ptr, p, node.slabPins[p]);
+    else
+      readSlabPin(index, Json::object(), ptr, p, node.slabPins[p]);
+  if (unlit) return;
   if (auto it = j.find("sss_type"); it != j.end()) {
     const std::optional<SssType> t = enumOfJson(kSssTypeNames, *it, ptr + "/sss_type", d_);
     if (t) node.sssType = *t;

@@ -51,6 +51,7 @@ struct SNode {
   std::string pointer;
   int left = -1, right = -1;  // SNode indices
   PinRef a, b;                // operator values (mix/thickness/weight/value, threshold)
+  BsdfKind kind = BsdfKind::Slab;  // BSDF leaves (op Slab): the node's kind
   std::array<PinRef, kSlabPinCount> slabPins{};
   int specularProfileInput = -1;
   SssType sssType = SssType::None;

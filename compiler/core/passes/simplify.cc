@@ -53,8 +53,16 @@ void disableFeature(Material& m, std::uint16_t feature) {
 
 namespace {
 
+/// A slab leaf that parameter blending can merge: not an unlit, which holds
+/// no closure (collapsing it saves nothing) and has no pins to blend.
+bool blendableLeaf(const Material& m, int node) {
+  return node < 0 || (m.nodes[node].op == TreeOp::Slab && m.slabs[m.nodes[node].slab].kind == BsdfKind::Slab);
+}
+
 /// The next operator to collapse: deepest first; at equal depth horizontal,
 /// add, select and coverage weight before vertical; then the smallest tree id.
+/// Only operators over two slabs (or one, for a weight): one over an unlit
+/// never collapses, nor therefore do those above it.
 int pickOperator(const Material& m, const TreeInfo& t) {
   int best = -1;
   auto rank = [&](int n) {
@@ -62,10 +70,19 @@ int pickOperator(const Material& m, const TreeInfo& t) {
     return std::tuple<int, int, int>(-t.depth[n], vertical ? 1 : 0, t.reportId[n]);
   };
   for (int n : t.preorder) {
-    if (m.nodes[n].op == TreeOp::Slab) continue;
+    const TreeNode& node = m.nodes[n];
+    if (node.op == TreeOp::Slab || !blendableLeaf(m, node.left) || !blendableLeaf(m, node.right)) continue;
     if (best < 0 || rank(n) < rank(best)) best = n;
   }
   return best;
+}
+
+/// Why the material cannot shrink further when it holds an unlit leaf ("" otherwise).
+std::string unlitNote(const Material& m) {
+  for (int n : analyzeTree(m).preorder)
+    if (m.nodes[n].op == TreeOp::Slab && m.slabs[m.nodes[n].slab].kind == BsdfKind::Unlit)
+      return " (an operator over an unlit node is never collapsed: the unlit holds no closure to blend)";
+  return "";
 }
 
 /// Collapses operator `n` (whose children are slabs: it is the deepest).
@@ -155,14 +172,14 @@ bool simplifyToBudget(Material& m, const SimplifyBudget& budget, Reprice reprice
   if (over(layout, budget)) {
     if (budget.full)
       diags.error("", fmt::format("full simplification cannot fit a {}-byte payload: the smallest reachable size is {} "
-                                  "bytes per pixel",
-                                  kFullSimplificationBytes, layout.bytes()));
+                                  "bytes per pixel{}",
+                                  kFullSimplificationBytes, layout.bytes(), unlitNote(m)));
     else
       diags.error("", fmt::format("material does not fit the budget of {} bytes per pixel and {} closures{}: the "
-                                  "smallest reachable size is {} bytes per pixel with {} closure(s)",
+                                  "smallest reachable size is {} bytes per pixel with {} closure(s){}",
                                   budget.bytesPerPixel, budget.maxClosures,
                                   budget.platform.empty() ? "" : " (platform " + quoteForDiagnostic(budget.platform) + ")",
-                                  layout.bytes(), layout.closures.size()));
+                                  layout.bytes(), layout.closures.size(), unlitNote(m)));
     return false;
   }
   return true;

@@ -61,7 +61,7 @@ std::string formatReportText(const CompileResult& r) {
       const TreeNode& node = m.nodes[n];
       bool slab = node.op == TreeOp::Slab;
       o += fmt::format("Id={} Op={} ParentId={} Left={} Right={} BSDFId={} LayerDepth={} IsTop={} IsBottom={} Node={}\n",
-                       t.reportId[n], treeOpName(node.op), t.parent[n] >= 0 ? t.reportId[t.parent[n]] : -1,
+                       t.reportId[n], nodeOpName(m, node), t.parent[n] >= 0 ? t.reportId[t.parent[n]] : -1,
                        node.left >= 0 ? t.reportId[node.left] : -1, node.right >= 0 ? t.reportId[node.right] : -1,
                        slab ? t.bsdfId[node.slab] : -1, t.layerDepth[n], slab && t.isTop[n] ? 1 : 0,
                        slab && t.isBottom[n] ? 1 : 0, node.id);
@@ -72,6 +72,10 @@ std::string formatReportText(const CompileResult& r) {
     const Slab& s = m.slabs[t.slabOrder[i]];
     o += fmt::format("BSDF {} ({}): {}\n", i, s.id, featureLine(s));
   }
+  for (int n : t.preorder)  // unlit leaves: no closure, no bytes
+    if (m.nodes[n].op == TreeOp::Slab && m.slabs[m.nodes[n].slab].kind == BsdfKind::Unlit)
+      o += fmt::format("Unlit ({}): Emissive={} (no closure: it emits and lets through, and stores nothing)\n",
+                       m.nodes[n].id, (m.slabs[m.nodes[n].slab].features & kFeatEmissive) ? 1 : 0);
   o += fmt::format("----- Culled - {} -----\n", m.name);
   if (m.culled.empty()) o += "(nothing)\n";
   for (const auto& c : m.culled) o += fmt::format("{}: {}\n", c.what, c.why);
@@ -117,7 +121,7 @@ nlohmann::ordered_json reportJson(const CompileResult& r) {
     bool slab = node.op == TreeOp::Slab;
     tree.push_back({{"id", t.reportId[n]},
                     {"node", node.id},
-                    {"op", std::string(treeOpName(node.op))},
+                    {"op", std::string(nodeOpName(m, node))},
                     {"parent", t.parent[n] >= 0 ? t.reportId[t.parent[n]] : -1},
                     {"left", node.left >= 0 ? t.reportId[node.left] : -1},
                     {"right", node.right >= 0 ? t.reportId[node.right] : -1},

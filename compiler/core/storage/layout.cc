@@ -26,7 +26,7 @@ void finishLayout(StorageLayout& L) {
   // Class.
   if (all & (kFeatGlint | kFeatSpecularProfile)) L.layoutClass = LayoutClass::Special;
   else if (multi || (all & kFeatAnisotropy)) L.layoutClass = LayoutClass::Complex;
-  else if (all || L.closures[0].storesWeight) L.layoutClass = LayoutClass::Single;
+  else if (all || (count > 0 && L.closures[0].storesWeight)) L.layoutClass = LayoutClass::Single;
   else L.layoutClass = LayoutClass::Simple;
 
   // Bases: a lone closure's normal is the top-layer normal; with several,
@@ -41,8 +41,9 @@ void finishLayout(StorageLayout& L) {
     L.totalBits += b;
   };
   add("header", bits::kHeader,
-      multi ? "layout class 2 | closure count-1 3 | basis count 4 | reserved 7"
-            : "layout class 2 | feature bits 8 | sss type 2 | reserved 4");
+      multi        ? "layout class 2 | closure count-1 3 | basis count 4 | reserved 7"
+      : count == 0 ? "layout class 2 (SIMPLE) | no closure (bit 14): an unlit material"
+                   : "layout class 2 | feature bits 8 | sss type 2 | reserved 4");
   for (int i = 0; i < count; ++i) {
     const ClosureLayout& c = L.closures[i];
     const std::string p = fmt::format("closure{}.", i);
@@ -93,7 +94,7 @@ StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
     c.extraInterfaces = storedExtraInterfaces(info.interfacesAbove[node]);
     L.closures.push_back(c);
   }
-  L.basisCount = static_cast<int>(m.bases.size());
+  L.basisCount = static_cast<int>(m.bases.size());  // 0 without closures (an unlit material)
   finishLayout(L);
   return L;
 }

@@ -299,10 +299,14 @@ void writeGlint(std::vector<std::uint32_t>& w, std::size_t& pos, const ClosureVa
 void checkPackArguments(const StorageLayout& layout, const std::vector<ClosureValues>& closures,
                         const std::vector<BasisValues>& bases) {
   const int count = static_cast<int>(layout.closures.size());
-  if (count < 1 || count > packfmt::kMaxClosures)
-    throw std::invalid_argument(fmt::format("packMaterial: {} closures (the format holds 1 to 8)", count));
+  if (count < 0 || count > packfmt::kMaxClosures)
+    throw std::invalid_argument(fmt::format("packMaterial: {} closures (the format holds 0 to 8)", count));
   if (static_cast<int>(closures.size()) != count)
     throw std::invalid_argument("packMaterial: one ClosureValues per layout closure");
+  if (count == 0) {  // an unlit material: the header alone
+    if (layout.basisCount != 0) throw std::invalid_argument("packMaterial: no closure, so no basis");
+    return;
+  }
   const bool multi = count > 1;
   if (layout.basisCount < 1 || layout.basisCount > packfmt::kMaxBases)
     throw std::invalid_argument(fmt::format("packMaterial: {} bases (the format holds 1 to 8)", layout.basisCount));
@@ -401,7 +405,9 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
       if (what != "header") throw std::invalid_argument(fmt::format("packMaterial: unknown field '{}'", f.name));
       expectBits(f, bits::kHeader);
       std::uint32_t h = classBits(layout.layoutClass);
-      if (multi) {
+      if (count == 0) {
+        h |= packfmt::kNoClosureHeaderBit;  // an unlit material: nothing to light
+      } else if (multi) {
         h |= static_cast<std::uint32_t>(count - 1) << 2;
         h |= static_cast<std::uint32_t>(layout.basisCount) << 5;
         h |= packfmt::kMultiClosureHeaderBit;
@@ -580,6 +586,7 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
   const bool multi = (header & packfmt::kMultiClosureHeaderBit) != 0;
   int closureCount = 1;
   int basisCount = 1;
+  if (!multi && (header & packfmt::kNoClosureHeaderBit)) return out;  // an unlit pixel: no closure, no basis
   if (multi) {
     closureCount = static_cast<int>((header >> 2) & 7u) + 1;
     basisCount = static_cast<int>((header >> 5) & 15u);

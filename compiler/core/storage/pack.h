@@ -56,6 +56,7 @@ inline constexpr std::uint32_t kSssTypeNone = SUBSTRATE_SSS_NONE, kSssTypeWrap =
 
 namespace packfmt {
 inline constexpr std::uint32_t kMultiClosureHeaderBit = 1u << 15;  // material header bit 15
+inline constexpr std::uint32_t kNoClosureHeaderBit = 1u << 14;  // single-closure header bit 14: an unlit pixel
 inline constexpr int kMaxClosures = 8;     // closure count - 1 is 3 bits
 inline constexpr int kMaxBases = 8;        // basis id is 3 bits
 inline constexpr double kMfpLog2Min = -24.0;

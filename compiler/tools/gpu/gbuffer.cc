@@ -131,6 +131,12 @@ GbufferPixel packPixel(const CompileResult& r, const reference::Geometry& g, con
   GbufferPixel p;
   const auto ref = reference::evaluateMaterial<double>(r, g, inputs, sampleTexture);
   const StorageLayout& L = r.after;
+  if (L.closures.empty()) {  // an unlit material: the no-closure header; the top-layer word's normal is g.N's
+    p.cls = L.layoutClass;
+    p.words = packMaterial(L, {}, {}, g.dither);
+    p.topLayer = packTopLayer({g.N, 1.0}, g.dither);
+    return p;
+  }
   std::vector<ClosureValues> values;
   for (const auto& c : ref.closures) values.push_back(closureValues(c));
   std::vector<BasisValues> bases;

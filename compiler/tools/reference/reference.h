@@ -151,6 +151,7 @@ struct MaterialResult {
   std::vector<Closure<T>> closures;  // in closure order (r.after.closures)
   T coverage;                        // the root's C
   V3<T> transmittance;               // the root's T
+  V3<T> emission{T(0), T(0), T(0)};  // what the unlit nodes emit, weighted (the emitter's `emission`)
 };
 
 /// <name>_evaluate: the value DAG, the tree walk (C and T per node, operators

@@ -173,6 +173,7 @@ class Walk {
     }
     assignProfiles();
     for (const ClosureLayout& cl : L_.closures) out.closures.push_back(closure(cl));
+    out.emission = emission();
     // What the layers' top lets through at grazing angles (the emitter's emitCoatFloor).
     setCoatFloor(out.closures, topRoughness(out.closures));
     setCoatInterface(out.closures);  // the emitter's emitCoatInterface
@@ -207,6 +208,10 @@ class Walk {
       if (node.op != TreeOp::Slab) continue;
       const Slab& s = m_.slabs[node.slab];
       C_[n] = s.coverage == kNoValue ? T(1) : scalar(s.coverage);
+      if (s.kind == BsdfKind::Unlit) {  // no interface: TI = T (an unlit is never in a vertical)
+        Tr_[n] = TI_[n] = vec3(s.pin(SlabPin::Transmittance));
+        continue;
+      }
       const int v = t_.layerVertical[n];
       const ValueId mfp = s.pin(SlabPin::SssMfp);
       const double d = m_.settings.surfaceThickness;
@@ -341,6 +346,22 @@ class Walk {
       }
     }
     return weight;
+  }
+
+  /// The emitter's emitEmission: each emitting unlit's emissive times its
+  /// path weight.
+  V3<T> emission() const {
+    V3<T> e = splat3(T(0));
+    if (m_.root < 0) return e;
+    for (int n : t_.preorder) {
+      const TreeNode& node = m_.nodes[n];
+      if (node.op != TreeOp::Slab) continue;
+      const Slab& s = m_.slabs[node.slab];
+      if (s.kind != BsdfKind::Unlit || !has(s.features, kFeatEmissive)) continue;
+      std::vector<int> tops;
+      e = e + vec3(s.pin(SlabPin::Emissive)) * weightAndTops(s, n, tops);
+    }
+    return e;
   }
 
   /// The emitter's FT_ of a slab with fuzz: substrate_fuzz_transmission of its

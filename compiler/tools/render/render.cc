@@ -227,7 +227,7 @@ gpu::RasterPipeline* pipelineFor(gpu::Context& ctx, Pipelines& ps, int material,
     s.depthWrite = false;
     s.colorWriteMask = (1u << std::min(words, 3)) - 1u;
     s.colorWriteMask |= 1u << kTopLayerAttachment;
-    if (anyEmissive(m.result->material, m.result->after)) s.colorWriteMask |= 1u << kEmissiveAttachment;
+    if (basePassEmissive(m.result->material, m.result->after)) s.colorWriteMask |= 1u << kEmissiveAttachment;
   } else {
     s.colors = kColorFormats;
     s.depthTest = gpu::DepthTest::Less;
