@@ -48,6 +48,25 @@ TEST(AccuracyCli, ReadsMaterialX) {
   EXPECT_NE(r.out.find("rel_err"), std::string::npos) << r.out;
 }
 
+// A material of unlit nodes only reflects nothing: no BRDF to measure, said
+// as such (not a black truth compared with itself).
+TEST(AccuracyCli, AnUnlitMaterialHasNoAccuracyAndSaysWhy) {
+  CliResult r = cli({"accuracy", kSourceDir + "/examples/unlit_hologram.json", "--samples", "64"});
+  EXPECT_EQ(r.status, 1);
+  EXPECT_NE(r.err.find("unlit_hologram.json: no accuracy to report: the material has no closure (unlit nodes only)"),
+            std::string::npos)
+      << r.err;
+  // Mixed with a slab, the unlit is left out of the truth: the slab alone is measured.
+  CliResult mixed = cli({"accuracy", kSourceDir + "/examples/unlit_display.json", "--json", "--samples", "256",
+                         "--eval-samples", "32"});
+  ASSERT_EQ(mixed.status, 0) << mixed.err;
+  // The truth's white furnace is the reflecting share: the glass's 1 - fill
+  // (0.65), not 1 (the unlit counted as matter).
+  const auto j = nlohmann::json::parse(mixed.out);
+  ASSERT_FALSE(j["rows"].empty());
+  for (const auto& row : j["rows"]) EXPECT_NEAR(row["furnace_truth"][0].get<double>(), 0.65, 1e-9) << row.dump();
+}
+
 TEST(AccuracyCli, ABadFileFailsWithAMessage) {
   CliResult missing = cli({"accuracy", kSourceDir + "/examples/no_such_material.json"});
   EXPECT_EQ(missing.status, 1);

@@ -1118,6 +1118,11 @@ int runAccuracy(const AccuracyArgs& a, std::ostream& out, std::ostream& err) {
   if (!compiled) return compileFailure(s, err);
   auto authored = compileText(s.displayName, s.text, unsimplified, ignored);  // compiled: so does the authored tree
   if (!authored) return printInternalError(err, "the unsimplified material does not compile: " + ignored.errorMessages());
+  if (authored->after.closures.empty())  // unlit nodes only: nothing reflects, so there is no BRDF to measure
+    return printError(err, kExitBadInput,
+                      fmt::format("{}: no accuracy to report: the material has no closure (unlit nodes only): it "
+                                  "reflects nothing",
+                                  s.displayName));
   accuracy::Options ao;
   ao.samples = a.samples;
   ao.evalSamples = a.evalSamples;

@@ -134,10 +134,17 @@ TEST(RandomWalkGroundTruth, RunsOnEveryExample) {
   const TextureFn tex = [](int, double u, double v) {
     return std::array<double, 4>{0.5 + 0.4 * std::sin(7 * u), 0.5 + 0.4 * std::cos(5 * v), 0.3, 1};
   };
-  int count = 0;
+  int count = 0, unlit = 0;
   for (const auto& path : examples()) {
     CompileResult r = compileUnsimplified(path.filename().string(), readText(path));
     ASSERT_GE(r.material.root, 0) << path;
+    if (r.after.closures.empty()) {  // unlit nodes only: nothing reflects, so no term and no light
+      EXPECT_TRUE(groundTruthTerms(r, Geometry{}, {}).empty()) << path;
+      const D3 f = groundTruth(r, Geometry{}, dir(0.5, 2.5), {}, opts(64));
+      EXPECT_EQ(f[0] + f[1] + f[2], 0) << path;
+      ++unlit;
+      continue;
+    }
     EXPECT_FALSE(groundTruthTerms(r, Geometry{}, {}).empty()) << path;
     double total = 0;
     for (int k = 0; k < 3; ++k) {
@@ -160,6 +167,7 @@ TEST(RandomWalkGroundTruth, RunsOnEveryExample) {
     ++count;
   }
   EXPECT_GE(count, 16);
+  EXPECT_GE(unlit, 1);  // examples/unlit_hologram.json
 }
 
 TEST(RandomWalkGroundTruth, MetalnessSlabSplitsIntoConductorAndDielectric) {

@@ -45,6 +45,7 @@ class TreeExpansion {
     switch (node.op) {
       case TreeOp::Slab: {
         const Slab& s = m_.slabs[node.slab];
+        if (s.kind == BsdfKind::Unlit) break;  // reflects nothing (and is never in a vertical)
         double c = s.coverage == kNoValue ? 1.0 : saturate(scalar(s.coverage));
         out.push_back({c, {node.slab}});
         break;

@@ -76,6 +76,8 @@ struct Rewriter {
       force(node, "f90", "f90", nullptr);
       force(node, "diffuse_albedo", "albedo", 0.18);
       force(node, "sss_mfp", "mfp", nullptr);
+    } else if (kind == "unlit") {
+      force(node, "transmittance", "albedo", 1.0);  // 0 (opaque) and 1 (clear)
     } else if (kind == "vertical") {
       force(node, "thickness", "thickness", 0.0001);
     } else if (kind == "coverage_weight") {
@@ -261,6 +263,7 @@ std::string evaluate(const CompileResult& r, const Point& p, const reference::In
   const auto m = reference::evaluateMaterial<T>(r, p.g, in, textures);
   if (!std::isfinite(m.coverage)) return *value = m.coverage, "coverage";
   if (!finite3(m.transmittance)) return *value = m.transmittance[0], "transmittance";
+  if (!finite3(m.emission)) return *value = m.emission[0], "emission";
   const auto V = toT<T>(p.g.V), L = toT<T>(p.light), one = toT<T>({1, 1, 1}), pi = toT<T>({std::numbers::pi, std::numbers::pi, std::numbers::pi});
   for (std::size_t k = 0; k < m.closures.size(); ++k) {
     const auto& c = m.closures[k];
@@ -509,15 +512,18 @@ bool run(const CompileResult& r, const std::vector<ForcedKind>& kinds, const Opt
     }
   }
   if (o.gpu && !runGpu(r, grid, points, work, o.textures, *gpu, report, diags)) return false;
-  if (o.cpu) furnace(r, grid, o.furnaceSamples, textures, report);
-  report->furnaceJudged = o.cpu;
+  // The furnace measures reflection: a material with no closure (unlit
+  // nodes only) reflects nothing, by definition, so it has no furnace.
+  report->furnaceApplicable = !r.after.closures.empty();
+  if (o.cpu && report->furnaceApplicable) furnace(r, grid, o.furnaceSamples, textures, report);
+  report->furnaceJudged = o.cpu && report->furnaceApplicable;
   // `add` sums two pieces of matter: more light than arrives, by construction.
   for (const TreeNode& n : r.material.nodes)
     if (n.op == TreeOp::Add) report->furnaceJudged = false;
   return true;
 }
 
-bool furnaceExercised(const Report& r) { return !r.cpu || r.furnaceLit > 0; }
+bool furnaceExercised(const Report& r) { return !r.cpu || !r.furnaceApplicable || r.furnaceLit > 0; }
 
 bool passed(const Report& r) {
   return r.nonfinite == 0 && r.gpuNonfinite == 0 && !(r.furnaceJudged && r.furnaceMax > kFurnaceLimit) &&
@@ -539,12 +545,14 @@ std::string formatText(const Report& r) {
     s += "cpu evaluations:   not run (--gpu-only)\n";
   s += fmt::format("gpu evaluations:   {} (forward and deferred, {} precision), non-finite: {}\n", r.gpuEvaluations,
                    precisionName(r.precision), r.gpuNonfinite);
-  if (r.cpu)
+  if (r.cpu && !r.furnaceApplicable)
+    s += "furnace:           not applicable (no closure: an unlit material reflects nothing)\n";
+  else if (r.cpu)
     s += fmt::format("furnace max:       {:.5f}  ({}; {}){}\n", r.furnaceMax, r.furnaceWorst.configuration,
                      r.furnaceWorst.geometry, r.furnaceJudged ? "" : "  [not judged: `add` sums matter]");
   else
     s += "furnace max:       not run (--gpu-only)\n";
-  if (r.cpu)
+  if (r.cpu && r.furnaceApplicable)
     s += fmt::format("furnace lit:       {} of {} evaluations{}\n", r.furnaceLit, r.furnaceEvaluations,
                      r.furnaceLit == 0 ? "  [never exercised: no evaluation returned any light]" : "");
   for (const Case& c : r.worst)
@@ -579,6 +587,7 @@ json toJson(const Report& r) {
   j["furnace_exercised"] = furnaceExercised(r);
   j["furnace_max"] = r.furnaceMax;
   j["furnace_judged"] = r.furnaceJudged;
+  j["furnace_applicable"] = r.furnaceApplicable;
   j["furnace_worst"] = caseJson(r.furnaceWorst);
   j["worst"] = json::array();
   for (const Case& c : r.worst) j["worst"].push_back(caseJson(c));

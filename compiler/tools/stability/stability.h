@@ -119,6 +119,7 @@ struct Report {
   double furnaceMax = 0;                      // largest directional albedo, white inputs, white furnace (glints off)
   long furnaceEvaluations = 0, furnaceLit = 0;  // furnace evaluations, and those that returned any light
   bool cpu = true;                            // Options::cpu: the CPU grid and the furnace ran
+  bool furnaceApplicable = true;              // false for a material with no closure (unlit only): it reflects nothing
   bool furnaceJudged = true;                  // false when the tree has an `add` (it sums matter: > 1 by design)
                                               // or without the CPU part
   Case furnaceWorst;
