@@ -120,7 +120,7 @@ TEST(ImportCorpus, EveryMaterialFitsEveryBudget) {
         ASSERT_TRUE(c.has_value()) << "budget " << b << "\n" << diags.formatAll();
         if (o.budgetOverride) EXPECT_LE(c->after.bytes(), *o.budgetOverride) << "budget " << b;
         if (o.fullSimplification) {
-          EXPECT_EQ(c->after.closures.size(), 1u);
+          EXPECT_LE(c->after.closures.size(), 1u);  // 0: an unlit material (KHR_materials_unlit)
           EXPECT_LE(c->after.bytes(), kFullSimplificationBytes);
         }
       }

@@ -447,14 +447,21 @@ TEST(GltfImport, AnisotropyMatchesGltfAlphasAlongTheRotatedTangent) {
   expectNear3(c[0].T_, 0, 1, 0, 1e-9);  // the tangent turned by 90 degrees
 }
 
-TEST(GltfImport, UnlitIsItsBaseColourEmitted) {
-  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 1]}, "extensions": {"KHR_materials_unlit": {}}}])");
+// KHR_materials_unlit is the unlit BSDF: no closure (8 bytes, nothing lit),
+// its base colour emitted, its alpha the presence.
+TEST(GltfImport, UnlitIsItsBaseColourEmittedByAnUnlitNode) {
+  Imported r = gltf(R"([{"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.4, 0.6, 0.5]}, "alphaMode": "BLEND",
+                        "extensions": {"KHR_materials_unlit": {}}}])");
   ASSERT_TRUE(r.materials) << r.diags;
-  const auto c = closures((*r.materials)[0], compiled((*r.materials)[0]));
-  expectNear3(c[0].emissive, 0.2, 0.4, 0.6);
-  expectNear3(c[0].diffuseAlbedo, 0, 0, 0);
-  expectNear3(c[0].f0, 0, 0, 0);
-  expectNear3(c[0].f90, 0, 0, 0);
+  const ImportedMaterial& m = (*r.materials)[0];
+  EXPECT_NE(m.text.find("\"kind\": \"unlit\""), std::string::npos) << m.text;
+  const CompileResult c = compiled(m);
+  EXPECT_TRUE(c.after.closures.empty());
+  EXPECT_EQ(c.after.bytes(), 8);
+  reference::Geometry g;
+  const auto e = reference::evaluateMaterial<double>(c, g, {}, {});
+  expectNear3(e.emission, 0.2 * 0.5, 0.4 * 0.5, 0.6 * 0.5);  // presence 0.5 weights the emission
+  EXPECT_NEAR(e.coverage, 0.5, 1e-12);
 }
 
 // --- MaterialX ----------------------------------------------------------------

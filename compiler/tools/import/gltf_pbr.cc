@@ -118,13 +118,9 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
   s.normal = g.normal;
 
   if (g.unlit) {
-    // KHR_materials_unlit: the base colour is the radiance; nothing reflects.
-    s.metallic = Value();
-    s.diffuseColor = 0.0;
-    s.specularF0 = 0.0;
-    s.specularF90 = 0.0;
-    s.roughness = 1.0;
-    s.normal = Value();
+    // KHR_materials_unlit: the base colour is the radiance; nothing reflects:
+    // the unlit BSDF (no closure).
+    s.unlit = true;
     s.emissive = baseColor;
     s.opacity = g.alpha;
     s.alphaMode = g.alphaMode;

@@ -103,7 +103,17 @@ Value coatedRoot(const LayeredSurface& s, MaterialWriter& w, const Value& root) 
 
 }  // namespace
 
+/// The presence (opacity, alpha mode) over `root` and the blend mode: a
+/// coverage weight, translucent or masked.
+void writePresence(const LayeredSurface& s, MaterialWriter& w, Value root, bool transmits);
+
 void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
+  if (s.unlit) {  // no closure: the unlit BSDF, its radiance and its presence
+    Json unlit = {{"kind", "unlit"}};
+    if (!absent(s.emissive, 0)) unlit["emissive"] = s.emissive;
+    writePresence(s, w, w.node("unlit", unlit), false);
+    return;
+  }
   const bool metal = !absent(s.metallic, 0);
   Value diffuse, f0, f90;
   baseReflectance(s, w, metal, diffuse, f0, f90);
@@ -147,6 +157,10 @@ void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
     }
   }
   if (!absent(s.coatWeight, 0)) root = coatedRoot(s, w, root);
+  writePresence(s, w, root, transmits);
+}
+
+void writePresence(const LayeredSurface& s, MaterialWriter& w, Value root, bool transmits) {
   std::string blend = transmits ? "translucent_colored" : "opaque";
   const bool present = s.alphaMode != AlphaMode::Opaque || !absent(s.opacity, 1);
   if (present && !s.opacity.is_null()) {

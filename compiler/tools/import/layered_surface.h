@@ -33,6 +33,9 @@ inline constexpr const char* kTransmissionNote =
     "slab's transmittance (blend mode translucent_colored)";
 
 struct LayeredSurface {
+  /// The surface is an unlit BSDF (KHR_materials_unlit): `emissive` is its
+  /// radiance, `opacity` and the alpha mode its presence; nothing else is read.
+  bool unlit = false;
   // Base.
   Value baseColor;      // color: the dielectric's diffuse colour and the metal's F0 (required)
   Value diffuseColor;   // color: the dielectric's diffuse colour when it is not baseColor
