@@ -10,7 +10,7 @@
 //    top-layer word's bound, every other field neutral, and light as the
 //    static layout's pixel does and as the CPU reference lights what they
 //    unpack. Pixels with more than one closure left keep the static layout.
-//  - The scene's lighting: a small G-buffer of the `street` scene's materials
+//  - The scene's lighting: a small G-buffer of the `street` scene's materials and an unlit sign
 //    (packed by the CPU mirror of docs/storage.md, some pixels in the SIMPLE
 //    layout as dynamic simplification stores them) goes through the emitted
 //    tile classification, which must list every tile under the class of its
@@ -240,15 +240,16 @@ TEST_F(SceneOnGpu, AMaterialWhoseInputsMakeItSimpleIsStoredSimpleAndLightsTheSam
 // The scene's tile classification and lighting shaders.
 
 TEST_F(SceneOnGpu, TilesAreClassifiedAndEachClassLightsItsPixelsAsTheReference) {
-  // The street scene's materials, as `substratec scene` builds them.
-  const char* names[] = {"plaster", "painted_metal", "wet_asphalt", "dusty_plastic"};
+  // The street scene's materials, as `substratec scene` builds them, and an
+  // unlit sign (examples/scenes/materials/neon_sign.json: no closure).
+  const char* names[] = {"plaster", "painted_metal", "wet_asphalt", "dusty_plastic", "neon_sign"};
   std::map<std::string, CompileResult> m;
   std::vector<SceneMaterialShape> shapes;
   for (const char* n : names) {
     m[n] = compileSceneMaterial(n);
     shapes.push_back(summarize(m[n]).shape());
   }
-  const SceneShape shape = sceneShape("street", shapes, kDefaultDiffuseModel);
+  const SceneShape shape = sceneShape("street_and_sign", shapes, kDefaultDiffuseModel);
   ASSERT_EQ(shape.classes.size(), 3u);  // simple, single, complex
   gpu::SceneFrame frame;
   frame.width = 20;  // 3 x 2 tiles, the last column and row partial
@@ -271,11 +272,15 @@ TEST_F(SceneOnGpu, TilesAreClassifiedAndEachClassLightsItsPixelsAsTheReference) 
         return gpu::packPixel(m[material], gpu::pixelGeometry(frame, x, y, {u, 0.3 + 0.05 * y}), in);
       };
       const auto plaster = inputsWith(m["plaster"].material, {});
+      // Unlit pixels (no closure: lit 0) in a SIMPLE, a SINGLE and a COMPLEX
+      // tile, so each unpacker meets the no-closure header.
+      const bool neon = x % 4 == 1;
+      const auto sign = inputsWith(m["neon_sign"].material, {});
       gpu::GbufferPixel& p = pixels[y * W + x];
-      if (ty == 0 && tx == 0) p = at("plaster", plaster, 0.2);
+      if (ty == 0 && tx == 0) p = neon ? at("neon_sign", sign, 0.5) : at("plaster", plaster, 0.2);
       else if (ty == 0 && tx == 1) p = odd ? at("plaster", plaster, 0.2) : at("painted_metal", inputsWith(m["painted_metal"].material, {}), 0.5);
-      else if (ty == 0) p = odd ? at("dusty_plastic", dusty, 0.5) : at("plaster", plaster, 0.2);
-      else if (tx == 0) p = odd ? at("wet_asphalt", wet, 0.8) : at("dusty_plastic", dustyClean, 0.5);
+      else if (ty == 0) p = odd ? at("dusty_plastic", dusty, 0.5) : neon ? at("neon_sign", sign, 0.5) : at("plaster", plaster, 0.2);
+      else if (tx == 0) p = odd ? (neon ? at("neon_sign", sign, 0.5) : at("wet_asphalt", wet, 0.8)) : at("dusty_plastic", dustyClean, 0.5);
       else if (tx == 1) p = odd ? at("wet_asphalt", wet, 0.2) : at("dusty_plastic", dustyClean, 0.5);
       else p = odd ? at("wet_asphalt", wet, 0.2) : at("dusty_plastic", dusty, 0.5);
       gbuffer.set(x, y, p);

@@ -99,6 +99,7 @@ SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialSh
       k.materials.push_back(m.name);
       k.metalnessMix = k.metalnessMix || m.metalnessMix;
       if (!full) continue;
+      k.noClosure = k.noClosure || m.closures == 0;
       k.features |= m.storedFeatures;
       k.maxClosures = std::max(k.maxClosures, m.closures);
       k.maxWords = std::max(k.maxWords, m.words);
@@ -139,6 +140,9 @@ std::string sceneUseDefines(const SceneLightingClass& k) {
   // Nor which closures under layers wrap or have a fuzz.
   s += fmt::format("#define SUBSTRATE_USE_WRAP_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
   s += fmt::format("#define SUBSTRATE_USE_FUZZ_UNDER_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);
+  // Only an unlit material's pixels hold the no-closure header (host-cleared
+  // pixels hold 0): a class that lights none compiles no test for it.
+  s += fmt::format("#define SUBSTRATE_USE_NO_CLOSURE {}\n", k.noClosure ? 1 : 0);
   // The stream does not say which closures are metalness mixes, so a class
   // that lights some material with a metalness slab reads every conductor-like
   // F0 as one (the runtime's default); a class that lights none reads none,

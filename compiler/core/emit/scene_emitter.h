@@ -63,6 +63,7 @@ struct SceneLightingClass {
   int maxWords = 2;
   std::vector<std::string> materials;  // those materials (names, scene order)
   bool metalnessMix = false;           // some of them is a metalness mix (SUBSTRATE_USE_METALNESS_MIX)
+  bool noClosure = false;              // some of them has no closure (unlit only: SUBSTRATE_USE_NO_CLOSURE)
 };
 
 struct SceneShape {
