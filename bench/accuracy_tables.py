@@ -106,6 +106,9 @@ def main():
              "profile are compared at their mean on both sides.", "",
              "## Examples", ""]
     lines += accuracy_table(examples)
+    unread_examples = [u for u in open(os.path.join(tmp, "examples_unread.txt")).read().split("\n") if u.strip()]
+    if unread_examples:
+        lines += ["", "Not measured (`accuracy` cannot measure the example):", ""] + ["- %s" % u for u in unread_examples]
     lines += ["", "## Controls: one effect at a time (`bench/materials/`, Lambert diffuse)", ""]
     lines += accuracy_table(controls)
     corpus = sorted(glob.glob(os.path.join(tmp, "corpus", "*.json")))
