@@ -186,9 +186,7 @@ bool unlitEmission(const Material& m) {
   if (m.root < 0) return false;
   for (int n : analyzeTree(m).preorder) {
     const TreeNode& node = m.nodes[n];
-    if (node.op == TreeOp::Slab && m.slabs[node.slab].kind == BsdfKind::Unlit &&
-        (m.slabs[node.slab].features & kFeatEmissive))
-      return true;
+    if (isUnlitLeaf(m, node) && (m.slabs[node.slab].features & kFeatEmissive)) return true;
   }
   return false;
 }
@@ -452,7 +450,7 @@ void Emitter::collectNeeded() {
   }
   for (int n : t_.preorder) {  // unlit leaves: what they let through and emit
     const TreeNode& node = m_.nodes[n];
-    if (node.op != TreeOp::Slab || m_.slabs[node.slab].kind != BsdfKind::Unlit) continue;
+    if (!isUnlitLeaf(m_, node)) continue;
     const Slab& s = m_.slabs[node.slab];
     need(s.pin(SlabPin::Transmittance));
     if (s.coverage != kNoValue) need(s.coverage);
@@ -726,7 +724,7 @@ void Emitter::emitClosures() {
 
 int Emitter::firstUnlit() const {
   for (int n : t_.preorder)
-    if (m_.nodes[n].op == TreeOp::Slab && m_.slabs[m_.nodes[n].slab].kind == BsdfKind::Unlit) return n;
+    if (isUnlitLeaf(m_, m_.nodes[n])) return n;
   return -1;
 }
 
@@ -756,9 +754,8 @@ void Emitter::emitEmission() {
   std::string sum;
   for (int n : t_.preorder) {
     const TreeNode& node = m_.nodes[n];
-    if (node.op != TreeOp::Slab) continue;
+    if (!isUnlitLeaf(m_, node) || !(m_.slabs[node.slab].features & kFeatEmissive)) continue;
     const Slab& s = m_.slabs[node.slab];
-    if (s.kind != BsdfKind::Unlit || !(s.features & kFeatEmissive)) continue;
     std::vector<std::pair<int, int>> layers;
     const std::string weight = pathWeight(n, node.id, layers);
     const std::string e = expr(s.pin(SlabPin::Emissive));

@@ -59,10 +59,11 @@ std::string_view featureName(int bit) {
 
 std::string_view treeOpName(TreeOp op) { return enumName(kTreeOpNames, op, "?"); }
 
-std::string_view nodeOpName(const Material& m, const TreeNode& n) {
-  if (n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Unlit) return "UNLIT";
-  return treeOpName(n.op);
+bool isUnlitLeaf(const Material& m, const TreeNode& n) {
+  return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Unlit;
 }
+
+std::string_view nodeOpName(const Material& m, const TreeNode& n) { return isUnlitLeaf(m, n) ? "UNLIT" : treeOpName(n.op); }
 
 int Material::inputIndex(std::string_view n) const {
   for (std::size_t i = 0; i < inputs.size(); ++i)

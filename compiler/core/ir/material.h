@@ -141,6 +141,9 @@ struct TreeNode {
   std::string pointer;  // JSON pointer of the source node
 };
 
+/// Tree node `n` is an unlit leaf (a Slab of BsdfKind::Unlit: no closure).
+bool isUnlitLeaf(const struct Material& m, const TreeNode& n);
+
 /// The name of tree node `n` in reports and dumps: its operator's
 /// (treeOpName), "UNLIT" for an unlit leaf.
 std::string_view nodeOpName(const struct Material& m, const TreeNode& n);

@@ -156,7 +156,7 @@ void checkUnlitPlacement(const Material& m, Diagnostics& diags) {
   std::unordered_set<std::string> reported;
   for (int n : t.preorder) {
     const TreeNode& node = m.nodes[n];
-    if (node.op != TreeOp::Slab || m.slabs[node.slab].kind != BsdfKind::Unlit) continue;
+    if (!isUnlitLeaf(m, node)) continue;
     for (int x = n, p = t.parent[n]; p >= 0; x = p, p = t.parent[p]) {
       if (m.nodes[p].op != TreeOp::Vertical) continue;
       if (reported.insert(node.pointer).second)

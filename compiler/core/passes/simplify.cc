@@ -56,7 +56,7 @@ namespace {
 /// A slab leaf that parameter blending can merge: not an unlit, which holds
 /// no closure (collapsing it saves nothing) and has no pins to blend.
 bool blendableLeaf(const Material& m, int node) {
-  return node < 0 || (m.nodes[node].op == TreeOp::Slab && m.slabs[m.nodes[node].slab].kind == BsdfKind::Slab);
+  return node < 0 || (m.nodes[node].op == TreeOp::Slab && !isUnlitLeaf(m, m.nodes[node]));
 }
 
 /// The next operator to collapse: deepest first; at equal depth horizontal,
@@ -80,7 +80,7 @@ int pickOperator(const Material& m, const TreeInfo& t) {
 /// Why the material cannot shrink further when it holds an unlit leaf ("" otherwise).
 std::string unlitNote(const Material& m) {
   for (int n : analyzeTree(m).preorder)
-    if (m.nodes[n].op == TreeOp::Slab && m.slabs[m.nodes[n].slab].kind == BsdfKind::Unlit)
+    if (isUnlitLeaf(m, m.nodes[n]))
       return " (an operator over an unlit node is never collapsed: the unlit holds no closure to blend)";
   return "";
 }

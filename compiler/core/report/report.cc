@@ -73,7 +73,7 @@ std::string formatReportText(const CompileResult& r) {
     o += fmt::format("BSDF {} ({}): {}\n", i, s.id, featureLine(s));
   }
   for (int n : t.preorder)  // unlit leaves: no closure, no bytes
-    if (m.nodes[n].op == TreeOp::Slab && m.slabs[m.nodes[n].slab].kind == BsdfKind::Unlit)
+    if (isUnlitLeaf(m, m.nodes[n]))
       o += fmt::format("Unlit ({}): Emissive={} (no closure: it emits and lets through, and stores nothing)\n",
                        m.nodes[n].id, (m.slabs[m.nodes[n].slab].features & kFeatEmissive) ? 1 : 0);
   o += fmt::format("----- Culled - {} -----\n", m.name);
