@@ -14,6 +14,8 @@
 #ifndef SUBSTRATE_BSDF_H
 #define SUBSTRATE_BSDF_H 1
 
+#include "substrate_hair.h"  // a hair closure's lobes (substrate_eval_closure branches to them)
+
 // The including shader may define this before including the runtime to tint
 // the specular with its profile atlas: index = profile index (uint), uv =
 // float2(NoV, NoL). Default: no tint.
@@ -1323,6 +1325,11 @@ float3 substrate_fuzz_diffuse_pair_mean(SubstrateClosure c, float amount, float3
 }
 
 float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
+#if SUBSTRATE_USE_HAIR
+  if ((c.features & SUBSTRATE_FEATURE_HAIR) != 0u) {
+    return substrate_hair_eval(c, V, L);  // a fibre: lit from every direction
+  }
+#endif
   float3 N = substrate_closure_normal(c);
   float NoVraw = dot(N, V);
   // Back-facing beyond the bias (or NaN): nothing. Otherwise NoV >= 1e-4.

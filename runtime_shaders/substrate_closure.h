@@ -14,6 +14,12 @@
 #define SUBSTRATE_MAX_CLOSURES 8
 #endif
 
+// 1: some closure may be a hair (SUBSTRATE_FEATURE_HAIR, substrate_hair.h);
+// 0 leaves its field out of the closure and its code out of the runtime.
+#ifndef SUBSTRATE_USE_HAIR
+#define SUBSTRATE_USE_HAIR 1
+#endif
+
 struct SubstrateClosure {
   float3 diffuseAlbedo;   // post multiple scattering, [0,1]
   float3 f0;              // reflectance at normal incidence, [0,1]
@@ -34,6 +40,10 @@ struct SubstrateClosure {
   float2 glintUv;
   float4 glintUvDerivatives;  // d(uv)/dx in xy, d(uv)/dy in zw
   uint specularProfile;       // profile index + 1; 0 = none
+#if SUBSTRATE_USE_HAIR
+  float4 hair;                // a hair closure's (SUBSTRATE_FEATURE_HAIR, substrate_hair.h): azimuthal
+                              // roughness, ior, cuticle angle in degrees, scatter
+#endif
   float3 emissive;            // forward only (deferred adds it in the base pass)
   float weight;               // mix and coverage weights on the path to the root
   float3 topTransmittance;    // transmittance of the layers above along the normal (1 on top)
@@ -96,6 +106,7 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_EMISSIVE
 #define SUBSTRATE_USE_EMISSIVE 1
 #endif
+
 // 1: some closure lies under more than one interface (a stack of layers), so
 // the lighting raises the interface term to the power 1 + extraInterfaces.
 #ifndef SUBSTRATE_USE_EXTRA_INTERFACES
@@ -185,6 +196,9 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.glintUv = SUBSTRATE_SPLAT2(0.0);
   c.glintUvDerivatives = SUBSTRATE_SPLAT4(0.0);
   c.specularProfile = 0u;
+#if SUBSTRATE_USE_HAIR
+  c.hair = float4(0.5, 1.55, 2.0, 0.0);
+#endif
   c.emissive = SUBSTRATE_SPLAT3(0.0);
   c.weight = 1.0;
   c.topTransmittance = SUBSTRATE_SPLAT3(1.0);

@@ -16,6 +16,9 @@
 #define SUBSTRATE_FEATURE_SPECULAR_PROFILE 32u
 #define SUBSTRATE_FEATURE_WEIGHT 64u
 #define SUBSTRATE_FEATURE_COVERAGE_ABOVE 128u
+// A hair closure (runtime_shaders/substrate_hair.h): not one of the 8 header
+// feature bits; single-closure header bit 12 (a hair is always alone).
+#define SUBSTRATE_FEATURE_HAIR 256u
 
 #define SUBSTRATE_SSS_NONE 0u
 #define SUBSTRATE_SSS_WRAP 1u

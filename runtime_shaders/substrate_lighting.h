@@ -172,6 +172,11 @@ float substrate_env_mip(float roughness, float mipCount) {
 // The layers above are crossed at NoV by the specular (its light comes from
 // the mirror direction) and at SUBSTRATE_DIFFUSE_MEAN_COS by the diffuse and fuzz.
 float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredRadiance, float3 irradiance) {
+#if SUBSTRATE_USE_HAIR
+  if ((c.features & SUBSTRATE_FEATURE_HAIR) != 0u) {
+    return substrate_hair_env(c, V, irradiance);  // a fibre's albedo times the mean radiance
+  }
+#endif
   float3 N = substrate_closure_normal(c);
   float NoVraw = dot(N, V);
   if (!(NoVraw > -SUBSTRATE_NOV_BIAS)) {
@@ -251,6 +256,12 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 // which the closure does not carry.
 void substrate_translucency(SubstrateClosure c, float NoV, float3 V, out float coverage, out float3 transmittance) {
   coverage = saturate(c.weight);
+#if SUBSTRATE_USE_HAIR
+  if ((c.features & SUBSTRATE_FEATURE_HAIR) != 0u) {
+    transmittance = SUBSTRATE_SPLAT3(0.0);  // a fibre covers what it covers (its TT lobe is lit, not blended)
+    return;
+  }
+#endif
   float mu = clamp(NoV, SUBSTRATE_MIN_COS, 1.0);
   mfloat3 specAlbedo = substrate_closure_specular_albedo(c, mu);
   transmittance = SUBSTRATE_F3(substrate_closure_above_throughput(c, mu, V) * (SUBSTRATE_MSPLAT3(1.0) - specAlbedo));

@@ -37,6 +37,9 @@
 // Bit 14 of a single-closure header: the pixel holds no closure (an unlit
 // material: it emits, the base pass added that, and nothing is lit).
 #define SUBSTRATE_HEADER_NO_CLOSURE 0x4000u
+// Bit 12 of a single-closure header: the closure is a hair (SUBSTRATE_FEATURE_HAIR):
+// its F0 field is the hair field, and its basis stores the fibre's tangent angle.
+#define SUBSTRATE_HEADER_HAIR 0x1000u
 
 // Field widths in bits (docs/storage.md, "Field table").
 #define SUBSTRATE_BITS_HEADER 16u
@@ -50,6 +53,7 @@
 #define SUBSTRATE_BITS_FUZZ 32u
 #define SUBSTRATE_BITS_ANISOTROPY 8u
 #define SUBSTRATE_BITS_SPECULAR_PROFILE 8u
+#define SUBSTRATE_BITS_HAIR 32u
 #define SUBSTRATE_BITS_GLINT 136u
 #define SUBSTRATE_BITS_NORMAL 32u
 #define SUBSTRATE_BITS_TANGENT_ANGLE 14u
@@ -153,6 +157,19 @@ void substrate_dq_fuzz(uint code, out float amount, out float3 color, out float 
   amount = substrate_dq_unorm(code, 6u);
   color = substrate_dq_color20((code >> 6u) & 0xfffffu);
   roughness = substrate_dq_unorm(code >> 26u, 6u);
+}
+
+// Hair (32 bits, SubstrateClosure.hair): azimuthal roughness unorm8 (bits
+// 0-7), (ior - 1) / 2 unorm8 (8-15), cuticle angle / 20 degrees snorm8
+// (16-23), scatter unorm8 (24-31).
+uint substrate_q_hair(float4 hair, float dither) {
+  return substrate_q_unorm(hair.x, 8u, dither) | (substrate_q_unorm((hair.y - 1.0) * 0.5, 8u, dither) << 8u) |
+         (substrate_q_snorm(hair.z / 20.0, 8u, dither) << 16u) | (substrate_q_unorm(hair.w, 8u, dither) << 24u);
+}
+
+float4 substrate_dq_hair(uint code) {
+  return float4(substrate_dq_unorm(code, 8u), 1.0 + 2.0 * substrate_dq_unorm(code >> 8u, 8u),
+                20.0 * substrate_dq_snorm(code >> 16u, 8u), substrate_dq_unorm(code >> 24u, 8u));
 }
 
 // Anisotropy (8 bits): snorm8, code = round(127 a) + 127 on average.
@@ -330,7 +347,8 @@ float3 substrate_tangent_angle_decode(uint code, float3 N) {
 // ---- Headers --------------------------------------------------------------------
 
 // Single-closure header: class (bits 0-1), SUBSTRATE_FEATURE_* bits F90 ..
-// WEIGHT (2-8; bit 9, coverage above, is reserved), SSS type (10-11).
+// WEIGHT (2-8; bit 9, coverage above, is reserved), SSS type (10-11); a hair
+// closure ORs SUBSTRATE_HEADER_HAIR (bit 12).
 uint substrate_material_header_single(uint layoutClass, uint features, uint sssType) {
   return (layoutClass & 3u) | ((features & 0x7fu) << 2u) | ((sssType & 3u) << 10u);
 }

@@ -13,6 +13,14 @@
 #define SUBSTRATE_USE_NO_CLOSURE 1
 #endif
 
+// The closure feature bits whose basis stores a tangent angle: anisotropy's,
+// and a hair's (its fibre) where one may be.
+#if SUBSTRATE_USE_HAIR
+#define SUBSTRATE_TANGENT_FEATURES (SUBSTRATE_FEATURE_ANISOTROPY | SUBSTRATE_FEATURE_HAIR)
+#else
+#define SUBSTRATE_TANGENT_FEATURES SUBSTRATE_FEATURE_ANISOTROPY
+#endif
+
 // The fields of one closure that follow its header bits, from stream bit
 // `pos` (advanced past them), into `c` (initialized by the caller): albedo,
 // F0, roughness, then weight, top transmittance, coverage above and the
@@ -28,8 +36,20 @@ void substrate_unpack_closure_fields(uint words[SUBSTRATE_MAX_WORDS], inout uint
   c.coverageAbove = isTop ? 0.0 : 1.0;
   c.diffuseAlbedo = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
   pos += SUBSTRATE_BITS_COLOR;
-  c.f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
-  pos += SUBSTRATE_BITS_COLOR;
+  // A fibre stores its own field in place of F0. A lighting pass compiled
+  // without hair (SUBSTRATE_USE_HAIR 0) meets no hair pixel: the scene's class
+  // of a hair material defines it 1 (its field is wider than F0's, so it cannot
+  // be skipped without the header bit, which that pass does not read).
+#if SUBSTRATE_USE_HAIR
+  if ((feats & SUBSTRATE_FEATURE_HAIR) != 0u) {
+    c.hair = substrate_dq_hair(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_HAIR));
+    pos += SUBSTRATE_BITS_HAIR;
+  } else
+#endif
+  {
+    c.f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
+    pos += SUBSTRATE_BITS_COLOR;
+  }
   c.roughness = substrate_dq_unorm(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_ROUGHNESS), 8u);
   pos += SUBSTRATE_BITS_ROUGHNESS;
   if ((feats & SUBSTRATE_FEATURE_WEIGHT) != 0u) {
@@ -159,6 +179,9 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       uint basis = 0u;
       bool isTop = true;
       uint feats = (header >> 2u) & 0x7fu;
+#if SUBSTRATE_USE_HAIR
+      feats |= (header & SUBSTRATE_HEADER_HAIR) != 0u ? SUBSTRATE_FEATURE_HAIR : 0u;  // a hair is always alone
+#endif
       uint sss = (header >> 10u) & 3u;
       if (multi) {
         uint h = SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_CLOSURE_HEADER);
@@ -181,8 +204,8 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
         topStretched = (feats & (SUBSTRATE_FEATURE_ANISOTROPY | SUBSTRATE_FEATURE_HAZE)) == SUBSTRATE_FEATURE_ANISOTROPY;
         topIndex = uint(i);
       }
-      if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
-        basisAniso[basis] = true;
+      if ((feats & SUBSTRATE_TANGENT_FEATURES) != 0u) {
+        basisAniso[basis] = true;  // a stored tangent angle: an anisotropic lobe's, a fibre's
       }
       substrate_unpack_closure_fields(words, pos, feats, sss, isTop, closures[i]);
       if (isTop) {
@@ -265,6 +288,9 @@ void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLa
   substrate_closure_init(c);
   uint header = words[0] & 0xffffu;
   uint feats = (header >> 2u) & 0x7fu;
+#if SUBSTRATE_USE_HAIR
+  feats |= (header & SUBSTRATE_HEADER_HAIR) != 0u ? SUBSTRATE_FEATURE_HAIR : 0u;
+#endif
   uint pos = SUBSTRATE_BITS_HEADER;
   substrate_unpack_closure_fields(words, pos, feats, (header >> 10u) & 3u, true, c);
 #if SUBSTRATE_USE_NO_CLOSURE
@@ -276,8 +302,8 @@ void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLa
   substrate_dq_top_layer(topLayer, c.N, topRoughness);
   float3 b0;
   substrate_orthonormal_basis(c.N, c.T, b0);
-#if SUBSTRATE_USE_ANISOTROPY
-  if ((feats & SUBSTRATE_FEATURE_ANISOTROPY) != 0u) {
+#if SUBSTRATE_USE_ANISOTROPY || SUBSTRATE_USE_HAIR
+  if ((feats & SUBSTRATE_TANGENT_FEATURES) != 0u) {  // a stretched lobe's, a fibre's
     c.T = substrate_tangent_angle_decode(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_TANGENT_ANGLE), c.N);
   }
 #endif

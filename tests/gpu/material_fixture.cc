@@ -79,7 +79,7 @@ std::array<T, N> arrayOf(const std::array<double, N>& a) {
 template <class T>
 reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   // Every field is copied by name: a new one left out would keep its default here.
-  static_assert(sizeof(reference::Closure<double>) == 440,
+  static_assert(sizeof(reference::Closure<double>) == 472,
                 "Closure gained or lost a field: copy it below, then update the size");
   reference::Closure<T> o;
   o.diffuseAlbedo = arrayOf<T>(c.diffuseAlbedo);
@@ -101,6 +101,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.glintUv = arrayOf<T>(c.glintUv);
   o.glintUvDerivatives = arrayOf<T>(c.glintUvDerivatives);
   o.specularProfile = c.specularProfile;
+  o.hair = arrayOf<T>(c.hair);
   o.emissive = arrayOf<T>(c.emissive);
   o.weight = static_cast<T>(c.weight);
   o.topTransmittance = arrayOf<T>(c.topTransmittance);
@@ -226,6 +227,8 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.coatStretch = {p[kClosureCoatStretch], p[kClosureCoatStretch + 1]};
   c.coatTangent = v3(kClosureCoatTangent);
   c.coatShare = p[kClosureCoatShare];
+  if (c.features & reference::kFeatureHair)  // else the kernel has no hair field (SUBSTRATE_USE_HAIR 0)
+    c.hair = {p[kClosureHair], p[kClosureHair + 1], p[kClosureHair + 2], p[kClosureHair + 3]};
   c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }

@@ -227,7 +227,7 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
         check("roughness", at + kClosureRoughness, c64.roughness, c32.roughness);
         check("anisotropy", at + kClosureAnisotropy, c64.anisotropy, c32.anisotropy);
         field3("N", kClosureN, c64.N, c32.N);
-        if (c64.features & reference::kFeatureAnisotropy) field3("T", kClosureT, c64.T_, c32.T_);
+        if (c64.features & (reference::kFeatureAnisotropy | reference::kFeatureHair)) field3("T", kClosureT, c64.T_, c32.T_);
         field3("sssMfp", kClosureSssMfp, c64.sssMfp, c32.sssMfp);
         check("sssPhaseAnisotropy", at + kClosureSssPhase, c64.sssPhaseAnisotropy, c32.sssPhaseAnisotropy);
         check("sssType", at + kClosureSssType, c64.sssType, c64.sssType);
@@ -256,6 +256,8 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
           check("coatStretch", at + kClosureCoatStretch + c, c64.coatStretch[c], c32.coatStretch[c]);
         field3("coatTangent", kClosureCoatTangent, c64.coatTangent, c32.coatTangent);
         check("coatShare", at + kClosureCoatShare, c64.coatShare, c32.coatShare);
+        if (c64.features & reference::kFeatureHair)  // the field exists where a hair may be (SUBSTRATE_USE_HAIR)
+          for (int c = 0; c < 4; ++c) check("hair", at + kClosureHair + c, c64.hair[c], c32.hair[c]);
       }
       check("coverage", kResultCoverage, ref.material.coverage, r32.material.coverage);
       for (int c = 0; c < 3; ++c) {
@@ -440,6 +442,12 @@ void MaterialOnGpu::deferredAgreesWithForwardWithinTheStorageBounds() {
             }
             bound("sss.phase", std::abs(std::clamp(f.sssPhaseAnisotropy, -1.0, 1.0) - d.sssPhaseAnisotropy), 1.0 / 7);
           }
+          if (stored.count(pre + "hair")) {  // docs/storage.md, "Hair"
+            unorm("hair.azimuthal_roughness", f.hair[0], d.hair[0], 8);
+            bound("hair.ior", std::abs(std::clamp(f.hair[1], 1.0, 3.0) - d.hair[1]), 2.0 / 255);
+            bound("hair.cuticle_angle (degrees)", std::abs(std::clamp(f.hair[2], -20.0, 20.0) - d.hair[2]), 20.0 / 127);
+            unorm("hair.scatter", f.hair[3], d.hair[3], 8);
+          }
           if (stored.count(pre + "glint")) {
             unorm("glint.density", f.glintValue, d.glintValue, 8);
             for (int c = 0; c < 2; ++c) bound("glint.uv", std::abs(f.glintUv[c] - d.glintUv[c]), 0.0);
@@ -455,7 +463,8 @@ void MaterialOnGpu::deferredAgreesWithForwardWithinTheStorageBounds() {
           const double normalBound = normalStored ? 0.0075 : 0.119;
           bound(normalStored ? "basis.normal (degrees)" : "top_layer.normal (degrees)", angleDegrees(f.N, d.N),
                 normalBound + 1e-3);
-          if (stored.count(fmt::format("basis{}.tangent_angle", b)) && (f.features & reference::kFeatureAnisotropy))
+          if (stored.count(fmt::format("basis{}.tangent_angle", b)) &&
+              (f.features & (reference::kFeatureAnisotropy | reference::kFeatureHair)))
             bound("basis.tangent (degrees)", angleDegrees(f.T_, d.T_), 0.022 + normalBound + 1e-3);
         }
         // The deferred lighting is the reference's lighting of the unpacked closures.

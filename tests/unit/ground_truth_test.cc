@@ -134,10 +134,15 @@ TEST(RandomWalkGroundTruth, RunsOnEveryExample) {
   const TextureFn tex = [](int, double u, double v) {
     return std::array<double, 4>{0.5 + 0.4 * std::sin(7 * u), 0.5 + 0.4 * std::cos(5 * v), 0.3, 1};
   };
-  int count = 0, unlit = 0;
+  int count = 0, unlit = 0, hair = 0;
   for (const auto& path : examples()) {
     CompileResult r = compileUnsimplified(path.filename().string(), readText(path));
     ASSERT_GE(r.material.root, 0) << path;
+    if (isHairLeaf(r.material, r.material.nodes[r.material.root])) {  // a fibre: its truth is hair_truth.h
+      EXPECT_TRUE(groundTruthTerms(r, Geometry{}, {}).empty()) << path;
+      ++hair;
+      continue;
+    }
     if (r.after.closures.empty()) {  // unlit nodes only: nothing reflects, so no term and no light
       EXPECT_TRUE(groundTruthTerms(r, Geometry{}, {}).empty()) << path;
       const D3 f = groundTruth(r, Geometry{}, dir(0.5, 2.5), {}, opts(64));
@@ -168,6 +173,7 @@ TEST(RandomWalkGroundTruth, RunsOnEveryExample) {
   }
   EXPECT_GE(count, 16);
   EXPECT_GE(unlit, 1);  // examples/unlit_hologram.json
+  EXPECT_GE(hair, 2);   // examples/hair_*.json
 }
 
 TEST(RandomWalkGroundTruth, MetalnessSlabSplitsIntoConductorAndDielectric) {

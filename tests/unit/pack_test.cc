@@ -493,7 +493,10 @@ Pixel randomPixel(const StorageLayout& L, Rng& rng) {
     ClosureValues v;
     const auto f = c.storedFeatures;
     v.diffuseAlbedo = rng.color();
-    v.f0 = rng.color();
+    if (f & kFeatHair)
+      v.hair = {rng.uniform(), rng.uniform(1, 3), rng.uniform(-20, 20), rng.uniform()};
+    else
+      v.f0 = rng.color();
     v.roughness = rng.uniform();
     if (c.storesWeight) v.weight = rng.uniform();
     if (!c.isTop) v.topTransmittance = rng.color();
@@ -596,7 +599,15 @@ void roundTrip(const StorageLayout& L, const Pixel& px, double u, const std::str
     EXPECT_EQ(got.features, closureHeaderFeatures(c));
     EXPECT_EQ(got.sssType, want.sssType);
     expectColor(got.diffuseAlbedo, want.diffuseAlbedo, "diffuse_albedo");
-    expectColor(got.f0, want.f0, "f0");
+    if (c.storedFeatures & kFeatHair) {  // a fibre's hair field in place of F0
+      expectUnorm(got.hair[0], want.hair[0], 8, "hair azimuthal roughness");
+      EXPECT_LE(std::abs(got.hair[1] - want.hair[1]), 2.0 / 255 + kEps) << "hair ior";
+      EXPECT_LE(std::abs(got.hair[2] - want.hair[2]), 20.0 / 127 + kEps) << "hair cuticle angle";
+      expectUnorm(got.hair[3], want.hair[3], 8, "hair scatter");
+      EXPECT_EQ(got.f0, ClosureValues{}.f0) << "a fibre stores no F0";
+    } else {
+      expectColor(got.f0, want.f0, "f0");
+    }
     expectColor(got.f90, want.f90, "f90");
     expectColor(got.topTransmittance, want.topTransmittance, "top_transmittance");
     expectUnorm(got.roughness, want.roughness, 8, "roughness");
@@ -635,7 +646,7 @@ void roundTrip(const StorageLayout& L, const Pixel& px, double u, const std::str
     EXPECT_LE(angleDeg(m.bases[b].normal, px.bases[b].normal), normalBound);
     bool aniso = false;
     for (const auto& c : L.closures)
-      if (c.basis == b && (c.storedFeatures & kFeatAnisotropy)) aniso = true;
+      if (c.basis == b && (c.storedFeatures & kTangentFeatures)) aniso = true;  // a fibre's tangent too
     EXPECT_NEAR(dot(m.bases[b].tangent, m.bases[b].normal), 0, 1e-9);
     if (aniso) {
       // The angle step, plus the tilt of the decoded normal's plane.

@@ -193,7 +193,7 @@ std::string packedBasisFieldCode(const StorageLayout& L, const LayoutField& f, c
                               : fmt::format("substrate_normal_as_stored({}, dither)", n);
   int aniso = first;
   for (std::size_t i = 0; i < L.closures.size(); ++i)
-    if (L.closures[i].basis == f.basis && (L.closures[i].storedFeatures & kFeatAnisotropy)) {
+    if (L.closures[i].basis == f.basis && (L.closures[i].storedFeatures & kTangentFeatures)) {
       aniso = static_cast<int>(i);
       break;
     }
@@ -230,7 +230,8 @@ std::string packFields(const Material& m, const StorageLayout& L, const std::vec
     } else if (f.name == "header") {
       const ClosureLayout& c0 = L.closures[0];
       put(multi ? fmt::format("substrate_material_header_multi({}u, {}u, {}u)", cls, L.closures.size(), L.basisCount)
-                : fmt::format("substrate_material_header_single({}u, {}u, {}u)", cls, featureBits(c0), sssCode(c0)),
+                : fmt::format("substrate_material_header_single({}u, {}u, {}u){}", cls, featureBits(c0), sssCode(c0),
+                              (c0.storedFeatures & kFeatHair) ? " | SUBSTRATE_HEADER_HAIR" : ""),
           f.bits);
     } else if (field == "header") {
       const ClosureLayout& cl = L.closures[f.closure];
@@ -251,6 +252,8 @@ std::string packFields(const Material& m, const StorageLayout& L, const std::vec
       put(fmt::format("substrate_q_haze({0}.secondRoughness, {0}.secondRoughnessWeight, dither)", c), f.bits);
     } else if (field == "fuzz") {
       put(fmt::format("substrate_q_fuzz({0}.fuzzAmount, {0}.fuzzColor, {0}.fuzzRoughness, dither)", c), f.bits);
+    } else if (field == "hair") {
+      put(fmt::format("substrate_q_hair({}.hair, dither)", c), f.bits);
     } else if (field == "anisotropy") {
       put(fmt::format("substrate_q_anisotropy({}.anisotropy, dither)", c), f.bits);
     } else if (field == "specular_profile") {

@@ -95,7 +95,12 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   put(kClosureCoatStretch + 1, c + ".coatStretch.y");
   put3(kClosureCoatTangent, "coatTangent");
   put(kClosureCoatShare, c + ".coatShare");
-  for (int at = kClosureCoatShare + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 56)
+  s += "#if SUBSTRATE_USE_HAIR\n";  // the field exists only where a hair may be
+  for (int i = 0; i < 4; ++i) put(kClosureHair + i, c + ".hair." + "xyzw"[i]);
+  s += "#else\n";
+  for (int i = 0; i < 4; ++i) put(kClosureHair + i, "0.0");
+  s += "#endif\n";
+  for (int at = kClosureHair + 4; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 60)
   return s;
 }
 

@@ -38,6 +38,7 @@ std::string useDefines(std::uint16_t features) {
   use("SUBSTRATE_USE_GLINT", kFeatGlint);
   use("SUBSTRATE_USE_SPECULAR_PROFILE", kFeatSpecularProfile);
   use("SUBSTRATE_USE_EMISSIVE", kFeatEmissive);
+  use("SUBSTRATE_USE_HAIR", kFeatHair);
   return s;
 }
 
@@ -238,6 +239,8 @@ class Emitter {
   void emitEmission();
   void emitNoClosureSlot();
   int firstUnlit() const;  // the first unlit leaf in pre-order, or -1
+  void emitHairClosure(const std::string& c, const Slab& s);  // closure c of hair s
+  unsigned emitFeaturePins(const std::string& c, const Slab& s);  // returns the feature bits
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
   bool knownOpaque(int node) const;   // a slab with the constant MFP 0 and a positive constant thickness: T = 0
@@ -447,6 +450,10 @@ void Emitter::collectNeeded() {
       need(s.pin(SlabPin::GlintUv));
     }
     if (f & kFeatEmissive) need(s.pin(SlabPin::Emissive));
+    if (f & kFeatHair)  // emitHairClosure's pins
+      for (SlabPin p : {SlabPin::BaseColor, SlabPin::Tangent, SlabPin::AzimuthalRoughness, SlabPin::Ior,
+                        SlabPin::CuticleAngle, SlabPin::Scatter})
+        need(s.pin(p));
   }
   for (int n : t_.preorder) {  // unlit leaves: what they let through and emit
     const TreeNode& node = m_.nodes[n];
@@ -656,6 +663,10 @@ void Emitter::emitClosures() {
                      s.collapsedFrom.empty() ? "" : fmt::format(" (a blended {})", s.collapsedFrom)));
     const std::string weight = walkUp(cl, node, id);
     line(fmt::format("substrate_closure_init({});", c));
+    if (s.kind == BsdfKind::Hair) {  // always the whole material: no weight, nothing above
+      emitHairClosure(c, s);
+      continue;
+    }
     const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);
     if (verticalOfTop(node) >= 0 && !knownOpaque(node) && !m_.values.isConstEqual(albedo, 0.0))
       // A layer scatters back only what it does not let through (substrate_tree.h).
@@ -668,46 +679,7 @@ void Emitter::emitClosures() {
       rough = fmt::format("substrate_variance_to_roughness(substrate_roughness_to_variance({}) + va_{})", rough, id);
     line(fmt::format("{}.roughness = {};", c, rough));
     line(fmt::format("{}.N = substrate_tangent_to_world({}, g.N, g.T);", c, expr(s.pin(SlabPin::Normal))));
-    unsigned bits = 0;
-    const std::uint16_t f = s.features;
-    if (f & kFeatF90) {
-      bits |= SUBSTRATE_FEATURE_F90;
-      line(fmt::format("{}.f90 = {};", c, expr(s.pin(SlabPin::F90))));
-    }
-    if (f & kFeatAnisotropy) {
-      bits |= SUBSTRATE_FEATURE_ANISOTROPY;
-      line(fmt::format("{}.anisotropy = {};", c, expr(s.pin(SlabPin::Anisotropy))));
-      line(fmt::format("{0}.T = substrate_orthogonal_tangent({0}.N, substrate_tangent_to_world({1}, g.N, g.T));", c,
-                       expr(s.pin(SlabPin::Tangent))));
-    }
-    if (f & kFeatSss) {
-      line(fmt::format("{}.sssMfp = {};", c, mfpOf(s)));
-      line(fmt::format("{}.sssPhaseAnisotropy = {};", c, expr(s.pin(SlabPin::SssPhaseAnisotropy))));
-      line(fmt::format("{}.sssType = {}u;", c, static_cast<unsigned>(s.sssType)));
-    }
-    if (f & kFeatHaze) {
-      bits |= SUBSTRATE_FEATURE_HAZE;
-      line(fmt::format("{}.secondRoughness = {};", c, expr(s.pin(SlabPin::SecondRoughness))));
-      line(fmt::format("{}.secondRoughnessWeight = {};", c, expr(s.pin(SlabPin::SecondRoughnessWeight))));
-    }
-    if (f & kFeatFuzz) {
-      bits |= SUBSTRATE_FEATURE_FUZZ;
-      line(fmt::format("{}.fuzzAmount = {};", c, expr(s.pin(SlabPin::FuzzAmount))));
-      line(fmt::format("{}.fuzzColor = {};", c, expr(s.pin(SlabPin::FuzzColor))));
-      line(fmt::format("{}.fuzzRoughness = {};", c, expr(s.pin(SlabPin::FuzzRoughness))));
-    }
-    if (f & kFeatGlint) {
-      bits |= SUBSTRATE_FEATURE_GLINT;
-      line(fmt::format("{}.glintValue = {};", c, expr(s.pin(SlabPin::GlintValue))));
-      line(fmt::format("{}.glintUv = {};", c, expr(s.pin(SlabPin::GlintUv))));
-      line(fmt::format("{}.glintUvDerivatives = g.uvDerivatives;", c));
-    }
-    if (f & kFeatSpecularProfile) {
-      bits |= SUBSTRATE_FEATURE_SPECULAR_PROFILE;
-      line(fmt::format("{}.specularProfile = {}u;  // ${}", c, profileIndex_[s.specularProfileInput] + 1,
-                       m_.inputs[s.specularProfileInput].name));
-    }
-    if (f & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
+    unsigned bits = emitFeaturePins(c, s);
     if (cl.storesWeight) bits |= SUBSTRATE_FEATURE_WEIGHT;
     if (cl.storesCoverageAbove) bits |= SUBSTRATE_FEATURE_COVERAGE_ABOVE;
     if (!weight.empty()) line(fmt::format("{}.weight = {};", c, weight));
@@ -720,6 +692,67 @@ void Emitter::emitClosures() {
     }
     line(fmt::format("{}.features = {}u;", c, bits));
   }
+}
+
+/// The pins of slab s's features into closure c (emitClosures); returns
+/// their SUBSTRATE_FEATURE_* bits.
+unsigned Emitter::emitFeaturePins(const std::string& c, const Slab& s) {
+  unsigned bits = 0;
+  const std::uint16_t f = s.features;
+  if (f & kFeatF90) {
+    bits |= SUBSTRATE_FEATURE_F90;
+    line(fmt::format("{}.f90 = {};", c, expr(s.pin(SlabPin::F90))));
+  }
+  if (f & kFeatAnisotropy) {
+    bits |= SUBSTRATE_FEATURE_ANISOTROPY;
+    line(fmt::format("{}.anisotropy = {};", c, expr(s.pin(SlabPin::Anisotropy))));
+    line(fmt::format("{0}.T = substrate_orthogonal_tangent({0}.N, substrate_tangent_to_world({1}, g.N, g.T));", c,
+                     expr(s.pin(SlabPin::Tangent))));
+  }
+  if (f & kFeatSss) {
+    line(fmt::format("{}.sssMfp = {};", c, mfpOf(s)));
+    line(fmt::format("{}.sssPhaseAnisotropy = {};", c, expr(s.pin(SlabPin::SssPhaseAnisotropy))));
+    line(fmt::format("{}.sssType = {}u;", c, static_cast<unsigned>(s.sssType)));
+  }
+  if (f & kFeatHaze) {
+    bits |= SUBSTRATE_FEATURE_HAZE;
+    line(fmt::format("{}.secondRoughness = {};", c, expr(s.pin(SlabPin::SecondRoughness))));
+    line(fmt::format("{}.secondRoughnessWeight = {};", c, expr(s.pin(SlabPin::SecondRoughnessWeight))));
+  }
+  if (f & kFeatFuzz) {
+    bits |= SUBSTRATE_FEATURE_FUZZ;
+    line(fmt::format("{}.fuzzAmount = {};", c, expr(s.pin(SlabPin::FuzzAmount))));
+    line(fmt::format("{}.fuzzColor = {};", c, expr(s.pin(SlabPin::FuzzColor))));
+    line(fmt::format("{}.fuzzRoughness = {};", c, expr(s.pin(SlabPin::FuzzRoughness))));
+  }
+  if (f & kFeatGlint) {
+    bits |= SUBSTRATE_FEATURE_GLINT;
+    line(fmt::format("{}.glintValue = {};", c, expr(s.pin(SlabPin::GlintValue))));
+    line(fmt::format("{}.glintUv = {};", c, expr(s.pin(SlabPin::GlintUv))));
+    line(fmt::format("{}.glintUvDerivatives = g.uvDerivatives;", c));
+  }
+  if (f & kFeatSpecularProfile) {
+    bits |= SUBSTRATE_FEATURE_SPECULAR_PROFILE;
+    line(fmt::format("{}.specularProfile = {}u;  // ${}", c, profileIndex_[s.specularProfileInput] + 1,
+                     m_.inputs[s.specularProfileInput].name));
+  }
+  if (f & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
+  return bits;
+}
+
+/// A hair closure (runtime_shaders/substrate_hair.h): the base colour in
+/// diffuseAlbedo, the longitudinal roughness in roughness, the fibre in T
+/// (orthogonal to the normal, as the stored tangent angle is), the rest in hair.
+void Emitter::emitHairClosure(const std::string& c, const Slab& s) {
+  line(fmt::format("{}.diffuseAlbedo = {};", c, expr(s.pin(SlabPin::BaseColor))));
+  line(fmt::format("{}.roughness = {};", c, expr(s.pin(SlabPin::Roughness))));
+  line(fmt::format("{}.N = substrate_tangent_to_world({}, g.N, g.T);", c, expr(s.pin(SlabPin::Normal))));
+  line(fmt::format("{0}.T = substrate_orthogonal_tangent({0}.N, substrate_tangent_to_world({1}, g.N, g.T));", c,
+                   expr(s.pin(SlabPin::Tangent))));
+  line(fmt::format("{}.hair = float4({}, {}, {}, {});", c, expr(s.pin(SlabPin::AzimuthalRoughness)),
+                   expr(s.pin(SlabPin::Ior)), expr(s.pin(SlabPin::CuticleAngle)), expr(s.pin(SlabPin::Scatter))));
+  if (s.features & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
+  line(fmt::format("{}.features = {}u;", c, SUBSTRATE_FEATURE_HAIR));
 }
 
 int Emitter::firstUnlit() const {

@@ -9,20 +9,20 @@ std::string_view blendModeName(BlendMode m) { return enumName(kBlendModeNames, m
 namespace {
 constexpr double kInf = 1e300;
 constexpr int kNoGeo = -1;
-constexpr std::uint8_t kBoth = kPinOfSlab | kPinOfUnlit;
+constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair, kSlabHair = kPinOfSlab | kPinOfHair;
 // name, type, color, default, geometry default, lo, hi, kinds
 const SlabPinInfo kPins[kSlabPinCount] = {
     {"diffuse_albedo", VType::Vec3, true, 0.18, kNoGeo, 0, 1},
     {"f0", VType::Vec3, true, 0.04, kNoGeo, 0, 1},
     {"f90", VType::Vec3, true, 1.0, kNoGeo, 0, 1},
-    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
+    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kSlabHair},  // a hair's: longitudinal (Chiang's beta_m)
     {"anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
-    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kBoth},
-    {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1},
+    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfSlab | kPinOfUnlit},
+    {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1, kSlabHair},  // a hair's fibre
     {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
     {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf},
     {"sss_phase_anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
-    {"emissive", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kBoth},
+    {"emissive", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kAll},
     {"second_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
     {"second_roughness_weight", VType::Float, false, 0.0, kNoGeo, 0, 1},
     {"fuzz_amount", VType::Float, false, 0.0, kNoGeo, 0, 1},
@@ -32,6 +32,14 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     {"glint_uv", VType::Vec2, false, 0.0, static_cast<int>(GeometryAttr::Uv0), -kInf, kInf},
     // The unlit's: what it lets through from behind (or below), along the normal.
     {"transmittance", VType::Vec3, true, 1.0, kNoGeo, 0, 1, kPinOfUnlit},
+    // The hair's (runtime_shaders/substrate_hair.h; UE's Hair BSDF, Chiang et al. 2016's parameters):
+    // the colour of dense hair (its absorption follows), azimuthal roughness (beta_n), the fibre's
+    // index of refraction, its cuticle scales' tilt in degrees, and the dense-hair scattering.
+    {"base_color", VType::Vec3, true, 0.0, kNoGeo, 0, 1, kPinOfHair},
+    {"azimuthal_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kPinOfHair},
+    {"ior", VType::Float, false, 1.55, kNoGeo, 1, 3, kPinOfHair},
+    {"cuticle_angle", VType::Float, false, 2.0, kNoGeo, -20, 20, kPinOfHair},
+    {"scatter", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfHair},
 };
 }  // namespace
 
@@ -44,16 +52,25 @@ std::optional<SlabPin> slabPinByName(std::string_view name) {
 }
 
 bool bsdfTakesPin(BsdfKind k, SlabPin p) {
-  return (kPins[static_cast<int>(p)].kinds & (k == BsdfKind::Unlit ? kPinOfUnlit : kPinOfSlab)) != 0;
+  const std::uint8_t bit = k == BsdfKind::Unlit ? kPinOfUnlit : k == BsdfKind::Hair ? kPinOfHair : kPinOfSlab;
+  return (kPins[static_cast<int>(p)].kinds & bit) != 0;
 }
 
-std::string_view bsdfKindName(BsdfKind k) { return k == BsdfKind::Unlit ? "unlit" : "slab"; }
+std::string_view bsdfKindName(BsdfKind k) {
+  return k == BsdfKind::Unlit ? "unlit" : k == BsdfKind::Hair ? "hair" : "slab";
+}
+
+std::optional<BsdfKind> bsdfKindByName(std::string_view name) {
+  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair})
+    if (bsdfKindName(k) == name) return k;
+  return std::nullopt;
+}
 
 std::string_view sssTypeName(SssType t) { return enumName(kSssTypeNames, t, "none"); }
 
 std::string_view featureName(int bit) {
   static constexpr std::string_view names[kFeatureCount] = {
-      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium"};
+      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium", "hair"};
   return bit >= 0 && bit < kFeatureCount ? names[bit] : "?";
 }
 
@@ -63,7 +80,13 @@ bool isUnlitLeaf(const Material& m, const TreeNode& n) {
   return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Unlit;
 }
 
-std::string_view nodeOpName(const Material& m, const TreeNode& n) { return isUnlitLeaf(m, n) ? "UNLIT" : treeOpName(n.op); }
+bool isHairLeaf(const Material& m, const TreeNode& n) {
+  return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Hair;
+}
+
+std::string_view nodeOpName(const Material& m, const TreeNode& n) {
+  return isUnlitLeaf(m, n) ? "UNLIT" : isHairLeaf(m, n) ? "HAIR" : treeOpName(n.op);
+}
 
 int Material::inputIndex(std::string_view n) const {
   for (std::size_t i = 0; i < inputs.size(); ++i)

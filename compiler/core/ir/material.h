@@ -48,18 +48,22 @@ struct Input {
 enum class SlabPin : std::uint8_t {
   DiffuseAlbedo, F0, F90, Roughness, Anisotropy, Normal, Tangent, SssMfp, SssMfpScale,
   SssPhaseAnisotropy, Emissive, SecondRoughness, SecondRoughnessWeight, FuzzAmount, FuzzColor,
-  FuzzRoughness, GlintValue, GlintUv, Transmittance, Count_
+  FuzzRoughness, GlintValue, GlintUv, Transmittance, BaseColor, AzimuthalRoughness, Ior, CuticleAngle, Scatter,
+  Count_
 };
 inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
 
-/// The kinds of BSDF leaf (docs/format.md, "BSDF nodes"): the slab, and the
+/// The kinds of BSDF leaf (docs/format.md, "BSDF nodes"): the slab; the
 /// unlit BSDF, which emits and lets through but reflects nothing, so it is no
-/// closure: it stores nothing per pixel and the lighting never sees it.
-enum class BsdfKind : std::uint8_t { Slab, Unlit };
-std::string_view bsdfKindName(BsdfKind k);  // "slab", "unlit": the node kind in materials
+/// closure: it stores nothing per pixel and the lighting never sees it; and
+/// the hair BSDF, a fibre's far-field scattering (runtime_shaders/substrate_hair.h),
+/// one closure that is always the whole material (build_tree).
+enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair };
+std::string_view bsdfKindName(BsdfKind k);  // "slab", "unlit", "hair": the node kind in materials
+std::optional<BsdfKind> bsdfKindByName(std::string_view name);
 
 /// BsdfKind bits: which kinds of BSDF node take a pin.
-inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2;
+inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4;
 
 struct SlabPinInfo {
   std::string_view name;
@@ -90,8 +94,12 @@ enum Feature : std::uint16_t {
   kFeatSpecularProfile = 1 << 6,
   kFeatEmissive = 1 << 7,
   kFeatMedium = 1 << 8,   // a coating slab's medium (MFP): drives transmittance only
+  kFeatHair = 1 << 9,     // a hair BSDF's closure: the fibre's lobes, its own field and a tangent
 };
-inline constexpr int kFeatureCount = 9;
+inline constexpr int kFeatureCount = 10;
+/// Features whose lighting reads the closure's tangent, so its basis stores
+/// one: anisotropy (the stretched lobe) and hair (the fibre's direction).
+inline constexpr std::uint16_t kTangentFeatures = kFeatAnisotropy | kFeatHair;
 std::string_view featureName(int bit);  // scene/report names: "f90", "anisotropy", ...
 
 /// Provenance of a slab whose diffuse_albedo and f0 pins are the two outputs
@@ -143,9 +151,11 @@ struct TreeNode {
 
 /// Tree node `n` is an unlit leaf (a Slab of BsdfKind::Unlit: no closure).
 bool isUnlitLeaf(const struct Material& m, const TreeNode& n);
+/// Tree node `n` is a hair leaf (a Slab of BsdfKind::Hair).
+bool isHairLeaf(const struct Material& m, const TreeNode& n);
 
 /// The name of tree node `n` in reports and dumps: its operator's
-/// (treeOpName), "UNLIT" for an unlit leaf.
+/// (treeOpName), "UNLIT" for an unlit leaf, "HAIR" for a hair leaf.
 std::string_view nodeOpName(const struct Material& m, const TreeNode& n);
 
 struct Basis {

@@ -170,6 +170,26 @@ void checkUnlitPlacement(const Material& m, Diagnostics& diags) {
   }
 }
 
+/// A hair BSDF is the whole material: a located error at a hair leaf with a
+/// parent, naming the operator. Its closure is lit by the fibre's own model
+/// (a far field around the fibre, no interface or diffuse), which no operator
+/// can blend, layer or weigh against a slab's lobes (UE's Substrate keeps its
+/// Hair BSDF alone at the root too).
+void checkHairPlacement(const Material& m, Diagnostics& diags) {
+  const TreeInfo t = analyzeTree(m);
+  std::unordered_set<std::string> reported;
+  for (int n : t.preorder) {
+    const TreeNode& node = m.nodes[n];
+    if (!isHairLeaf(m, node) || t.parent[n] < 0 || !reported.insert(node.pointer).second) continue;
+    const TreeNode& p = m.nodes[t.parent[n]];
+    diags.error(node.pointer,
+                fmt::format("hair '{}' is an operand of {} '{}': a hair BSDF must be the whole material (the "
+                            "output), since its fibre lobes are a closure of their own kind that no operator can "
+                            "mix, layer or weigh with other matter",
+                            node.id, treeOpName(p.op), p.id));
+  }
+}
+
 }  // namespace
 
 bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Material& m, Diagnostics& diags,
@@ -206,6 +226,7 @@ bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Materia
   TreeBuilder builder(doc, table, m, diags);
   m.root = builder.instance(doc.output);
   checkUnlitPlacement(m, diags);
+  checkHairPlacement(m, diags);
   return !diags.hasErrors();
 }
 

@@ -16,6 +16,11 @@ void analyzeFeatures(Material& m) {
       s.features = used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0;
       continue;
     }
+    if (s.kind == BsdfKind::Hair) {  // a hair's lobes are one closure kind, with no optional part
+      s.sssType = SssType::None;
+      s.features = kFeatHair | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
+      continue;
+    }
     if (used(SlabPin::F90, 1.0)) f |= kFeatF90;
     if (used(SlabPin::Anisotropy, 0.0)) f |= kFeatAnisotropy;
     bool hasMfp = used(SlabPin::SssMfp, 0.0) && used(SlabPin::SssMfpScale, 0.0);

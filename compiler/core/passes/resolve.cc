@@ -115,7 +115,7 @@ const OpSpec* findOpSpec(const std::string& kind) {
 }
 
 std::optional<TreeOp> substrateKind(const std::string& kind) {
-  if (kind == "slab" || kind == "unlit") return TreeOp::Slab;  // BSDF leaves (SNode::kind)
+  if (bsdfKindByName(kind)) return TreeOp::Slab;  // BSDF leaves (SNode::kind)
   if (kind == "horizontal") return TreeOp::Horizontal;
   if (kind == "vertical") return TreeOp::Vertical;
   if (kind == "coverage_weight") return TreeOp::CoverageWeight;
@@ -519,7 +519,7 @@ void Resolver::checkOutput() {
         d_.error("/output", fmt::format("unknown node {}", quoteForDiagnostic(outputId_)));
     } else if (isValueKindName(outputId_)) {
       d_.error("/output", fmt::format("{} is a value node; the output must be a Substrate node "
-                                      "(slab, unlit, horizontal, vertical, add, coverage_weight, select)",
+                                      "(slab, unlit, hair, horizontal, vertical, add, coverage_weight, select)",
                                       quoteForDiagnostic(outputId_)));
     } else if (isSubstrateName(outputId_)) {
       out_.output = namedSubstrate_[outputId_];
@@ -1339,26 +1339,39 @@ void Resolver::fillOperatorNode(int index, const Json& j, const std::string& ptr
   }
 }
 
+namespace {
+/// The pins a BSDF kind other than the slab takes, for "unknown pin" errors.
+std::string pinListOf(BsdfKind kind) {
+  std::string list;
+  for (int p = 0; p < kSlabPinCount; ++p)
+    if (bsdfTakesPin(kind, static_cast<SlabPin>(p)))
+      list += (list.empty() ? "" : ", ") + std::string(slabPinInfo(static_cast<SlabPin>(p)).name);
+  return list;
+}
+}  // namespace
+
 void Resolver::fillSlabNode(int index, const Json& j, const std::string& ptr, SNode& node) {
-  node.kind = j["kind"].get<std::string>() == "unlit" ? BsdfKind::Unlit : BsdfKind::Slab;
-  const bool unlit = node.kind == BsdfKind::Unlit;
+  node.kind = bsdfKindByName(j["kind"].get<std::string>()).value_or(BsdfKind::Slab);
+  const bool slab = node.kind == BsdfKind::Slab;
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string& k = it.key();
-    if (k == "kind" || k == "comment" || (!unlit && (k == "sss_type" || k == "specular_profile"))) continue;
+    if (k == "kind" || k == "comment" || (slab && (k == "sss_type" || k == "specular_profile"))) continue;
     const std::optional<SlabPin> p = slabPinByName(k);
     if (!p || !bsdfTakesPin(node.kind, *p))
       d_.error(ptr + "/" + pointerToken(k),
-               unlit ? fmt::format("unknown pin {} for an unlit node (pins: emissive, transmittance, normal)",
-                                   quoteForDiagnostic(k))
-                     : fmt::format("unknown slab pin {}", quoteForDiagnostic(k)));
+               slab ? fmt::format("unknown slab pin {}", quoteForDiagnostic(k))
+                    : fmt::format("unknown pin {} for {} {} node (pins: {})", quoteForDiagnostic(k),
+                                  node.kind == BsdfKind::Unlit ? "an" : "a", bsdfKindName(node.kind),
+                                  pinListOf(node.kind)));
   }
-  // A pin the kind does not take keeps its default (an unlit's slab pins: nothing reads them).
+  // A pin the kind does not take keeps its default (an unlit's slab pins, a
+  // hair's normal: nothing reads them).
   for (int p = 0; p < kSlabPinCount; ++p)
     if (bsdfTakesPin(node.kind, static_cast<SlabPin>(p)))
       readSlabPin(index, j, ptr, p, node.slabPins[p]);
     else
       readSlabPin(index, Json::object(), ptr, p, node.slabPins[p]);
-  if (unlit) return;
+  if (!slab) return;
   if (auto it = j.find("sss_type"); it != j.end()) {
     const std::optional<SssType> t = enumOfJson(kSssTypeNames, *it, ptr + "/sss_type", d_);
     if (t) node.sssType = *t;

@@ -7,7 +7,7 @@ namespace substratec {
 void shareLocalBases(Material& m) {
   m.bases.clear();
   const TreeInfo info = analyzeTree(m);
-  // Anisotropic slabs first fix the (normal, tangent) pairs; isotropic slabs
+  // Anisotropic slabs (and a hair, whose tangent is the fibre's) first fix the (normal, tangent) pairs; isotropic slabs
   // then join any basis with their normal. Both loops run in closure order.
   auto findBasis = [&](ValueId n, ValueId t, bool anyTangent) -> int {
     for (std::size_t b = 0; b < m.bases.size(); ++b)
@@ -18,7 +18,7 @@ void shareLocalBases(Material& m) {
   for (int pass = 0; pass < 2; ++pass) {
     for (int s : info.slabOrder) {
       Slab& slab = m.slabs[s];
-      bool aniso = slab.features & kFeatAnisotropy;
+      bool aniso = slab.features & kTangentFeatures;  // its basis has a tangent
       if ((pass == 0) != aniso) continue;
       ValueId n = slab.pin(SlabPin::Normal);
       ValueId t = aniso ? slab.pin(SlabPin::Tangent) : kNoValue;

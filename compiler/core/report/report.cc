@@ -70,7 +70,12 @@ std::string formatReportText(const CompileResult& r) {
   o += fmt::format("----- BSDF features - {} -----\n", m.name);
   for (std::size_t i = 0; i < t.slabOrder.size(); ++i) {
     const Slab& s = m.slabs[t.slabOrder[i]];
-    o += fmt::format("BSDF {} ({}): {}\n", i, s.id, featureLine(s));
+    if (s.kind == BsdfKind::Hair)  // no slab feature applies: its lobes are one closure kind
+      o += fmt::format("BSDF {} ({}): Hair=1 Emissive={} Basis={} (a fibre: R, TT, TRT lobes and the rest; "
+                       "its basis stores the fibre's tangent)\n",
+                       i, s.id, (s.features & kFeatEmissive) ? 1 : 0, s.basis);
+    else
+      o += fmt::format("BSDF {} ({}): {}\n", i, s.id, featureLine(s));
   }
   for (int n : t.preorder)  // unlit leaves: no closure, no bytes
     if (isUnlitLeaf(m, m.nodes[n]))

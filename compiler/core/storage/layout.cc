@@ -24,7 +24,7 @@ void finishLayout(StorageLayout& L) {
   const int count = static_cast<int>(L.closures.size());
   const bool multi = count > 1;
   // Class.
-  if (all & (kFeatGlint | kFeatSpecularProfile)) L.layoutClass = LayoutClass::Special;
+  if (all & (kFeatGlint | kFeatSpecularProfile | kFeatHair)) L.layoutClass = LayoutClass::Special;
   else if (multi || (all & kFeatAnisotropy)) L.layoutClass = LayoutClass::Complex;
   else if (all || (count > 0 && L.closures[0].storesWeight)) L.layoutClass = LayoutClass::Single;
   else L.layoutClass = LayoutClass::Simple;
@@ -43,6 +43,7 @@ void finishLayout(StorageLayout& L) {
   add("header", bits::kHeader,
       multi        ? "layout class 2 | closure count-1 3 | basis count 4 | reserved 7"
       : count == 0 ? "layout class 2 (SIMPLE) | no closure (bit 14): an unlit material"
+      : (all & kFeatHair) ? "layout class 2 (SPECIAL) | feature bits 8 | sss type 2 | hair (bit 12) | reserved 3"
                    : "layout class 2 | feature bits 8 | sss type 2 | reserved 4");
   for (int i = 0; i < count; ++i) {
     const ClosureLayout& c = L.closures[i];
@@ -50,8 +51,12 @@ void finishLayout(StorageLayout& L) {
     if (multi)
       add(p + "header", bits::kClosureHeader,
           "basis id 3 | is top 1 | feature bits 8 | sss type 2 | extra interfaces 2", i);
-    add(p + "diffuse_albedo", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
-    add(p + "f0", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
+    add(p + "diffuse_albedo", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);  // a hair's base colour
+    if (c.storedFeatures & kFeatHair)  // a fibre has no F0: its lobes' own parameters instead
+      add(p + "hair", bits::kHair,
+          "azimuthal roughness unorm8 | (ior - 1) / 2 unorm8 | cuticle angle snorm8 over 20 deg | scatter unorm8", i);
+    else
+      add(p + "f0", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
     add(p + "roughness", bits::kRoughness, "unorm8", i);
     if (c.storesWeight) add(p + "weight", bits::kGreyWeight, "unorm8", i);
     if (!c.isTop) add(p + "top_transmittance", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
@@ -70,7 +75,7 @@ void finishLayout(StorageLayout& L) {
     const std::string p = fmt::format("basis{}.", b);
     bool anisotropic = false;
     for (const auto& c : L.closures)
-      if (c.basis == b && (c.storedFeatures & kFeatAnisotropy)) anisotropic = true;
+      if (c.basis == b && (c.storedFeatures & kTangentFeatures)) anisotropic = true;
     bool elided = !multi || (b == 0 && L.basis0NormalElided);
     if (!elided) add(p + "normal", bits::kNormal, "octahedral 2 x snorm16", -1, b);
     if (anisotropic) add(p + "tangent_angle", bits::kTangentAngle, "unorm14 of angle/2pi around the normal", -1, b);
@@ -165,7 +170,7 @@ std::vector<int> runtimeSimpleClosures(const Material& m, const StorageLayout& L
     if (f & kFeatHaze) possible = possible && pinVaries(s, SlabPin::SecondRoughnessWeight);
     if (f & kFeatFuzz) possible = possible && pinVaries(s, SlabPin::FuzzAmount);
     if (f & kFeatGlint) possible = possible && pinVaries(s, SlabPin::GlintValue);
-    if (f & kFeatSpecularProfile) possible = false;  // a static choice
+    if (f & (kFeatSpecularProfile | kFeatHair)) possible = false;  // a static choice; a fibre is never a slab
     if (possible) out.push_back(k);
   }
   return out;

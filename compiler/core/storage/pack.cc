@@ -239,6 +239,16 @@ void writeBits(std::vector<std::uint32_t>& words, std::size_t offset, int bits, 
 
 // ---- Materials ---------------------------------------------------------------
 
+std::uint32_t quantizeHair(const std::array<double, 4>& h, double dither) {
+  return quantizeUnorm(h[0], 8, dither) | (quantizeUnorm((h[1] - 1.0) / 2.0, 8, dither) << 8) |
+         (quantizeSnorm(h[2] / 20.0, 8, dither) << 16) | (quantizeUnorm(h[3], 8, dither) << 24);
+}
+
+std::array<double, 4> dequantizeHair(std::uint32_t code) {
+  return {dequantizeUnorm(code & 0xffu, 8), 1.0 + 2.0 * dequantizeUnorm((code >> 8) & 0xffu, 8),
+          20.0 * dequantizeSnorm((code >> 16) & 0xffu, 8), dequantizeUnorm(code >> 24, 8)};
+}
+
 std::uint32_t closureHeaderFeatures(const ClosureLayout& c) {
   std::uint32_t f = 0;
   if (c.storedFeatures & kFeatF90) f |= kClosureF90;
@@ -249,6 +259,7 @@ std::uint32_t closureHeaderFeatures(const ClosureLayout& c) {
   if (c.storedFeatures & kFeatSpecularProfile) f |= kClosureSpecularProfile;
   if (c.storesWeight) f |= kClosureWeight;
   if (c.storesCoverageAbove) f |= kClosureCoverageAbove;
+  if (c.storedFeatures & kFeatHair) f |= kClosureHair;  // beyond the 8 header bits: single-closure header bit 12
   return f;
 }
 
@@ -256,6 +267,7 @@ namespace {
 
 std::uint16_t featuresFromHeader(std::uint32_t f, std::uint32_t sssType) {
   std::uint16_t s = 0;
+  if (f & kClosureHair) s |= kFeatHair;
   if (f & kClosureF90) s |= kFeatF90;
   if (f & kClosureAnisotropy) s |= kFeatAnisotropy;
   if (f & kClosureHaze) s |= kFeatHaze;
@@ -330,6 +342,7 @@ struct PackedClosureField {
 const PackedClosureField kPackedClosureFields[] = {
     {"diffuse_albedo", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.diffuseAlbedo, d); }},
     {"f0", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.f0, d); }},
+    {"hair", bits::kHair, [](const ClosureValues& v, double d) { return quantizeHair(v.hair, d); }},
     {"roughness", bits::kRoughness, [](const ClosureValues& v, double d) { return quantizeUnorm(v.roughness, 8, d); }},
     {"weight", bits::kGreyWeight, [](const ClosureValues& v, double d) { return quantizeUnorm(v.weight, 8, d); }},
     {"top_transmittance", bits::kColor,
@@ -373,7 +386,7 @@ void putClosureHeader(const LayoutField& f, const ClosureLayout& c, const Closur
     throw std::invalid_argument(fmt::format("packMaterial: closure {} has {} extra interfaces (0 to 3)",
                                             f.closure, c.extraInterfaces));
   std::uint32_t h = static_cast<std::uint32_t>(c.basis) | (c.isTop ? 8u : 0u);
-  h |= closureHeaderFeatures(c) << 4;
+  h |= (closureHeaderFeatures(c) & 0xffu) << 4;
   h |= headerSssType(c, v) << 12;
   h |= static_cast<std::uint32_t>(c.extraInterfaces) << 14;
   put(bits::kClosureHeader, h);
@@ -414,6 +427,7 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
       } else {
         h |= (closureHeaderFeatures(layout.closures[0]) & 0x7fu) << 2;
         h |= headerSssType(layout.closures[0], closures[0]) << 10;
+        if (layout.closures[0].storedFeatures & kFeatHair) h |= packfmt::kHairHeaderBit;
       }
       put(16, h);
       continue;
@@ -513,6 +527,7 @@ ClosureLayout unpackClosureHeader(FieldReader& r, int i, std::uint32_t header, b
     c.isTop = true;
     feats = (header >> 2) & 0x7fu;
     sss = (header >> 10) & 3u;
+    if (header & packfmt::kHairHeaderBit) feats |= kClosureHair;
   }
   c.storesWeight = feats & kClosureWeight;
   c.storesCoverageAbove = feats & kClosureCoverageAbove;
@@ -546,7 +561,10 @@ void unpackClosure(FieldReader& r, int i, std::uint32_t header, bool multi, int 
   if (!c.isTop) v.coverageAbove = 1;  // below layers of static coverage 1 unless stored
 
   v.diffuseAlbedo = dequantizeColor(r.field(p + "diffuse_albedo", bits::kColor, i));
-  v.f0 = dequantizeColor(r.field(p + "f0", bits::kColor, i));
+  if (feats & kClosureHair)
+    v.hair = dequantizeHair(r.field(p + "hair", bits::kHair, i));
+  else
+    v.f0 = dequantizeColor(r.field(p + "f0", bits::kColor, i));
   v.roughness = dequantizeUnorm(r.field(p + "roughness", bits::kRoughness, i), 8);
   if (c.storesWeight) v.weight = dequantizeUnorm(r.field(p + "weight", bits::kGreyWeight, i), 8);
   if (!c.isTop) v.topTransmittance = dequantizeColor(r.field(p + "top_transmittance", bits::kColor, i));
@@ -604,7 +622,7 @@ UnpackedMaterial unpackMaterial(const std::uint32_t* words, std::size_t count, s
     const std::string p = fmt::format("basis{}.", b);
     bool anisotropic = false;
     for (const auto& c : L.closures)
-      if (c.basis == b && (c.storedFeatures & kFeatAnisotropy)) anisotropic = true;
+      if (c.basis == b && (c.storedFeatures & kTangentFeatures)) anisotropic = true;
     const bool elided = !multi || (b == 0 && topShare);
     BasisValues bv;
     bv.normal = elided ? out.topLayer.normal : dequantizeNormal(r.field(p + "normal", bits::kNormal, -1, b));

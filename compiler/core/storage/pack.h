@@ -47,6 +47,7 @@ enum ClosureFeatureBit : std::uint32_t {
   kClosureSpecularProfile = SUBSTRATE_FEATURE_SPECULAR_PROFILE,
   kClosureWeight = SUBSTRATE_FEATURE_WEIGHT,
   kClosureCoverageAbove = SUBSTRATE_FEATURE_COVERAGE_ABOVE,
+  kClosureHair = SUBSTRATE_FEATURE_HAIR,  // not a header feature bit: single-closure header bit 12
 };
 
 /// SSS types as stored (SUBSTRATE_SSS_*; the values of SssType).
@@ -57,6 +58,7 @@ inline constexpr std::uint32_t kSssTypeNone = SUBSTRATE_SSS_NONE, kSssTypeWrap =
 namespace packfmt {
 inline constexpr std::uint32_t kMultiClosureHeaderBit = 1u << 15;  // material header bit 15
 inline constexpr std::uint32_t kNoClosureHeaderBit = 1u << 14;  // single-closure header bit 14: an unlit pixel
+inline constexpr std::uint32_t kHairHeaderBit = 1u << 12;  // single-closure header bit 12: a hair closure
 inline constexpr int kMaxClosures = 8;     // closure count - 1 is 3 bits
 inline constexpr int kMaxBases = 8;        // basis id is 3 bits
 inline constexpr double kMfpLog2Min = -24.0;
@@ -73,6 +75,9 @@ struct ClosureValues {
   Vec3d f90{1, 1, 1};
   double roughness = 0.5;
   double anisotropy = 0;
+  /// A hair closure's (SubstrateClosure.hair): azimuthal roughness, ior,
+  /// cuticle angle in degrees, scatter; stored in place of f0.
+  std::array<double, 4> hair{0.5, 1.55, 2.0, 0.0};
   Vec3d sssMfp{0, 0, 0};  // meters, after sss_mfp_scale; 0 = no medium
   double sssPhaseAnisotropy = 0;
   std::uint32_t sssType = kSssTypeNone;
@@ -113,6 +118,11 @@ double dequantizeUnorm(std::uint32_t code, int bits);
 /// snorm over [-1, 1]: code = floor(s·x + s + u) in [0, 2s], s = 2^(bits-1) - 1.
 std::uint32_t quantizeSnorm(double x, int bits, double dither);
 double dequantizeSnorm(std::uint32_t code, int bits);
+
+/// Hair (32 bits): azimuthal roughness unorm8 (bits 0-7), (ior - 1) / 2
+/// unorm8 (8-15), cuticle angle / 20 degrees snorm8 (16-23), scatter unorm8 (24-31).
+std::uint32_t quantizeHair(const std::array<double, 4>& hair, double dither);
+std::array<double, 4> dequantizeHair(std::uint32_t code);
 
 /// Colour (20 bits): sqrt(saturate(c)) as unorm 7/7/6, r in bits 0-6, g 7-13, b 14-19.
 std::uint32_t quantizeColor(const Vec3d& c, double dither);

@@ -17,6 +17,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "reference/hair.h"
+#include "reference/hair_truth.h"
 #include "util/random.h"
 
 namespace substratec::accuracy {
@@ -64,6 +66,7 @@ std::vector<reference::Closure<double>> comparableClosures(const CompileResult& 
     c.features &= ~(reference::kFeatureGlint | reference::kFeatureSpecularProfile);
     c.glintValue = 1;
     c.specularProfile = 0;
+    c.hair[3] = 0;  // a hair's truth is one fibre: the dense-hair blend is not part of it
   }
   return closures;
 }
@@ -78,8 +81,10 @@ Rgb analyticAlbedo(const CompileResult& r, const reference::Geometry& g, const O
   for (std::size_t i = 0; i < closures.size(); ++i) {
     const reference::Closure<double>& c = closures[i];
     const Rgb t = reference::viewThroughput<double>(c, dot3(c.N, V), V);
-    const Rgb e = reference::envIntegrated(
-        c, V, [](const Rgb&) { return Rgb{1, 1, 1}; }, o.diffuseModel, o.envSamples, seedOf(o.seed, salt * 64 + i));
+    const Rgb e = (c.features & reference::kFeatureHair)  // a fibre scatters all around: the sphere
+                      ? reference::hairAlbedoIntegrated(c, V)
+                      : reference::envIntegrated(c, V, [](const Rgb&) { return Rgb{1, 1, 1}; }, o.diffuseModel,
+                                                 o.envSamples, seedOf(o.seed, salt * 64 + i));
     for (int k = 0; k < 3; ++k) sum[k] += t[k] * e[k];
   }
   return sum;
@@ -154,7 +159,50 @@ reference::WalkOptions walkOptions(int samples, std::uint32_t seed) {
   return o;
 }
 
+/// The hair closure of `r` when a hair BSDF is the whole material (else nullopt).
+std::optional<reference::Closure<double>> hairClosureOf(const CompileResult& r, const reference::Geometry& g) {
+  const auto closures = comparableClosures(r, g);
+  if (closures.size() != 1 || !(closures[0].features & reference::kFeatureHair)) return std::nullopt;
+  return closures[0];
+}
+
+/// A hair's truth (reference/hair_truth.h): pbrt-v4's HairBxDF at the
+/// closure's parameters (its absorption from the base colour as the runtime
+/// takes it, clamped alike), integrated over the fibre's width, by quadrature
+/// (exact figures: no standard error). The furnace is the same white fibre.
+Truth hairTruthOf(const CompileResult& authored, const Options& options) {
+  const std::vector<Rgb> grid = lightGrid(options);
+  Truth truth;
+  truth.brdfThreshold = options.brdfThreshold;
+  truth.rows.resize(kNoV.size());
+  parallelFor(kNoV.size(), options.threads, [&](std::size_t v) {
+    const reference::Geometry g = viewGeometry(kNoV[v]);
+    const reference::Closure<double> c = *hairClosureOf(authored, g);
+    const Rgb V{g.V[0], g.V[1], g.V[2]};
+    const double tl = std::sqrt(dot3(c.T_, c.T_));
+    const Rgb T{c.T_[0] / tl, c.T_[1] / tl, c.T_[2] / tl};  // unit (the walk's is already)
+    reference::HairParams p;
+    Rgb color;
+    for (int k = 0; k < 3; ++k) color[k] = std::clamp(c.diffuseAlbedo[k], 1e-6, 1.0);
+    p.betaM = c.roughness;
+    p.betaN = c.hair[0];
+    p.eta = std::max(c.hair[1], 1.0 + 1e-6);
+    p.alphaDeg = c.hair[2];
+    p.sigmaA = reference::hairSigmaAFromColor(color, p.betaN);
+    const double sinO = std::clamp(dot3(V, T), -1.0, 1.0);
+    TruthRow& row = truth.rows[v];
+    row.nov = kNoV[v];
+    row.albedo.value = reference::chiangAlbedo(p, sinO);
+    reference::HairParams white = p;
+    white.sigmaA = {0, 0, 0};
+    row.furnace = reference::Estimate{reference::chiangAlbedo(white, sinO), {0, 0, 0}, 1};
+    for (const Rgb& L : grid) row.grid.push_back({reference::chiangFarField(p, V, L, T), {0, 0, 0}, 1});
+  });
+  return truth;
+}
+
 Truth truthOf(const CompileResult& authored, const Options& options) {
+  if (hairClosureOf(authored, viewGeometry(1))) return hairTruthOf(authored, options);
   const std::vector<Rgb> grid = lightGrid(options);
   const std::size_t perView = grid.size() + 2;  // albedo, furnace, the grid
   const CompileResult furnace = reference::furnaceMaterial(authored);

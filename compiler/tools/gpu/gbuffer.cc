@@ -34,6 +34,7 @@ void copySharedFields(const From& from, To& to) {
   to.glintUv = from.glintUv;
   to.glintUvDerivatives = from.glintUvDerivatives;
   to.specularProfile = from.specularProfile;
+  to.hair = from.hair;
   to.weight = from.weight;
   to.topTransmittance = from.topTransmittance;
   to.coverageAbove = from.coverageAbove;
@@ -144,7 +145,7 @@ GbufferPixel packPixel(const CompileResult& r, const reference::Geometry& g, con
     BasisValues bv;
     bool found = false;
     for (std::size_t i = 0; i < L.closures.size(); ++i)
-      if (L.closures[i].basis == b && (!found || (L.closures[i].storedFeatures & kFeatAnisotropy))) {
+      if (L.closures[i].basis == b && (!found || (L.closures[i].storedFeatures & kTangentFeatures))) {
         bv = {ref.closures[i].N, ref.closures[i].T_};
         found = true;
       }

@@ -13,6 +13,7 @@
 #include <cstdint>
 
 #include "reference/common.h"
+#include "reference/hair.h"
 #include "reference/energy_lut.h"
 #include "substrate_constants.h"  // runtime_shaders/
 
@@ -936,6 +937,7 @@ V3<T> fuzzDiffusePairMean(const Closure<T>& c, T amount, const V3<T>& albedo) {
 // are compared side by side (the float instantiation must round as the shader).
 template <class T>
 V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffuseModel) {
+  if (c.features & kFeatureHair) return hairEval(c, V, L);  // a fibre: lit from every direction
   const V3<T> zero = splat3(T(0));
   V3<T> N = closureNormal(c);
   T NoVraw = dot(N, V);

@@ -46,6 +46,9 @@ class TreeExpansion {
       case TreeOp::Slab: {
         const Slab& s = m_.slabs[node.slab];
         if (s.kind == BsdfKind::Unlit) break;  // reflects nothing (and is never in a vertical)
+        // A fibre is no slab: its truth is reference/hair_truth.h (accuracy
+        // takes it from there); the walk has nothing of it.
+        if (s.kind == BsdfKind::Hair) break;
         double c = s.coverage == kNoValue ? 1.0 : saturate(scalar(s.coverage));
         out.push_back({c, {node.slab}});
         break;
@@ -362,6 +365,11 @@ namespace {
 void whitenSlab(const CompileResult& r, const LayerReader& reader, int index, Material& m) {
   ValueDag& dag = m.values;
   Slab& s = m.slabs[index];
+  if (s.kind == BsdfKind::Hair) {  // a white fibre: no absorption (base colour 1)
+    s.pin(SlabPin::BaseColor) = dag.splat(VType::Vec3, 1.0);
+    return;
+  }
+  if (s.kind == BsdfKind::Unlit) return;  // reflects nothing
   const WalkLayer L = reader.layer(index);
   const ValueId one3 = dag.splat(VType::Vec3, 1.0);
   s.pin(SlabPin::FuzzColor) = one3;

@@ -8,6 +8,7 @@
 
 #include "reference/bsdf.h"
 #include "reference/common.h"
+#include "reference/hair.h"
 #include "reference/energy_lut.h"
 #include "substrate_constants.h"  // runtime_shaders/
 #include "reference/reference.h"
@@ -109,6 +110,7 @@ T envMip(T roughness, T mipCount) {
 template <class T>
 V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredRadiance, const V3<T>& irradiance,
                   int diffuseModel /* the diffuse is albedo for every model; its coat factor is the model's */) {
+  if (c.features & kFeatureHair) return hairEnv(c, V, irradiance);  // a fibre's albedo times the mean radiance
   V3<T> N = closureNormal(c);
   T NoVraw = dot(N, V);
   if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));
@@ -157,6 +159,10 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
 template <class T>
 void translucency(const Closure<T>& c, T NoV, const V3<T>& V, T& coverage, V3<T>& transmittanceOut) {
   coverage = saturate(c.weight);
+  if (c.features & kFeatureHair) {  // a fibre covers what it covers
+    transmittanceOut = splat3(T(0));
+    return;
+  }
   T mu = clampT(NoV, K<T>::minCos, T(1));
   T dielectric;
   V3<T> specAlbedo = specularAlbedo(c, mu, dielectric);

@@ -296,6 +296,7 @@ class Walk {
     if (!cl.isTop) layersAbove(cl, tops, ca, va, ta);
 
     Closure<T> c;  // substrate_closure_init
+    if (s.kind == BsdfKind::Hair) return hairClosure(s);  // always the whole material: weight 1, on top
     c.diffuseAlbedo = vec3(s.pin(SlabPin::DiffuseAlbedo));
     // A slab layered on top scatters back only what it does not let through
     // (substrate_layer_scattering; the emitter skips it for a known-opaque
@@ -394,6 +395,21 @@ class Walk {
       if (extra > 0) tTop = tTop * extraInterfaces<T>(extra);
       layerAbove(ca, ta, C_[*it], tTop);
     }
+  }
+
+  /// emitHairClosure: a hair's pins into its closure.
+  Closure<T> hairClosure(const Slab& s) const {
+    Closure<T> c;
+    c.diffuseAlbedo = vec3(s.pin(SlabPin::BaseColor));
+    c.roughness = scalar(s.pin(SlabPin::Roughness));
+    c.N = tangentToWorld(vec3(s.pin(SlabPin::Normal)), gN_, gT_);
+    c.T_ = orthogonalTangent(c.N, tangentToWorld(vec3(s.pin(SlabPin::Tangent)), gN_, gT_));
+    c.hair = {scalar(s.pin(SlabPin::AzimuthalRoughness)), scalar(s.pin(SlabPin::Ior)),
+              scalar(s.pin(SlabPin::CuticleAngle)), scalar(s.pin(SlabPin::Scatter))};
+    if (has(s.features, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
+    c.features = kFeatureHair;
+    c.metalnessMix = m_.metalnessMix;
+    return c;
   }
 
   /// The pins of the slab's features into c; returns their feature bits.

@@ -12,6 +12,7 @@
 #include "pipeline/generate.h"
 #include "emit/kernel_emitter.h"
 #include "gpu/sample_run.h"
+#include "reference/hair.h"
 #include "reference/reference.h"
 
 namespace substratec::stability {
@@ -31,6 +32,7 @@ const std::vector<std::pair<std::string, std::vector<double>>>& kindTable() {
       {"roughness", {0, 1e-4, 0.02, 0.5, 1}}, {"anisotropy", {-1, 0, 1}},     {"f0", {0, 1}},
       {"f90", {0, 1}},                        {"albedo", {0, 1}},             {"coverage", {0, 1e-7, 1}},
       {"mfp", {0, 1e-9, 1e6}},                {"thickness", {0, 1e-9, 10}},
+      {"ior", {1, 1.0001, 3}},                {"cuticle_angle", {-20, 0, 20}},  // a hair's
   };
   return table;
 }
@@ -76,6 +78,13 @@ struct Rewriter {
       force(node, "f90", "f90", nullptr);
       force(node, "diffuse_albedo", "albedo", 0.18);
       force(node, "sss_mfp", "mfp", nullptr);
+    } else if (kind == "hair") {  // absorption 0 (white) and huge (black), every lobe width
+      force(node, "base_color", "albedo", 0.0);
+      force(node, "roughness", "roughness", 0.5);
+      force(node, "azimuthal_roughness", "roughness", 0.5);
+      force(node, "ior", "ior", 1.55);
+      force(node, "cuticle_angle", "cuticle_angle", 2.0);
+      force(node, "scatter", "coverage", 0.0);
     } else if (kind == "unlit") {
       force(node, "transmittance", "albedo", 1.0);  // 0 (opaque) and 1 (clear)
     } else if (kind == "vertical") {
@@ -339,7 +348,7 @@ bool runGpu(const CompileResult& r, const Grid& grid, const std::vector<Point>& 
       }
       gpu::Resources res = gpu::kernelResources(r.material, pipeline->reflection(), spirv, {},
                                                 gpu::sampleBuffer(samples), padded * stride, textures);
-      if (inputCount > 0) {
+      {  // bound even without inputs: the kernel declares it (a material of literals only)
         gpu::BufferResource buf;
         buf.data.resize(inputs.size() * sizeof(float));
         std::memcpy(buf.data.data(), inputs.data(), buf.data.size());
@@ -409,8 +418,11 @@ void furnace(const CompileResult& r, const Grid& grid, int samples, const refere
         cl.glintValue = 1;
         const double NoV = cl.N[0] * g.V[0] + cl.N[1] * g.V[1] + cl.N[2] * g.V[2];
         const V3 t = reference::viewThroughput<double>(cl, NoV, V3{g.V[0], g.V[1], g.V[2]});
-        const V3 e = reference::envIntegrated(
-            cl, g.V, [](const V3&) { return V3{1, 1, 1}; }, kDiffuseModel, samples, seed++);
+        // A fibre scatters all around: its albedo is over the sphere, by quadrature.
+        const V3 e = (cl.features & reference::kFeatureHair)
+                         ? reference::hairAlbedoIntegrated(cl, V3{g.V[0], g.V[1], g.V[2]})
+                         : reference::envIntegrated(
+                               cl, g.V, [](const V3&) { return V3{1, 1, 1}; }, kDiffuseModel, samples, seed++);
         for (int k = 0; k < 3; ++k) albedoSum[k] += t[k] * e[k];
       }
       const double a = std::max({albedoSum[0], albedoSum[1], albedoSum[2]});
