@@ -160,17 +160,58 @@ TEST(ImportCli, BadImportsExitOne) {
                       scratch("x").string()});
   EXPECT_EQ(plain.status, 1);
   EXPECT_NE(plain.err.find("import reads .gltf, .glb, .materials.json and .mtlx files"), std::string::npos);
-  CliRun hair = cli({"import", (kCorpus / "materialx/SimpleHair/simple_hair_default.mtlx").string(), "-o",
-                     scratch("y").string()});
-  EXPECT_EQ(hair.status, 1);
-  EXPECT_NE(hair.err.find("simple_hair_default.mtlx:44:6: error: chiang_hair_bsdf 'chiang_bsdf' in nodegraph "
-                          "'NG_simple_hair_shader': unsupported node 'chiang_hair_bsdf'"),
-            std::string::npos) << hair.err;
   CliRun missing = cli({"report", "no_such_file.gltf"});
   EXPECT_EQ(missing.status, 1);
   CliRun materialOnJson = cli({"report", "--material", "x", (fs::path(SUBSTRATEC_SOURCE_DIR) / "examples/car_paint.json").string()});
   EXPECT_EQ(materialOnJson.status, 1);
   EXPECT_NE(materialOnJson.err.find("--material chooses among the materials of"), std::string::npos);
+}
+
+// SimpleHair (the MaterialX corpus' hair): its simple_hair shader is a nodedef
+// whose graph ends in chiang_hair_bsdf, imported as the format's hair node
+// (docs/import.md, "chiang_hair_bsdf").
+TEST(ImportCli, SimpleHairImportsAsAHairNode) {
+  const fs::path out = scratch("hair");
+  CliRun r = cli({"import", (kCorpus / "materialx/SimpleHair/simple_hair_default.mtlx").string(), "-o", out.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("simple_hair_default.mtlx:44:6: warning: material \"simple_hair_default\": chiang_hair_bsdf "
+                       "'chiang_bsdf' in nodegraph 'NG_simple_hair_shader': roughness_R and absorption_coefficient: "
+                       "evaluated at import with the material inputs they read at their values (longitudinalRoughness, "
+                       "azimuthalRoughness, melaninConcentration, melaninRedness, baseColor, melaninMix)"),
+            std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("tint_"), std::string::npos) << r.err;         // the tints are white
+  EXPECT_EQ(r.err.find("roughness_TT"), std::string::npos) << r.err;  // pbrt's ratios: scale_TT 0.5, scale_TRT 2
+  std::ifstream in(out / "simple_hair_default.json");
+  const nlohmann::json doc = nlohmann::json::parse(in);
+  EXPECT_EQ(doc["output"], "hair");
+  const nlohmann::json& hair = doc["nodes"]["hair"];
+  EXPECT_EQ(hair["kind"], "hair");
+  // roughness_R = chiang_hair_roughness(0.1, 0.1)'s (v, s) = ((0.726·0.1 + 0.812·0.01 + 3.7·0.1^20)^2,
+  // 0.265·0.1 + 1.194·0.01 + 5.372·0.1^22) = (0.0065157184, 0.03844): inverted, the artist's 0.1 and 0.1.
+  EXPECT_DOUBLE_EQ(hair["roughness"].get<double>(), 0.1);
+  EXPECT_DOUBLE_EQ(hair["azimuthal_roughness"].get<double>(), 0.1);
+  // absorption_coefficient = mix(melanin, from_color(white) = 0, melaninMix 1) = deon_hair_absorption_from_melanin(0.5, 0.5):
+  //   melanin = −ln(1 − 0.5) = 0.693147, eumelanin = pheomelanin = 0.346574;
+  //   sigma = 0.346574 · ((0.419, 0.697, 1.37) + (0.187, 0.4, 1.05)) = (0.210024, 0.380191, 0.838708)
+  //   (−ln of MaterialX's default pigment colours (0.657704, 0.498077, 0.254107) and (0.829444, 0.67032, 0.349938));
+  //   P(0.1) = 5.969 − 0.0215 + 0.02532 − 0.01073 + 0.0005574 + 0.00000245 = 5.96264985;
+  //   base_color = exp(−sqrt(sigma) · P(0.1)) = exp(−(0.458283, 0.616597, 0.915810) · 5.96265)
+  //              = (0.0650511, 0.0253101, 0.00425078): dark brown.
+  ASSERT_EQ(hair["base_color"].size(), 3u);
+  EXPECT_NEAR(hair["base_color"][0].get<double>(), 0.0650511, 1e-6);
+  EXPECT_NEAR(hair["base_color"][1].get<double>(), 0.0253101, 1e-6);
+  EXPECT_NEAR(hair["base_color"][2].get<double>(), 0.00425078, 1e-7);
+  // ior and cuticleAngle stay inputs: ior 1.55, and (0.5 − cuticleAngle) · 180 = 0 degrees at 0.5.
+  EXPECT_EQ(hair["ior"], "$ior");
+  EXPECT_EQ(doc["inputs"]["ior"]["default"], 1.55);
+  EXPECT_EQ(doc["inputs"]["cuticleAngle"]["default"], 0.5);
+  EXPECT_EQ(hair["cuticle_angle"], nlohmann::json::parse(R"({"kind": "multiply", "a": {"kind": "subtract", "a": 0.5,
+                                                           "b": "$cuticleAngle"}, "b": 180.0})"));
+  EXPECT_FALSE(hair.contains("tangent"));  // curve_direction unconnected: the geometric tangent
+  // What was written is an ordinary material: report reads it back, one hair closure.
+  CliRun back = cli({"report", (out / "simple_hair_default.json").string()});
+  EXPECT_EQ(back.status, 0) << back.err;
+  EXPECT_NE(back.out.find("Op=HAIR"), std::string::npos) << back.out;
 }
 
 // --- issue 16 ----------------------------------------------------------------

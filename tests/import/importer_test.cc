@@ -3,6 +3,7 @@
 // located), and the mapping formulas, checked on the closures the CPU
 // reference evaluates from the imported material at its inputs' defaults.
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <iterator>
 #include <random>
@@ -15,6 +16,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "pipeline/generate.h"
 #include "import/glb_container.h"
@@ -575,6 +577,227 @@ TEST(MaterialXImport, ImagesAreTextureInputsAndProceduralsAreBaked) {
   bool tiled = false;
   for (const auto& uv : uvs) tiled |= std::fabs(uv[0] - 0.4) < 1e-12 && std::fabs(uv[1] - 0.6) < 1e-12;
   EXPECT_TRUE(tiled);  // uv · uvtiling
+}
+
+// chiang_hair_bsdf under a surface: the format's hair node (docs/import.md,
+// "chiang_hair_bsdf"); the expected values from the formulas of MaterialX's
+// genglsl implementation and of the hair node, worked here.
+namespace {
+
+/// Chiang 2016's eq. 9 denominator.
+double chiangP(double b) { return 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b + 5.574 * std::pow(b, 4) + 0.245 * std::pow(b, 5); }
+
+const char* const kHairSurface = R"(  <surface name="surf" type="surfaceshader">
+    <input name="bsdf" type="BSDF" nodename="fibre" />
+  </surface>
+  <surfacematerial name="Hair" type="material">
+    <input name="surfaceshader" type="surfaceshader" nodename="surf" />
+  </surfacematerial>
+)";
+
+const char* const kHairRoughness = R"(  <chiang_hair_roughness name="rough" type="multioutput">
+    <input name="longitudinal" type="float" %s />
+    <input name="azimuthal" type="float" value="%s" />
+    <output name="roughness_R" type="vector2" />
+    <output name="roughness_TT" type="vector2" />
+    <output name="roughness_TRT" type="vector2" />
+  </chiang_hair_roughness>
+)";
+
+std::string hairRoughness(const std::string& longitudinal, const std::string& azimuthal) {
+  char buf[1024];
+  std::snprintf(buf, sizeof buf, kHairRoughness, longitudinal.c_str(), azimuthal.c_str());
+  return buf;
+}
+
+const char* const kLobesOfRough = R"(    <input name="roughness_R" type="vector2" nodename="rough" output="roughness_R" />
+    <input name="roughness_TT" type="vector2" nodename="rough" output="roughness_TT" />
+    <input name="roughness_TRT" type="vector2" nodename="rough" output="roughness_TRT" />
+)";
+
+}  // namespace
+
+TEST(MaterialXImport, ChiangHairIsAHairNodeWithChiangsParameters) {
+  Imported r = mtlx(hairRoughness("value=\"0.3\"", "0.4") + R"(  <deon_hair_absorption_from_melanin name="melanin" type="vector3">
+    <input name="melanin_concentration" type="float" value="0.8" />
+    <input name="melanin_redness" type="float" value="0.2" />
+  </deon_hair_absorption_from_melanin>
+  <chiang_hair_bsdf name="fibre" type="BSDF">
+    <input name="tint_R" type="color3" value="0.9, 0.8, 0.7" />
+    <input name="ior" type="float" value="1.6" />
+    <input name="cuticle_angle" type="float" value="0.52" />
+)" + kLobesOfRough + R"(    <input name="absorption_coefficient" type="vector3" nodename="melanin" />
+  </chiang_hair_bsdf>
+)" + kHairSurface);
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  const auto doc = nlohmann::ordered_json::parse(m.text);
+  const auto& hair = doc["nodes"]["hair"];
+  ASSERT_EQ(hair["kind"], "hair") << m.text;
+  // roughness_R folds to chiang_hair_roughness's (v, s), inverted back to the artist's roughness.
+  EXPECT_EQ(hair["roughness"], 0.3);
+  EXPECT_EQ(hair["azimuthal_roughness"], 0.4);
+  // melanin = −ln(1 − 0.8); sigma = melanin · (0.8 · (0.419, 0.697, 1.37) + 0.2 · (0.187, 0.4, 1.05))
+  // = (0.599677, 1.02618, 2.10193); base colour exp(−sqrt(sigma) · P(0.4)) = (0.0116774, 0.00296365, 0.000240826).
+  const double melanin = -std::log(0.2);
+  const double eu[3] = {-std::log(0.657704), -std::log(0.498077), -std::log(0.254107)};
+  const double pheo[3] = {-std::log(0.829444), -std::log(0.67032), -std::log(0.349938)};
+  double color[3];
+  for (int i = 0; i < 3; ++i) color[i] = std::exp(-std::sqrt(melanin * (0.8 * eu[i] + 0.2 * pheo[i])) * chiangP(0.4));
+  EXPECT_NEAR(color[0], 0.0116774, 1e-7);
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(hair["base_color"][i].get<double>(), color[i], 1e-9 * color[i] + 1e-12);
+  // The tint is not represented; the lobes keep pbrt's ratios (the default scales): no warning for them.
+  EXPECT_NE(r.diags.find("t.mtlx:14:4: warning: material \"Hair\": chiang_hair_bsdf 'fibre': tint_R (0.9, 0.8, 0.7): "
+                         "the hair node has no per-lobe tint; ignored (white)"),
+            std::string::npos) << r.diags;
+  EXPECT_EQ(r.diags.find("roughness_T"), std::string::npos) << r.diags;
+  EXPECT_EQ(r.diags.find("evaluated at import"), std::string::npos) << r.diags;  // no material input is frozen
+  // The closure at the inputs' defaults: ior 1.6 and cuticle_angle 0.52 are inputs, the tilt
+  // (0.5 − 0.52) · 180 = −3.6 degrees (MaterialX's R lobe peaks at theta_i + theta_o = −2 alpha,
+  // the hair node's at +2 alpha: the opposite angle).
+  const auto c = closures(m, compiled(m));
+  ASSERT_EQ(c.size(), 1u);
+  expectNear3(c[0].diffuseAlbedo, color[0], color[1], color[2], 1e-9);
+  EXPECT_NEAR(c[0].roughness, 0.3, 1e-12);
+  EXPECT_NEAR(c[0].hair[0], 0.4, 1e-12);
+  EXPECT_NEAR(c[0].hair[1], 1.6, 1e-12);
+  EXPECT_NEAR(c[0].hair[2], -3.6, 1e-9);
+  EXPECT_NEAR(c[0].hair[3], 0.0, 1e-12);  // scatter: MaterialX has none
+}
+
+TEST(MaterialXImport, ChiangHairWarnsOfWhatTheHairNodeCannotExpress) {
+  // The nodedef's defaults: roughness_R (0.1, 0.1), TT (0.05, 0.05) and TRT (0.2, 0.2) are not pbrt's
+  // (variance / 4 and · 4, one azimuthal scale); cuticle_angle 0.9 is −72 degrees, ior 3.5 beyond the pin.
+  Imported r = mtlx(R"(  <image name="tex" type="color3"><input name="file" type="filename" value="tint.png" /></image>
+  <chiang_hair_bsdf name="fibre" type="BSDF">
+    <input name="tint_TT" type="color3" nodename="tex" />
+    <input name="ior" type="float" value="3.5" />
+    <input name="cuticle_angle" type="float" value="0.9" />
+  </chiang_hair_bsdf>
+)" + std::string(kHairSurface));
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  const auto doc = nlohmann::ordered_json::parse(m.text);
+  const auto& hair = doc["nodes"]["hair"];
+  // (v, s) = (0.1, 0.1) inverted: the roughness whose Chiang variance is 0.1, and scale 0.1.
+  const double b = hair["roughness"].get<double>(), a = hair["azimuthal_roughness"].get<double>();
+  EXPECT_NEAR(std::pow(0.726 * b + 0.812 * b * b + 3.7 * std::pow(b, 20), 2), 0.1, 1e-9) << b;
+  EXPECT_NEAR(0.265 * a + 1.194 * a * a + 5.372 * std::pow(a, 22), 0.1, 1e-9) << a;
+  EXPECT_EQ(hair["base_color"], nlohmann::ordered_json::parse("[1.0, 1.0, 1.0]"));  // no absorption: white
+  for (const char* w : {"tint_TT varies: the hair node has no per-lobe tint; not represented",
+                        "roughness_TT (0.05, 0.05): the hair node's lobe has R's / 4 longitudinal variance and R's "
+                        "azimuthal scale, (0.025, 0.1) here; the authored lobe is not represented",
+                        "roughness_TRT (0.2, 0.2): the hair node's lobe has R's * 4 longitudinal variance and R's "
+                        "azimuthal scale, (0.4, 0.1) here",
+                        "cuticle_angle 0.9 (-72 degrees of tilt): outside the hair node's [-20, 20] degrees; clamped",
+                        "ior 3.5: outside the hair node's [1, 3]; clamped"})
+    EXPECT_NE(r.diags.find(w), std::string::npos) << w << "\n" << r.diags;
+  EXPECT_EQ(r.diags.find("tint_R"), std::string::npos) << r.diags;
+  const auto c = closures(m, compiled(m));
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_NEAR(c[0].hair[1], 3.0, 1e-12);
+  EXPECT_NEAR(c[0].hair[2], -20.0, 1e-12);
+}
+
+TEST(MaterialXImport, ChiangHairFollowsVaryingInputsWithValueNodes) {
+  // A textured longitudinal roughness through chiang_hair_roughness is the roughness pin (clamped to
+  // what the BSDF's clamp of v to [0.001, 1] leaves); a textured colour through
+  // chiang_hair_absorption_from_color (its azimuthal roughness 0.2) is c^(P(0.3) / P(0.2)): no logarithm.
+  Imported r = mtlx(R"(  <image name="lmap" type="float"><input name="file" type="filename" value="l.png" /></image>
+  <image name="cmap" type="color3"><input name="file" type="filename" value="c.png" /></image>
+  <chiang_hair_absorption_from_color name="dye" type="vector3">
+    <input name="color" type="color3" nodename="cmap" />
+  </chiang_hair_absorption_from_color>
+)" + hairRoughness("nodename=\"lmap\"", "0.3") + R"(  <chiang_hair_bsdf name="fibre" type="BSDF">
+)" + kLobesOfRough + R"(    <input name="absorption_coefficient" type="vector3" nodename="dye" />
+  </chiang_hair_bsdf>
+)" + kHairSurface);
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  const auto doc = nlohmann::ordered_json::parse(m.text);
+  const auto& hair = doc["nodes"]["hair"];
+  EXPECT_EQ(hair["azimuthal_roughness"], 0.3);
+  EXPECT_EQ(hair["roughness"]["kind"], "clamp") << m.text;
+  EXPECT_EQ(hair["base_color"], "base_color") << m.text;
+  EXPECT_EQ(doc["nodes"]["base_color"]["kind"], "pow") << m.text;
+  EXPECT_EQ(r.diags.find("warning"), std::string::npos) << r.diags;  // same lobes as pbrt's, nothing frozen
+  // Textures read 0.5: roughness 0.5 (inside [0.0416, 0.7442]), colour 0.5^(P(0.3) / P(0.2)) = 0.503625.
+  const auto c = closures(m, compiled(m));
+  ASSERT_EQ(c.size(), 1u);
+  EXPECT_NEAR(c[0].roughness, 0.5, 1e-12);
+  const double k = std::pow(0.5, chiangP(0.3) / chiangP(0.2));
+  EXPECT_NEAR(k, 0.503625, 1e-6);
+  expectNear3(c[0].diffuseAlbedo, k, k, k, 1e-9);
+}
+
+TEST(MaterialXImport, ChiangHairAbsorptionThatVariesIsAColourOfValueNodes) {
+  // SimpleHair's graph with a textured melaninMix: the absorption (a mix of two constants by the
+  // texture) reaches base_color as exp(−sqrt(sigma) P(bn)), written pow(e, ·) (no exp op).
+  Imported r = mtlx(hairRoughness("value=\"0.2\"", "0.25") + R"(  <image name="mixmap" type="float"><input name="file" type="filename" value="m.png" /></image>
+  <deon_hair_absorption_from_melanin name="melanin" type="vector3">
+    <input name="melanin_concentration" type="float" value="0.5" />
+  </deon_hair_absorption_from_melanin>
+  <chiang_hair_absorption_from_color name="dye" type="vector3">
+    <input name="color" type="color3" value="0.6, 0.3, 0.2" />
+  </chiang_hair_absorption_from_color>
+  <mix name="both" type="vector3">
+    <input name="fg" type="vector3" nodename="melanin" />
+    <input name="bg" type="vector3" nodename="dye" />
+    <input name="mix" type="float" nodename="mixmap" />
+  </mix>
+  <chiang_hair_bsdf name="fibre" type="BSDF">
+)" + kLobesOfRough + R"(    <input name="absorption_coefficient" type="vector3" nodename="both" />
+  </chiang_hair_bsdf>
+)" + kHairSurface);
+  ASSERT_TRUE(r.materials) << r.diags;
+  const auto& m = (*r.materials)[0];
+  // melanin(0.5, redness 0.5) and from_color((0.6, 0.3, 0.2), 0.2), mixed half and half.
+  const double melanin = -std::log(0.5);
+  const double eu[3] = {-std::log(0.657704), -std::log(0.498077), -std::log(0.254107)};
+  const double pheo[3] = {-std::log(0.829444), -std::log(0.67032), -std::log(0.349938)};
+  const double dye[3] = {0.6, 0.3, 0.2};
+  double color[3];
+  for (int i = 0; i < 3; ++i) {
+    const double fromColor = std::pow(std::log(dye[i]) / chiangP(0.2), 2);
+    const double sigma = 0.5 * fromColor + 0.5 * melanin * 0.5 * (eu[i] + pheo[i]);
+    color[i] = std::exp(-std::sqrt(sigma) * chiangP(0.25));
+  }
+  const auto c = closures(m, compiled(m));
+  ASSERT_EQ(c.size(), 1u);
+  expectNear3(c[0].diffuseAlbedo, color[0], color[1], color[2], 1e-9);
+}
+
+TEST(MaterialXImport, ChiangHairInputsWithoutAValueNodeAreErrors) {
+  // A textured melanin concentration needs ln; a roughness_R of anything but chiang_hair_roughness
+  // that varies needs the polynomials' inverse; a surface of another BSDF has no import rule.
+  Imported r = mtlx(R"(  <image name="tex" type="float"><input name="file" type="filename" value="t.png" /></image>
+  <deon_hair_absorption_from_melanin name="melanin" type="vector3">
+    <input name="melanin_concentration" type="float" nodename="tex" />
+  </deon_hair_absorption_from_melanin>
+  <chiang_hair_bsdf name="fibre" type="BSDF">
+    <input name="absorption_coefficient" type="vector3" nodename="melanin" />
+  </chiang_hair_bsdf>
+  <convert name="r2" type="vector2"><input name="in" type="float" nodename="tex" /></convert>
+  <chiang_hair_bsdf name="fibre2" type="BSDF">
+    <input name="roughness_R" type="vector2" nodename="r2" />
+  </chiang_hair_bsdf>
+  <dielectric_bsdf name="glass" type="BSDF" />
+  <surface name="surf" type="surfaceshader"><input name="bsdf" type="BSDF" nodename="fibre" /></surface>
+  <surface name="surf2" type="surfaceshader"><input name="bsdf" type="BSDF" nodename="fibre2" /></surface>
+  <surface name="surf3" type="surfaceshader"><input name="bsdf" type="BSDF" nodename="glass" /></surface>
+  <surfacematerial name="A" type="material"><input name="surfaceshader" type="surfaceshader" nodename="surf" /></surfacematerial>
+  <surfacematerial name="B" type="material"><input name="surfaceshader" type="surfaceshader" nodename="surf2" /></surfacematerial>
+  <surfacematerial name="C" type="material"><input name="surfaceshader" type="surfaceshader" nodename="surf3" /></surfacematerial>
+)");
+  EXPECT_FALSE(r.materials);
+  for (const char* e : {"t.mtlx:4:4: error: deon_hair_absorption_from_melanin 'melanin': melanin_concentration or a "
+                        "pigment colour varies, and the absorption is its logarithm, which no "
+                        "value node computes",
+                        "t.mtlx:11:4: error: chiang_hair_bsdf 'fibre2': roughness_R varies: the hair node takes Chiang's "
+                        "roughness, and no value node inverts chiang_hair_roughness's polynomials",
+                        "t.mtlx:14:4: error: dielectric_bsdf 'glass': unsupported node 'dielectric_bsdf': a BSDF node is "
+                        "not a Substrate slab"})
+    EXPECT_NE(r.diags.find(e), std::string::npos) << e << "\n" << r.diags;
 }
 
 TEST(MaterialXImport, AMissingIncludeIsAnErrorAtTheInclude) {

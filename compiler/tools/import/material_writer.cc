@@ -213,16 +213,14 @@ bool isLiteral(const Value& v, double x) {
   return std::all_of(c->begin(), c->end(), [x](double y) { return y == x; });
 }
 
-namespace {
-
-/// Rounds away binary noise so that folded literals read like their source
-/// (0.1 * 3 is written 0.3): 12 significant digits.
 double tidy(double x) {
   if (x == 0 || !std::isfinite(x)) return x;
   const double scale = std::pow(10.0, 11 - static_cast<int>(std::floor(std::log10(std::fabs(x)))));
   const double r = std::round(x * scale) / scale;
   return std::isfinite(r) ? r : x;
 }
+
+namespace {
 
 /// Folds a component-wise operation on two literals with broadcasting, or nullopt.
 template <class F>

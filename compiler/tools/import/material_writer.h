@@ -142,6 +142,9 @@ bool isNull(const Value& v);
 std::optional<std::vector<double>> literalOf(const Value& v);
 /// True when `v` is a literal whose every component equals `x`.
 bool isLiteral(const Value& v, double x);
+/// `x` rounded to 12 significant digits: the binary noise of a computed
+/// literal rounded away, so that it reads like its source (0.1 * 3 is 0.3).
+double tidy(double x);
 /// A number (one component) or an array.
 Value literal(const std::vector<double>& c);
 Value literal3(double r, double g, double b);

@@ -8,6 +8,8 @@
 
 #include <fmt/format.h>
 
+#include "import/mtlx_hair.h"
+
 namespace substratec::import {
 
 namespace {
@@ -91,6 +93,26 @@ void MtlxValues::error(pugi::xml_node at, const std::string& what) {
 
 bool MtlxValues::given(pugi::xml_node shader, const std::string& name) const {
   return static_cast<bool>(shader.find_child_by_attribute("input", "name", name.c_str()));
+}
+
+Value MtlxValues::value(pugi::xml_node node, const std::string& name, const std::string& type,
+                       const std::vector<double>& def) {
+  return inputOf(node, name, type, def, false, 0).v;
+}
+
+std::pair<pugi::xml_node, std::string> MtlxValues::upstream(pugi::xml_node node, const std::string& name) const {
+  pugi::xml_node in = node.find_child_by_attribute("input", "name", name.c_str());
+  if (!in || !in.attribute("nodename")) return {};
+  pugi::xml_node n = resolveNodeName(node, str(in, "nodename"));
+  if (!n || std::string(n.name()) == "nodegraph") return {};
+  return {n, str(in, "output")};
+}
+
+std::vector<std::string> MtlxValues::frozenInputsSince(std::size_t count) const {
+  std::vector<std::string> names;
+  for (std::size_t i = count; i < frozenNames_.size(); ++i)
+    if (std::find(names.begin(), names.end(), frozenNames_[i]) == names.end()) names.push_back(frozenNames_[i]);
+  return names;
 }
 
 pugi::xml_node MtlxValues::resolveNodeName(pugi::xml_node user, const std::string& name) const {
@@ -218,7 +240,7 @@ MtlxValues::Typed MtlxValues::connection(pugi::xml_node input, const std::string
       if (!c) {
         pugi::xml_node src = instIn ? instIn : defIn;
         const auto v = src ? parseMtlxNumbers(str(src, "value")) : std::nullopt;
-        if (frozen && instIn) ++frozenReads_;
+        if (frozen && instIn) frozenNames_.push_back(iname);
         if (!v) error(input, fmt::format("interface input '{}' has no value", iname));
         else r = {frozen || !instIn ? mtlxLiteral(*v, type, str(src, "colorspace"))
                                     : valueInput(iname, type, *v, doc_.describe(instIn)),
@@ -236,7 +258,7 @@ MtlxValues::Typed MtlxValues::connection(pugi::xml_node input, const std::string
     Typed r = connection(gi, type, frozen, depth + 1, &c);
     if (c) return r;
     if (frozen) {
-      ++frozenReads_;
+      frozenNames_.push_back(iname);
       const auto v = parseMtlxNumbers(str(gi, "value"));
       if (!v) {
         error(gi, fmt::format("interface input '{}' has no value", iname));
@@ -455,6 +477,11 @@ struct MtlxValues::Call {
   Typed fold() const;
   std::optional<std::vector<double>> folded() const;
   Typed hsvToRgbNode() const;
+  // MaterialX's hair helpers (mtlx_hair.h): folded, else value nodes, else an error.
+  Typed hairHelper() const;
+  std::optional<std::vector<double>> hairFolded() const;
+  Typed hairRoughnessNode() const;
+  std::optional<Typed> melaninNode() const;
   // Nodes with value nodes.
   Typed constant() const;
   Typed convert() const;
@@ -518,7 +545,9 @@ const std::map<std::string, MtlxValues::Call::Rule>& MtlxValues::Call::rules() {
         {"separate3", &Call::extract}, {"separate4", &Call::extract}, {"swizzle", &Call::swizzleNode},
         {"normalmap", &Call::normalmap}, {"texcoord", &Call::texcoord}, {"place2d", &Call::place2d},
         {"position", &Call::geometric}, {"normal", &Call::geometric}, {"tangent", &Call::geometric},
-        {"bitangent", &Call::geometric}, {"geomcolor", &Call::geometric}};
+        {"bitangent", &Call::geometric}, {"geomcolor", &Call::geometric},
+        {"chiang_hair_roughness", &Call::hairHelper}, {"chiang_hair_absorption_from_color", &Call::hairHelper},
+        {"deon_hair_absorption_from_melanin", &Call::hairHelper}};
     for (const char* k : kProceduralKinds) t.emplace(k, &Call::procedural);
     for (const char* k : kFoldableKinds) t.emplace(k, &Call::fold);
     return t;
@@ -670,10 +699,10 @@ std::optional<std::vector<double>> MtlxValues::Call::constantIn(const char* name
 /// warning when that freezes a material input); else hsvtorgb written out,
 /// anything else baked.
 MtlxValues::Typed MtlxValues::Call::fold() const {
-  const int readsBefore = self.frozenReads_;
+  const std::size_t readsBefore = self.frozenReads();
   const std::optional<std::vector<double>> r = folded();
   if (r && std::all_of(r->begin(), r->end(), [](double v) { return std::isfinite(v); })) {
-    if (!frozen && self.frozenReads_ > readsBefore)
+    if (!frozen && self.frozenReads() > readsBefore)
       self.warn(node, fmt::format("{} has no value node: evaluated at import with the material inputs it reads at "
                                   "their values (changing them at run time does not change this)", kind));
     return {mtlxLiteral(*r, type, ""), type};
@@ -764,6 +793,113 @@ MtlxValues::Typed MtlxValues::Call::hsvToRgbNode() const {
   const Value rgb = mul(vlerp(literal3(1, 1, 1), saturate(sub(tri, 1.0)), swizzle(hsv, "y")), swizzle(hsv, "z"));
   self.warn(node, "hsvtorgb: written with abs and clamp (exact for hue in [-1/3, 1]; hue is clamped to it)");
   return {rgb, "color3"};
+}
+
+// ---- the hair helpers ----
+
+/// chiang_hair_roughness (one of its three outputs), chiang_hair_absorption_from_color
+/// and deon_hair_absorption_from_melanin: their value at import when their
+/// inputs are constants (a warning naming the material inputs that freezes);
+/// else chiang_hair_roughness's polynomials and the melanin's absorption
+/// (linear in the redness once the concentration and the pigment colours are
+/// constants) as value nodes; else an error: the rest takes the logarithm of
+/// what varies, and no value node computes one.
+MtlxValues::Typed MtlxValues::Call::hairHelper() const {
+  const bool roughness = kind == "chiang_hair_roughness";
+  const std::string t = roughness ? "vector2" : "vector3";
+  if (roughness && output != "roughness_R" && output != "roughness_TT" && output != "roughness_TRT") {
+    self.error(node, fmt::format("chiang_hair_roughness has no output '{}' (the connection names roughness_R, "
+                                 "roughness_TT or roughness_TRT)", output));
+    return none(t);
+  }
+  const std::size_t before = self.frozenReads();
+  Typed r = none(t);
+  if (auto folded = hairFolded()) {
+    for (double& x : *folded) x = tidy(x);
+    r = {literal(*folded), t};
+  } else if (frozen) {
+    return r;
+  } else if (roughness) {
+    r = hairRoughnessNode();
+  } else if (kind == "deon_hair_absorption_from_melanin") {
+    if (auto m = melaninNode()) r = *m;
+  }
+  if (r.v.is_null()) {  // an absorption helper whose logarithm varies
+    const bool melanin = kind == "deon_hair_absorption_from_melanin";
+    self.error(node, fmt::format("{} varies, and the absorption is its logarithm, which no value node computes (give "
+                                 "it a constant value{})",
+                                 melanin ? "melanin_concentration or a pigment colour" : "color",
+                                 melanin ? "" : ", or connect the node straight to chiang_hair_bsdf's absorption_coefficient"));
+    return r;
+  }
+  if (!frozen && self.frozenReads() > before) {
+    std::string names;
+    for (const auto& n : self.frozenInputsSince(before)) names += (names.empty() ? "" : ", ") + n;
+    self.warn(node, fmt::format("{} is evaluated at import with the material inputs it reads at their values ({}): "
+                                "changing them at run time does not change this", kind, names));
+  }
+  return r;
+}
+
+/// The hair helper's value from its inputs' constants (nullopt when one varies).
+std::optional<std::vector<double>> MtlxValues::Call::hairFolded() const {
+  auto vec = [](const auto& a) { return std::vector<double>(a.begin(), a.end()); };
+  auto rgb = [](const std::vector<double>& c) { return hair::Vec3{c[0], c[1], c[2]}; };
+  if (kind == "chiang_hair_roughness") {
+    const auto l = constantIn("longitudinal", "float", {0.1}), a = constantIn("azimuthal", "float", {0.2});
+    const auto tt = constantIn("scale_TT", "float", {0.5}), trt = constantIn("scale_TRT", "float", {2.0});
+    if (!l || !a || !tt || !trt) return std::nullopt;
+    const hair::LobeRoughness r = hair::chiangHairRoughness((*l)[0], (*a)[0], (*tt)[0], (*trt)[0]);
+    return vec(output == "roughness_TT" ? r.tt : output == "roughness_TRT" ? r.trt : r.r);
+  }
+  if (kind == "chiang_hair_absorption_from_color") {
+    const auto c = constantIn("color", "color3", {1, 1, 1}), b = constantIn("azimuthal_roughness", "float", {0.2});
+    if (!c || !b) return std::nullopt;
+    return vec(hair::absorptionFromColor(rgb(*c), (*b)[0]));
+  }
+  const auto k = constantIn("melanin_concentration", "float", {0.25}), r = constantIn("melanin_redness", "float", {0.5});
+  const auto eu = constantIn("eumelanin_color", "color3", {0.657704, 0.498077, 0.254107});
+  const auto ph = constantIn("pheomelanin_color", "color3", {0.829444, 0.67032, 0.349938});
+  if (!k || !r || !eu || !ph) return std::nullopt;
+  return vec(hair::absorptionFromMelanin((*k)[0], (*r)[0], rgb(*eu), rgb(*ph)));
+}
+
+/// chiang_hair_roughness on varying inputs: (v, s) of the output, v = (0.726 l
+/// + 0.812 l^2 + 3.7 l^20)^2 (times scale_TT^2 or scale_TRT^2), s = 0.265 a +
+/// 1.194 a^2 + 5.372 a^22, l and a clamped to [0.001, 1].
+MtlxValues::Typed MtlxValues::Call::hairRoughnessNode() const {
+  const std::string name = str(node, "name");
+  auto clamped = [&](const char* input, double def) {
+    return namedValue(self.w_, name + "_" + input,
+                      vclamp(in(input, "float", {def}), hair::kMinRoughness, hair::kMaxRoughness));
+  };
+  const Value l = clamped("longitudinal", 0.1), a = clamped("azimuthal", 0.2);
+  const Value d = namedValue(self.w_, name + "_deviation",
+                             add(add(mul(l, 0.726), mul(mul(l, l), 0.812)), mul(vpow(l, 20.0), 3.7)));
+  Value v = mul(d, d);
+  if (output != "roughness_R") {
+    const bool tt = output == "roughness_TT";
+    const Value scale = in(tt ? "scale_TT" : "scale_TRT", "float", {tt ? 0.5 : 2.0});
+    v = mul(v, mul(scale, scale));
+  }
+  const Value s = add(add(mul(a, 0.265), mul(mul(a, a), 1.194)), mul(vpow(a, 22.0), 5.372));
+  return {combine({v, s}), "vector2"};
+}
+
+/// deon_hair_absorption_from_melanin with a varying redness r: max(melanin ·
+/// lerp(−ln eumelanin_color, −ln pheomelanin_color, r), 0); nullopt when the
+/// concentration or a pigment colour varies.
+std::optional<MtlxValues::Typed> MtlxValues::Call::melaninNode() const {
+  const auto k = constantIn("melanin_concentration", "float", {0.25});
+  const auto eu = constantIn("eumelanin_color", "color3", {0.657704, 0.498077, 0.254107});
+  const auto ph = constantIn("pheomelanin_color", "color3", {0.829444, 0.67032, 0.349938});
+  if (!k || !eu || !ph) return std::nullopt;
+  const hair::Vec3 e{(*eu)[0], (*eu)[1], (*eu)[2]}, p{(*ph)[0], (*ph)[1], (*ph)[2]};
+  const double melanin = hair::melaninAmount((*k)[0]);
+  const hair::Vec3 allEu = hair::pigmentAbsorption(melanin, e), allPheo = hair::pigmentAbsorption(melanin, p);
+  const Value r = in("melanin_redness", "float", {0.5});
+  return Typed{vmax(vlerp(literal3(allEu[0], allEu[1], allEu[2]), literal3(allPheo[0], allPheo[1], allPheo[2]), r), 0.0),
+               "vector3"};
 }
 
 // ---- nodes with value nodes ----

@@ -12,6 +12,10 @@
 //     evaluated at import when their inputs are constants (a warning when that
 //     freezes an input), and procedural noises (or such nodes on varying
 //     inputs) replaced by a texture input to bake them into (a warning);
+//   the hair helpers (chiang_hair_roughness, chiang_hair_absorption_from_color,
+//     deon_hair_absorption_from_melanin; mtlx_hair.h): evaluated at import
+//     when their inputs are constants, else value nodes where the format has
+//     the operations, else an error (a logarithm of what varies);
 //   anything else: an error naming the node and its line.
 // Values the document gives on a shading node or a node graph's interface
 // become material inputs named after them (docs/import.md, "MaterialX").
@@ -48,6 +52,16 @@ class MtlxValues {
                                               const std::vector<double>& def);
   /// True when the document sets or connects the input.
   bool given(pugi::xml_node shader, const std::string& name) const;
+  /// Input `name` of a node inside a graph as the graph reads it (its value a
+  /// literal, not a material input as param() makes a shading node's).
+  Value value(pugi::xml_node node, const std::string& name, const std::string& type, const std::vector<double>& def);
+  /// The node input `name` of `node` reads with `nodename` (in its scope; not
+  /// a node graph), and which of its outputs; a null node otherwise.
+  std::pair<pugi::xml_node, std::string> upstream(pugi::xml_node node, const std::string& name) const;
+  /// Material inputs read at their values so far (by constant(), by frozen
+  /// folds): a count, and the names read since a count (each once, in order).
+  std::size_t frozenReads() const { return frozenNames_.size(); }
+  std::vector<std::string> frozenInputsSince(std::size_t count) const;
 
   void warn(pugi::xml_node at, const std::string& what);
   void error(pugi::xml_node at, const std::string& what);
@@ -104,7 +118,7 @@ class MtlxValues {
   std::map<std::string, Value> samples_;    // input + uv -> sample node
   std::map<std::string, Value> interface_;  // graph input -> "$input"
   std::set<std::string> warned_;
-  int frozenReads_ = 0;  // interface/shader inputs read at their values (frozen evaluation)
+  std::vector<std::string> frozenNames_;  // interface inputs read at their values (frozen evaluation), one per read
 };
 
 /// A MaterialX value (`type` components) as a literal; colours given in

@@ -6,6 +6,8 @@
 //   mtlx_gltf_pbr.cc              MaterialX's gltf_pbr (through gltf_pbr.h)
 //   mtlx_usd_preview_surface.cc   UsdPreviewSurface
 //   mtlx_disney_principled.cc     Disney principled (2015)
+// and a `surface` of MaterialX's chiang_hair_bsdf, written straight as the
+// format's hair node (chiangHairSurface in mtlx_import.cc; mtlx_hair.h).
 #pragma once
 #include <pugixml.hpp>
 
@@ -19,6 +21,8 @@ LayeredSurface openPbrSurface(pugi::xml_node shader, MtlxValues& v, MaterialWrit
 LayeredSurface mtlxGltfPbr(pugi::xml_node shader, MtlxValues& v, MaterialWriter& w);
 LayeredSurface usdPreviewSurface(pugi::xml_node shader, MtlxValues& v, MaterialWriter& w);
 LayeredSurface disneyPrincipled(pugi::xml_node shader, MtlxValues& v, MaterialWriter& w);
+/// A `surface` whose bsdf is a chiang_hair_bsdf: the hair node, the output of `w`.
+void chiangHairSurface(pugi::xml_node surface, pugi::xml_node bsdf, MtlxValues& v, MaterialWriter& w);
 
 // Shared by the units: MaterialX's roughness_anisotropy (Standard Surface):
 // a = max(r², ε), aspect = sqrt(1 − min(A, 0.98)), at = min(a / aspect, 1),
