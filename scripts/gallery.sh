@@ -89,7 +89,8 @@ EOF
   echo "Every example in \`examples/\`, rendered by \`substratec preview FILE --size 128\` on lavapipe"
   echo "(the generated GLSL preview kernel: render's key light and the procedural \"studio\" environment,"
   echo "exposed and white-balanced so that a Lambertian lands on its albedo at the centre; each texture"
-  echo "bound to its input's \`file\` or, without one, to its neutral texel: docs/textures.md)."
+  echo "bound to its input's \`file\` or, without one, to its neutral texel: docs/textures.md). A volume"
+  echo "(\`fog_*\`: a volumetric fog cloud) is marched through the cube [-1.2, 1.2]^3 instead of a sphere."
   echo "Regenerate with \`scripts/gallery.sh\`."
   echo
   echo "| | | | |"

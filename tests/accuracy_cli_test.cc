@@ -79,3 +79,33 @@ TEST(AccuracyCli, ABadFileFailsWithAMessage) {
 }
 
 }  // namespace
+
+// A volume (a volumetric fog cloud) has no BRDF: its accuracy is its march
+// against step counts and its froxel payload's error (accuracy/fog_accuracy.h).
+TEST(AccuracyCli, AVolumeReportsItsMarchAgainstStepCounts) {
+  CliResult r = cli({"accuracy", kSourceDir + "/examples/fog_cloud_puff.json", "--json"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["domain"], "volume");
+  EXPECT_EQ(j["bytes_per_froxel"], 12);
+  EXPECT_GT(j["rays"].get<int>(), 0);
+  ASSERT_EQ(j["rows"].size(), 6u);
+  EXPECT_LT(j["rows"][5]["max_rel_error"].get<double>(), j["rows"][0]["max_rel_error"].get<double>());
+  CliResult black = cli({"accuracy", kSourceDir + "/examples/fog_cloud_puff.json"});
+  EXPECT_NE(black.out.find("steps  median rel err"), std::string::npos) << black.out;
+}
+
+// The commands that shade a surface refuse a volume, saying what it has instead.
+TEST(AccuracyCli, SurfaceCommandsRefuseAVolumeAndSayWhy) {
+  const std::string fog = kSourceDir + "/examples/fog_neon_haze.json";
+  for (const std::vector<std::string>& args :
+       {std::vector<std::string>{"preview", fog, "-o", "unused.png"}, std::vector<std::string>{"sweep", fog},
+        std::vector<std::string>{"stability", fog, "--no-gpu"}}) {
+    CliResult r = cli(args);
+    EXPECT_EQ(r.status, 1) << args[0];
+    EXPECT_NE(r.err.find("'fog_neon_haze' is a volume (volumetric fog cloud 'haze'): " +
+                         std::string(args[0] == "stability" ? "stability's grid" : args[0]) + " shades surfaces"),
+              std::string::npos)
+        << r.err;
+  }
+}

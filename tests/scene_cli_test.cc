@@ -180,6 +180,32 @@ TEST(Scene, TheOutputIsTheSameWhateverJobsCompileIt) {
       << "the SIMPLE shader lights the pixels dynamic simplification stores SIMPLE";
 }
 
+// A volume (a volumetric fog cloud) in a scene: its files are written, but it
+// stores no pixel, so the lighting and the largest material buffer are the
+// surfaces' alone; a scene of volumes only has nothing to light.
+TEST(Scene, AVolumeIsCompiledButTheLightingIsTheSurfaces) {
+  const fs::path work = freshDir("volume");
+  fs::create_directories(work);
+  const std::string plaster = (kSource / "examples" / "scenes" / "materials" / "plaster.json").string();
+  const std::string fog = (kSource / "examples" / "fog_cloud_puff.json").string();
+  std::ofstream(work / "mixed.json") << R"({"format": "substrate-scene/1", "name": "mixed", "materials": [")" + plaster +
+                                            R"(", ")" + fog + R"("]})";
+  CliResult r = cli({"scene", (work / "mixed.json").string(), "-o", (work / "out").string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_TRUE(fs::exists(work / "out" / "fog_cloud_puff.volume.comp"));
+  const auto j = sceneJson(work / "out");
+  EXPECT_EQ(j["max_bytes_per_pixel"], j["materials"][0]["bytes_per_pixel"]) << "the plaster's: the volume's froxel is not a pixel";
+  EXPECT_EQ(j["materials"][1]["layout"], "VOLUME");
+  for (const auto& k : j["lighting"])
+    for (const auto& name : k["materials"]) EXPECT_NE(name, "fog_cloud_puff") << k.dump();
+
+  std::ofstream(work / "only.json") << R"({"format": "substrate-scene/1", "name": "only", "materials": [")" + fog + R"("]})";
+  CliResult only = cli({"scene", (work / "only.json").string(), "-o", (work / "out2").string()});
+  EXPECT_EQ(only.status, 1);
+  EXPECT_NE(only.err.find("every material of the scene is a volume"), std::string::npos) << only.err;
+  EXPECT_FALSE(fs::exists(work / "out2"));
+}
+
 TEST(Scene, EveryMistakeIsLocatedAndNothingIsWritten) {
   const fs::path work = freshDir("bad");
   fs::create_directories(work);

@@ -19,6 +19,7 @@
 #include <fmt/format.h>
 
 #include "accuracy/accuracy.h"
+#include "accuracy/fog_accuracy.h"
 #include "batch/batch.h"
 #include "format/json_document.h"
 #include "cli/cli_options.h"
@@ -266,6 +267,17 @@ int compileFailure(const import::MaterialSource& s, std::ostream& err) {
 
 /// The material at each simplification step (preview --sweep, sweep), and
 /// unsimplified in `full`.
+/// The commands that shade surfaces (sweep, render, stability's grid)
+/// refuse a volume (a volumetric fog cloud, isVolumeMaterial) with a
+/// located message naming what it has instead; kExitOk for a surface.
+int rejectVolume(const Material& m, const std::string& where, std::string_view command, std::ostream& err) {
+  if (!isVolumeMaterial(m)) return kExitOk;
+  return printError(err, kExitBadInput,
+                    fmt::format("{}: '{}' is a volume (volumetric fog cloud '{}'): {} shades surfaces; `compile` "
+                                "writes its froxel pass ({}.volume.comp), `accuracy` measures its march",
+                                where, m.name, m.nodes[m.root].id, command, m.name));
+}
+
 int simplificationSteps(const import::MaterialSource& s, const CompileOptions& o, std::vector<sweep::Step>& steps,
                         CompileResult& full, std::ostream& err) {
   Diagnostics failure(s.displayName);  // printed as the compile's own diagnostics
@@ -883,6 +895,7 @@ int compileRenderMaterials(const RenderArgs& a, const render::SceneSources& s, c
     auto r = compileText(src.displayName, src.text, o, diags);
     err << diags.formatAll();
     if (!r) return compileFailure(src, err);
+    if (int volume = rejectVolume(r->material, src.displayName, "render", err); volume != kExitOk) return volume;
     (*results)[i] = std::move(*r);
     // --texture NAME=PATH binds every material's input NAME; a NAME no material has is an error below.
     TextureFlags flags{{}, a.textures.searchPaths};
@@ -1055,6 +1068,8 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   std::vector<sweep::Step> steps;
   CompileResult full;
   if (int failed = simplificationSteps(sources->front(), o, steps, full, err); failed != kExitOk) return failed;
+  if (int volume = rejectVolume(full.material, sources->front().displayName, "sweep", err); volume != kExitOk)
+    return volume;
   auto ctx = openGpu(a.precision, "sweep times the generated code on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
   sweep::Options so;
@@ -1099,6 +1114,20 @@ void addAccuracyOptions(CLI::App* c, AccuracyArgs& a) {
   addMaxInputSize(c, a.compile);
 }
 
+/// `accuracy` of a volume (accuracy/fog_accuracy.h): its march against step
+/// counts, and its froxel payload's error; no ray to compare (nothing emits or
+/// scatters) is bad input, like a black truth.
+int volumeAccuracy(const import::MaterialSource& s, const CompileResult& r, bool json, std::ostream& out,
+                   std::ostream& err) {
+  const accuracy::FogReport report = accuracy::fogAccuracy(r.material, r.after.bytes());
+  out << (json ? accuracy::fogJson(report).dump(2) + "\n" : accuracy::formatFogTable(report));
+  if (report.rays > 0) return kExitOk;
+  return printError(err, kExitBadInput,
+                    fmt::format("{}: no accuracy to report: no ray through the volume has any radiance (the medium "
+                                "neither emits nor scatters)",
+                                s.displayName));
+}
+
 /// `accuracy`: the material as compiled (its settings, --budget,
 /// --full-simplification) against the Monte Carlo truth of the authored
 /// material (compiled without simplification) and, when they differ, against
@@ -1118,6 +1147,7 @@ int runAccuracy(const AccuracyArgs& a, std::ostream& out, std::ostream& err) {
   if (!compiled) return compileFailure(s, err);
   auto authored = compileText(s.displayName, s.text, unsimplified, ignored);  // compiled: so does the authored tree
   if (!authored) return printInternalError(err, "the unsimplified material does not compile: " + ignored.errorMessages());
+  if (isVolumeMaterial(authored->material)) return volumeAccuracy(s, *authored, a.json, out, err);
   if (authored->after.closures.empty())  // unlit nodes only: nothing reflects, so there is no BRDF to measure
     return printError(err, kExitBadInput,
                       fmt::format("{}: no accuracy to report: the material has no closure (unlit nodes only): it "
@@ -1185,10 +1215,13 @@ StabilityOutcome stabilityOf(const import::MaterialSource& source, const Compile
                              const stability::Options& so, gpu::Context* ctx, std::ostream& err) {
   {  // The material as written: its diagnostics name its own lines.
     Diagnostics diags(source.displayName);
-    if (!compileText(source.displayName, source.text, o, diags)) {
+    auto written = compileText(source.displayName, source.text, o, diags);
+    if (!written) {
       err << diags.formatAll();
       return {compileFailure(source, err), false, std::nullopt};
     }
+    if (int volume = rejectVolume(written->material, source.displayName, "stability's grid", err); volume != kExitOk)
+      return {volume, false, std::nullopt};
   }
   std::string forceable;
   std::vector<stability::ForcedKind> kinds;

@@ -28,6 +28,7 @@
 
 #include "pipeline/generate.h"
 #include "material_fixture.h"
+#include "../examples.h"
 
 namespace substratec::gputest {
 namespace {
@@ -49,9 +50,7 @@ constexpr Variant kVariants[] = {{"full_budget", 0, false}, {"budget_48", 48, fa
 
 std::vector<std::string> exampleStems() {
   std::vector<std::string> stems;
-  for (const auto& e : fs::directory_iterator(fs::path(SUBSTRATEC_SOURCE_DIR) / "examples"))
-    if (e.path().extension() == ".json") stems.push_back(e.path().stem().string());
-  std::sort(stems.begin(), stems.end());
+  for (const fs::path& e : test::exampleFiles(test::Examples::Surfaces)) stems.push_back(e.stem().string());
   return stems;
 }
 

@@ -85,6 +85,29 @@ TEST(Preview, WritesAnSrgbPngOfTheSphere) {
   EXPECT_EQ(centre[3], 255);
 }
 
+// A volume has no sphere: its preview marches the cube around the origin
+// (kernel_emitter.h, kVolumePreview*). The puff is opaque at its centre and
+// absent at the corners, where the environment shows; both languages agree.
+TEST(Preview, AVolumeIsMarchedThroughItsCube) {
+  const fs::path dir = workDir();
+  const fs::path png = dir / "puff.png";
+  CliRun r = cli({"preview", example("fog_cloud_puff.json"), "-o", png.string(), "--size", "48"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  Png img;
+  ASSERT_TRUE(readPng(png, &img));
+  auto at = [&](int x, int y) { return &img.rgba[(static_cast<std::size_t>(y) * img.width + x) * 4]; };
+  const unsigned char* centre = at(24, 24);
+  const unsigned char* corner = at(1, 1);
+  EXPECT_GT(centre[3], 230) << "optical depth 4 through the centre: 98 % covered";
+  EXPECT_EQ(corner[3], 0) << "outside the cube: the environment alone";
+  EXPECT_NE(std::vector<unsigned char>(centre, centre + 3), std::vector<unsigned char>(corner, corner + 3));
+  ASSERT_EQ(cli({"preview", example("fog_cloud_puff.json"), "-o", (dir / "puff_hlsl.png").string(), "--size", "48",
+                 "--target", "hlsl"})
+                .status,
+            0);
+  EXPECT_EQ(bytesOf(png), bytesOf(dir / "puff_hlsl.png"));
+}
+
 TEST(Preview, TheSameCommandTwiceAndBothLanguagesGiveTheSameBytes) {
   const fs::path dir = workDir();
   ASSERT_EQ(cli({"preview", example("worked_example_72.json"), "-o", (dir / "a.png").string(), "--size", "48"}).status, 0);

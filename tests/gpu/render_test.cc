@@ -23,6 +23,7 @@
 
 #include "batch/batch.h"
 #include "cli/cli.h"
+#include "../examples.h"
 #include "import/gltf_resources.h"
 #include "material_fixture.h"
 #include "mesh/gltf_mesh.h"
@@ -137,9 +138,7 @@ std::vector<double> relativeDifferences(const render::RenderResult& a, const ren
 
 std::vector<std::string> everyExampleStem() {
   std::vector<std::string> stems;
-  for (const auto& e : fs::directory_iterator(kSource / "examples"))
-    if (e.path().extension() == ".json") stems.push_back(e.path().stem().string());
-  std::sort(stems.begin(), stems.end());
+  for (const fs::path& e : test::exampleFiles(test::Examples::Surfaces)) stems.push_back(e.stem().string());
   return stems;
 }
 

@@ -16,6 +16,7 @@
 
 #include "cli/cli.h"
 #include "pipeline/generate.h"
+#include "../examples.h"
 #include "gpu/sample_run.h"
 #include "../stack_furnace.h"
 #include "material_fixture.h"
@@ -183,9 +184,7 @@ void expectHalfAgreesWithFloat32(const std::string& name) {
 
 std::vector<std::string> exampleNames() {
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(fs::path(SUBSTRATEC_SOURCE_DIR) / "examples"))
-    if (e.path().extension() == ".json") names.push_back(e.path().filename().string());
-  std::sort(names.begin(), names.end());
+  for (const fs::path& e : test::exampleFiles(test::Examples::Surfaces)) names.push_back(e.filename().string());
   return names;
 }
 

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Validates every tests/golden/*.expected.layout.json against
 schema/substrate-layout.schema.json, and checks each file's arithmetic
-(offsets contiguous, words = ceil(bits/32), bytes = 4*words + 4)."""
+(offsets contiguous, words = ceil(bits/32), bytes = 4*words + 4 top-layer bytes,
+or 4*words for a VOLUME layout's froxel, which has no top layer)."""
 import glob, json, os, sys
 
 import jsonschema
@@ -20,7 +21,10 @@ for path in files:
         if f["offset"] != offset or f["word"] != offset // 32 or f["shift"] != offset % 32:
             problems.append(f"field {f['name']} is not at offset {offset}")
         offset += f["bits"]
-    if offset != doc.get("bits") or doc.get("words") != (offset + 31) // 32 or doc.get("bytes_per_pixel") != 4 * doc.get("words", 0) + 4:
+    top = 0 if doc.get("layout") == "VOLUME" else 4
+    if doc.get("top_layer", {}).get("bits") != 8 * top:
+        problems.append("the top-layer word is not what the layout class says")
+    if offset != doc.get("bits") or doc.get("words") != (offset + 31) // 32 or doc.get("bytes_per_pixel") != 4 * doc.get("words", 0) + top:
         problems.append("bits/words/bytes do not add up")
     name = os.path.basename(path)
     if problems:

@@ -16,6 +16,7 @@
 #include "reference/common.h"
 #include "reference/ground_truth.h"
 #include "test_util.h"
+#include "../examples.h"
 
 namespace substratec {
 namespace {
@@ -79,13 +80,7 @@ TEST(RandomWalkGroundTruth, TheTreeIsAWeightedSumOfStacks) {
   EXPECT_DOUBLE_EQ(t[1].stack[1].roughness, 0.6);
 }
 
-std::vector<std::filesystem::path> examples() {
-  std::vector<std::filesystem::path> files;
-  for (const auto& e : std::filesystem::directory_iterator(SUBSTRATEC_SOURCE_DIR "/examples"))
-    if (e.path().extension() == ".json") files.push_back(e.path());
-  std::sort(files.begin(), files.end());
-  return files;
-}
+std::vector<std::filesystem::path> examples() { return test::exampleFiles(test::Examples::Surfaces); }
 
 std::string readText(const std::filesystem::path& p) {
   std::ifstream in(p);

@@ -23,8 +23,19 @@ std::string emitBasePassEntry(const Material& m, const StorageLayout& layout, co
 std::string emitPackFunction(const Material& m, const StorageLayout& layout, const Syntax& syn,
                              bool dynamicSimplification = true);
 
+/// A volume's entry (isVolumeMaterial; it has no forward or base pass): the
+/// froxel pass, a compute shader that samples the medium at the centre of
+/// every froxel of a grid and stores its payload (docs/codegen.md, "Volumes").
+/// Set 0: binding 0 the grid (SubstrateVolumeGrid: origin, cell size, counts),
+/// binding 1 the froxels (uint words, `<NAME>_WORD_COUNT` a froxel, x fastest,
+/// then y, then z). Dispatched as ceil(n.x n.y / kVolumeLocalSize) x n.z groups:
+/// a row of groups a slice.
+std::string emitVolumeEntry(const Material& m, const StorageLayout& layout, const Syntax& syn);
+inline constexpr int kVolumeLocalSize = 64;  // invocations a group, one froxel each
+
 /// File names: `<name>.forward.frag` / `<name>.forward.ps.hlsl`, ...
 std::string forwardFileName(const Material& m, const Syntax& syn);
 std::string basePassFileName(const Material& m, const Syntax& syn);
+std::string volumeFileName(const Material& m, const Syntax& syn);  // `<name>.volume.comp` / `.volume.cs.hlsl`
 
 }  // namespace substratec

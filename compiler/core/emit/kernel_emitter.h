@@ -85,6 +85,12 @@ inline constexpr int kPreviewParamVec4s = 2 + 2 * kPreviewLights;
 /// the texture p_<input> at set 1, binding kPreviewProfileBinding + k (HLSL's
 /// sampler ps_<input> at 16 more), above the material's own textures.
 inline constexpr int kPreviewProfileBinding = 40;
+/// A volume's preview (isVolumeMaterial): the cube [-extent, extent]^3 around
+/// the origin, marched in kVolumePreviewSteps steps, each lit by the key light
+/// through kVolumePreviewShadowSteps steps toward it (same resources as the sphere's).
+inline constexpr double kVolumePreviewExtent = 1.2;
+inline constexpr int kVolumePreviewSteps = 48;
+inline constexpr int kVolumePreviewShadowSteps = 8;
 }  // namespace kernel
 
 /// The kernel source; it includes "<name>.material.{glsl,hlsl}" and the runtime.

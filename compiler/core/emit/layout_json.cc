@@ -25,7 +25,10 @@ nlohmann::ordered_json layoutJson(const Material& m, const StorageLayout& L) {
     offset += f.bits;
   }
   j["fields"] = fields;
-  j["top_layer"] = {{"bits", 32},
+  if (L.layoutClass == LayoutClass::Volume)  // a volume has no surface: no top layer
+    j["top_layer"] = {{"bits", 0}, {"fields", J::array()}};
+  else
+    j["top_layer"] = {{"bits", 32},
                     {"fields", J::array({J{{"name", "normal"}, {"offset", 0}, {"bits", 24}, {"encoding", "octahedral 2 x unorm12"}},
                                          J{{"name", "roughness"}, {"offset", 24}, {"bits", 8}, {"encoding", "unorm8"}}})}};
   J closures = J::array();

@@ -80,7 +80,10 @@ std::string tileClassName(LayoutClass cls) {
   return s;
 }
 
-SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& materials, DiffuseModel diffuseModel) {
+SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& all, DiffuseModel diffuseModel) {
+  std::vector<SceneMaterialShape> materials;  // the surfaces: a volume stores no pixel for the lighting to read
+  for (const SceneMaterialShape& m : all)
+    if (m.layoutClass != LayoutClass::Volume) materials.push_back(m);
   SceneShape s;
   s.name = name;
   s.diffuseModel = diffuseModel;

@@ -77,7 +77,8 @@ struct SceneShape {
 
 inline constexpr int kSceneTileSize = 8;
 
-/// The lighting shaders a scene of these materials needs.
+/// The lighting shaders a scene of these materials needs (volumes have none:
+/// they store no pixel; a scene needs one surface, scene.cc checks).
 SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialShape>& materials, DiffuseModel diffuseModel);
 
 /// Material-buffer slices to allocate: words beyond the three render targets.

@@ -9,7 +9,7 @@ std::string_view blendModeName(BlendMode m) { return enumName(kBlendModeNames, m
 namespace {
 constexpr double kInf = 1e300;
 constexpr int kNoGeo = -1;
-constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair, kSlabHair = kPinOfSlab | kPinOfHair;
+constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair | kPinOfFogCloud, kSlabHair = kPinOfSlab | kPinOfHair;
 // name, type, color, default, geometry default, lo, hi, kinds
 const SlabPinInfo kPins[kSlabPinCount] = {
     {"diffuse_albedo", VType::Vec3, true, 0.18, kNoGeo, 0, 1},
@@ -40,6 +40,12 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     {"ior", VType::Float, false, 1.55, kNoGeo, 1, 3, kPinOfHair},
     {"cuticle_angle", VType::Float, false, 2.0, kNoGeo, -20, 20, kPinOfHair},
     {"scatter", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfHair},
+    // The volumetric fog cloud's (runtime_shaders/substrate_fog_cloud.h; UE's Volumetric Fog Cloud
+    // BSDF): single-scattering albedo, extinction in 1/m (the medium's density) and the ambient
+    // occlusion of the ambient light it scatters. Its emissive is radiance emitted per metre.
+    {"albedo", VType::Vec3, true, 0.0, kNoGeo, 0, 1, kPinOfFogCloud},
+    {"extinction", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kPinOfFogCloud},
+    {"ambient_occlusion", VType::Float, false, 1.0, kNoGeo, 0, 1, kPinOfFogCloud},
 };
 }  // namespace
 
@@ -52,16 +58,20 @@ std::optional<SlabPin> slabPinByName(std::string_view name) {
 }
 
 bool bsdfTakesPin(BsdfKind k, SlabPin p) {
-  const std::uint8_t bit = k == BsdfKind::Unlit ? kPinOfUnlit : k == BsdfKind::Hair ? kPinOfHair : kPinOfSlab;
-  return (kPins[static_cast<int>(p)].kinds & bit) != 0;
+  static constexpr std::uint8_t kBit[] = {kPinOfSlab, kPinOfUnlit, kPinOfHair, kPinOfFogCloud};  // BsdfKind order
+  return (kPins[static_cast<int>(p)].kinds & kBit[static_cast<int>(k)]) != 0;
 }
 
 std::string_view bsdfKindName(BsdfKind k) {
-  return k == BsdfKind::Unlit ? "unlit" : k == BsdfKind::Hair ? "hair" : "slab";
+  static constexpr std::string_view kNames[] = {"slab", "unlit", "hair", "volumetric_fog_cloud"};  // BsdfKind order
+  return kNames[static_cast<int>(k)];
 }
 
+bool bsdfIsClosure(BsdfKind k) { return k == BsdfKind::Slab || k == BsdfKind::Hair; }
+bool bsdfIsWholeMaterial(BsdfKind k) { return k == BsdfKind::Hair || k == BsdfKind::FogCloud; }
+
 std::optional<BsdfKind> bsdfKindByName(std::string_view name) {
-  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair})
+  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair, BsdfKind::FogCloud})
     if (bsdfKindName(k) == name) return k;
   return std::nullopt;
 }
@@ -80,12 +90,21 @@ bool isUnlitLeaf(const Material& m, const TreeNode& n) {
   return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Unlit;
 }
 
-bool isHairLeaf(const Material& m, const TreeNode& n) {
-  return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Hair;
+bool isHairLeaf(const Material& m, const TreeNode& n) { return isLeafOfKind(m, n, BsdfKind::Hair); }
+
+bool isLeafOfKind(const Material& m, const TreeNode& n, BsdfKind k) {
+  return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == k;
+}
+
+bool isVolumeMaterial(const Material& m) {
+  return m.root >= 0 && isLeafOfKind(m, m.nodes[m.root], BsdfKind::FogCloud);
 }
 
 std::string_view nodeOpName(const Material& m, const TreeNode& n) {
-  return isUnlitLeaf(m, n) ? "UNLIT" : isHairLeaf(m, n) ? "HAIR" : treeOpName(n.op);
+  return isUnlitLeaf(m, n)                              ? "UNLIT"
+         : isHairLeaf(m, n)                             ? "HAIR"
+         : isLeafOfKind(m, n, BsdfKind::FogCloud) ? "FOG_CLOUD"
+                                                        : treeOpName(n.op);
 }
 
 int Material::inputIndex(std::string_view n) const {

@@ -49,6 +49,7 @@ enum class SlabPin : std::uint8_t {
   DiffuseAlbedo, F0, F90, Roughness, Anisotropy, Normal, Tangent, SssMfp, SssMfpScale,
   SssPhaseAnisotropy, Emissive, SecondRoughness, SecondRoughnessWeight, FuzzAmount, FuzzColor,
   FuzzRoughness, GlintValue, GlintUv, Transmittance, BaseColor, AzimuthalRoughness, Ior, CuticleAngle, Scatter,
+  Albedo, Extinction, AmbientOcclusion,
   Count_
 };
 inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
@@ -57,13 +58,22 @@ inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
 /// unlit BSDF, which emits and lets through but reflects nothing, so it is no
 /// closure: it stores nothing per pixel and the lighting never sees it; and
 /// the hair BSDF, a fibre's far-field scattering (runtime_shaders/substrate_hair.h),
-/// one closure that is always the whole material (build_tree).
-enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair };
-std::string_view bsdfKindName(BsdfKind k);  // "slab", "unlit", "hair": the node kind in materials
+/// one closure that is always the whole material (build_tree); and the
+/// volumetric fog cloud, a participating medium a ray-marcher samples per point
+/// (runtime_shaders/substrate_fog_cloud.h): no closure, always the whole
+/// material, which it makes a volume-domain material (isVolumeMaterial).
+enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair, FogCloud };
+/// "slab", "unlit", "hair", "volumetric_fog_cloud": the node kind in materials.
+std::string_view bsdfKindName(BsdfKind k);
 std::optional<BsdfKind> bsdfKindByName(std::string_view name);
+/// Whether a BSDF of kind `k` is a closure the lighting sees (slab, hair); an
+/// unlit only emits and lets through, a fog cloud is sampled, not lit as a surface.
+bool bsdfIsClosure(BsdfKind k);
+/// Whether a BSDF of kind `k` must be the whole material (hair, fog cloud: build_tree).
+bool bsdfIsWholeMaterial(BsdfKind k);
 
 /// BsdfKind bits: which kinds of BSDF node take a pin.
-inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4;
+inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4, kPinOfFogCloud = 8;
 
 struct SlabPinInfo {
   std::string_view name;
@@ -153,9 +163,17 @@ struct TreeNode {
 bool isUnlitLeaf(const struct Material& m, const TreeNode& n);
 /// Tree node `n` is a hair leaf (a Slab of BsdfKind::Hair).
 bool isHairLeaf(const struct Material& m, const TreeNode& n);
+/// Tree node `n` is a leaf of BSDF kind `k`.
+bool isLeafOfKind(const struct Material& m, const TreeNode& n, BsdfKind k);
+/// The material is a volume (its root is a volumetric fog cloud: build_tree
+/// keeps one alone at the root): no surface, no closure, no GBuffer; it is
+/// evaluated per sample point (`<name>_sample`) into a froxel payload
+/// (docs/storage.md, "Volumetric fog cloud").
+bool isVolumeMaterial(const struct Material& m);
 
 /// The name of tree node `n` in reports and dumps: its operator's
-/// (treeOpName), "UNLIT" for an unlit leaf, "HAIR" for a hair leaf.
+/// (treeOpName), "UNLIT" for an unlit leaf, "HAIR" for a hair leaf,
+/// "FOG_CLOUD" for a volumetric fog cloud.
 std::string_view nodeOpName(const struct Material& m, const TreeNode& n);
 
 struct Basis {

@@ -39,7 +39,7 @@ void analyzeCoverage(const Material& m, TreeInfo& t) {
     auto f = [&](int j) { return j >= 0 && t.holdsFuzz[j]; };
     t.holdsFuzz[*it] = node.op == TreeOp::Slab ? (m.slabs[node.slab].features & kFeatFuzz) != 0 : f(node.left) || f(node.right);
     auto k = [&](int j) { return j >= 0 ? t.interfaces[j] : 0; };
-    t.interfaces[*it] = node.op == TreeOp::Slab       ? (m.slabs[node.slab].kind == BsdfKind::Unlit ? 0 : 1)
+    t.interfaces[*it] = node.op == TreeOp::Slab       ? (bsdfIsClosure(m.slabs[node.slab].kind) ? 1 : 0)
                         : node.op == TreeOp::Vertical ? k(node.left) + k(node.right)
                                                       : std::max(k(node.left), k(node.right));
   }
@@ -78,7 +78,7 @@ void analyzePreorder(const Material& m, TreeInfo& t) {
       t.unitCoverageAbove[it.node] = it.coverAbove;
       t.interfacesAbove[it.node] = it.above;
       t.slabNode[node.slab] = it.node;
-      if (m.slabs[node.slab].kind == BsdfKind::Unlit) continue;  // no closure: emits and lets through only
+      if (!bsdfIsClosure(m.slabs[node.slab].kind)) continue;  // unlit, fog cloud: no closure
       t.bsdfId[node.slab] = static_cast<int>(t.slabOrder.size());
       t.slabOrder.push_back(node.slab);
       continue;

@@ -170,23 +170,31 @@ void checkUnlitPlacement(const Material& m, Diagnostics& diags) {
   }
 }
 
-/// A hair BSDF is the whole material: a located error at a hair leaf with a
-/// parent, naming the operator. Its closure is lit by the fibre's own model
-/// (a far field around the fibre, no interface or diffuse), which no operator
-/// can blend, layer or weigh against a slab's lobes (UE's Substrate keeps its
-/// Hair BSDF alone at the root too).
-void checkHairPlacement(const Material& m, Diagnostics& diags) {
+/// A hair BSDF and a volumetric fog cloud are the whole material: a located
+/// error at such a leaf with a parent, naming the operator. A hair's closure
+/// is lit by the fibre's own model (a far field around the fibre, no
+/// interface or diffuse), which no operator can blend, layer or weigh against
+/// a slab's lobes; a fog cloud is a medium sampled through a volume, not a
+/// surface (UE's Substrate keeps both alone at the root; the fog cloud there
+/// sets the material's domain to volume).
+void checkWholeMaterialPlacement(const Material& m, Diagnostics& diags) {
   const TreeInfo t = analyzeTree(m);
   std::unordered_set<std::string> reported;
   for (int n : t.preorder) {
     const TreeNode& node = m.nodes[n];
-    if (!isHairLeaf(m, node) || t.parent[n] < 0 || !reported.insert(node.pointer).second) continue;
+    if (node.op != TreeOp::Slab || !bsdfIsWholeMaterial(m.slabs[node.slab].kind) || t.parent[n] < 0 ||
+        !reported.insert(node.pointer).second)
+      continue;
     const TreeNode& p = m.nodes[t.parent[n]];
+    const bool hair = isHairLeaf(m, node);
     diags.error(node.pointer,
-                fmt::format("hair '{}' is an operand of {} '{}': a hair BSDF must be the whole material (the "
-                            "output), since its fibre lobes are a closure of their own kind that no operator can "
-                            "mix, layer or weigh with other matter",
-                            node.id, treeOpName(p.op), p.id));
+                fmt::format("{} '{}' is an operand of {} '{}': a {} must be the whole material (the output), since {}",
+                            bsdfKindName(m.slabs[node.slab].kind), node.id, treeOpName(p.op), p.id,
+                            hair ? "hair BSDF" : "volumetric fog cloud",
+                            hair ? "its fibre lobes are a closure of their own kind that no operator can mix, layer "
+                                   "or weigh with other matter"
+                                 : "it is a medium a ray-marcher samples through a volume, not a surface that an "
+                                   "operator can mix, layer or weigh with other matter"));
   }
 }
 
@@ -226,7 +234,7 @@ bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Materia
   TreeBuilder builder(doc, table, m, diags);
   m.root = builder.instance(doc.output);
   checkUnlitPlacement(m, diags);
-  checkHairPlacement(m, diags);
+  checkWholeMaterialPlacement(m, diags);
   return !diags.hasErrors();
 }
 

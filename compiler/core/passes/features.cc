@@ -12,7 +12,8 @@ void analyzeFeatures(Material& m) {
     Slab& s = m.slabs[m.nodes[node].slab];
     std::uint16_t f = 0;
     auto used = [&](SlabPin p, double neutral) { return !v.isConstEqual(s.pin(p), neutral); };
-    if (s.kind == BsdfKind::Unlit) {  // an unlit only emits (and lets through, which costs nothing)
+    if (s.kind == BsdfKind::Unlit || s.kind == BsdfKind::FogCloud) {  // an unlit only emits (and lets through,
+      // which costs nothing); a fog cloud's albedo, extinction and occlusion are what it is, not options
       s.features = used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0;
       continue;
     }

@@ -148,6 +148,9 @@ bool over(const StorageLayout& L, const SimplifyBudget& b) {
 
 bool simplifyToBudget(Material& m, const SimplifyBudget& budget, Reprice reprice, StorageLayout& layout,
                       std::vector<SimplifyStep>& steps, Diagnostics& diags) {
+  // A volume stores no pixel: the budget is the GBuffer's, and its froxel
+  // payload is fixed (storage/layout.h, LayoutClass::Volume).
+  if (isVolumeMaterial(m)) return true;
   // What the platform's lighting does not evaluate goes first.
   disableAll(m, budget.disallowed, "disallow", reprice, layout, steps);
   while (over(layout, budget)) {

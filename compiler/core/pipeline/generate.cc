@@ -57,6 +57,10 @@ Generated generateFiles(const CompileResult& r, const GenerateOptions& o) {
     if ((t == Target::Glsl && !o.glsl) || (t == Target::Hlsl && !o.hlsl)) continue;
     const Syntax& syn = syntaxFor(t);
     g.files.push_back({m.name + std::string(syn.materialExtension), materialFile(r, syn, o.emit)});
+    if (isVolumeMaterial(m)) {  // no surface: the froxel pass instead of the forward and base passes
+      g.files.push_back({volumeFileName(m, syn), emitVolumeEntry(m, r.after, syn)});
+      continue;
+    }
     g.files.push_back({basePassFileName(m, syn), emitBasePassEntry(m, r.after, syn)});
     g.files.push_back({forwardFileName(m, syn), emitForwardEntry(m, r.after, syn, o.emit.precision)});
   }

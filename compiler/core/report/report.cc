@@ -22,7 +22,16 @@ std::string featureLine(const Slab& s) {
 std::uint16_t featureUnion(const Material& m, const TreeInfo& t) {
   std::uint16_t all = 0;
   for (int s : t.slabOrder) all |= m.slabs[s].features;
+  if (isVolumeMaterial(m)) all |= m.slabs[m.nodes[m.root].slab].features;  // the fog cloud is no closure
   return all;
+}
+
+/// What a layout's bytes are made of: the GBuffer's words and top-layer word,
+/// or a volume's froxel words.
+std::string bytesNote(const StorageLayout& L) {
+  return L.layoutClass == LayoutClass::Volume
+             ? fmt::format("{} UINT32 per froxel: a volume stores no pixel", L.words())
+             : fmt::format("{} UINT32 + 4 top-layer bytes", L.words());
 }
 
 }  // namespace
@@ -34,10 +43,8 @@ std::string formatReportText(const CompileResult& r) {
   o += fmt::format("----- SUBSTRATE - {} -----\n", m.name);
   o += fmt::format("- Byte per pixel budget: {}\n", r.budgetBytes);
   o += fmt::format("- Closure budget: {}\n", r.maxClosures);
-  o += fmt::format("- Requested bytes before simplification: {} ({} UINT32 + 4 top-layer bytes)\n", r.before.bytes(),
-                   r.before.words());
-  o += fmt::format("- Requested bytes after simplification: {} ({} UINT32 + 4 top-layer bytes)\n", r.after.bytes(),
-                   r.after.words());
+  o += fmt::format("- Requested bytes before simplification: {} ({})\n", r.before.bytes(), bytesNote(r.before));
+  o += fmt::format("- Requested bytes after simplification: {} ({})\n", r.after.bytes(), bytesNote(r.after));
   o += fmt::format("- Closures before simplification: {}\n", r.before.closures.size());
   o += fmt::format("- Closures after simplification: {}\n", r.after.closures.size());
   o += fmt::format("- Material complexity: {}\n", layoutClassName(r.after.layoutClass));
@@ -81,6 +88,10 @@ std::string formatReportText(const CompileResult& r) {
     if (isUnlitLeaf(m, m.nodes[n]))
       o += fmt::format("Unlit ({}): Emissive={} (no closure: it emits and lets through, and stores nothing)\n",
                        m.nodes[n].id, (m.slabs[m.nodes[n].slab].features & kFeatEmissive) ? 1 : 0);
+  if (isVolumeMaterial(m))  // the root: no closure, sampled per point
+    o += fmt::format("Volumetric fog cloud ({}): Emissive={} (no closure: a medium sampled per point by "
+                     "{}_sample into the froxel payload below)\n",
+                     m.nodes[m.root].id, (m.slabs[m.nodes[m.root].slab].features & kFeatEmissive) ? 1 : 0, m.name);
   o += fmt::format("----- Culled - {} -----\n", m.name);
   if (m.culled.empty()) o += "(nothing)\n";
   for (const auto& c : m.culled) o += fmt::format("{}: {}\n", c.what, c.why);
@@ -94,7 +105,10 @@ std::string formatReportText(const CompileResult& r) {
   o += fmt::format("----- Storage layout - {} -----\n", m.name);
   for (const auto& f : r.after.fields) o += fmt::format("{:<32} {:>3} bits  {}\n", f.name, f.bits, f.encoding);
   o += fmt::format("{:<32} {:>3} bits  (packed into {} UINT32)\n", "total", r.after.totalBits, r.after.words());
-  o += fmt::format("{:<32} {:>3} bits  octahedral normal 2 x unorm12 | roughness unorm8\n", "top_layer", 32);
+  if (r.after.layoutClass == LayoutClass::Volume)
+    o += fmt::format("{:<32} {:>3} bits  (a volume has no surface)\n", "top_layer", 0);
+  else
+    o += fmt::format("{:<32} {:>3} bits  octahedral normal 2 x unorm12 | roughness unorm8\n", "top_layer", 32);
   return o;
 }
 
@@ -166,7 +180,7 @@ nlohmann::ordered_json reportJson(const CompileResult& r) {
   J fields = J::array();
   for (const auto& f : r.after.fields)
     fields.push_back({{"name", f.name}, {"bits", f.bits}, {"encoding", f.encoding}});
-  j["storage"] = {{"fields", fields}, {"top_layer_bits", 32}};
+  j["storage"] = {{"fields", fields}, {"top_layer_bits", r.after.layoutClass == LayoutClass::Volume ? 0 : 32}};
   return j;
 }
 

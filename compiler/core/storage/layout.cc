@@ -10,6 +10,7 @@ std::string_view layoutClassName(LayoutClass c) {
     case LayoutClass::Single: return "SINGLE";
     case LayoutClass::Complex: return "COMPLEX";
     case LayoutClass::Special: return "SPECIAL";
+    case LayoutClass::Volume: return "VOLUME";
   }
   return "?";
 }
@@ -82,9 +83,26 @@ void finishLayout(StorageLayout& L) {
   }
 }
 
+/// A volume's froxel payload: what `<name>_sample` returns, as
+/// substrate_fog_cloud_pack stores it (docs/storage.md, "Volumetric fog cloud").
+StorageLayout volumeLayout() {
+  StorageLayout L;
+  L.layoutClass = LayoutClass::Volume;
+  auto add = [&](std::string name, int b, std::string enc) {
+    L.fields.push_back({std::move(name), b, std::move(enc)});
+    L.totalBits += b;
+  };
+  add("fog.albedo", bits::kFogAlbedo, "unorm8 x 3, linear");
+  add("fog.ambient_occlusion", bits::kFogOcclusion, "unorm8");
+  add("fog.extinction", bits::kRgb9e5, "RGB9E5 shared exponent (1/m, up to 65408)");
+  add("fog.emissive", bits::kRgb9e5, "RGB9E5 shared exponent (radiance per metre, up to 65408)");
+  return L;
+}
+
 }  // namespace
 
 StorageLayout computeLayout(const Material& m, const TreeInfo& info) {
+  if (isVolumeMaterial(m)) return volumeLayout();  // no closure: the sample's payload
   StorageLayout L;
   for (int s : info.slabOrder) {
     const Slab& slab = m.slabs[s];

@@ -12,7 +12,9 @@
 
 namespace substratec {
 
-enum class LayoutClass { Simple, Single, Complex, Special };
+/// The GBuffer classes (docs/storage.md, "Layout classes"), and VOLUME: a
+/// volume-domain material's froxel payload (a fog cloud's sample, no GBuffer).
+enum class LayoutClass { Simple, Single, Complex, Special, Volume };
 std::string_view layoutClassName(LayoutClass c);  // "SIMPLE", ...
 
 /// Field widths in bits (docs/storage.md, "Field table").
@@ -33,6 +35,10 @@ inline constexpr int kGlint = 136;          // density 8 + uv 2 x fp32 + uv deri
 inline constexpr int kNormal = 32;          // octahedral 2 x 16
 inline constexpr int kTangentAngle = 14;
 inline constexpr int kTopLayerBytes = 4;    // octahedral normal 2 x 12 + roughness 8
+// A volume's froxel payload (runtime_shaders/substrate_fog_cloud.h), 3 words:
+inline constexpr int kFogAlbedo = 24;       // unorm8 x 3
+inline constexpr int kFogOcclusion = 8;     // unorm8
+inline constexpr int kRgb9e5 = 32;          // extinction, emissive: shared-exponent RGB
 }  // namespace bits
 
 struct LayoutField {
@@ -62,8 +68,9 @@ struct StorageLayout {
   int totalBits = 0;
 
   int words() const { return (totalBits + 31) / 32; }
-  /// Bytes per pixel, including the 4 bytes of top-layer data.
-  int bytes() const { return words() * 4 + bits::kTopLayerBytes; }
+  /// Bytes per pixel, including the 4 bytes of top-layer data; a VOLUME
+  /// layout's bytes per froxel (it has no surface, so no top layer).
+  int bytes() const { return words() * 4 + (layoutClass == LayoutClass::Volume ? 0 : bits::kTopLayerBytes); }
 };
 
 /// Features whose data lives in a closure (emissive and medium cost no bytes).

@@ -53,7 +53,8 @@ std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) 
     s.closures = j.at("closures").get<int>();
     const std::string layout = j.at("layout").get<std::string>();
     bool known = false;
-    for (LayoutClass c : {LayoutClass::Simple, LayoutClass::Single, LayoutClass::Complex, LayoutClass::Special})
+    for (LayoutClass c :
+         {LayoutClass::Simple, LayoutClass::Single, LayoutClass::Complex, LayoutClass::Special, LayoutClass::Volume})
       if (layoutClassName(c) == layout) s.layoutClass = c, known = true;
     s.features = j.at("features").get<std::uint16_t>();
     s.storedFeatures = j.at("stored_features").get<std::uint16_t>();
@@ -62,7 +63,8 @@ std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) 
     s.maxClosures = j.at("max_closures").get<int>();
     s.simplificationSteps = j.at("simplification_steps").get<int>();
     s.metalnessMix = j.at("metalness_mix").get<bool>();
-    if (!known || s.name.empty() || s.words < 1 || s.closures < 1 || s.closures > 8) return std::nullopt;
+    const int leastClosures = s.layoutClass == LayoutClass::Volume ? 0 : 1;  // a volume has none
+    if (!known || s.name.empty() || s.words < 1 || s.closures < leastClosures || s.closures > 8) return std::nullopt;
     return s;
   } catch (const nlohmann::json::exception&) {
     return std::nullopt;

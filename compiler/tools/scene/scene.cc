@@ -1,5 +1,6 @@
 #include "scene/scene.h"
 
+#include <algorithm>
 #include <cctype>
 #include <map>
 
@@ -159,6 +160,7 @@ J sceneReport(const SceneOptions& o, const SceneManifest& scene, const std::opti
   std::uint16_t features = 0;
   int maxBytes = 0;
   for (const MaterialBuild& m : built) {
+    if (m.summary.layoutClass == LayoutClass::Volume) continue;  // a volume stores no pixel (its froxels are its own)
     features |= m.summary.features;
     maxBytes = std::max(maxBytes, m.summary.bytes);
   }
@@ -232,6 +234,15 @@ SceneBuild buildScene(const SceneOptions& o) {
 
   std::vector<SceneMaterialShape> shapes;
   for (const MaterialBuild& m : built) shapes.push_back(m.summary.shape());
+  if (std::all_of(built.begin(), built.end(),
+                  [](const MaterialBuild& m) { return m.summary.layoutClass == LayoutClass::Volume; })) {
+    Diagnostics d(o.manifest);  // a volume's froxels are its own: nothing for a scene's lighting to read
+    d.setLocator(scene->locator);
+    d.error("/materials", "every material of the scene is a volume (a volumetric fog cloud), which stores no pixel: "
+                          "a scene's lighting needs at least one surface material");
+    b.messages += d.formatAll();
+    return b.status = SceneStatus::BadInput, b;
+  }
   const SceneShape shape = sceneShape(scene->name, shapes, o.batch.generate.emit.diffuseModel);
   Generated lighting = generateSceneLighting(o, shape);
   if (o.batch.validate) {
