@@ -64,6 +64,15 @@ TEST(FogCloudNode, IsTheWholeMaterialNeverAnOperand) {
   }
 }
 
+TEST(FogCloudNode, OneThatNeitherExtinguishesNorEmitsIsAWarning) {
+  EXPECT_NE(diagnosticsOf(material(R"("root": {"kind": "volumetric_fog_cloud", "albedo": 0.5})"))
+                .find("warning: volumetric fog cloud 'root' has extinction 0 and emissive 0: it shows nothing "
+                      "[/nodes/root]"),
+            std::string::npos);
+  EXPECT_EQ(diagnosticsOf(material(R"("root": {"kind": "volumetric_fog_cloud", "emissive": 0.1})")), "");
+  EXPECT_EQ(diagnosticsOf(material(kCloud)), "");
+}
+
 TEST(FogCloudNode, MakesAVolumeWithATwelveByteFroxelPayloadAndNoClosure) {
   auto r = compiled(material(kCloud));
   ASSERT_TRUE(r);

@@ -202,6 +202,22 @@ class Culler {
 
 }  // namespace
 
+namespace {
+
+/// A volume whose extinction and emissive are both the constant 0 neither
+/// hides, scatters nor emits anything: a warning at the fog cloud (it still
+/// compiles, like a slab under a weight that happens to be 0 at run time).
+void warnInvisibleVolume(const Material& m, Diagnostics& diags) {
+  if (!isVolumeMaterial(m)) return;
+  const TreeNode& n = m.nodes[m.root];
+  const Slab& fog = m.slabs[n.slab];
+  if (m.values.isConstEqual(fog.pin(SlabPin::Extinction), 0) && m.values.isConstEqual(fog.pin(SlabPin::Emissive), 0))
+    diags.warning(n.pointer, fmt::format("volumetric fog cloud '{}' has extinction 0 and emissive 0: it shows nothing",
+                                         n.id));
+}
+
+}  // namespace
+
 bool cullStaticMatter(Material& m, Diagnostics& diags) {
   if (m.root < 0) return false;
   // Rounds until nothing more is removed: replacing a vertical by its opaque
@@ -220,6 +236,7 @@ bool cullStaticMatter(Material& m, Diagnostics& diags) {
     return false;
   }
   m.root = root;
+  warnInvisibleVolume(m, diags);
   return true;
 }
 

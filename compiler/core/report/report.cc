@@ -96,7 +96,8 @@ std::string formatReportText(const CompileResult& r) {
   if (m.culled.empty()) o += "(nothing)\n";
   for (const auto& c : m.culled) o += fmt::format("{}: {}\n", c.what, c.why);
   o += fmt::format("----- Simplification - {} -----\n", m.name);
-  if (r.steps.empty()) o += "(no step: the material fits its budget)\n";
+  if (isVolumeMaterial(m)) o += "(none: a volume stores no pixel, so no budget applies)\n";
+  else if (r.steps.empty()) o += "(no step: the material fits its budget)\n";
   for (std::size_t i = 0; i < r.steps.size(); ++i) {
     const SimplifyStep& s = r.steps[i];
     o += fmt::format("Step {}: {} {} '{}' (depth {}): {} B / {} closures -> {} B / {} closures\n", i + 1, s.action,
