@@ -523,14 +523,24 @@ void partClosures(gpu::Context& ctx, const Args& a) {
   fits(1, "2–8 closures (the forward shader lights one closure without a loop, several in one loop)");
 }
 
+/// examples/*.json, sorted, without the volumes (a volumetric fog cloud has no
+/// surface, so no throughput kernel or forward shader: `accuracy` measures it).
+std::vector<std::string> surfaceExamples(const std::string& source) {
+  std::vector<std::string> files;
+  for (const auto& e : fs::directory_iterator(source + "/examples")) {
+    if (e.path().extension() != ".json") continue;
+    if (isVolumeMaterial(compileOrDie(e.path().filename().string(), readAll(e.path().string()), {}).material)) continue;
+    files.push_back(e.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
 // ---------------------------------------------------------------------------
 // 3. Every example at every budget.
 
 void partExamples(gpu::Context& ctx, const Args& a) {
-  std::vector<std::string> files;
-  for (const auto& e : fs::directory_iterator(a.source + "/examples"))
-    if (e.path().extension() == ".json") files.push_back(e.path().string());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = surfaceExamples(a.source);
 
   struct Budget {
     std::string label;
@@ -652,10 +662,7 @@ void partDiffuse(gpu::Context& ctx, const Args& a) {
 
 void partHalf(gpu::Context& ctx, const Args& a) {
   if (!ctx.shaderFloat16()) die("part 5 needs shaderFloat16 (" + ctx.deviceName() + " has none)");
-  std::vector<std::string> files;
-  for (const auto& e : fs::directory_iterator(a.source + "/examples"))
-    if (e.path().extension() == ".json") files.push_back(e.path().string());
-  std::sort(files.begin(), files.end());
+  const std::vector<std::string> files = surfaceExamples(a.source);
   EmitOptions full, half;
   half.precision = Precision::Half;
   if (!a.callgrind) {

@@ -18,7 +18,7 @@ layout(set = 1, binding = 0, std140) uniform fog_neon_haze_Inputs {
 // at every step, a froxel pass at every froxel. Values are sanitized: finite, in the pins' ranges.
 SubstrateFogCloudSample fog_neon_haze_sample(SubstrateGeometry g) {
   float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in tangent space
-  return substrate_fog_cloud_make(float3(0.2, 0.2, 0.2), float3(0.05, 0.06, 0.08), fog_neon_haze_inputs.i_glow, 1.0);
+  return substrate_fog_cloud_make(float3(0.2, 0.2, 0.2), float3(0.3, 0.4, 0.5), fog_neon_haze_inputs.i_glow, 1.0);
 }
 
 // Packs a sample into the froxel payload of docs/storage.md ("Volumetric fog cloud").
