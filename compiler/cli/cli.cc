@@ -45,6 +45,7 @@
 #include "stability/stability.h"
 #include "storage/pack.h"
 #include "sweep/sweep.h"
+#include "sweep/volume_sweep.h"
 #include "validate/toolchain.h"
 
 namespace substratec {
@@ -267,8 +268,8 @@ int compileFailure(const import::MaterialSource& s, std::ostream& err) {
 
 /// The material at each simplification step (preview --sweep, sweep), and
 /// unsimplified in `full`.
-/// The commands that shade surfaces (sweep, render, stability's grid)
-/// refuse a volume (a volumetric fog cloud, isVolumeMaterial) with a
+/// The commands that shade surfaces (render, stability's grid) refuse a
+/// volume (a volumetric fog cloud, isVolumeMaterial) with a
 /// located message naming what it has instead; kExitOk for a surface.
 int rejectVolume(const Material& m, const std::string& where, std::string_view command, std::ostream& err) {
   if (!isVolumeMaterial(m)) return kExitOk;
@@ -1054,6 +1055,29 @@ int printSweep(const SweepArgs& a, const std::string& name, const std::vector<sw
   return kExitOk;
 }
 
+/// A volume's sweep (sweep/volume_sweep.h): nothing simplifies it, so its
+/// rows are step counts of its march, lavapipe ns per ray against the error.
+/// --csv, --plot and --max-error choose among simplification steps: a usage
+/// error here.
+int volumeSweep(const SweepArgs& a, const import::MaterialSource& s, const CompileResult& r, std::ostream& out,
+                std::ostream& err) {
+  if (a.csv || !a.plot.empty() || a.maxError >= 0)
+    return printError(err, kExitUsage,
+                      fmt::format("{}: '{}' is a volume: its sweep is step counts of its march (the table or --json); "
+                                  "--csv, --plot and --max-error are for surfaces' simplification steps",
+                                  s.displayName, r.material.name));
+  auto ctx = openGpu(a.precision, "sweep times the generated code on Vulkan (Mesa lavapipe)", err);
+  if (!ctx) return kExitBadInput;
+  sweep::Options so;
+  so.pixels = a.pixels;
+  so.timedRuns = a.runs;
+  std::vector<sweep::VolumeRow> rows;
+  Diagnostics failure(r.material.name);
+  if (!sweep::measureVolume(*ctx, r, so, &rows, failure)) return printInternalError(err, failure.errorMessages());
+  out << (a.json ? sweep::formatVolumeJson(r.material.name, rows) : sweep::formatVolumeTable(r.material.name, rows));
+  return kExitOk;
+}
+
 /// The material at its full budget and at each simplification step: cost
 /// (bytes, closures, instructions, lavapipe time) against error (vs the
 /// authored tree; the accuracy metric against the truths). --max-error
@@ -1068,8 +1092,7 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   std::vector<sweep::Step> steps;
   CompileResult full;
   if (int failed = simplificationSteps(sources->front(), o, steps, full, err); failed != kExitOk) return failed;
-  if (int volume = rejectVolume(full.material, sources->front().displayName, "sweep", err); volume != kExitOk)
-    return volume;
+  if (isVolumeMaterial(full.material)) return volumeSweep(a, sources->front(), full, out, err);
   auto ctx = openGpu(a.precision, "sweep times the generated code on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
   sweep::Options so;

@@ -235,4 +235,23 @@ TEST(Sweep, ABrokenMaterialIsBadInput) {
   fs::remove(broken);
 }
 
+
+// A volume: nothing simplifies it, so its rows are step counts of its march,
+// each timed on lavapipe (the cost kernel: one ray an invocation) beside the
+// march's error against a 4,096-step march (accuracy/fog_accuracy.h).
+TEST(Sweep, AVolumeTradesStepsOfItsMarchForError) {
+  CliRun r = cli({"sweep", example("fog_cloud_puff.json"), "--json", "--pixels", "4096", "--runs", "2"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["domain"], "volume");
+  ASSERT_EQ(j["rows"].size(), 6u);  // 4 ... 128 steps
+  double previous = 1e30;
+  for (const auto& row : j["rows"]) {
+    EXPECT_GT(row["gpu_ns_per_ray"].get<double>(), 0.0) << row.dump();
+    EXPECT_TRUE(std::isfinite(row["gpu_ns_per_ray"].get<double>())) << row.dump();
+    EXPECT_LT(row["max_rel_error"].get<double>(), previous) << row.dump();
+    previous = row["max_rel_error"].get<double>();
+  }
+}
+
 }  // namespace

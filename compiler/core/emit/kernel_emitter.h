@@ -30,7 +30,8 @@ enum class KernelMode {
   Deferred,  // evaluate, pack into the uint stream, unpack generically, then light (base pass + deferred lighting)
   Preview,   // a sphere, the key light and a split-sum environment, one RGBA float4 per pixel
   Throughput,  // cost: each invocation hashes its own shading point, evaluates, lights it (one light and a
-               // constant split-sum environment) and writes one float4 (results[i]): no input buffer to read
+               // constant split-sum environment) and writes one float4 (results[i]): no input buffer to read;
+               // a volume's: one hashed ray marched in EmitOptions::volumeSteps steps (kVolumeCostExtent)
 };
 
 /// Sample layout (float4 index within a sample; `kSampleVec4s` per sample).
@@ -91,6 +92,11 @@ inline constexpr int kPreviewProfileBinding = 40;
 inline constexpr double kVolumePreviewExtent = 1.2;
 inline constexpr int kVolumePreviewSteps = 48;
 inline constexpr int kVolumePreviewShadowSteps = 8;
+/// A volume's cost kernel (KernelMode::Throughput, EmitOptions::volumeSteps
+/// steps, clamped to [1, kMaxVolumeSteps]): rays through the cube
+/// [-extent, extent]^3, the one `accuracy` measures the march in.
+inline constexpr double kVolumeCostExtent = 2.0;
+inline constexpr int kMaxVolumeSteps = 4096;
 }  // namespace kernel
 
 /// The kernel source; it includes "<name>.material.{glsl,hlsl}" and the runtime.
@@ -100,6 +106,7 @@ std::string emitKernel(const Material& m, const StorageLayout& layout, const Syn
                        const EmitOptions& emit = {});
 
 /// `<name>.<mode>.comp` / `<name>.<mode>.cs.hlsl` (mode: forward_samples, deferred_samples, preview, throughput).
+/// A volume (isVolumeMaterial) has Preview and Throughput kernels only.
 std::string kernelFileName(const Material& m, const Syntax& syn, KernelMode mode);
 
 }  // namespace substratec

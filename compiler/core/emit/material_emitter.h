@@ -39,6 +39,8 @@ struct EmitOptions {
   /// SIMPLE layout (storage/layout.h, runtimeSimpleClosures). Off only to
   /// compare with the static layout (tests).
   bool dynamicSimplification = true;
+  /// A volume's throughput kernel (the cost `sweep` times): the steps of its march.
+  int volumeSteps = 64;
 };
 
 /// `<name>.material.glsl` / `.hlsl`.

@@ -1,0 +1,80 @@
+#include "sweep/volume_sweep.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "emit/kernel_emitter.h"
+#include "gpu/sample_run.h"
+
+namespace substratec::sweep {
+
+namespace {
+
+/// Median lavapipe time per ray of the cost kernel marching `steps` steps.
+bool nsPerRay(gpu::Context& ctx, const CompileResult& r, const Options& o, int steps, double* ns, Diagnostics& diags) {
+  EmitOptions emit;
+  emit.volumeSteps = steps;
+  std::vector<uint32_t> spirv;
+  auto pipeline = gpu::kernelPipeline(ctx, r, Target::Glsl, KernelMode::Throughput, emit,
+                                      "volume throughput", &spirv, diags);
+  if (!pipeline) return false;
+  const int rays = (o.pixels + kernel::kLocalSize - 1) / kernel::kLocalSize * kernel::kLocalSize;
+  std::vector<double> times;
+  for (int run = 0; run <= o.timedRuns; ++run) {  // run 0 warms up (JIT, caches)
+    gpu::Resources res =
+        gpu::kernelResources(r.material, pipeline->reflection(), spirv, {}, {}, static_cast<std::size_t>(rays) * 4);
+    double t = 0;
+    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(rays / kernel::kLocalSize), 1, 1, diags, &t)) return false;
+    if (run > 0) times.push_back(t / rays);
+  }
+  std::sort(times.begin(), times.end());
+  *ns = times[times.size() / 2];
+  return true;
+}
+
+}  // namespace
+
+bool measureVolume(gpu::Context& ctx, const CompileResult& r, const Options& o, std::vector<VolumeRow>* rows,
+                   Diagnostics& diags) {
+  const accuracy::FogReport error = accuracy::fogAccuracy(r.material, r.after.bytes());
+  for (const accuracy::FogRow& e : error.rows) {
+    VolumeRow row;
+    row.steps = e.steps;
+    row.error = e;
+    if (!nsPerRay(ctx, r, o, e.steps, &row.gpuNsPerRay, diags)) return false;
+    rows->push_back(row);
+  }
+  return true;
+}
+
+std::string formatVolumeTable(const std::string& material, const std::vector<VolumeRow>& rows) {
+  std::string s = fmt::format(
+      "{}: a volume; cost per ray through the cube of half side {} m (lavapipe) against the march's error "
+      "(`accuracy`: a 4096-step march)\n",
+      material, kernel::kVolumeCostExtent);
+  s += fmt::format("{:>6}  {:>10}  {:>14}  {:>14}  {:>20}\n", "steps", "ns/ray", "median rel err", "max rel err",
+                   "max rel err (12 B)");
+  for (const VolumeRow& r : rows)
+    s += fmt::format("{:>6}  {:>10.1f}  {:>14.3e}  {:>14.3e}  {:>20.3e}\n", r.steps, r.gpuNsPerRay, r.error.medianError,
+                     r.error.maxError, r.error.payloadMaxError);
+  return s;
+}
+
+std::string formatVolumeJson(const std::string& material, const std::vector<VolumeRow>& rows) {
+  nlohmann::ordered_json j;
+  j["material"] = material;
+  j["domain"] = "volume";
+  nlohmann::ordered_json a = nlohmann::ordered_json::array();
+  for (const VolumeRow& r : rows)
+    a.push_back({{"steps", r.steps},
+                 {"gpu_ns_per_ray", r.gpuNsPerRay},
+                 {"median_rel_error", r.error.medianError},
+                 {"max_rel_error", r.error.maxError},
+                 {"payload_max_rel_error", r.error.payloadMaxError}});
+  j["rows"] = a;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace substratec::sweep
