@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "accuracy/accuracy.h"
 #include "ir/value_eval.h"
 #include "reference/fog_cloud.h"
 
@@ -13,8 +14,6 @@ namespace substratec::accuracy {
 namespace {
 
 using D3 = std::array<double, 3>;
-
-double lum(const D3& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
 /// The fog cloud's pins at `p`, sanitized as substrate_fog_cloud_make does.
 reference::FogCloudSample sampleAt(const Material& m, const D3& p) {
@@ -77,7 +76,7 @@ FogReport fogAccuracy(const Material& m, int bytesPerFroxel, const FogOptions& o
   for (int k = 0; k < o.rays; ++k) {
     const Ray ray = rayOf(k, o.rays, o.extent);
     const auto t = reference::marchFogCloud(exact, ray.origin, ray.direction, ray.length, o.truthSteps, light, ambient);
-    if (lum(t.radiance) <= 0) continue;  // nothing to compare against: relative errors need a denominator
+    if (luminance(t.radiance) <= 0) continue;  // nothing to compare against: relative errors need a denominator
     rays.push_back(ray);
     truth.push_back(t);
   }
@@ -90,10 +89,10 @@ FogReport fogAccuracy(const Material& m, int bytesPerFroxel, const FogOptions& o
       const Ray& ray = rays[i];
       const auto a = reference::marchFogCloud(exact, ray.origin, ray.direction, ray.length, n, light, ambient);
       const auto q = reference::marchFogCloud(stored, ray.origin, ray.direction, ray.length, n, light, ambient);
-      const double ref = lum(truth[i].radiance);
-      errors.push_back(std::abs(lum(a.radiance) - ref) / ref);
-      row.maxThroughputError = std::max(row.maxThroughputError, std::abs(lum(a.throughput) - lum(truth[i].throughput)));
-      row.payloadMaxError = std::max(row.payloadMaxError, std::abs(lum(q.radiance) - ref) / ref);
+      const double ref = luminance(truth[i].radiance);
+      errors.push_back(std::abs(luminance(a.radiance) - ref) / ref);
+      row.maxThroughputError = std::max(row.maxThroughputError, std::abs(luminance(a.throughput) - luminance(truth[i].throughput)));
+      row.payloadMaxError = std::max(row.payloadMaxError, std::abs(luminance(q.radiance) - ref) / ref);
     }
     row.medianError = median(errors);
     row.maxError = errors.empty() ? 0 : *std::max_element(errors.begin(), errors.end());

@@ -63,27 +63,36 @@ bool forwardInstructions(const CompileResult& r, const Options& options, std::si
   return true;
 }
 
+}  // namespace
+
+bool nsPerInvocation(gpu::Context& ctx, const CompileResult& r, const EmitOptions& emit, const Options& o, double* ns,
+                     Diagnostics& diags) {
+  std::vector<uint32_t> spirv;
+  auto pipeline = gpu::kernelPipeline(ctx, r, Target::Glsl, KernelMode::Throughput, emit, "throughput", &spirv, diags);
+  if (!pipeline) return false;
+  const int count = (o.pixels + kernel::kLocalSize - 1) / kernel::kLocalSize * kernel::kLocalSize;
+  std::vector<double> times;
+  for (int run = 0; run <= o.timedRuns; ++run) {  // run 0 warms up (JIT, caches)
+    gpu::Resources res =
+        gpu::kernelResources(r.material, pipeline->reflection(), spirv, {}, {}, static_cast<std::size_t>(count) * 4);
+    double t = 0;
+    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(count / kernel::kLocalSize), 1, 1, diags, &t))
+      return false;
+    if (run > 0) times.push_back(t / count);
+  }
+  std::sort(times.begin(), times.end());
+  *ns = times[times.size() / 2];
+  return true;
+}
+
+namespace {
+
 /// Median lavapipe time per shading point of the throughput kernel.
 bool nsPerPixel(gpu::Context& ctx, const CompileResult& r, const Options& o, double* ns, Diagnostics& diags) {
   EmitOptions emit;
   emit.diffuseModel = o.diffuseModel;  // the model the errors are measured with
   emit.precision = o.precision;
-  std::vector<uint32_t> spirv;
-  auto pipeline = gpu::kernelPipeline(ctx, r, Target::Glsl, KernelMode::Throughput, emit, "throughput", &spirv, diags);
-  if (!pipeline) return false;
-  const int pixels = (o.pixels + kernel::kLocalSize - 1) / kernel::kLocalSize * kernel::kLocalSize;
-  std::vector<double> times;
-  for (int run = 0; run <= o.timedRuns; ++run) {  // run 0 warms up (JIT, caches)
-    gpu::Resources res =
-        gpu::kernelResources(r.material, pipeline->reflection(), spirv, {}, {}, static_cast<std::size_t>(pixels) * 4);
-    double t = 0;
-    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(pixels / kernel::kLocalSize), 1, 1, diags, &t))
-      return false;
-    if (run > 0) times.push_back(t / pixels);
-  }
-  std::sort(times.begin(), times.end());
-  *ns = times[times.size() / 2];
-  return true;
+  return nsPerInvocation(ctx, r, emit, o, ns, diags);
 }
 
 /// The colour fields a closure stores, by the layout's field names.

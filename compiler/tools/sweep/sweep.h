@@ -78,6 +78,13 @@ struct Options {
   Precision precision = Precision::Float;  // of the timed kernels and the counted forward shader
 };
 
+/// Median lavapipe time per invocation of `r`'s throughput kernel with `emit`
+/// (a surface's: one shading point; a volume's: one ray, EmitOptions::volumeSteps)
+/// over options.pixels invocations (whole groups), options.timedRuns runs after
+/// one warm-up.
+bool nsPerInvocation(gpu::Context& gpu, const CompileResult& r, const EmitOptions& emit, const Options& options,
+                     double* ns, Diagnostics& diags);
+
 /// Measures every step. `gpu` runs the timing kernels. False, with errors reported, on a failure.
 bool measure(gpu::Context& gpu, const std::vector<Step>& steps, const CompileResult& full, const Options& options,
              std::vector<Row>* rows, Diagnostics& diags);

@@ -1,40 +1,11 @@
 #include "sweep/volume_sweep.h"
 
-#include <algorithm>
-
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "emit/kernel_emitter.h"
-#include "gpu/sample_run.h"
 
 namespace substratec::sweep {
-
-namespace {
-
-/// Median lavapipe time per ray of the cost kernel marching `steps` steps.
-bool nsPerRay(gpu::Context& ctx, const CompileResult& r, const Options& o, int steps, double* ns, Diagnostics& diags) {
-  EmitOptions emit;
-  emit.volumeSteps = steps;
-  std::vector<uint32_t> spirv;
-  auto pipeline = gpu::kernelPipeline(ctx, r, Target::Glsl, KernelMode::Throughput, emit,
-                                      "volume throughput", &spirv, diags);
-  if (!pipeline) return false;
-  const int rays = (o.pixels + kernel::kLocalSize - 1) / kernel::kLocalSize * kernel::kLocalSize;
-  std::vector<double> times;
-  for (int run = 0; run <= o.timedRuns; ++run) {  // run 0 warms up (JIT, caches)
-    gpu::Resources res =
-        gpu::kernelResources(r.material, pipeline->reflection(), spirv, {}, {}, static_cast<std::size_t>(rays) * 4);
-    double t = 0;
-    if (!ctx.dispatch(*pipeline, res, static_cast<uint32_t>(rays / kernel::kLocalSize), 1, 1, diags, &t)) return false;
-    if (run > 0) times.push_back(t / rays);
-  }
-  std::sort(times.begin(), times.end());
-  *ns = times[times.size() / 2];
-  return true;
-}
-
-}  // namespace
 
 bool measureVolume(gpu::Context& ctx, const CompileResult& r, const Options& o, std::vector<VolumeRow>* rows,
                    Diagnostics& diags) {
@@ -43,7 +14,9 @@ bool measureVolume(gpu::Context& ctx, const CompileResult& r, const Options& o, 
     VolumeRow row;
     row.steps = e.steps;
     row.error = e;
-    if (!nsPerRay(ctx, r, o, e.steps, &row.gpuNsPerRay, diags)) return false;
+    EmitOptions emit;
+    emit.volumeSteps = e.steps;
+    if (!nsPerInvocation(ctx, r, emit, o, &row.gpuNsPerRay, diags)) return false;
     rows->push_back(row);
   }
   return true;
