@@ -86,9 +86,7 @@ std::string_view featureName(int bit) {
 
 std::string_view treeOpName(TreeOp op) { return enumName(kTreeOpNames, op, "?"); }
 
-bool isUnlitLeaf(const Material& m, const TreeNode& n) {
-  return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == BsdfKind::Unlit;
-}
+bool isUnlitLeaf(const Material& m, const TreeNode& n) { return isLeafOfKind(m, n, BsdfKind::Unlit); }
 
 bool isHairLeaf(const Material& m, const TreeNode& n) { return isLeafOfKind(m, n, BsdfKind::Hair); }
 
@@ -101,10 +99,9 @@ bool isVolumeMaterial(const Material& m) {
 }
 
 std::string_view nodeOpName(const Material& m, const TreeNode& n) {
-  return isUnlitLeaf(m, n)                              ? "UNLIT"
-         : isHairLeaf(m, n)                             ? "HAIR"
-         : isLeafOfKind(m, n, BsdfKind::FogCloud) ? "FOG_CLOUD"
-                                                        : treeOpName(n.op);
+  static constexpr std::string_view kLeafNames[] = {"SLAB", "UNLIT", "HAIR", "FOG_CLOUD"};  // BsdfKind order
+  if (n.op != TreeOp::Slab || n.slab < 0) return treeOpName(n.op);
+  return kLeafNames[static_cast<int>(m.slabs[n.slab].kind)];
 }
 
 int Material::inputIndex(std::string_view n) const {
