@@ -19,6 +19,11 @@
 #ifndef SUBSTRATE_USE_HAIR
 #define SUBSTRATE_USE_HAIR 1
 #endif
+// 1: some closure may be an eye (SUBSTRATE_FEATURE_EYE, substrate_eye.h);
+// 0 leaves its fields out of the closure and its code out of the runtime.
+#ifndef SUBSTRATE_USE_EYE
+#define SUBSTRATE_USE_EYE 1
+#endif
 
 struct SubstrateClosure {
   float3 diffuseAlbedo;   // post multiple scattering, [0,1]
@@ -43,6 +48,11 @@ struct SubstrateClosure {
 #if SUBSTRATE_USE_HAIR
   float4 hair;                // a hair closure's (SUBSTRATE_FEATURE_HAIR, substrate_hair.h): azimuthal
                               // roughness, ior, cuticle angle in degrees, scatter
+#endif
+#if SUBSTRATE_USE_EYE
+  float3 irisN;               // an eye closure's (SUBSTRATE_FEATURE_EYE, substrate_eye.h): the iris's normal,
+  float3 irisPlaneN;          // the iris plane's normal (the caustic's axis), both unit,
+  float2 iris;                // and the iris mask and iris distance, [0,1]
 #endif
   float3 emissive;            // forward only (deferred adds it in the base pass)
   float weight;               // mix and coverage weights on the path to the root
@@ -198,6 +208,11 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.specularProfile = 0u;
 #if SUBSTRATE_USE_HAIR
   c.hair = float4(0.5, 1.55, 2.0, 0.0);
+#endif
+#if SUBSTRATE_USE_EYE
+  c.irisN = float3(0.0, 0.0, 1.0);
+  c.irisPlaneN = float3(0.0, 0.0, 1.0);
+  c.iris = SUBSTRATE_SPLAT2(0.0);
 #endif
   c.emissive = SUBSTRATE_SPLAT3(0.0);
   c.weight = 1.0;

@@ -19,6 +19,16 @@
 // A hair closure (runtime_shaders/substrate_hair.h): not one of the 8 header
 // feature bits; single-closure header bit 12 (a hair is always alone).
 #define SUBSTRATE_FEATURE_HAIR 256u
+// An eye closure (runtime_shaders/substrate_eye.h): not a header feature bit
+// either; single-closure header bit 13 (an eye is always alone).
+#define SUBSTRATE_FEATURE_EYE 512u
+
+// The eye's iris (substrate_eye.h): (1 / pi) times the integral over the
+// hemisphere around I of max(I.L, 0) (0.8 + 0.2 (p + 1) (I.L)^p),
+// p = 12 - 11 I.L, UE's iris lighting with the caustic on the iris normal, in
+// units of a Lambertian's (scipy quad of 2 mu (0.8 + 0.2 (13 - 11 mu)
+// mu^(12 - 11 mu)) over [0, 1]); the iris's cosine is divided by it.
+#define SUBSTRATE_EYE_CAUSTIC_MEAN 1.0411601538663962
 
 #define SUBSTRATE_SSS_NONE 0u
 #define SUBSTRATE_SSS_WRAP 1u

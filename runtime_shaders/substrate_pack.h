@@ -40,6 +40,9 @@
 // Bit 12 of a single-closure header: the closure is a hair (SUBSTRATE_FEATURE_HAIR):
 // its F0 field is the hair field, and its basis stores the fibre's tangent angle.
 #define SUBSTRATE_HEADER_HAIR 0x1000u
+// Bit 13 of a single-closure header: the closure is an eye (SUBSTRATE_FEATURE_EYE):
+// its F0 field is the iris normal and iris fields (its F0 is 0.04).
+#define SUBSTRATE_HEADER_EYE 0x2000u
 
 // Field widths in bits (docs/storage.md, "Field table").
 #define SUBSTRATE_BITS_HEADER 16u
@@ -54,6 +57,8 @@
 #define SUBSTRATE_BITS_ANISOTROPY 8u
 #define SUBSTRATE_BITS_SPECULAR_PROFILE 8u
 #define SUBSTRATE_BITS_HAIR 32u
+#define SUBSTRATE_BITS_IRIS_NORMAL 32u
+#define SUBSTRATE_BITS_IRIS 32u
 #define SUBSTRATE_BITS_GLINT 136u
 #define SUBSTRATE_BITS_NORMAL 32u
 #define SUBSTRATE_BITS_TANGENT_ANGLE 14u
@@ -317,6 +322,21 @@ float3 substrate_top_layer_normal_as_stored(float3 n, float dither) {
   return d;
 }
 
+// Iris (32 bits, SubstrateClosure.irisPlaneN and .iris): the iris plane's
+// normal octahedral 2 x unorm8 (x bits 0-7, y 8-15), iris mask unorm8
+// (16-23), iris distance unorm8 (24-31). The iris normal is a field of its
+// own, encoded as a basis normal (substrate_q_normal).
+uint substrate_q_iris(float3 planeN, float2 iris, float dither) {
+  uint2 o = substrate_oct_encode_unorm(planeN, 8u, dither);
+  return o.x | (o.y << 8u) | (substrate_q_unorm(iris.x, 8u, dither) << 16u) |
+         (substrate_q_unorm(iris.y, 8u, dither) << 24u);
+}
+
+void substrate_dq_iris(uint code, out float3 planeN, out float2 iris) {
+  planeN = substrate_oct_decode_unorm(uint2(code & 0xffu, (code >> 8u) & 0xffu), 8u);
+  iris = float2(substrate_dq_unorm((code >> 16u) & 0xffu, 8u), substrate_dq_unorm(code >> 24u, 8u));
+}
+
 // The canonical frame around a unit N (Duff et al. 2017) is
 // substrate_orthonormal_basis (substrate_common.h), as in the compiler's
 // rotationToTangent.
@@ -348,7 +368,7 @@ float3 substrate_tangent_angle_decode(uint code, float3 N) {
 
 // Single-closure header: class (bits 0-1), SUBSTRATE_FEATURE_* bits F90 ..
 // WEIGHT (2-8; bit 9, coverage above, is reserved), SSS type (10-11); a hair
-// closure ORs SUBSTRATE_HEADER_HAIR (bit 12).
+// closure ORs SUBSTRATE_HEADER_HAIR (bit 12), an eye SUBSTRATE_HEADER_EYE (bit 13).
 uint substrate_material_header_single(uint layoutClass, uint features, uint sssType) {
   return (layoutClass & 3u) | ((features & 0x7fu) << 2u) | ((sssType & 3u) << 10u);
 }

@@ -46,6 +46,14 @@ void substrate_unpack_closure_fields(uint words[SUBSTRATE_MAX_WORDS], inout uint
     pos += SUBSTRATE_BITS_HAIR;
   } else
 #endif
+#if SUBSTRATE_USE_EYE
+  if ((feats & SUBSTRATE_FEATURE_EYE) != 0u) {  // an eye: its iris in place of F0 (0.04, the init's)
+    c.irisN = substrate_dq_normal(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_IRIS_NORMAL));
+    pos += SUBSTRATE_BITS_IRIS_NORMAL;
+    substrate_dq_iris(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_IRIS), c.irisPlaneN, c.iris);
+    pos += SUBSTRATE_BITS_IRIS;
+  } else
+#endif
   {
     c.f0 = substrate_dq_color20(SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_COLOR));
     pos += SUBSTRATE_BITS_COLOR;
@@ -182,6 +190,9 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
 #if SUBSTRATE_USE_HAIR
       feats |= (header & SUBSTRATE_HEADER_HAIR) != 0u ? SUBSTRATE_FEATURE_HAIR : 0u;  // a hair is always alone
 #endif
+#if SUBSTRATE_USE_EYE
+      feats |= (header & SUBSTRATE_HEADER_EYE) != 0u ? SUBSTRATE_FEATURE_EYE : 0u;  // so is an eye
+#endif
       uint sss = (header >> 10u) & 3u;
       if (multi) {
         uint h = SUBSTRATE_READ_BITS(words, pos, SUBSTRATE_BITS_CLOSURE_HEADER);
@@ -290,6 +301,9 @@ void substrate_unpack_single_closure(uint words[SUBSTRATE_MAX_WORDS], uint topLa
   uint feats = (header >> 2u) & 0x7fu;
 #if SUBSTRATE_USE_HAIR
   feats |= (header & SUBSTRATE_HEADER_HAIR) != 0u ? SUBSTRATE_FEATURE_HAIR : 0u;
+#endif
+#if SUBSTRATE_USE_EYE
+  feats |= (header & SUBSTRATE_HEADER_EYE) != 0u ? SUBSTRATE_FEATURE_EYE : 0u;
 #endif
   uint pos = SUBSTRATE_BITS_HEADER;
   substrate_unpack_closure_fields(words, pos, feats, (header >> 10u) & 3u, true, c);

@@ -79,7 +79,7 @@ std::array<T, N> arrayOf(const std::array<double, N>& a) {
 template <class T>
 reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   // Every field is copied by name: a new one left out would keep its default here.
-  static_assert(sizeof(reference::Closure<double>) == 472,
+  static_assert(sizeof(reference::Closure<double>) == 536,
                 "Closure gained or lost a field: copy it below, then update the size");
   reference::Closure<T> o;
   o.diffuseAlbedo = arrayOf<T>(c.diffuseAlbedo);
@@ -102,6 +102,9 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.glintUvDerivatives = arrayOf<T>(c.glintUvDerivatives);
   o.specularProfile = c.specularProfile;
   o.hair = arrayOf<T>(c.hair);
+  o.irisN = arrayOf<T>(c.irisN);
+  o.irisPlaneN = arrayOf<T>(c.irisPlaneN);
+  o.iris = arrayOf<T>(c.iris);
   o.emissive = arrayOf<T>(c.emissive);
   o.weight = static_cast<T>(c.weight);
   o.topTransmittance = arrayOf<T>(c.topTransmittance);
@@ -229,6 +232,11 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.coatShare = p[kClosureCoatShare];
   if (c.features & reference::kFeatureHair)  // else the kernel has no hair field (SUBSTRATE_USE_HAIR 0)
     c.hair = {p[kClosureHair], p[kClosureHair + 1], p[kClosureHair + 2], p[kClosureHair + 3]};
+  if (c.features & reference::kFeatureEye) {  // else the kernel has no iris fields (SUBSTRATE_USE_EYE 0)
+    c.irisN = v3(kClosureIrisN);
+    c.irisPlaneN = v3(kClosureIrisPlaneN);
+    c.iris = {p[kClosureIris], p[kClosureIris + 1]};
+  }
   c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   return c;
 }

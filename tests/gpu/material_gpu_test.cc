@@ -257,6 +257,11 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
         check("coatShare", at + kClosureCoatShare, c64.coatShare, c32.coatShare);
         if (c64.features & reference::kFeatureHair)  // the field exists where a hair may be (SUBSTRATE_USE_HAIR)
           for (int c = 0; c < 4; ++c) check("hair", at + kClosureHair + c, c64.hair[c], c32.hair[c]);
+        if (c64.features & reference::kFeatureEye) {  // the fields exist where an eye may be (SUBSTRATE_USE_EYE)
+          field3("irisN", kClosureIrisN, c64.irisN, c32.irisN);
+          field3("irisPlaneN", kClosureIrisPlaneN, c64.irisPlaneN, c32.irisPlaneN);
+          for (int c = 0; c < 2; ++c) check("iris", at + kClosureIris + c, c64.iris[c], c32.iris[c]);
+        }
       }
       check("coverage", kResultCoverage, ref.material.coverage, r32.material.coverage);
       for (int c = 0; c < 3; ++c) {

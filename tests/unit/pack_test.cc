@@ -36,6 +36,7 @@ constexpr double kEps = 1e-9;
 // (The table's 0.006 and 0.09 degrees hold for most normals, not all.)
 constexpr double kNormalBoundDeg = 0.0075;    // basis normal, octahedral 2 x snorm16
 constexpr double kTopNormalBoundDeg = 0.119;  // top-layer word, octahedral 2 x unorm12
+constexpr double kIrisPlaneBoundDeg = 1.91;   // an eye's iris plane normal, octahedral 2 x unorm8 (step 2/255)
 constexpr double kTangentBoundDeg = 0.022;   // tangent angle unorm14
 constexpr double kMfpBoundStops = 32.0 / 255.0;
 constexpr double kHalfRelative = 1.0 / 2048.0;  // 2^-11
@@ -493,10 +494,15 @@ Pixel randomPixel(const StorageLayout& L, Rng& rng) {
     ClosureValues v;
     const auto f = c.storedFeatures;
     v.diffuseAlbedo = rng.color();
-    if (f & kFeatHair)
+    if (f & kFeatHair) {
       v.hair = {rng.uniform(), rng.uniform(1, 3), rng.uniform(-20, 20), rng.uniform()};
-    else
+    } else if (f & kFeatEye) {
+      v.irisN = rng.unit();
+      v.irisPlaneN = rng.unit();
+      v.iris = {rng.uniform(), rng.uniform()};
+    } else {
       v.f0 = rng.color();
+    }
     v.roughness = rng.uniform();
     if (c.storesWeight) v.weight = rng.uniform();
     if (!c.isTop) v.topTransmittance = rng.color();
@@ -605,6 +611,12 @@ void roundTrip(const StorageLayout& L, const Pixel& px, double u, const std::str
       EXPECT_LE(std::abs(got.hair[2] - want.hair[2]), 20.0 / 127 + kEps) << "hair cuticle angle";
       expectUnorm(got.hair[3], want.hair[3], 8, "hair scatter");
       EXPECT_EQ(got.f0, ClosureValues{}.f0) << "a fibre stores no F0";
+    } else if (c.storedFeatures & kFeatEye) {  // an eye's iris fields in place of F0
+      EXPECT_LE(angleDeg(got.irisN, want.irisN), kNormalBoundDeg) << "iris normal";
+      EXPECT_LE(angleDeg(got.irisPlaneN, want.irisPlaneN), kIrisPlaneBoundDeg) << "iris plane normal";
+      expectUnorm(got.iris[0], want.iris[0], 8, "iris mask");
+      expectUnorm(got.iris[1], want.iris[1], 8, "iris distance");
+      EXPECT_EQ(got.f0, ClosureValues{}.f0) << "an eye stores no F0: its cornea's is 0.04";
     } else {
       expectColor(got.f0, want.f0, "f0");
     }

@@ -449,7 +449,7 @@ D3 directionAt(const D3& N, double cosine, double azimuth) {
 template <class To>
 Closure<To> castClosure(const Closure<double>& c) {
   // Every field is copied by name: a new one left out would keep its default here.
-  static_assert(sizeof(Closure<double>) == 472, "Closure gained or lost a field: copy it below, then update the size");
+  static_assert(sizeof(Closure<double>) == 536, "Closure gained or lost a field: copy it below, then update the size");
   auto v = [](const auto& a) {
     std::array<To, std::tuple_size_v<std::decay_t<decltype(a)>>> r;
     for (std::size_t i = 0; i < r.size(); ++i) r[i] = static_cast<To>(a[i]);
@@ -469,6 +469,9 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.secondRoughness = static_cast<To>(c.secondRoughness);
   o.secondRoughnessWeight = static_cast<To>(c.secondRoughnessWeight);
   o.hair = v(c.hair);
+  o.irisN = v(c.irisN);
+  o.irisPlaneN = v(c.irisPlaneN);
+  o.iris = v(c.iris);
   o.fuzzAmount = static_cast<To>(c.fuzzAmount);
   o.fuzzColor = v(c.fuzzColor);
   o.fuzzRoughness = static_cast<To>(c.fuzzRoughness);

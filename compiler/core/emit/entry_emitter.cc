@@ -265,7 +265,9 @@ std::string packFields(const Material& m, const StorageLayout& L, const std::vec
       const ClosureLayout& c0 = L.closures[0];
       put(multi ? fmt::format("substrate_material_header_multi({}u, {}u, {}u)", cls, L.closures.size(), L.basisCount)
                 : fmt::format("substrate_material_header_single({}u, {}u, {}u){}", cls, featureBits(c0), sssCode(c0),
-                              (c0.storedFeatures & kFeatHair) ? " | SUBSTRATE_HEADER_HAIR" : ""),
+                              (c0.storedFeatures & kFeatHair)  ? " | SUBSTRATE_HEADER_HAIR"
+                              : (c0.storedFeatures & kFeatEye) ? " | SUBSTRATE_HEADER_EYE"
+                                                               : ""),
           f.bits);
     } else if (field == "header") {
       const ClosureLayout& cl = L.closures[f.closure];
@@ -288,6 +290,10 @@ std::string packFields(const Material& m, const StorageLayout& L, const std::vec
       put(fmt::format("substrate_q_fuzz({0}.fuzzAmount, {0}.fuzzColor, {0}.fuzzRoughness, dither)", c), f.bits);
     } else if (field == "hair") {
       put(fmt::format("substrate_q_hair({}.hair, dither)", c), f.bits);
+    } else if (field == "iris_normal") {
+      put(fmt::format("substrate_q_normal({}.irisN, dither)", c), f.bits);
+    } else if (field == "iris") {
+      put(fmt::format("substrate_q_iris({0}.irisPlaneN, {0}.iris, dither)", c), f.bits);
     } else if (field == "anisotropy") {
       put(fmt::format("substrate_q_anisotropy({}.anisotropy, dither)", c), f.bits);
     } else if (field == "specular_profile") {

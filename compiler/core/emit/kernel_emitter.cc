@@ -100,7 +100,14 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   s += "#else\n";
   for (int i = 0; i < 4; ++i) put(kClosureHair + i, "0.0");
   s += "#endif\n";
-  for (int at = kClosureHair + 4; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 60)
+  s += "#if SUBSTRATE_USE_EYE\n";  // the fields exist only where an eye may be
+  put3(kClosureIrisN, "irisN");
+  put3(kClosureIrisPlaneN, "irisPlaneN");
+  for (int i = 0; i < 2; ++i) put(kClosureIris + i, c + ".iris." + "xy"[i]);
+  s += "#else\n";
+  for (int at = kClosureIrisN; at < kClosureIris + 2; ++at) put(at, "0.0");
+  s += "#endif\n";
+  for (int at = kClosureIris + 2; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 68)
   return s;
 }
 

@@ -60,7 +60,7 @@ inline constexpr int kResultDirect = 8;          // rgb: sum over closures of su
 inline constexpr int kResultEnvironment = 12;    // rgb: sum of view throughput * substrate_env_split_sum
 inline constexpr int kResultEmissive = 16;       // rgb: sum of view throughput * emissive (Forward only; 0 in Deferred)
 /// Each closure's SubstrateClosure fields, in this order (floats):
-inline constexpr int kClosureFloats = 60;
+inline constexpr int kClosureFloats = 68;
 inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6, kClosureRoughness = 9,
                      kClosureAnisotropy = 10, kClosureN = 11, kClosureT = 14, kClosureSssMfp = 17,
                      kClosureSssPhase = 20, kClosureSssType = 21, kClosureSecondRoughness = 22,
@@ -71,7 +71,7 @@ inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6,
                      kClosureFeatures = 45, kClosureIsTop = 46, kClosureExtraInterfaces = 47,
                      kClosureCoatFloor = 48, kClosureCoatInterface = 49,
                      kClosureCoatStretch = 50, kClosureCoatTangent = 52, kClosureCoatShare = 55,
-                     kClosureHair = 56;
+                     kClosureHair = 56, kClosureIrisN = 60, kClosureIrisPlaneN = 63, kClosureIris = 66;
 
 /// Preview parameters (set 0, binding 0, std140 / cbuffer, float4 each):
 ///   camera: xyz eye position, w tan(vertical half field of view)

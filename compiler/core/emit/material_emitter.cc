@@ -39,6 +39,7 @@ std::string useDefines(std::uint16_t features) {
   use("SUBSTRATE_USE_SPECULAR_PROFILE", kFeatSpecularProfile);
   use("SUBSTRATE_USE_EMISSIVE", kFeatEmissive);
   use("SUBSTRATE_USE_HAIR", kFeatHair);
+  use("SUBSTRATE_USE_EYE", kFeatEye);
   return s;
 }
 
@@ -244,6 +245,7 @@ class Emitter {
   void emitNoClosureSlot();
   int firstUnlit() const;  // the first unlit leaf in pre-order, or -1
   void emitHairClosure(const std::string& c, const Slab& s);  // closure c of hair s
+  void emitEyeClosure(const std::string& c, const Slab& s);   // closure c of eye s
   unsigned emitFeaturePins(const std::string& c, const Slab& s);  // returns the feature bits
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
@@ -457,6 +459,10 @@ void Emitter::collectNeeded() {
     if (f & kFeatHair)  // emitHairClosure's pins
       for (SlabPin p : {SlabPin::BaseColor, SlabPin::Tangent, SlabPin::AzimuthalRoughness, SlabPin::Ior,
                         SlabPin::CuticleAngle, SlabPin::Scatter})
+        need(s.pin(p));
+    if (f & kFeatEye)  // emitEyeClosure's pins
+      for (SlabPin p : {SlabPin::DiffuseAlbedo, SlabPin::Roughness, SlabPin::IrisNormal, SlabPin::IrisPlaneNormal,
+                        SlabPin::IrisMask, SlabPin::IrisDistance})
         need(s.pin(p));
   }
   for (int n : t_.preorder) {  // unlit leaves: what they let through and emit
@@ -675,6 +681,10 @@ void Emitter::emitClosures() {
       emitHairClosure(c, s);
       continue;
     }
+    if (s.kind == BsdfKind::Eye) {  // always the whole material too
+      emitEyeClosure(c, s);
+      continue;
+    }
     const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);
     if (verticalOfTop(node) >= 0 && !knownOpaque(node) && !m_.values.isConstEqual(albedo, 0.0))
       // A layer scatters back only what it does not let through (substrate_tree.h).
@@ -761,6 +771,22 @@ void Emitter::emitHairClosure(const std::string& c, const Slab& s) {
                    expr(s.pin(SlabPin::Ior)), expr(s.pin(SlabPin::CuticleAngle)), expr(s.pin(SlabPin::Scatter))));
   if (s.features & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
   line(fmt::format("{}.features = {}u;", c, SUBSTRATE_FEATURE_HAIR));
+}
+
+/// An eye closure (runtime_shaders/substrate_eye.h): the cornea's normal and
+/// roughness, F0 0.04 (substrate_closure_init's), the sclera's and iris's
+/// colour in diffuseAlbedo, the iris's normals in world space and its mask
+/// and distance in iris.
+void Emitter::emitEyeClosure(const std::string& c, const Slab& s) {
+  line(fmt::format("{}.diffuseAlbedo = {};", c, expr(s.pin(SlabPin::DiffuseAlbedo))));
+  line(fmt::format("{}.roughness = {};", c, expr(s.pin(SlabPin::Roughness))));
+  line(fmt::format("{}.N = substrate_tangent_to_world({}, g.N, g.T);", c, expr(s.pin(SlabPin::Normal))));
+  line(fmt::format("{}.irisN = substrate_tangent_to_world({}, g.N, g.T);", c, expr(s.pin(SlabPin::IrisNormal))));
+  line(fmt::format("{}.irisPlaneN = substrate_tangent_to_world({}, g.N, g.T);", c,
+                   expr(s.pin(SlabPin::IrisPlaneNormal))));
+  line(fmt::format("{}.iris = float2({}, {});", c, expr(s.pin(SlabPin::IrisMask)), expr(s.pin(SlabPin::IrisDistance))));
+  if (s.features & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
+  line(fmt::format("{}.features = {}u;", c, SUBSTRATE_FEATURE_EYE));
 }
 
 int Emitter::firstUnlit() const {

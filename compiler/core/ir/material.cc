@@ -9,15 +9,18 @@ std::string_view blendModeName(BlendMode m) { return enumName(kBlendModeNames, m
 namespace {
 constexpr double kInf = 1e300;
 constexpr int kNoGeo = -1;
-constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair | kPinOfFogCloud, kSlabHair = kPinOfSlab | kPinOfHair;
+constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair | kPinOfFogCloud | kPinOfEye,
+                       kSlabHair = kPinOfSlab | kPinOfHair, kSlabEye = kPinOfSlab | kPinOfEye;
 // name, type, color, default, geometry default, lo, hi, kinds
 const SlabPinInfo kPins[kSlabPinCount] = {
-    {"diffuse_albedo", VType::Vec3, true, 0.18, kNoGeo, 0, 1},
+    {"diffuse_albedo", VType::Vec3, true, 0.18, kNoGeo, 0, 1, kSlabEye},  // an eye's: the sclera's and iris's
     {"f0", VType::Vec3, true, 0.04, kNoGeo, 0, 1},
     {"f90", VType::Vec3, true, 1.0, kNoGeo, 0, 1},
-    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kSlabHair},  // a hair's: longitudinal (Chiang's beta_m)
+    // A hair's: longitudinal (Chiang's beta_m); an eye's: the cornea's.
+    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kSlabHair | kPinOfEye},
     {"anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
-    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfSlab | kPinOfUnlit},
+    // An eye's: the cornea's and sclera's (UE's Cornea Normal).
+    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfSlab | kPinOfUnlit | kPinOfEye},
     {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1, kSlabHair},  // a hair's fibre
     {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
     {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf},
@@ -46,6 +49,13 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     {"albedo", VType::Vec3, true, 0.0, kNoGeo, 0, 1, kPinOfFogCloud},
     {"extinction", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kPinOfFogCloud},
     {"ambient_occlusion", VType::Float, false, 1.0, kNoGeo, 0, 1, kPinOfFogCloud},
+    // The eye's (runtime_shaders/substrate_eye.h; UE's Eye BSDF): the iris's normal (its lighting),
+    // the iris plane's normal (the caustic's axis), the iris mask (1: iris, 0: sclera) and the
+    // iris distance (how deep the iris sits behind the cornea: the caustic's concavity).
+    {"iris_normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfEye},
+    {"iris_plane_normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfEye},
+    {"iris_mask", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfEye},
+    {"iris_distance", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfEye},
 };
 }  // namespace
 
@@ -58,20 +68,20 @@ std::optional<SlabPin> slabPinByName(std::string_view name) {
 }
 
 bool bsdfTakesPin(BsdfKind k, SlabPin p) {
-  static constexpr std::uint8_t kBit[] = {kPinOfSlab, kPinOfUnlit, kPinOfHair, kPinOfFogCloud};  // BsdfKind order
+  static constexpr std::uint8_t kBit[] = {kPinOfSlab, kPinOfUnlit, kPinOfHair, kPinOfFogCloud, kPinOfEye};  // BsdfKind order
   return (kPins[static_cast<int>(p)].kinds & kBit[static_cast<int>(k)]) != 0;
 }
 
 std::string_view bsdfKindName(BsdfKind k) {
-  static constexpr std::string_view kNames[] = {"slab", "unlit", "hair", "volumetric_fog_cloud"};  // BsdfKind order
+  static constexpr std::string_view kNames[] = {"slab", "unlit", "hair", "volumetric_fog_cloud", "eye"};  // BsdfKind order
   return kNames[static_cast<int>(k)];
 }
 
-bool bsdfIsClosure(BsdfKind k) { return k == BsdfKind::Slab || k == BsdfKind::Hair; }
-bool bsdfIsWholeMaterial(BsdfKind k) { return k == BsdfKind::Hair || k == BsdfKind::FogCloud; }
+bool bsdfIsClosure(BsdfKind k) { return k == BsdfKind::Slab || k == BsdfKind::Hair || k == BsdfKind::Eye; }
+bool bsdfIsWholeMaterial(BsdfKind k) { return k == BsdfKind::Hair || k == BsdfKind::FogCloud || k == BsdfKind::Eye; }
 
 std::optional<BsdfKind> bsdfKindByName(std::string_view name) {
-  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair, BsdfKind::FogCloud})
+  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair, BsdfKind::FogCloud, BsdfKind::Eye})
     if (bsdfKindName(k) == name) return k;
   return std::nullopt;
 }
@@ -80,7 +90,7 @@ std::string_view sssTypeName(SssType t) { return enumName(kSssTypeNames, t, "non
 
 std::string_view featureName(int bit) {
   static constexpr std::string_view names[kFeatureCount] = {
-      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium", "hair"};
+      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium", "hair", "eye"};
   return bit >= 0 && bit < kFeatureCount ? names[bit] : "?";
 }
 
@@ -99,7 +109,7 @@ bool isVolumeMaterial(const Material& m) {
 }
 
 std::string_view nodeOpName(const Material& m, const TreeNode& n) {
-  static constexpr std::string_view kLeafNames[] = {"SLAB", "UNLIT", "HAIR", "FOG_CLOUD"};  // BsdfKind order
+  static constexpr std::string_view kLeafNames[] = {"SLAB", "UNLIT", "HAIR", "FOG_CLOUD", "EYE"};  // BsdfKind order
   if (n.op != TreeOp::Slab || n.slab < 0) return treeOpName(n.op);
   return kLeafNames[static_cast<int>(m.slabs[n.slab].kind)];
 }

@@ -49,7 +49,7 @@ enum class SlabPin : std::uint8_t {
   DiffuseAlbedo, F0, F90, Roughness, Anisotropy, Normal, Tangent, SssMfp, SssMfpScale,
   SssPhaseAnisotropy, Emissive, SecondRoughness, SecondRoughnessWeight, FuzzAmount, FuzzColor,
   FuzzRoughness, GlintValue, GlintUv, Transmittance, BaseColor, AzimuthalRoughness, Ior, CuticleAngle, Scatter,
-  Albedo, Extinction, AmbientOcclusion,
+  Albedo, Extinction, AmbientOcclusion, IrisNormal, IrisPlaneNormal, IrisMask, IrisDistance,
   Count_
 };
 inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
@@ -61,19 +61,22 @@ inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
 /// one closure that is always the whole material (build_tree); and the
 /// volumetric fog cloud, a participating medium a ray-marcher samples per point
 /// (runtime_shaders/substrate_fog_cloud.h): no closure, always the whole
-/// material, which it makes a volume-domain material (isVolumeMaterial).
-enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair, FogCloud };
-/// "slab", "unlit", "hair", "volumetric_fog_cloud": the node kind in materials.
+/// material, which it makes a volume-domain material (isVolumeMaterial); and
+/// the eye BSDF, a slab's cornea interface and sclera with an iris of its own
+/// normal and caustic (runtime_shaders/substrate_eye.h): one closure, always
+/// the whole material.
+enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair, FogCloud, Eye };
+/// "slab", "unlit", "hair", "volumetric_fog_cloud", "eye": the node kind in materials.
 std::string_view bsdfKindName(BsdfKind k);
 std::optional<BsdfKind> bsdfKindByName(std::string_view name);
-/// Whether a BSDF of kind `k` is a closure the lighting sees (slab, hair); an
+/// Whether a BSDF of kind `k` is a closure the lighting sees (slab, hair, eye); an
 /// unlit only emits and lets through, a fog cloud is sampled, not lit as a surface.
 bool bsdfIsClosure(BsdfKind k);
-/// Whether a BSDF of kind `k` must be the whole material (hair, fog cloud: build_tree).
+/// Whether a BSDF of kind `k` must be the whole material (hair, fog cloud, eye: build_tree).
 bool bsdfIsWholeMaterial(BsdfKind k);
 
 /// BsdfKind bits: which kinds of BSDF node take a pin.
-inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4, kPinOfFogCloud = 8;
+inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4, kPinOfFogCloud = 8, kPinOfEye = 16;
 
 struct SlabPinInfo {
   std::string_view name;
@@ -105,8 +108,9 @@ enum Feature : std::uint16_t {
   kFeatEmissive = 1 << 7,
   kFeatMedium = 1 << 8,   // a coating slab's medium (MFP): drives transmittance only
   kFeatHair = 1 << 9,     // a hair BSDF's closure: the fibre's lobes, its own field and a tangent
+  kFeatEye = 1 << 10,     // an eye BSDF's closure: the iris's normals, mask and distance in place of F0
 };
-inline constexpr int kFeatureCount = 10;
+inline constexpr int kFeatureCount = 11;
 /// Features whose lighting reads the closure's tangent, so its basis stores
 /// one: anisotropy (the stretched lobe) and hair (the fibre's direction).
 inline constexpr std::uint16_t kTangentFeatures = kFeatAnisotropy | kFeatHair;

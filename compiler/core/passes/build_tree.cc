@@ -170,12 +170,14 @@ void checkUnlitPlacement(const Material& m, Diagnostics& diags) {
   }
 }
 
-/// A hair BSDF and a volumetric fog cloud are the whole material: a located
-/// error at such a leaf with a parent, naming the operator. A hair's closure
-/// is lit by the fibre's own model (a far field around the fibre, no
-/// interface or diffuse), which no operator can blend, layer or weigh against
-/// a slab's lobes; a fog cloud is a medium sampled through a volume, not a
-/// surface (UE's Substrate keeps both alone at the root; the fog cloud there
+/// A hair BSDF, an eye BSDF and a volumetric fog cloud are the whole
+/// material: a located error at such a leaf with a parent, naming the
+/// operator. A hair's closure is lit by the fibre's own model (a far field
+/// around the fibre, no interface or diffuse), which no operator can blend,
+/// layer or weigh against a slab's lobes; an eye's iris is lit through its
+/// cornea by a caustic of its own, which no operator's blend of closures
+/// keeps; a fog cloud is a medium sampled through a volume, not a surface
+/// (UE's Substrate keeps all three alone at the root; the fog cloud there
 /// sets the material's domain to volume).
 void checkWholeMaterialPlacement(const Material& m, Diagnostics& diags) {
   const TreeInfo t = analyzeTree(m);
@@ -186,15 +188,20 @@ void checkWholeMaterialPlacement(const Material& m, Diagnostics& diags) {
         !reported.insert(node.pointer).second)
       continue;
     const TreeNode& p = m.nodes[t.parent[n]];
-    const bool hair = isHairLeaf(m, node);
-    diags.error(node.pointer,
-                fmt::format("{} '{}' is an operand of {} '{}': a {} must be the whole material (the output), since {}",
-                            bsdfKindName(m.slabs[node.slab].kind), node.id, treeOpName(p.op), p.id,
-                            hair ? "hair BSDF" : "volumetric fog cloud",
-                            hair ? "its fibre lobes are a closure of their own kind that no operator can mix, layer "
-                                   "or weigh with other matter"
-                                 : "it is a medium a ray-marcher samples through a volume, not a surface that an "
-                                   "operator can mix, layer or weigh with other matter"));
+    const BsdfKind kind = m.slabs[node.slab].kind;
+    const char* what = kind == BsdfKind::Hair  ? "a hair BSDF"
+                       : kind == BsdfKind::Eye ? "an eye BSDF"
+                                               : "a volumetric fog cloud";
+    const char* why =
+        kind == BsdfKind::Hair  ? "its fibre lobes are a closure of their own kind that no operator can mix, layer or "
+                                  "weigh with other matter"
+        : kind == BsdfKind::Eye ? "its iris is lit through its cornea by a caustic of its own, a closure of its own "
+                                  "kind that no operator can mix, layer or weigh with other matter"
+                                : "it is a medium a ray-marcher samples through a volume, not a surface that an "
+                                  "operator can mix, layer or weigh with other matter";
+    diags.error(node.pointer, fmt::format("{} '{}' is an operand of {} '{}': {} must be the whole material (the "
+                                          "output), since {}",
+                                          bsdfKindName(kind), node.id, treeOpName(p.op), p.id, what, why));
   }
 }
 

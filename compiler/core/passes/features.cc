@@ -22,6 +22,11 @@ void analyzeFeatures(Material& m) {
       s.features = kFeatHair | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
       continue;
     }
+    if (s.kind == BsdfKind::Eye) {  // an eye's cornea, sclera and iris are one closure kind, its fields fixed
+      s.sssType = SssType::None;
+      s.features = kFeatEye | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
+      continue;
+    }
     if (used(SlabPin::F90, 1.0)) f |= kFeatF90;
     if (used(SlabPin::Anisotropy, 0.0)) f |= kFeatAnisotropy;
     bool hasMfp = used(SlabPin::SssMfp, 0.0) && used(SlabPin::SssMfpScale, 0.0);

@@ -519,7 +519,7 @@ void Resolver::checkOutput() {
         d_.error("/output", fmt::format("unknown node {}", quoteForDiagnostic(outputId_)));
     } else if (isValueKindName(outputId_)) {
       d_.error("/output", fmt::format("{} is a value node; the output must be a Substrate node "
-                                      "(slab, unlit, hair, volumetric_fog_cloud, horizontal, vertical, add, coverage_weight, select)",
+                                      "(slab, unlit, hair, volumetric_fog_cloud, eye, horizontal, vertical, add, coverage_weight, select)",
                                       quoteForDiagnostic(outputId_)));
     } else if (isSubstrateName(outputId_)) {
       out_.output = namedSubstrate_[outputId_];
@@ -1361,7 +1361,10 @@ void Resolver::fillSlabNode(int index, const Json& j, const std::string& ptr, SN
       d_.error(ptr + "/" + pointerToken(k),
                slab ? fmt::format("unknown slab pin {}", quoteForDiagnostic(k))
                     : fmt::format("unknown pin {} for {} {} node (pins: {})", quoteForDiagnostic(k),
-                                  node.kind == BsdfKind::Unlit ? "an" : "a", bsdfKindName(node.kind),
+                                  std::string_view("aeiou").find(bsdfKindName(node.kind)[0]) != std::string_view::npos
+                                      ? "an"
+                                      : "a",
+                                  bsdfKindName(node.kind),
                                   pinListOf(node.kind)));
   }
   // A pin the kind does not take keeps its default (an unlit's slab pins, a

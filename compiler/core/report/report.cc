@@ -81,6 +81,10 @@ std::string formatReportText(const CompileResult& r) {
       o += fmt::format("BSDF {} ({}): Hair=1 Emissive={} Basis={} (a fibre: R, TT, TRT lobes and the rest; "
                        "its basis stores the fibre's tangent)\n",
                        i, s.id, (s.features & kFeatEmissive) ? 1 : 0, s.basis);
+    else if (s.kind == BsdfKind::Eye)  // nor to an eye: its cornea, sclera and iris are one closure kind
+      o += fmt::format("BSDF {} ({}): Eye=1 Emissive={} Basis={} (a cornea's GGX interface, F0 0.04, over the "
+                       "sclera's diffuse and an iris of its own normal and caustic)\n",
+                       i, s.id, (s.features & kFeatEmissive) ? 1 : 0, s.basis);
     else
       o += fmt::format("BSDF {} ({}): {}\n", i, s.id, featureLine(s));
   }

@@ -25,7 +25,7 @@ void finishLayout(StorageLayout& L) {
   const int count = static_cast<int>(L.closures.size());
   const bool multi = count > 1;
   // Class.
-  if (all & (kFeatGlint | kFeatSpecularProfile | kFeatHair)) L.layoutClass = LayoutClass::Special;
+  if (all & (kFeatGlint | kFeatSpecularProfile | kFeatHair | kFeatEye)) L.layoutClass = LayoutClass::Special;
   else if (multi || (all & kFeatAnisotropy)) L.layoutClass = LayoutClass::Complex;
   else if (all || (count > 0 && L.closures[0].storesWeight)) L.layoutClass = LayoutClass::Single;
   else L.layoutClass = LayoutClass::Simple;
@@ -45,6 +45,7 @@ void finishLayout(StorageLayout& L) {
       multi        ? "layout class 2 | closure count-1 3 | basis count 4 | reserved 7"
       : count == 0 ? "layout class 2 (SIMPLE) | no closure (bit 14): an unlit material"
       : (all & kFeatHair) ? "layout class 2 (SPECIAL) | feature bits 8 | sss type 2 | hair (bit 12) | reserved 3"
+      : (all & kFeatEye)  ? "layout class 2 (SPECIAL) | feature bits 8 | sss type 2 | reserved 1 | eye (bit 13) | reserved 2"
                    : "layout class 2 | feature bits 8 | sss type 2 | reserved 4");
   for (int i = 0; i < count; ++i) {
     const ClosureLayout& c = L.closures[i];
@@ -53,11 +54,15 @@ void finishLayout(StorageLayout& L) {
       add(p + "header", bits::kClosureHeader,
           "basis id 3 | is top 1 | feature bits 8 | sss type 2 | extra interfaces 2", i);
     add(p + "diffuse_albedo", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);  // a hair's base colour
-    if (c.storedFeatures & kFeatHair)  // a fibre has no F0: its lobes' own parameters instead
+    if (c.storedFeatures & kFeatHair) {  // a fibre has no F0: its lobes' own parameters instead
       add(p + "hair", bits::kHair,
           "azimuthal roughness unorm8 | (ior - 1) / 2 unorm8 | cuticle angle snorm8 over 20 deg | scatter unorm8", i);
-    else
+    } else if (c.storedFeatures & kFeatEye) {  // a cornea's F0 is fixed (0.04): the iris instead
+      add(p + "iris_normal", bits::kIrisNormal, "octahedral 2 x snorm16", i);
+      add(p + "iris", bits::kIris, "iris plane normal octahedral 2 x unorm8 | iris mask unorm8 | iris distance unorm8", i);
+    } else {
       add(p + "f0", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
+    }
     add(p + "roughness", bits::kRoughness, "unorm8", i);
     if (c.storesWeight) add(p + "weight", bits::kGreyWeight, "unorm8", i);
     if (!c.isTop) add(p + "top_transmittance", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
@@ -188,7 +193,7 @@ std::vector<int> runtimeSimpleClosures(const Material& m, const StorageLayout& L
     if (f & kFeatHaze) possible = possible && pinVaries(s, SlabPin::SecondRoughnessWeight);
     if (f & kFeatFuzz) possible = possible && pinVaries(s, SlabPin::FuzzAmount);
     if (f & kFeatGlint) possible = possible && pinVaries(s, SlabPin::GlintValue);
-    if (f & (kFeatSpecularProfile | kFeatHair)) possible = false;  // a static choice; a fibre is never a slab
+    if (f & (kFeatSpecularProfile | kFeatHair | kFeatEye)) possible = false;  // a static choice; a fibre is never a slab
     if (possible) out.push_back(k);
   }
   return out;

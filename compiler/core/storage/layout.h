@@ -31,6 +31,8 @@ inline constexpr int kFuzz = 32;            // amount 6 + color 20 + roughness 6
 inline constexpr int kAnisotropy = 8;
 inline constexpr int kSpecularProfile = 8;
 inline constexpr int kHair = 32;            // a hair closure's, in place of F0: 4 x 8 bits
+inline constexpr int kIrisNormal = 32;      // an eye closure's, in place of F0 with kIris: octahedral 2 x 16
+inline constexpr int kIris = 32;            // iris plane normal octahedral 2 x 8 + mask 8 + distance 8
 inline constexpr int kGlint = 136;          // density 8 + uv 2 x fp32 + uv derivatives 4 x fp16
 inline constexpr int kNormal = 32;          // octahedral 2 x 16
 inline constexpr int kTangentAngle = 14;
@@ -75,7 +77,8 @@ struct StorageLayout {
 
 /// Features whose data lives in a closure (emissive and medium cost no bytes).
 inline constexpr std::uint16_t kStoredFeatureMask =
-    kFeatF90 | kFeatAnisotropy | kFeatSss | kFeatHaze | kFeatFuzz | kFeatGlint | kFeatSpecularProfile | kFeatHair;
+    kFeatF90 | kFeatAnisotropy | kFeatSss | kFeatHaze | kFeatFuzz | kFeatGlint | kFeatSpecularProfile | kFeatHair |
+    kFeatEye;
 
 StorageLayout computeLayout(const Material& m, const TreeInfo& info);
 

@@ -249,6 +249,16 @@ std::array<double, 4> dequantizeHair(std::uint32_t code) {
           20.0 * dequantizeSnorm((code >> 16) & 0xffu, 8), dequantizeUnorm(code >> 24, 8)};
 }
 
+std::uint32_t quantizeIris(const Vec3d& planeNormal, const std::array<double, 2>& iris, double dither) {
+  const auto o = octEncodeUnorm(planeNormal, 8, dither);
+  return o[0] | (o[1] << 8) | (quantizeUnorm(iris[0], 8, dither) << 16) | (quantizeUnorm(iris[1], 8, dither) << 24);
+}
+
+void dequantizeIris(std::uint32_t code, Vec3d& planeNormal, std::array<double, 2>& iris) {
+  planeNormal = octDecodeUnorm({code & 0xffu, (code >> 8) & 0xffu}, 8);
+  iris = {dequantizeUnorm((code >> 16) & 0xffu, 8), dequantizeUnorm(code >> 24, 8)};
+}
+
 std::uint32_t closureHeaderFeatures(const ClosureLayout& c) {
   std::uint32_t f = 0;
   if (c.storedFeatures & kFeatF90) f |= kClosureF90;
@@ -260,6 +270,7 @@ std::uint32_t closureHeaderFeatures(const ClosureLayout& c) {
   if (c.storesWeight) f |= kClosureWeight;
   if (c.storesCoverageAbove) f |= kClosureCoverageAbove;
   if (c.storedFeatures & kFeatHair) f |= kClosureHair;  // beyond the 8 header bits: single-closure header bit 12
+  if (c.storedFeatures & kFeatEye) f |= kClosureEye;    // and bit 13
   return f;
 }
 
@@ -268,6 +279,7 @@ namespace {
 std::uint16_t featuresFromHeader(std::uint32_t f, std::uint32_t sssType) {
   std::uint16_t s = 0;
   if (f & kClosureHair) s |= kFeatHair;
+  if (f & kClosureEye) s |= kFeatEye;
   if (f & kClosureF90) s |= kFeatF90;
   if (f & kClosureAnisotropy) s |= kFeatAnisotropy;
   if (f & kClosureHaze) s |= kFeatHaze;
@@ -343,6 +355,8 @@ const PackedClosureField kPackedClosureFields[] = {
     {"diffuse_albedo", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.diffuseAlbedo, d); }},
     {"f0", bits::kColor, [](const ClosureValues& v, double d) { return quantizeColor(v.f0, d); }},
     {"hair", bits::kHair, [](const ClosureValues& v, double d) { return quantizeHair(v.hair, d); }},
+    {"iris_normal", bits::kIrisNormal, [](const ClosureValues& v, double d) { return quantizeNormal(v.irisN, d); }},
+    {"iris", bits::kIris, [](const ClosureValues& v, double d) { return quantizeIris(v.irisPlaneN, v.iris, d); }},
     {"roughness", bits::kRoughness, [](const ClosureValues& v, double d) { return quantizeUnorm(v.roughness, 8, d); }},
     {"weight", bits::kGreyWeight, [](const ClosureValues& v, double d) { return quantizeUnorm(v.weight, 8, d); }},
     {"top_transmittance", bits::kColor,
@@ -428,6 +442,7 @@ std::vector<std::uint32_t> packMaterial(const StorageLayout& layout, const std::
         h |= (closureHeaderFeatures(layout.closures[0]) & 0x7fu) << 2;
         h |= headerSssType(layout.closures[0], closures[0]) << 10;
         if (layout.closures[0].storedFeatures & kFeatHair) h |= packfmt::kHairHeaderBit;
+        if (layout.closures[0].storedFeatures & kFeatEye) h |= packfmt::kEyeHeaderBit;
       }
       put(16, h);
       continue;
@@ -528,6 +543,7 @@ ClosureLayout unpackClosureHeader(FieldReader& r, int i, std::uint32_t header, b
     feats = (header >> 2) & 0x7fu;
     sss = (header >> 10) & 3u;
     if (header & packfmt::kHairHeaderBit) feats |= kClosureHair;
+    if (header & packfmt::kEyeHeaderBit) feats |= kClosureEye;
   }
   c.storesWeight = feats & kClosureWeight;
   c.storesCoverageAbove = feats & kClosureCoverageAbove;
@@ -561,10 +577,14 @@ void unpackClosure(FieldReader& r, int i, std::uint32_t header, bool multi, int 
   if (!c.isTop) v.coverageAbove = 1;  // below layers of static coverage 1 unless stored
 
   v.diffuseAlbedo = dequantizeColor(r.field(p + "diffuse_albedo", bits::kColor, i));
-  if (feats & kClosureHair)
+  if (feats & kClosureHair) {
     v.hair = dequantizeHair(r.field(p + "hair", bits::kHair, i));
-  else
+  } else if (feats & kClosureEye) {
+    v.irisN = dequantizeNormal(r.field(p + "iris_normal", bits::kIrisNormal, i));
+    dequantizeIris(r.field(p + "iris", bits::kIris, i), v.irisPlaneN, v.iris);
+  } else {
     v.f0 = dequantizeColor(r.field(p + "f0", bits::kColor, i));
+  }
   v.roughness = dequantizeUnorm(r.field(p + "roughness", bits::kRoughness, i), 8);
   if (c.storesWeight) v.weight = dequantizeUnorm(r.field(p + "weight", bits::kGreyWeight, i), 8);
   if (!c.isTop) v.topTransmittance = dequantizeColor(r.field(p + "top_transmittance", bits::kColor, i));

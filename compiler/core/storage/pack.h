@@ -48,6 +48,7 @@ enum ClosureFeatureBit : std::uint32_t {
   kClosureWeight = SUBSTRATE_FEATURE_WEIGHT,
   kClosureCoverageAbove = SUBSTRATE_FEATURE_COVERAGE_ABOVE,
   kClosureHair = SUBSTRATE_FEATURE_HAIR,  // not a header feature bit: single-closure header bit 12
+  kClosureEye = SUBSTRATE_FEATURE_EYE,    // nor this: single-closure header bit 13
 };
 
 /// SSS types as stored (SUBSTRATE_SSS_*; the values of SssType).
@@ -59,6 +60,7 @@ namespace packfmt {
 inline constexpr std::uint32_t kMultiClosureHeaderBit = 1u << 15;  // material header bit 15
 inline constexpr std::uint32_t kNoClosureHeaderBit = 1u << 14;  // single-closure header bit 14: an unlit pixel
 inline constexpr std::uint32_t kHairHeaderBit = 1u << 12;  // single-closure header bit 12: a hair closure
+inline constexpr std::uint32_t kEyeHeaderBit = 1u << 13;   // single-closure header bit 13: an eye closure
 inline constexpr int kMaxClosures = 8;     // closure count - 1 is 3 bits
 inline constexpr int kMaxBases = 8;        // basis id is 3 bits
 inline constexpr double kMfpLog2Min = -24.0;
@@ -78,6 +80,12 @@ struct ClosureValues {
   /// A hair closure's (SubstrateClosure.hair): azimuthal roughness, ior,
   /// cuticle angle in degrees, scatter; stored in place of f0.
   std::array<double, 4> hair{0.5, 1.55, 2.0, 0.0};
+  /// An eye closure's (SubstrateClosure.irisN, .irisPlaneN, .iris): the iris's
+  /// normal, its plane's normal (unit, world space like the bases'), and the
+  /// iris mask and distance; stored in place of f0 (whose 0.04 is fixed).
+  Vec3d irisN{0, 0, 1};
+  Vec3d irisPlaneN{0, 0, 1};
+  std::array<double, 2> iris{0, 0};
   Vec3d sssMfp{0, 0, 0};  // meters, after sss_mfp_scale; 0 = no medium
   double sssPhaseAnisotropy = 0;
   std::uint32_t sssType = kSssTypeNone;
@@ -123,6 +131,12 @@ double dequantizeSnorm(std::uint32_t code, int bits);
 /// unorm8 (8-15), cuticle angle / 20 degrees snorm8 (16-23), scatter unorm8 (24-31).
 std::uint32_t quantizeHair(const std::array<double, 4>& hair, double dither);
 std::array<double, 4> dequantizeHair(std::uint32_t code);
+
+/// Iris (32 bits): the iris plane's normal octahedral 2 x unorm8 (x bits 0-7,
+/// y 8-15), iris mask unorm8 (16-23), iris distance unorm8 (24-31). The iris
+/// normal is a field of its own, as a basis normal (quantizeNormal).
+std::uint32_t quantizeIris(const Vec3d& planeNormal, const std::array<double, 2>& iris, double dither);
+void dequantizeIris(std::uint32_t code, Vec3d& planeNormal, std::array<double, 2>& iris);
 
 /// Colour (20 bits): sqrt(saturate(c)) as unorm 7/7/6, r in bits 0-6, g 7-13, b 14-19.
 std::uint32_t quantizeColor(const Vec3d& c, double dither);

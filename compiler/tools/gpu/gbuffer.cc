@@ -35,6 +35,9 @@ void copySharedFields(const From& from, To& to) {
   to.glintUvDerivatives = from.glintUvDerivatives;
   to.specularProfile = from.specularProfile;
   to.hair = from.hair;
+  to.irisN = from.irisN;
+  to.irisPlaneN = from.irisPlaneN;
+  to.iris = from.iris;
   to.weight = from.weight;
   to.topTransmittance = from.topTransmittance;
   to.coverageAbove = from.coverageAbove;

@@ -264,6 +264,20 @@ V3<T> diffuseLambert(const V3<T>& albedo, T NoL) {
   return albedo * (K<T>::invPi * saturate(NoL));
 }
 
+// substrate_eye_iris_cosine: UE's iris lighting, max(I.L, 0) times the caustic
+// 0.8 + 0.2 (p + 1) max(C.L, 0)^p (p = lerp(12, 1, max(I.L, 0)), C = the iris
+// plane's normal pulled toward -N by mask * distance), over its mean.
+template <class T>
+T eyeIrisCosine(const Closure<T>& c, const V3<T>& N, const V3<T>& L) {
+  const T mask = saturate(c.iris[0]);
+  const T depth = mask * saturate(c.iris[1]);
+  const V3<T> axis = safeNormalize(lerp(c.irisPlaneN, N * T(-1), depth), c.irisPlaneN);
+  const T irisNoL = saturate(dot(c.irisN, L));
+  const T p = lerp(T(12), T(1), irisNoL);
+  const T caustic = T(0.8) + T(0.2) * (p + T(1)) * std::pow(saturate(dot(axis, L)), p);
+  return irisNoL * caustic * (T(1) / T(SUBSTRATE_EYE_CAUSTIC_MEAN));
+}
+
 // substrate_diffuse_chan2018: a2 = max(r^4, 1e-7); lobe capped at 1 (as UE),
 // divided by 1 + max(0, 0.41 (r - 0.74) - 0.59 sat(NoV)), the bound of the
 // model's albedo excess.
@@ -1042,9 +1056,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   const V3<T> f0d = vmin(f0, splat3(fd[0]));
   const V3<T> f90d = vmin(f90, splat3(fd[1]));
   // The light-side coupling for every lobe but the wrap (substrate_eval_closure).
-  V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL)
-                      : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
-                            diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
+  V3<T> diff = isWrap ? diffuseWrap(albedo, wrap, NoL) : diffuse(diffuseModel, albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
+  if (!isWrap && (c.features & kFeatureEye))  // the iris where the mask is: its own cosine (substrate_eye.h)
+    diff = lerp(diff, albedo * (K<T>::invPi * eyeIrisCosine(c, N, L)), saturate(c.iris[0]));
+  if (!isWrap) diff = diff * diffuseLightCoupling(f0d, f90d, NoLc, roughness, hazeRoughness, hazeWeight);
   // A slab's medium: its view and light dependence ("A slab's medium" in substrate_bsdf.h).
   if (c.sssType != kSssNone) {
     T p;
@@ -1133,6 +1148,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T diffuseLightCoupling<T>(const V3<T>&, const V3<T>&, T, T, T, T);                         \
   template T diffuseLightCouplingDeviation<T>(const V3<T>&, const V3<T>&, T, T, T);                   \
   template V3<T> diffuseLambert<T>(const V3<T>&, T);                                                   \
+  template T eyeIrisCosine<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                           \
   template V3<T> diffuseChan2018<T>(const V3<T>&, T, T, T, T, T);                                      \
   template V3<T> diffuseChan2024<T>(const V3<T>&, T, T, T, T, T);                                      \
   template T eonAlbedo<T>(T, T);                                                                       \

@@ -97,6 +97,9 @@ double fuzzPairMargin(int diffuseModel, double roughness);
 
 // Diffuse models (BRDF * NoL).
 template <class T> V3<T> diffuseLambert(const V3<T>& albedo, T NoL);
+/// substrate_eye_iris_cosine: what multiplies albedo / pi for an eye's iris in
+/// place of the diffuse's cosine (the cornea's normal N, toward the light L).
+template <class T> T eyeIrisCosine(const Closure<T>& c, const V3<T>& N, const V3<T>& L);
 template <class T> V3<T> diffuseChan2018(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
 template <class T> V3<T> diffuseChan2024(const V3<T>& albedo, T roughness, T NoV, T NoL, T NoH, T VoH);
 template <class T> T eonAlbedo(T mu, T r);

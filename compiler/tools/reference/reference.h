@@ -41,7 +41,7 @@ inline constexpr std::uint32_t kFeatureF90 = SUBSTRATE_FEATURE_F90, kFeatureAnis
                                kFeatureSpecularProfile = SUBSTRATE_FEATURE_SPECULAR_PROFILE,
                                kFeatureWeight = SUBSTRATE_FEATURE_WEIGHT,
                                kFeatureCoverageAbove = SUBSTRATE_FEATURE_COVERAGE_ABOVE,
-                               kFeatureHair = SUBSTRATE_FEATURE_HAIR;
+                               kFeatureHair = SUBSTRATE_FEATURE_HAIR, kFeatureEye = SUBSTRATE_FEATURE_EYE;
 // sssType values (SUBSTRATE_SSS_*).
 inline constexpr std::uint32_t kSssNone = 0, kSssWrap = 1, kSssDiffusion = 2, kSssSimpleVolume = 3;
 // Diffuse models (SUBSTRATE_DIFFUSE_MODEL).
@@ -74,6 +74,9 @@ struct Closure {
   V4<T> glintUvDerivatives{T(0), T(0), T(0), T(0)};
   std::uint32_t specularProfile = 0;
   V4<T> hair{T(0.5), T(1.55), T(2), T(0)};  // a hair's azimuthal roughness, ior, cuticle angle (deg), scatter
+  V3<T> irisN{T(0), T(0), T(1)};            // an eye's iris normal,
+  V3<T> irisPlaneN{T(0), T(0), T(1)};       // its iris plane's normal,
+  V2<T> iris{T(0), T(0)};                   // and its iris mask and iris distance
   V3<T> emissive{T(0), T(0), T(0)};
   T weight = T(1);
   V3<T> topTransmittance{T(1), T(1), T(1)};

@@ -297,6 +297,7 @@ class Walk {
 
     Closure<T> c;  // substrate_closure_init
     if (s.kind == BsdfKind::Hair) return hairClosure(s);  // always the whole material: weight 1, on top
+    if (s.kind == BsdfKind::Eye) return eyeClosure(s);    // so is an eye
     c.diffuseAlbedo = vec3(s.pin(SlabPin::DiffuseAlbedo));
     // A slab layered on top scatters back only what it does not let through
     // (substrate_layer_scattering; the emitter skips it for a known-opaque
@@ -408,6 +409,21 @@ class Walk {
               scalar(s.pin(SlabPin::CuticleAngle)), scalar(s.pin(SlabPin::Scatter))};
     if (has(s.features, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
     c.features = kFeatureHair;
+    c.metalnessMix = m_.metalnessMix;
+    return c;
+  }
+
+  /// emitEyeClosure: an eye's pins into its closure (F0 0.04, the init's).
+  Closure<T> eyeClosure(const Slab& s) const {
+    Closure<T> c;
+    c.diffuseAlbedo = vec3(s.pin(SlabPin::DiffuseAlbedo));
+    c.roughness = scalar(s.pin(SlabPin::Roughness));
+    c.N = tangentToWorld(vec3(s.pin(SlabPin::Normal)), gN_, gT_);
+    c.irisN = tangentToWorld(vec3(s.pin(SlabPin::IrisNormal)), gN_, gT_);
+    c.irisPlaneN = tangentToWorld(vec3(s.pin(SlabPin::IrisPlaneNormal)), gN_, gT_);
+    c.iris = {scalar(s.pin(SlabPin::IrisMask)), scalar(s.pin(SlabPin::IrisDistance))};
+    if (has(s.features, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
+    c.features = kFeatureEye;
     c.metalnessMix = m_.metalnessMix;
     return c;
   }

@@ -85,6 +85,11 @@ struct Rewriter {
       force(node, "ior", "ior", 1.55);
       force(node, "cuticle_angle", "cuticle_angle", 2.0);
       force(node, "scatter", "coverage", 0.0);
+    } else if (kind == "eye") {  // a smooth and a rough cornea, black and white, all sclera and all iris
+      force(node, "roughness", "roughness", 0.5);
+      force(node, "diffuse_albedo", "albedo", 0.18);
+      force(node, "iris_mask", "coverage", 0.0);
+      force(node, "iris_distance", "coverage", 0.0);
     } else if (kind == "unlit") {
       force(node, "transmittance", "albedo", 1.0);  // 0 (opaque) and 1 (clear)
     } else if (kind == "vertical") {
