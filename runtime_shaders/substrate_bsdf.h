@@ -1464,14 +1464,14 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (isWrap) {
     diffuse = substrate_diffuse_wrap(albedo, wrap, NoL);
   } else {
-    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL);
 #if SUBSTRATE_USE_EYE
-    if ((c.features & SUBSTRATE_FEATURE_EYE) != 0u) {  // the iris where the mask is: its own cosine
-      diffuse = mlerp(diffuse, albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * substrate_eye_iris_cosine(c, N, L)),
-                      SUBSTRATE_M(saturate(c.iris.x)));
-    }
+    // An eye's iris where its mask is: its own cosine (substrate_eye.h).
+    diffuse = substrate_eye_diffuse(c, substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL), albedo, N, L) *
+              substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
+#else
+    diffuse = substrate_diffuse(albedo, roughness, NoV, NoLc, NoH, VoH, VoL) *
+              substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
 #endif
-    diffuse *= substrate_diffuse_light_coupling(ends, NoLc, roughness, hazeRoughness, hazeWeight);
   }
 #if SUBSTRATE_USE_SSS
   // A slab's medium: its view and light dependence ("A slab's medium", above;

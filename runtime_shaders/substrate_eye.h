@@ -40,5 +40,17 @@ float substrate_eye_iris_cosine(SubstrateClosure c, float3 N, float3 L) {
   return irisNoL * caustic * (1.0 / SUBSTRATE_EYE_CAUSTIC_MEAN);
 }
 
+// The diffuse of closure c before the light-side coupling: the sclera's
+// (`sclera`, the material's diffuse model) lerped by the iris mask toward the
+// iris's, albedo / pi times substrate_eye_iris_cosine; `sclera` itself for a
+// closure that is no eye.
+mfloat3 substrate_eye_diffuse(SubstrateClosure c, mfloat3 sclera, mfloat3 albedo, float3 N, float3 L) {
+  if ((c.features & SUBSTRATE_FEATURE_EYE) == 0u) {
+    return sclera;
+  }
+  return mlerp(sclera, albedo * SUBSTRATE_M(SUBSTRATE_INV_PI * substrate_eye_iris_cosine(c, N, L)),
+               SUBSTRATE_M(saturate(c.iris.x)));
+}
+
 #endif
 #endif
