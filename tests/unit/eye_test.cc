@@ -78,8 +78,28 @@ TEST(Eye, StoresColourTheIrisAndRoughnessIn20Bytes) {
   EXPECT_EQ(names, "header:16 closure0.diffuse_albedo:20 closure0.iris_normal:32 closure0.iris:32 closure0.roughness:8 ");
   EXPECT_EQ(L.bytes(), 20);  // 108 bits in 4 words, and the top-layer word (the cornea's normal)
   EXPECT_EQ(r.material.slabs[r.material.nodes[r.material.root].slab].features, kFeatEye);
-  // Even at an iris mask of the constant 0 it is an eye: its layout is the node's, not its values'.
-  EXPECT_EQ(compiledEye(material(R"("root": {"kind": "eye"})")).after.bytes(), 20);
+  // An iris mask from an input may be 0 at run time: still an eye.
+  EXPECT_EQ(compiledEye(test::material(R"("root": {"kind": "eye", "iris_mask": "$m"})",
+                                       R"({"m": {"type": "float", "default": 0}})"))
+                .after.bytes(),
+            20);
+}
+
+TEST(Eye, WithAConstantIrisMaskOf0ItIsTheSlabItsCorneaAndScleraAre) {
+  // No iris: culled (it is lit as that slab bit for bit, AtIrisMask0...), and it
+  // stores what that slab stores: SIMPLE, 12 bytes, no iris fields.
+  const CompileResult r =
+      compiledEye(material(R"("root": {"kind": "eye", "diffuse_albedo": [0.8, 0.76, 0.72], "roughness": 0.08,
+                                       "iris_normal": [0, 0.3, 0.95], "iris_distance": 0.5})"));
+  const Slab& s = r.material.slabs[r.material.nodes[r.material.root].slab];
+  EXPECT_EQ(s.kind, BsdfKind::Slab);
+  EXPECT_EQ(s.features, 0);
+  EXPECT_TRUE(r.material.values.isConstEqual(s.pin(SlabPin::F0), 0.04));
+  EXPECT_EQ(r.after.layoutClass, LayoutClass::Simple);
+  EXPECT_EQ(r.after.bytes(), 12);
+  ASSERT_EQ(r.material.culled.size(), 1u);
+  EXPECT_EQ(r.material.culled[0].what, "root (iris)");
+  EXPECT_NE(r.material.culled[0].why.find("iris_mask is the constant 0"), std::string::npos);
 }
 
 TEST(Eye, HeaderBit13AndTheIrisFieldsRoundTrip) {

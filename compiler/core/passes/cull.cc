@@ -216,6 +216,20 @@ void warnInvisibleVolume(const Material& m, Diagnostics& diags) {
                                          n.id));
 }
 
+/// An eye whose iris mask is the constant 0 is lit as the slab its pins
+/// describe (its cornea's F0 0.04 is a slab's default; runtime_shaders/
+/// substrate_eye.h): it becomes that slab, and stores no iris.
+void cullIrislessEye(Material& m) {
+  const TreeNode& n = m.nodes[m.root];
+  if (!isLeafOfKind(m, n, BsdfKind::Eye)) return;
+  Slab& eye = m.slabs[n.slab];
+  if (!m.values.isConstEqual(eye.pin(SlabPin::IrisMask), 0)) return;
+  eye.kind = BsdfKind::Slab;
+  m.culled.push_back({n.id + " (iris)", fmt::format("iris_mask is the constant 0: eye '{}' is the slab its cornea and "
+                                                    "sclera describe (F0 0.04), with no iris to store",
+                                                    n.id)});
+}
+
 }  // namespace
 
 bool cullStaticMatter(Material& m, Diagnostics& diags) {
@@ -236,6 +250,7 @@ bool cullStaticMatter(Material& m, Diagnostics& diags) {
     return false;
   }
   m.root = root;
+  cullIrislessEye(m);  // an eye is always the root (build_tree)
   warnInvisibleVolume(m, diags);
   return true;
 }

@@ -12,7 +12,10 @@
 //  * an operator left with one empty side is rewritten: vertical/add keep the
 //    other side; horizontal becomes a coverage_weight of the other side by its
 //    weight (w for the foreground, 1-w for the background); select keeps the
-//    other side weighted by the run-time condition.
+//    other side weighted by the run-time condition;
+//  * an eye whose iris mask is the constant 0 has no iris: it becomes the slab
+//    its cornea and sclera are (F0 0.04; substrate_eye.h lights it so, bit for
+//    bit), which stores no iris fields.
 // The rules run in rounds until a round removes nothing (a top moved into
 // the enclosing layer can hide more), at most one round per tree node.
 // Every removal is recorded in Material::culled with the reason.
