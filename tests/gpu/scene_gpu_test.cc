@@ -16,7 +16,9 @@
 //    tile classification, which must list every tile under the class of its
 //    most complex pixel, then through each class's lighting shader over its
 //    tiles, which must light each pixel as the CPU reference lights the
-//    closures the CPU unpacker reads back, in GLSL and in HLSL.
+//    closures the CPU unpacker reads back, in GLSL and in HLSL. The same for
+//    a SPECIAL tile of eyes and white fibres beside a SIMPLE one, every pixel
+//    lit (a check of black against black would test nothing).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -52,8 +54,9 @@ std::string readFile(const fs::path& p) {
   return s.str();
 }
 
-CompileResult compileSceneMaterial(const std::string& stem) {
-  const fs::path path = fs::path(SUBSTRATEC_SOURCE_DIR) / "examples" / "scenes" / "materials" / (stem + ".json");
+/// examples/scenes/materials/<stem>.json, or with `dir` "" examples/<stem>.json, compiled.
+CompileResult compileSceneMaterial(const std::string& stem, const std::string& dir = "scenes/materials") {
+  const fs::path path = fs::path(SUBSTRATEC_SOURCE_DIR) / "examples" / dir / (stem + ".json");
   Diagnostics d(path.filename().string());
   auto r = compileText(path.filename().string(), readFile(path), CompileOptions{}, d);
   EXPECT_TRUE(r.has_value()) << d.formatAll();
@@ -123,6 +126,99 @@ class SceneOnGpu : public ::testing::Test {
     const bool ok = ctx_->dispatch(*k.pipeline, res, static_cast<uint32_t>(samples.size() / kLocalSize), 1, 1, diags);
     EXPECT_TRUE(ok) << diags.errorMessages();
     return ok ? floatsOf(res, 0, 7) : std::vector<float>{};
+  }
+
+
+  /// The emitted tile classification over `gbuffer` must list every tile once,
+  /// under `expected`, its most complex pixel's class; each class's emitted
+  /// lighting over its tiles must light every pixel as the CPU reference
+  /// lights the closures of `pixels` (what the CPU unpacker reads back), in
+  /// GLSL and in HLSL. Prints each language's largest error over its allowance
+  /// and how many pixels the reference lights (some channel above 1e-6);
+  /// `litByReference`, when given, gets per pixel whether the reference lit it.
+  void classifyAndLight(const SceneShape& shape, const gpu::SceneFrame& frame, const gpu::Gbuffer& gbuffer,
+                        const std::vector<gpu::GbufferPixel>& pixels, const std::vector<gpu::Sample>& samples,
+                        const std::map<uint32_t, LayoutClass>& expected, std::vector<bool>* lit = nullptr) {
+    const uint32_t W = frame.width, H = frame.height;
+    std::vector<bool> litByReference(W * H, false);
+    for (Target target : {Target::Glsl, Target::Hlsl}) {
+      SCOPED_TRACE(target == Target::Glsl ? "GLSL" : "HLSL");
+      const Syntax& syn = syntaxFor(target);
+      auto compile = [&](const std::string& name, const std::string& text) {
+        ShaderSource src;
+        src.name = name;
+        src.text = text;
+        src.language = target == Target::Glsl ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
+        src.stage = ShaderStage::Compute;
+        for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
+        ShaderValidation v = compileAndValidate(src);
+        EXPECT_TRUE(v.ok) << name << "\n" << v.log;
+        Diagnostics diags("test");
+        auto p = v.ok ? ctx_->createPipeline(v.spirv, diags) : nullptr;
+        EXPECT_TRUE(p) << diags.errorMessages();
+        return p;
+      };
+      // 1. Classification: every tile listed once, under the class of its most complex pixel.
+      auto classify = compile(tileClassificationFileName(shape, syn), emitTileClassification(shape, syn));
+      ASSERT_TRUE(classify);
+      gpu::TileLists lists;
+      Diagnostics diags("test");
+      ASSERT_TRUE(gpu::classifyTiles(*ctx_, *classify, frame, gbuffer, &lists, diags)) << diags.errorMessages();
+      std::size_t listed = 0;
+      for (const auto& [tile, cls] : expected) {
+        const auto& l = lists.tiles[static_cast<int>(cls)];
+        EXPECT_EQ(std::count(l.begin(), l.end(), tile), 1) << "tile " << tile << " as " << layoutClassName(cls);
+      }
+      for (const auto& l : lists.tiles) listed += l.size();
+      EXPECT_EQ(listed, frame.tiles()) << "each tile once";
+
+      // 2. Each class's lighting over its tiles.
+      std::vector<float> color(W * H * 4, NAN);
+      for (const SceneLightingClass& k : shape.classes) {
+        const auto& tiles = lists.tiles[static_cast<int>(k.cls)];
+        if (tiles.empty()) continue;
+        auto light = compile(sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn));
+        ASSERT_TRUE(light);
+        gpu::Resources res = gpu::lightingResources(*light, frame, gbuffer, lists);
+        ASSERT_TRUE(ctx_->dispatch(*light, res, static_cast<uint32_t>(tiles.size()), 1, 1, diags))
+            << diags.errorMessages();
+        const auto& out = std::get<gpu::StorageImageResource>(res[{0, 8}]).data;
+        std::vector<float> lit(W * H * 4);
+        std::memcpy(lit.data(), out.data(), lit.size() * 4);
+        for (uint32_t tile : tiles)
+          for (uint32_t y = (tile / frame.tilesX()) * 8; y < std::min(H, (tile / frame.tilesX()) * 8 + 8); ++y)
+            for (uint32_t x = (tile % frame.tilesX()) * 8; x < std::min(W, (tile % frame.tilesX()) * 8 + 8); ++x)
+              for (int ch = 0; ch < 4; ++ch) color[(y * W + x) * 4 + ch] = lit[(y * W + x) * 4 + ch];
+      }
+      // 3. Every pixel lit once, as the reference lights what the unpacker reads.
+      const Tolerance tol;
+      long failures = 0;
+      double margin = 0;
+      std::string first;
+      for (uint32_t i = 0; i < W * H; ++i) {
+        const auto r64 = lightClosures<double>(pixels[i].closures, samples[i], kDiffuseModel);
+        const auto r32 = lightClosures<float>(pixels[i].closures, samples[i], kDiffuseModel);
+        for (int ch = 0; ch < 3; ++ch) {
+          const double want = r64.direct[ch] + r64.environment[ch];
+          if (want > 1e-6) litByReference[i] = true;
+          const double cond = double(r32.direct[ch]) + r32.environment[ch];
+          const double allowed = tol.k * std::abs(cond - want) + tol.abs + tol.rel * std::abs(want);
+          const float got = color[i * 4 + ch];
+          margin = std::max(margin, std::abs(got - want) / allowed);
+          if (!tol.ok(got, want, cond) && failures++ == 0)
+            first = fmt::format("pixel ({}, {}) class {} channel {}: {} want {}", i % W, i / W,
+                                layoutClassName(pixels[i].cls), ch, got, want);
+        }
+        EXPECT_EQ(color[i * 4 + 3], 1.0f);
+      }
+      std::printf("[ scene    ] %s: %u pixels (%ld lit by the reference) in %u tiles (%zu simple, %zu single, "
+                  "%zu complex, %zu special); largest |gpu - ref| / allowed = %.3f\n",
+                  target == Target::Glsl ? "GLSL" : "HLSL", W * H,
+                  static_cast<long>(std::count(litByReference.begin(), litByReference.end(), true)), frame.tiles(),
+                  lists.tiles[0].size(), lists.tiles[1].size(), lists.tiles[2].size(), lists.tiles[3].size(), margin);
+      EXPECT_EQ(failures, 0) << first;
+    }
+    if (lit) *lit = litByReference;
   }
 
   gpu::Context* ctx_ = nullptr;
@@ -300,81 +396,62 @@ TEST_F(SceneOnGpu, TilesAreClassifiedAndEachClassLightsItsPixelsAsTheReference) 
   EXPECT_EQ(expected[4], LayoutClass::Simple);  // dry asphalt and clean plastic: stored SIMPLE dynamically
   EXPECT_EQ(expected[5], LayoutClass::Single);
 
-  for (Target target : {Target::Glsl, Target::Hlsl}) {
-    SCOPED_TRACE(target == Target::Glsl ? "GLSL" : "HLSL");
-    const Syntax& syn = syntaxFor(target);
-    auto compile = [&](const std::string& name, const std::string& text) {
-      ShaderSource src;
-      src.name = name;
-      src.text = text;
-      src.language = target == Target::Glsl ? ShaderLanguage::Glsl : ShaderLanguage::Hlsl;
-      src.stage = ShaderStage::Compute;
-      for (const RuntimeFile& f : runtimeFiles()) src.memoryFiles.emplace(std::string(f.name), f.text);
-      ShaderValidation v = compileAndValidate(src);
-      EXPECT_TRUE(v.ok) << name << "\n" << v.log;
-      Diagnostics diags("test");
-      auto p = v.ok ? ctx_->createPipeline(v.spirv, diags) : nullptr;
-      EXPECT_TRUE(p) << diags.errorMessages();
-      return p;
-    };
-    // 1. Classification: every tile listed once, under the class of its most complex pixel.
-    auto classify = compile(tileClassificationFileName(shape, syn), emitTileClassification(shape, syn));
-    ASSERT_TRUE(classify);
-    gpu::TileLists lists;
-    Diagnostics diags("test");
-    ASSERT_TRUE(gpu::classifyTiles(*ctx_, *classify, frame, gbuffer, &lists, diags)) << diags.errorMessages();
-    std::size_t listed = 0;
-    for (const auto& [tile, cls] : expected) {
-      const auto& l = lists.tiles[static_cast<int>(cls)];
-      EXPECT_EQ(std::count(l.begin(), l.end(), tile), 1) << "tile " << tile << " as " << layoutClassName(cls);
-    }
-    for (const auto& l : lists.tiles) listed += l.size();
-    EXPECT_EQ(listed, frame.tiles()) << "each tile once";
+  classifyAndLight(shape, frame, gbuffer, pixels, samples, expected);
+}
 
-    // 2. Each class's lighting over its tiles.
-    std::vector<float> color(W * H * 4, NAN);
-    for (const SceneLightingClass& k : shape.classes) {
-      const auto& tiles = lists.tiles[static_cast<int>(k.cls)];
-      if (tiles.empty()) continue;
-      auto light = compile(sceneLightingFileName(shape, k.cls, syn), emitSceneLighting(shape, k, syn));
-      ASSERT_TRUE(light);
-      gpu::Resources res = gpu::lightingResources(*light, frame, gbuffer, lists);
-      ASSERT_TRUE(ctx_->dispatch(*light, res, static_cast<uint32_t>(tiles.size()), 1, 1, diags))
-          << diags.errorMessages();
-      const auto& out = std::get<gpu::StorageImageResource>(res[{0, 8}]).data;
-      std::vector<float> lit(W * H * 4);
-      std::memcpy(lit.data(), out.data(), lit.size() * 4);
-      for (uint32_t tile : tiles)
-        for (uint32_t y = (tile / frame.tilesX()) * 8; y < std::min(H, (tile / frame.tilesX()) * 8 + 8); ++y)
-          for (uint32_t x = (tile % frame.tilesX()) * 8; x < std::min(W, (tile % frame.tilesX()) * 8 + 8); ++x)
-            for (int ch = 0; ch < 4; ++ch) color[(y * W + x) * 4 + ch] = lit[(y * W + x) * 4 + ch];
+TEST_F(SceneOnGpu, ASpecialTileLightsEyesAndHairAsTheReference) {
+  // The SPECIAL class's lighting (SUBSTRATE_USE_EYE and SUBSTRATE_USE_HAIR 1)
+  // over eye pixels (all iris, and the hazel eye's sclera, iris and pupil
+  // wherever the frame's positions put them), white fibres and plaster; a
+  // SIMPLE tile of plaster beside it.
+  const std::map<std::string, CompileResult> m = {
+      {"plaster", compileSceneMaterial("plaster")},
+      {"eye_hazel", compileSceneMaterial("eye_hazel", "")},
+      {"eye_iris_closeup", compileSceneMaterial("eye_iris_closeup", "")},
+      {"hair_white_fibre", compileSceneMaterial("hair_white_fibre", "")},
+  };
+  std::vector<SceneMaterialShape> shapes;
+  for (const auto& [name, r] : m) shapes.push_back(summarize(r).shape());
+  const SceneShape shape = sceneShape("eyes_and_hair", shapes, kDefaultDiffuseModel);
+  ASSERT_EQ(shape.classes.size(), 2u);  // simple, special
+  gpu::SceneFrame frame;
+  frame.width = 16;  // 2 x 1 tiles
+  frame.height = 8;
+  std::vector<gpu::GbufferPixel> pixels(frame.width * frame.height);
+  std::vector<gpu::Sample> samples(pixels.size());
+  std::map<uint32_t, LayoutClass> expected;
+  gpu::Gbuffer gbuffer(frame.width, frame.height, materialBufferSlices(shape));
+  const char* special[] = {"eye_hazel", "eye_iris_closeup", "hair_white_fibre", "plaster"};
+  int counts[4] = {0, 0, 0, 0};
+  for (uint32_t y = 0; y < frame.height; ++y)
+    for (uint32_t x = 0; x < frame.width; ++x) {
+      const int pick = x < 8 ? 3 : static_cast<int>((x + 3 * y) % 4);
+      const CompileResult& r = m.at(special[pick]);
+      ++counts[pick];
+      gpu::GbufferPixel& p = pixels[y * frame.width + x];
+      p = gpu::packPixel(r, gpu::pixelGeometry(frame, x, y, {0.5, 0.5}), inputsWith(r.material, {}));
+      gbuffer.set(x, y, p);
+      gpu::Sample& s = samples[y * frame.width + x];
+      s.geometry = gpu::pixelGeometry(frame, x, y, {0, 0});
+      s.light = frame.light;
+      s.radiance = frame.radiance;
+      s.prefiltered = frame.prefiltered;
+      s.irradiance = frame.irradiance;
+      const uint32_t tile = x / 8;
+      if (!expected.count(tile) || static_cast<int>(p.cls) > static_cast<int>(expected[tile])) expected[tile] = p.cls;
     }
-    // 3. Every pixel lit once, as the reference lights what the unpacker reads.
-    const Tolerance tol;
-    long failures = 0;
-    double margin = 0;
-    std::string first;
-    for (uint32_t i = 0; i < W * H; ++i) {
-      const auto r64 = lightClosures<double>(pixels[i].closures, samples[i], kDiffuseModel);
-      const auto r32 = lightClosures<float>(pixels[i].closures, samples[i], kDiffuseModel);
-      for (int ch = 0; ch < 3; ++ch) {
-        const double want = r64.direct[ch] + r64.environment[ch];
-        const double cond = double(r32.direct[ch]) + r32.environment[ch];
-        const double allowed = tol.k * std::abs(cond - want) + tol.abs + tol.rel * std::abs(want);
-        const float got = color[i * 4 + ch];
-        margin = std::max(margin, std::abs(got - want) / allowed);
-        if (!tol.ok(got, want, cond) && failures++ == 0)
-          first = fmt::format("pixel ({}, {}) class {} channel {}: {} want {}", i % W, i / W,
-                              layoutClassName(pixels[i].cls), ch, got, want);
-      }
-      EXPECT_EQ(color[i * 4 + 3], 1.0f);
-    }
-    std::printf("[ scene    ] %s: %u pixels in %u tiles (%zu simple, %zu single, %zu complex); largest |gpu - ref| / "
-                "allowed = %.3f\n",
-                target == Target::Glsl ? "GLSL" : "HLSL", W * H, frame.tiles(), lists.tiles[0].size(),
-                lists.tiles[1].size(), lists.tiles[2].size(), margin);
-    EXPECT_EQ(failures, 0) << first;
-  }
+  EXPECT_EQ(expected[0], LayoutClass::Simple);
+  EXPECT_EQ(expected[1], LayoutClass::Special);
+  EXPECT_EQ(counts[0] + counts[1], 32) << "eye pixels";
+  EXPECT_EQ(counts[2], 16) << "hair pixels";
+  std::vector<bool> lit;
+  classifyAndLight(shape, frame, gbuffer, pixels, samples, expected, &lit);
+  ASSERT_EQ(lit.size(), pixels.size());
+  // The special tile's pixels are lit (a check of black against black tests nothing).
+  long litSpecial = 0;
+  for (uint32_t y = 0; y < frame.height; ++y)
+    for (uint32_t x = 8; x < frame.width; ++x) litSpecial += lit[y * frame.width + x] ? 1 : 0;
+  EXPECT_EQ(litSpecial, 64);
 }
 
 }  // namespace
