@@ -24,6 +24,11 @@
 #ifndef SUBSTRATE_USE_EYE
 #define SUBSTRATE_USE_EYE 1
 #endif
+// 1: the material is a single-layer water (substrate_water.h): the lighting
+// defines substrate_water_seen.
+#ifndef SUBSTRATE_USE_WATER
+#define SUBSTRATE_USE_WATER 1
+#endif
 
 struct SubstrateClosure {
   float3 diffuseAlbedo;   // post multiple scattering, [0,1]

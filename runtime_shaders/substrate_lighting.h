@@ -272,4 +272,36 @@ void substrate_translucency(SubstrateClosure c, float NoV, float3 V, out float c
 #endif
 }
 
+// ---------------------------------------------------------------------------
+// Single-layer water (substrate_water.h): what the surface lets through of its body.
+
+#if SUBSTRATE_USE_WATER
+#include "substrate_water.h"
+
+// What a pixel of water shows of its body: the uncovered share of surface c
+// (1 - opacity) times what the water's interface lets through along the view,
+// of the body lit by `lightRadiance` from L through the interface.
+// `behind`: rgb what lies behind the water, a its distance from the eye;
+// `surfaceDistance`: the surface's.
+float3 substrate_water_seen(SubstrateClosure c, SubstrateWater w, float4 behind, float surfaceDistance, float3 V,
+                            float3 L, float3 lightRadiance) {
+  float3 N = substrate_closure_normal(c);
+  float NoVraw = dot(N, V);
+  if (!(NoVraw > -SUBSTRATE_NOV_BIAS)) {
+    return SUBSTRATE_SPLAT3(0.0);  // seen from below the surface: not this model's
+  }
+  SubstrateClosure s = c;  // the bare water interface
+  s.f0 = SUBSTRATE_SPLAT3(saturate(w.f0));
+  s.f90 = SUBSTRATE_SPLAT3(1.0);
+  s.features = 0u;
+  float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
+  float NoL = dot(N, L);
+  float3 through = SUBSTRATE_SPLAT3(1.0) - SUBSTRATE_F3(substrate_closure_specular_albedo(s, NoV));
+  float3 lightIn = NoL > 0.0 ? lightRadiance * (SUBSTRATE_SPLAT3(1.0) - SUBSTRATE_F3(substrate_closure_specular_albedo(s, NoL)))
+                             : SUBSTRATE_SPLAT3(0.0);
+  float3 body = substrate_water_body(w, behind.rgb, behind.a - surfaceDistance, dot(-L, V), lightIn);
+  return (1.0 - saturate(w.opacity)) * through * body;
+}
+#endif
+
 #endif

@@ -151,6 +151,12 @@ Shaded<T> shade(const CompileResult& r, const Sample& s, const reference::InputV
   out.material = reference::evaluateMaterial<T>(r, s.geometry, in, sampleTexture);
   lightInto(out, out.material.closures, s, diffuseModel);
   add(out.emissive, out.material.emission);  // the unlit nodes' (the forward kernel's `emission`)
+  if (out.material.water) {  // a water's body, the sample's prefiltered radiance kWaterSampleDepth behind it
+    const auto pre = toT<T>(s.prefiltered);
+    add(out.emissive, reference::waterSeen<T>(out.material.closures[0], *out.material.water,
+                                              {pre[0], pre[1], pre[2], T(kernel::kWaterSampleDepth)}, T(0),
+                                              toT<T>(s.geometry.V), toT<T>(s.light), toT<T>(s.radiance)));
+  }
   return out;
 }
 template Shaded<float> shade<float>(const CompileResult&, const Sample&, const reference::InputValues&, int);

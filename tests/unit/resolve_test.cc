@@ -421,7 +421,7 @@ TEST(Resolve, MixUp_OutputNamesAValueNode) {
     "v": {"kind": "multiply", "a": 0.5, "b": 0.5},
     "s": {"kind": "slab"})",
                                    "{}", "v")),
-            "test.json:3:39: error: \"v\" is a value node; the output must be a Substrate node (slab, unlit, hair, volumetric_fog_cloud, eye, horizontal, vertical, add, coverage_weight, select) [/output]\n");
+            "test.json:3:39: error: \"v\" is a value node; the output must be a Substrate node (slab, unlit, hair, volumetric_fog_cloud, eye, single_layer_water, horizontal, vertical, add, coverage_weight, select) [/output]\n");
 }
 
 TEST(Resolve, MixUp_OutputNamesAnInput) {

@@ -186,6 +186,10 @@ std::string sampleKernel(const Material& m, const StorageLayout& L, const Syntax
   if (mode == KernelMode::Forward && anyEmissive(m, L)) s += "    emissive += viewT * closures[k].emissive;\n";
   s += "  }\n";
   if (mode == KernelMode::Forward && unlitEmission(m)) s += "  emissive += emission;  // the unlit nodes'\n";
+  if (mode == KernelMode::Forward && isWaterMaterial(m))
+    s += fmt::format("  emissive += substrate_water_seen(closures[0], water, float4(prefiltered, {}), 0.0, g.V, L, "
+                     "radiance);  // the water's body\n",
+                     dialectLiteral(kWaterSampleDepth));
   s += fmt::format("  results[base + {}u] = float({});\n", kResultCount, count);
   s += fmt::format("  results[base + {}u] = coverage;\n", kResultCoverage);
   s += fmt::format("  results[base + {}u] = {};\n  results[base + 3u] = 0.0;\n", kResultLayoutClass,
@@ -288,6 +292,11 @@ std::string previewLighting(const Material& m, const StorageLayout& L) {
   if (anyEmissive(m, L)) s += "    color += viewT * closures[k].emissive;\n";
   s += "  }\n";
   if (unlitEmission(m)) s += "  color += emission;  // the unlit nodes'\n";
+  // A ball of water: behind its surface the environment along the view (not
+  // refracted), through the sphere's chord 2 N.V (substrate_water_seen).
+  if (isWaterMaterial(m))
+    s += "  color += substrate_water_seen(closures[0], water, float4(SUBSTRATE_ENV_PREFILTERED(-g.V, 0.0), "
+         "2.0 * max(dot(g.N, g.V), 0.0)), 0.0, g.V, preview.lightDirection[0].xyz, preview.lightRadiance[0].rgb);\n";
   switch (m.settings.blendMode) {
     case BlendMode::Masked:
       s += "  if (coverage < 0.5) color = background;\n";

@@ -58,7 +58,11 @@ inline constexpr int kResultLayoutClass = 2;     // Deferred: the class the base
 inline constexpr int kResultTransmittance = 4;   // rgb
 inline constexpr int kResultDirect = 8;          // rgb: sum over closures of substrate_light_closure
 inline constexpr int kResultEnvironment = 12;    // rgb: sum of view throughput * substrate_env_split_sum
-inline constexpr int kResultEmissive = 16;       // rgb: sum of view throughput * emissive (Forward only; 0 in Deferred)
+inline constexpr int kResultEmissive = 16;       // rgb: sum of view throughput * emissive (Forward only; 0 in Deferred),
+                                                 // and a single-layer water's body (substrate_water_seen) behind
+                                                 // which lies the sample's prefiltered radiance kWaterSampleDepth
+                                                 // metres below the surface
+inline constexpr double kWaterSampleDepth = 0.5;
 /// Each closure's SubstrateClosure fields, in this order (floats):
 inline constexpr int kClosureFloats = 68;
 inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6, kClosureRoughness = 9,

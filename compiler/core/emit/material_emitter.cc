@@ -40,6 +40,7 @@ std::string useDefines(std::uint16_t features) {
   use("SUBSTRATE_USE_EMISSIVE", kFeatEmissive);
   use("SUBSTRATE_USE_HAIR", kFeatHair);
   use("SUBSTRATE_USE_EYE", kFeatEye);
+  use("SUBSTRATE_USE_WATER", kFeatWater);
   return s;
 }
 
@@ -202,7 +203,9 @@ std::string evaluateCall(const Material& m) {
   return fmt::format(
       "  SubstrateClosure closures[{}];\n  float coverage;\n  float3 transmittance;\n{}"
       "  {}_evaluate(g, closures, coverage, transmittance{});\n",
-      closureArraySize(m), emission ? "  float3 emission;\n" : "", m.name, emission ? ", emission" : "");
+      closureArraySize(m), std::string(emission ? "  float3 emission;\n" : "") +
+                               (isWaterMaterial(m) ? "  SubstrateWater water;\n" : ""),
+      m.name, std::string(emission ? ", emission" : "") + (isWaterMaterial(m) ? ", water" : ""));
 }
 
 namespace {
@@ -246,6 +249,7 @@ class Emitter {
   int firstUnlit() const;  // the first unlit leaf in pre-order, or -1
   void emitHairClosure(const std::string& c, const Slab& s);  // closure c of hair s
   void emitEyeClosure(const std::string& c, const Slab& s);   // closure c of eye s
+  void emitWaterBody();                                         // `water`: a water material's body
   unsigned emitFeaturePins(const std::string& c, const Slab& s);  // returns the feature bits
   std::string nodeName(int n) const { return m_.nodes[n].id; }
   int verticalOfTop(int node) const;  // the vertical whose top layer holds `node` (TreeInfo::layerVertical), or -1
@@ -459,6 +463,10 @@ void Emitter::collectNeeded() {
     if (f & kFeatHair)  // emitHairClosure's pins
       for (SlabPin p : {SlabPin::BaseColor, SlabPin::Tangent, SlabPin::AzimuthalRoughness, SlabPin::Ior,
                         SlabPin::CuticleAngle, SlabPin::Scatter})
+        need(s.pin(p));
+    if (f & kFeatWater)  // emitWaterBody's pins
+      for (SlabPin p : {SlabPin::Specular, SlabPin::TopMaterialOpacity, SlabPin::WaterAlbedo,
+                        SlabPin::WaterExtinction, SlabPin::WaterPhaseG, SlabPin::ColorScaleBehindWater})
         need(s.pin(p));
     if (f & kFeatEye)  // emitEyeClosure's pins
       for (SlabPin p : {SlabPin::DiffuseAlbedo, SlabPin::Roughness, SlabPin::IrisNormal, SlabPin::IrisPlaneNormal,
@@ -789,6 +797,22 @@ void Emitter::emitEyeClosure(const std::string& c, const Slab& s) {
   line(fmt::format("{}.features = {}u;", c, SUBSTRATE_FEATURE_EYE));
 }
 
+/// A single-layer water's body (runtime_shaders/substrate_water.h) into
+/// `water`; its surface is closure 0, the slab build_tree lowered it to.
+void Emitter::emitWaterBody() {
+  if (!isWaterMaterial(m_)) return;
+  const Slab& s = m_.slabs[m_.nodes[m_.root].slab];
+  line("");
+  line(fmt::format("// The water body of '{}' (substrate_water_seen lights it).", s.id));
+  line("substrate_water_init(water);");
+  line(fmt::format("water.albedo = {};", expr(s.pin(SlabPin::WaterAlbedo))));
+  line(fmt::format("water.extinction = {};", expr(s.pin(SlabPin::WaterExtinction))));
+  line(fmt::format("water.phaseG = {};", expr(s.pin(SlabPin::WaterPhaseG))));
+  line(fmt::format("water.scaleBehind = {};", expr(s.pin(SlabPin::ColorScaleBehindWater))));
+  line(fmt::format("water.opacity = saturate({});", expr(s.pin(SlabPin::TopMaterialOpacity))));
+  line(fmt::format("water.f0 = 0.08 * saturate({});", expr(s.pin(SlabPin::Specular))));
+}
+
 int Emitter::firstUnlit() const {
   for (int n : t_.preorder)
     if (isUnlitLeaf(m_, m_.nodes[n])) return n;
@@ -937,6 +961,7 @@ std::string Emitter::run() {
   line("#include \"substrate_common.h\"");
   line("#include \"substrate_values.h\"");
   line("#include \"substrate_tree.h\"");
+  if (isWaterMaterial(m_)) line("#include \"substrate_water.h\"  // SubstrateWater, its body");
   // A fuzzy layer's transmission reads the fuzz albedo table (substrate_fuzz_transmission).
   if (fuzzAboveAny()) line("#include \"substrate_energy_lut.h\"");
   line("");
@@ -944,14 +969,16 @@ std::string Emitter::run() {
   line("");
   line(fmt::format("// Evaluates the material at one shading point into its closures (fully unrolled)."));
   line(fmt::format("void {0}_evaluate(SubstrateGeometry g, out SubstrateClosure closures[{1}], "
-                   "out float coverage, out float3 transmittance{2}) {{",
-                   m_.name, closureArraySize(m_), unlitEmission(m_) ? ", out float3 emission" : ""));
+                   "out float coverage, out float3 transmittance{2}{3}) {{",
+                   m_.name, closureArraySize(m_), unlitEmission(m_) ? ", out float3 emission" : "",
+                   isWaterMaterial(m_) ? ", out SubstrateWater water" : ""));
   indent_ = "  ";
   line("float3 ts_view = float3(dot(g.V, g.T), dot(g.V, cross(g.N, g.T)), dot(g.V, g.N));  // the view direction in "
        "tangent space");
   emitValues();
   emitTree();
   emitClosures();
+  emitWaterBody();
   emitCoatFloor();
   emitCoatInterface();
   emitNoClosureSlot();

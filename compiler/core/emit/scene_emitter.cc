@@ -131,7 +131,7 @@ namespace {
 /// headers cannot rule out stays compiled.
 std::string sceneUseDefines(const SceneLightingClass& k) {
   std::string s;
-  s += useDefines(k.features & ~kFeatEmissive);  // the base pass adds emissive
+  s += useDefines(k.features & ~(kFeatEmissive | kFeatWater));  // the base pass adds emissive and a water's body
   // Extra interfaces are in closure headers only: a lone closure is on top.
   s += fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n", k.maxClosures > 1 ? 1 : 0);
   s += fmt::format("#define SUBSTRATE_USE_LAYERS {}\n", k.maxClosures > 1 ? 1 : 0);  // so are layers

@@ -150,6 +150,11 @@ std::string Syntax::output(std::string_view n) const {
 
 std::string Syntax::fragCoord() const { return isGlsl(*this) ? "gl_FragCoord" : "i.position"; }
 
+std::string Syntax::texelFetch(std::string_view texture, std::string_view pixel) const {
+  if (isGlsl(*this)) return fmt::format("texelFetch({}, ivec2({}), 0)", texture, pixel);
+  return fmt::format("{}.Load(int3(int2({}), 0))", texture, pixel);
+}
+
 std::string Syntax::computeMain(int x, int y) const {
   if (isGlsl(*this)) return fmt::format("layout(local_size_x = {}, local_size_y = {}) in;\nvoid main() {{\n", x, y);
   return fmt::format(

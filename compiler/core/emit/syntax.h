@@ -82,6 +82,8 @@ struct Syntax {
   std::string input(std::string_view name) const;   // an interpolant
   std::string output(std::string_view name) const;  // a render target
   std::string fragCoord() const;                    // the pixel's window position (float4)
+  /// Texel `pixel` (an integer-valued float2) of mip 0 of 2D texture `texture` (float4).
+  std::string texelFetch(std::string_view texture, std::string_view pixel) const;
   /// A compute `main` of x·y invocations a group, up to its opening brace.
   std::string computeMain(int x, int y) const;
   std::string computeId(ComputeId id) const;

@@ -9,7 +9,7 @@ std::string_view blendModeName(BlendMode m) { return enumName(kBlendModeNames, m
 namespace {
 constexpr double kInf = 1e300;
 constexpr int kNoGeo = -1;
-constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair | kPinOfFogCloud | kPinOfEye,
+constexpr std::uint8_t kAll = kPinOfSlab | kPinOfUnlit | kPinOfHair | kPinOfFogCloud | kPinOfEye | kPinOfWater,
                        kSlabHair = kPinOfSlab | kPinOfHair, kSlabEye = kPinOfSlab | kPinOfEye;
 // name, type, color, default, geometry default, lo, hi, kinds
 const SlabPinInfo kPins[kSlabPinCount] = {
@@ -17,10 +17,10 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     {"f0", VType::Vec3, true, 0.04, kNoGeo, 0, 1},
     {"f90", VType::Vec3, true, 1.0, kNoGeo, 0, 1},
     // A hair's: longitudinal (Chiang's beta_m); an eye's: the cornea's.
-    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kSlabHair | kPinOfEye},
+    {"roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kSlabHair | kPinOfEye | kPinOfWater},
     {"anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
     // An eye's: the cornea's and sclera's (UE's Cornea Normal).
-    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfSlab | kPinOfUnlit | kPinOfEye},
+    {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfSlab | kPinOfUnlit | kPinOfEye | kPinOfWater},
     {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1, kSlabHair},  // a hair's fibre
     {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
     {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf},
@@ -38,7 +38,7 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     // The hair's (runtime_shaders/substrate_hair.h; UE's Hair BSDF, Chiang et al. 2016's parameters):
     // the colour of dense hair (its absorption follows), azimuthal roughness (beta_n), the fibre's
     // index of refraction, its cuticle scales' tilt in degrees, and the dense-hair scattering.
-    {"base_color", VType::Vec3, true, 0.0, kNoGeo, 0, 1, kPinOfHair},
+    {"base_color", VType::Vec3, true, 0.0, kNoGeo, 0, 1, kPinOfHair | kPinOfWater},  // a water's: its top material's
     {"azimuthal_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1, kPinOfHair},
     {"ior", VType::Float, false, 1.55, kNoGeo, 1, 3, kPinOfHair},
     {"cuticle_angle", VType::Float, false, 2.0, kNoGeo, -20, 20, kPinOfHair},
@@ -56,6 +56,17 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     {"iris_plane_normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfEye},
     {"iris_mask", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfEye},
     {"iris_distance", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfEye},
+    // The single-layer water's (runtime_shaders/substrate_water.h; UE's Single Layer Water BSDF):
+    // its top material's metalness and specular (F0 = 0.08 specular, the water's own too), that
+    // top material's opacity over the water, the water body's single-scattering albedo, extinction
+    // in 1/m, Henyey-Greenstein phase anisotropy, and the scale of what is seen behind the water.
+    {"metallic", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfWater},
+    {"specular", VType::Float, false, 0.5, kNoGeo, 0, 1, kPinOfWater},
+    {"top_material_opacity", VType::Float, false, 0.0, kNoGeo, 0, 1, kPinOfWater},
+    {"water_albedo", VType::Vec3, true, 0.0, kNoGeo, 0, 1, kPinOfWater},
+    {"water_extinction", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kPinOfWater},
+    {"water_phase_g", VType::Float, false, 0.0, kNoGeo, -1, 1, kPinOfWater},
+    {"color_scale_behind_water", VType::Vec3, true, 1.0, kNoGeo, 0, kInf, kPinOfWater},
 };
 }  // namespace
 
@@ -68,20 +79,21 @@ std::optional<SlabPin> slabPinByName(std::string_view name) {
 }
 
 bool bsdfTakesPin(BsdfKind k, SlabPin p) {
-  static constexpr std::uint8_t kBit[] = {kPinOfSlab, kPinOfUnlit, kPinOfHair, kPinOfFogCloud, kPinOfEye};  // BsdfKind order
+  static constexpr std::uint8_t kBit[] = {kPinOfSlab, kPinOfUnlit, kPinOfHair, kPinOfFogCloud, kPinOfEye, kPinOfWater};  // BsdfKind order
   return (kPins[static_cast<int>(p)].kinds & kBit[static_cast<int>(k)]) != 0;
 }
 
 std::string_view bsdfKindName(BsdfKind k) {
-  static constexpr std::string_view kNames[] = {"slab", "unlit", "hair", "volumetric_fog_cloud", "eye"};  // BsdfKind order
+  static constexpr std::string_view kNames[] = {"slab", "unlit", "hair", "volumetric_fog_cloud", "eye",
+                                                 "single_layer_water"};  // BsdfKind order
   return kNames[static_cast<int>(k)];
 }
 
-bool bsdfIsClosure(BsdfKind k) { return k == BsdfKind::Slab || k == BsdfKind::Hair || k == BsdfKind::Eye; }
-bool bsdfIsWholeMaterial(BsdfKind k) { return k == BsdfKind::Hair || k == BsdfKind::FogCloud || k == BsdfKind::Eye; }
+bool bsdfIsClosure(BsdfKind k) { return k != BsdfKind::Unlit && k != BsdfKind::FogCloud; }
+bool bsdfIsWholeMaterial(BsdfKind k) { return k != BsdfKind::Slab && k != BsdfKind::Unlit; }
 
 std::optional<BsdfKind> bsdfKindByName(std::string_view name) {
-  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair, BsdfKind::FogCloud, BsdfKind::Eye})
+  for (BsdfKind k : {BsdfKind::Slab, BsdfKind::Unlit, BsdfKind::Hair, BsdfKind::FogCloud, BsdfKind::Eye, BsdfKind::Water})
     if (bsdfKindName(k) == name) return k;
   return std::nullopt;
 }
@@ -90,7 +102,7 @@ std::string_view sssTypeName(SssType t) { return enumName(kSssTypeNames, t, "non
 
 std::string_view featureName(int bit) {
   static constexpr std::string_view names[kFeatureCount] = {
-      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium", "hair", "eye"};
+      "f90", "anisotropy", "sss", "haze", "fuzz", "glint", "specular_profile", "emissive", "medium", "hair", "eye", "water"};
   return bit >= 0 && bit < kFeatureCount ? names[bit] : "?";
 }
 
@@ -104,12 +116,16 @@ bool isLeafOfKind(const Material& m, const TreeNode& n, BsdfKind k) {
   return n.op == TreeOp::Slab && n.slab >= 0 && m.slabs[n.slab].kind == k;
 }
 
+bool isWaterMaterial(const Material& m) {
+  return m.root >= 0 && isLeafOfKind(m, m.nodes[m.root], BsdfKind::Water);
+}
+
 bool isVolumeMaterial(const Material& m) {
   return m.root >= 0 && isLeafOfKind(m, m.nodes[m.root], BsdfKind::FogCloud);
 }
 
 std::string_view nodeOpName(const Material& m, const TreeNode& n) {
-  static constexpr std::string_view kLeafNames[] = {"SLAB", "UNLIT", "HAIR", "FOG_CLOUD", "EYE"};  // BsdfKind order
+  static constexpr std::string_view kLeafNames[] = {"SLAB", "UNLIT", "HAIR", "FOG_CLOUD", "EYE", "WATER"};  // BsdfKind order
   if (n.op != TreeOp::Slab || n.slab < 0) return treeOpName(n.op);
   return kLeafNames[static_cast<int>(m.slabs[n.slab].kind)];
 }

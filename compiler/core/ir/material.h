@@ -49,7 +49,8 @@ enum class SlabPin : std::uint8_t {
   DiffuseAlbedo, F0, F90, Roughness, Anisotropy, Normal, Tangent, SssMfp, SssMfpScale,
   SssPhaseAnisotropy, Emissive, SecondRoughness, SecondRoughnessWeight, FuzzAmount, FuzzColor,
   FuzzRoughness, GlintValue, GlintUv, Transmittance, BaseColor, AzimuthalRoughness, Ior, CuticleAngle, Scatter,
-  Albedo, Extinction, AmbientOcclusion, IrisNormal, IrisPlaneNormal, IrisMask, IrisDistance,
+  Albedo, Extinction, AmbientOcclusion, IrisNormal, IrisPlaneNormal, IrisMask, IrisDistance, Metallic, Specular,
+  TopMaterialOpacity, WaterAlbedo, WaterExtinction, WaterPhaseG, ColorScaleBehindWater,
   Count_
 };
 inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
@@ -64,9 +65,12 @@ inline constexpr int kSlabPinCount = static_cast<int>(SlabPin::Count_);
 /// material, which it makes a volume-domain material (isVolumeMaterial); and
 /// the eye BSDF, a slab's cornea interface and sclera with an iris of its own
 /// normal and caustic (runtime_shaders/substrate_eye.h): one closure, always
-/// the whole material.
-enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair, FogCloud, Eye };
-/// "slab", "unlit", "hair", "volumetric_fog_cloud", "eye": the node kind in materials.
+/// the whole material; and the single-layer water, a water surface over the
+/// water body behind it (runtime_shaders/substrate_water.h): its surface is
+/// one slab closure, its body a forward term that reads what lies behind the
+/// water; always the whole material.
+enum class BsdfKind : std::uint8_t { Slab, Unlit, Hair, FogCloud, Eye, Water };
+/// "slab", "unlit", "hair", "volumetric_fog_cloud", "eye", "single_layer_water": the node kind in materials.
 std::string_view bsdfKindName(BsdfKind k);
 std::optional<BsdfKind> bsdfKindByName(std::string_view name);
 /// Whether a BSDF of kind `k` is a closure the lighting sees (slab, hair, eye); an
@@ -76,7 +80,8 @@ bool bsdfIsClosure(BsdfKind k);
 bool bsdfIsWholeMaterial(BsdfKind k);
 
 /// BsdfKind bits: which kinds of BSDF node take a pin.
-inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4, kPinOfFogCloud = 8, kPinOfEye = 16;
+inline constexpr std::uint8_t kPinOfSlab = 1, kPinOfUnlit = 2, kPinOfHair = 4, kPinOfFogCloud = 8, kPinOfEye = 16,
+                                kPinOfWater = 32;
 
 struct SlabPinInfo {
   std::string_view name;
@@ -109,8 +114,9 @@ enum Feature : std::uint16_t {
   kFeatMedium = 1 << 8,   // a coating slab's medium (MFP): drives transmittance only
   kFeatHair = 1 << 9,     // a hair BSDF's closure: the fibre's lobes, its own field and a tangent
   kFeatEye = 1 << 10,     // an eye BSDF's closure: the iris's normals, mask and distance in place of F0
+  kFeatWater = 1 << 11,   // a single-layer water: its body, a forward term (no bytes: its surface is a slab)
 };
-inline constexpr int kFeatureCount = 11;
+inline constexpr int kFeatureCount = 12;
 /// Features whose lighting reads the closure's tangent, so its basis stores
 /// one: anisotropy (the stretched lobe) and hair (the fibre's direction).
 inline constexpr std::uint16_t kTangentFeatures = kFeatAnisotropy | kFeatHair;
@@ -168,6 +174,9 @@ bool isUnlitLeaf(const struct Material& m, const TreeNode& n);
 /// Tree node `n` is a hair leaf (a Slab of BsdfKind::Hair).
 bool isHairLeaf(const struct Material& m, const TreeNode& n);
 /// Tree node `n` is a leaf of BSDF kind `k`.
+/// The material is a single-layer water (its root is one; build_tree keeps it
+/// the whole material): <name>_evaluate also returns its body (SubstrateWater).
+bool isWaterMaterial(const struct Material& m);
 bool isLeafOfKind(const struct Material& m, const TreeNode& n, BsdfKind k);
 /// The material is a volume (its root is a volumetric fog cloud: build_tree
 /// keeps one alone at the root): no surface, no closure, no GBuffer; it is

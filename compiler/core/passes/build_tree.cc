@@ -191,17 +191,42 @@ void checkWholeMaterialPlacement(const Material& m, Diagnostics& diags) {
     const BsdfKind kind = m.slabs[node.slab].kind;
     const char* what = kind == BsdfKind::Hair  ? "a hair BSDF"
                        : kind == BsdfKind::Eye ? "an eye BSDF"
-                                               : "a volumetric fog cloud";
+                       : kind == BsdfKind::Water ? "a single-layer water"
+                                                 : "a volumetric fog cloud";
     const char* why =
         kind == BsdfKind::Hair  ? "its fibre lobes are a closure of their own kind that no operator can mix, layer or "
                                   "weigh with other matter"
         : kind == BsdfKind::Eye ? "its iris is lit through its cornea by a caustic of its own, a closure of its own "
                                   "kind that no operator can mix, layer or weigh with other matter"
+        : kind == BsdfKind::Water ? "its body is what lies behind the surface seen through the water, which no "
+                                    "operator can mix, layer or weigh with other matter"
                                 : "it is a medium a ray-marcher samples through a volume, not a surface that an "
                                   "operator can mix, layer or weigh with other matter";
     diags.error(node.pointer, fmt::format("{} '{}' is an operand of {} '{}': {} must be the whole material (the "
                                           "output), since {}",
                                           bsdfKindName(kind), node.id, treeOpName(p.op), p.id, what, why));
+  }
+}
+
+/// A single-layer water's surface is the slab that its top material's share
+/// t = sat(top_material_opacity) (base colour b = sat(base_color), metallic
+/// m = t sat(metallic)) and the water's interface (F0 w = 0.08 sat(specular))
+/// mix to: its diffuse_albedo pin becomes b (t - m), its f0 pin w + m (b - w)
+/// (a horizontal mix by parameter blending, exact for the lobes' linear F0).
+/// The emitter, the reference and the truth then read a slab's pins; the
+/// water's body keeps its own (the emitter's `water`).
+void lowerWaterSurfaces(Material& m) {
+  ValueDag& v = m.values;
+  for (Slab& s : m.slabs) {
+    if (s.kind != BsdfKind::Water) continue;
+    const ValueId w = v.make(Op::Multiply, VType::Float, {v.splat(VType::Float, 0.08),
+                                                          v.make(Op::Saturate, VType::Float, {s.pin(SlabPin::Specular)})});
+    const ValueId t = v.make(Op::Saturate, VType::Float, {s.pin(SlabPin::TopMaterialOpacity)});
+    const ValueId metal = v.make(Op::Multiply, VType::Float, {t, v.make(Op::Saturate, VType::Float, {s.pin(SlabPin::Metallic)})});
+    const ValueId b = v.make(Op::Saturate, VType::Vec3, {s.pin(SlabPin::BaseColor)});
+    s.pin(SlabPin::DiffuseAlbedo) = v.make(Op::Multiply, VType::Vec3, {b, v.make(Op::Subtract, VType::Float, {t, metal})});
+    s.pin(SlabPin::F0) = v.make(Op::Add, VType::Vec3,
+                                {w, v.make(Op::Multiply, VType::Vec3, {v.make(Op::Subtract, VType::Vec3, {b, w}), metal})});
   }
 }
 
@@ -242,6 +267,7 @@ bool buildSubstrateTree(const ResolvedDoc& doc, const ValueTable& table, Materia
   m.root = builder.instance(doc.output);
   checkUnlitPlacement(m, diags);
   checkWholeMaterialPlacement(m, diags);
+  lowerWaterSurfaces(m);
   return !diags.hasErrors();
 }
 

@@ -22,6 +22,11 @@ void analyzeFeatures(Material& m) {
       s.features = kFeatHair | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
       continue;
     }
+    if (s.kind == BsdfKind::Water) {  // its surface is a plain slab (no stored feature); its body a forward term
+      s.sssType = SssType::None;
+      s.features = kFeatWater | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
+      continue;
+    }
     if (s.kind == BsdfKind::Eye) {  // an eye's cornea, sclera and iris are one closure kind, its fields fixed
       s.sssType = SssType::None;
       s.features = kFeatEye | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);

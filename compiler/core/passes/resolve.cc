@@ -519,7 +519,7 @@ void Resolver::checkOutput() {
         d_.error("/output", fmt::format("unknown node {}", quoteForDiagnostic(outputId_)));
     } else if (isValueKindName(outputId_)) {
       d_.error("/output", fmt::format("{} is a value node; the output must be a Substrate node "
-                                      "(slab, unlit, hair, volumetric_fog_cloud, eye, horizontal, vertical, add, coverage_weight, select)",
+                                      "(slab, unlit, hair, volumetric_fog_cloud, eye, single_layer_water, horizontal, vertical, add, coverage_weight, select)",
                                       quoteForDiagnostic(outputId_)));
     } else if (isSubstrateName(outputId_)) {
       out_.output = namedSubstrate_[outputId_];

@@ -34,6 +34,28 @@ std::string bytesNote(const StorageLayout& L) {
              : fmt::format("{} UINT32 + 4 top-layer bytes", L.words());
 }
 
+/// The features line of a closure: a slab's (featureLine); a hair, an eye
+/// and a water have no optional slab feature, so theirs says what they are.
+std::string bsdfFeatureLine(const Slab& s) {
+  const int emissive = (s.features & kFeatEmissive) ? 1 : 0;
+  switch (s.kind) {
+    case BsdfKind::Hair:
+      return fmt::format("Hair=1 Emissive={} Basis={} (a fibre: R, TT, TRT lobes and the rest; its basis stores the "
+                         "fibre's tangent)",
+                         emissive, s.basis);
+    case BsdfKind::Eye:
+      return fmt::format("Eye=1 Emissive={} Basis={} (a cornea's GGX interface, F0 0.04, over the sclera's diffuse "
+                         "and an iris of its own normal and caustic)",
+                         emissive, s.basis);
+    case BsdfKind::Water:
+      return fmt::format("Water=1 Emissive={} Basis={} (a water surface, a slab of the water's F0 and its top "
+                         "material; its body, what lies behind it through the water, added by the forward and base "
+                         "passes)",
+                         emissive, s.basis);
+    default: return featureLine(s);
+  }
+}
+
 }  // namespace
 
 std::string formatReportText(const CompileResult& r) {
@@ -77,16 +99,7 @@ std::string formatReportText(const CompileResult& r) {
   o += fmt::format("----- BSDF features - {} -----\n", m.name);
   for (std::size_t i = 0; i < t.slabOrder.size(); ++i) {
     const Slab& s = m.slabs[t.slabOrder[i]];
-    if (s.kind == BsdfKind::Hair)  // no slab feature applies: its lobes are one closure kind
-      o += fmt::format("BSDF {} ({}): Hair=1 Emissive={} Basis={} (a fibre: R, TT, TRT lobes and the rest; "
-                       "its basis stores the fibre's tangent)\n",
-                       i, s.id, (s.features & kFeatEmissive) ? 1 : 0, s.basis);
-    else if (s.kind == BsdfKind::Eye)  // nor to an eye: its cornea, sclera and iris are one closure kind
-      o += fmt::format("BSDF {} ({}): Eye=1 Emissive={} Basis={} (a cornea's GGX interface, F0 0.04, over the "
-                       "sclera's diffuse and an iris of its own normal and caustic)\n",
-                       i, s.id, (s.features & kFeatEmissive) ? 1 : 0, s.basis);
-    else
-      o += fmt::format("BSDF {} ({}): {}\n", i, s.id, featureLine(s));
+    o += fmt::format("BSDF {} ({}): {}\n", i, s.id, bsdfFeatureLine(s));
   }
   for (int n : t.preorder)  // unlit leaves: no closure, no bytes
     if (isUnlitLeaf(m, m.nodes[n]))

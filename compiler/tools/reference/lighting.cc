@@ -171,6 +171,57 @@ void translucency(const Closure<T>& c, T NoV, const V3<T>& V, T& coverage, V3<T>
     transmittanceOut = transmittanceOut * (T(1) - saturate(c.fuzzAmount) * std::min(fuzzAlbedo(fuzzCosine(c, mu), c.fuzzRoughness), T(1)));
 }
 
+namespace {
+template <class T>
+V3<T> clampPositive3(const V3<T>& x, T hi) {  // substrate_water_clamp3
+  V3<T> r;
+  for (int i = 0; i < 3; ++i) r[i] = x[i] > T(0) ? std::min(x[i], hi) : T(0);
+  return r;
+}
+template <class T>
+T hgPhaseT(T cosTheta, T g) {  // substrate_fog_hg_phase
+  const T k = g > T(-0.99) ? std::min(g, T(0.99)) : (g <= T(-0.99) ? T(-0.99) : T(0));
+  const T c = cosTheta > T(-1) ? std::min(cosTheta, T(1)) : (cosTheta <= T(-1) ? T(-1) : T(1));
+  const T d = std::max(T(1) + k * k - T(2) * k * c, T(1e-6));
+  return (T(1) - k * k) / (T(4) * K<T>::pi * d * std::sqrt(d));
+}
+}  // namespace
+
+// substrate_water_body.
+template <class T>
+V3<T> waterBody(const Water<T>& w, const V3<T>& background, T distance, T cosPhase, const V3<T>& light) {
+  const T d = distance > T(0) ? std::min(distance, K<T>::fltMax) : T(0);
+  const V3<T> sigma = clampPositive3(w.extinction, K<T>::fltMax);
+  V3<T> t;
+  for (int i = 0; i < 3; ++i) t[i] = std::exp(-std::min(sigma[i] * d, T(88)));
+  const V3<T> behind = clampPositive3(background, K<T>::fltMax) * clampPositive3(w.scaleBehind, T(65504));
+  const T phase = hgPhaseT(cosPhase, w.phaseG);
+  return clampPositive3(behind * t + saturate(w.albedo) * (splat3(T(1)) - t) * clampPositive3(light, K<T>::fltMax) * phase,
+                        K<T>::fltMax);
+}
+
+// substrate_water_seen: the uncovered share times the interface's 1 - E along the
+// view, of the body lit through it (1 - E along the light).
+template <class T>
+V3<T> waterSeen(const Closure<T>& c, const Water<T>& w, const V4<T>& behind, T surfaceDistance, const V3<T>& V,
+                const V3<T>& L, const V3<T>& lightRadiance) {
+  const V3<T> N = closureNormal(c);
+  const T NoVraw = dot(N, V);
+  if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));  // seen from below the surface: not this model's
+  Closure<T> s = c;  // the bare water interface
+  s.f0 = splat3(saturate(w.f0));
+  s.f90 = splat3(T(1));
+  s.features = 0;
+  const T NoV = clampT(NoVraw, K<T>::minCos, T(1));
+  const T NoL = dot(N, L);
+  T dielectric;
+  const V3<T> through = splat3(T(1)) - specularAlbedo(s, NoV, dielectric);
+  const V3<T> lightIn = NoL > T(0) ? lightRadiance * (splat3(T(1)) - specularAlbedo(s, NoL, dielectric)) : splat3(T(0));
+  const V3<T> body = waterBody(w, V3<T>{behind[0], behind[1], behind[2]}, behind[3] - surfaceDistance,
+                               dot(L * T(-1), V), lightIn);
+  return through * body * (T(1) - saturate(w.opacity));
+}
+
 #define SUBSTRATEC_INSTANTIATE(T)                                                                         \
   template V3<T> viewThroughput<T>(const Closure<T>&, T, const V3<T>&);                                                 \
   template V3<T> lightThroughput<T>(const Closure<T>&, T, const V3<T>&);                                                \
@@ -178,7 +229,10 @@ void translucency(const Closure<T>& c, T NoV, const V3<T>& V, T& coverage, V3<T>
   template V3<T> reflectionDir<T>(const Closure<T>&, const V3<T>&);                                       \
   template T envMip<T>(T, T);                                                                             \
   template V3<T> envSplitSum<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V3<T>&, int);        \
-  template void translucency<T>(const Closure<T>&, T, const V3<T>&, T&, V3<T>&);
+  template void translucency<T>(const Closure<T>&, T, const V3<T>&, T&, V3<T>&);                         \
+  template V3<T> waterBody<T>(const Water<T>&, const V3<T>&, T, T, const V3<T>&);                         \
+  template V3<T> waterSeen<T>(const Closure<T>&, const Water<T>&, const V4<T>&, T, const V3<T>&, const V3<T>&, \
+                              const V3<T>&);
 SUBSTRATEC_INSTANTIATE(float)
 SUBSTRATEC_INSTANTIATE(double)
 #undef SUBSTRATEC_INSTANTIATE

@@ -23,6 +23,7 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "pipeline/pipeline.h"
@@ -151,13 +152,36 @@ void setCoatFloor(std::vector<Closure<T>>& closures, T topR);
 template <class T>
 void setCoatInterface(std::vector<Closure<T>>& closures);
 
+/// SubstrateWater (substrate_water.h): a single-layer water's body, the same
+/// fields and neutral values (substrate_water_init).
+template <class T>
+struct Water {
+  V3<T> albedo{T(0), T(0), T(0)};
+  V3<T> extinction{T(0), T(0), T(0)};  // 1/m
+  T phaseG = T(0);
+  V3<T> scaleBehind{T(1), T(1), T(1)};
+  T opacity = T(0);  // the top material's
+  T f0 = T(0.04);    // the water surface's
+};
+
 template <class T>
 struct MaterialResult {
   std::vector<Closure<T>> closures;  // in closure order (r.after.closures)
   T coverage;                        // the root's C
   V3<T> transmittance;               // the root's T
   V3<T> emission{T(0), T(0), T(0)};  // what the unlit nodes emit, weighted (the emitter's `emission`)
+  std::optional<Water<T>> water;     // a single-layer water's body (the emitter's `water`)
 };
+
+/// substrate_water_body: `background` through `distance` metres of water plus
+/// `light` scattered once at the phase angle of cosine `cosPhase`.
+template <class T>
+V3<T> waterBody(const Water<T>& w, const V3<T>& background, T distance, T cosPhase, const V3<T>& light);
+/// substrate_water_seen: what a pixel of water shows of its body (`behind`:
+/// rgb what lies behind, [3] its distance from the eye).
+template <class T>
+V3<T> waterSeen(const Closure<T>& c, const Water<T>& w, const V4<T>& behind, T surfaceDistance, const V3<T>& V,
+                const V3<T>& L, const V3<T>& lightRadiance);
 
 /// <name>_evaluate: the value DAG, the tree walk (C and T per node, operators
 /// bottom-up) and each closure's walk to the root. An unset `tex` samples every

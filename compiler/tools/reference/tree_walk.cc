@@ -174,6 +174,7 @@ class Walk {
     assignProfiles();
     for (const ClosureLayout& cl : L_.closures) out.closures.push_back(closure(cl));
     out.emission = emission();
+    if (isWaterMaterial(m_)) out.water = water(m_.slabs[m_.nodes[m_.root].slab]);
     // What the layers' top lets through at grazing angles (the emitter's emitCoatFloor).
     setCoatFloor(out.closures, topRoughness(out.closures));
     setCoatInterface(out.closures);  // the emitter's emitCoatInterface
@@ -411,6 +412,18 @@ class Walk {
     c.features = kFeatureHair;
     c.metalnessMix = m_.metalnessMix;
     return c;
+  }
+
+  /// The emitter's `water`: a water's body.
+  Water<T> water(const Slab& s) const {
+    Water<T> w;
+    w.albedo = vec3(s.pin(SlabPin::WaterAlbedo));
+    w.extinction = vec3(s.pin(SlabPin::WaterExtinction));
+    w.phaseG = scalar(s.pin(SlabPin::WaterPhaseG));
+    w.scaleBehind = vec3(s.pin(SlabPin::ColorScaleBehindWater));
+    w.opacity = saturate(scalar(s.pin(SlabPin::TopMaterialOpacity)));
+    w.f0 = T(0.08) * saturate(scalar(s.pin(SlabPin::Specular)));  // its surface is closure 0: build_tree's slab
+    return w;
   }
 
   /// emitEyeClosure: an eye's pins into its closure (F0 0.04, the init's).

@@ -90,6 +90,12 @@ struct Rewriter {
       force(node, "diffuse_albedo", "albedo", 0.18);
       force(node, "iris_mask", "coverage", 0.0);
       force(node, "iris_distance", "coverage", 0.0);
+    } else if (kind == "single_layer_water") {  // its surface's roughness, all foam or none, clear to opaque water
+      force(node, "roughness", "roughness", 0.5);
+      force(node, "base_color", "albedo", 0.0);
+      force(node, "top_material_opacity", "coverage", 0.0);
+      force(node, "water_albedo", "albedo", 0.0);
+      force(node, "water_extinction", "mfp", 0.0);  // 0, 1e-9 and 1e6 per metre
     } else if (kind == "unlit") {
       force(node, "transmittance", "albedo", 1.0);  // 0 (opaque) and 1 (clear)
     } else if (kind == "vertical") {
@@ -279,6 +285,12 @@ std::string evaluate(const CompileResult& r, const Point& p, const reference::In
   if (!finite3(m.transmittance)) return *value = m.transmittance[0], "transmittance";
   if (!finite3(m.emission)) return *value = m.emission[0], "emission";
   const auto V = toT<T>(p.g.V), L = toT<T>(p.light), one = toT<T>({1, 1, 1}), pi = toT<T>({std::numbers::pi, std::numbers::pi, std::numbers::pi});
+  if (m.water) {  // a water's body: a white background behind 0, 1 m and 1e30 m of it
+    for (T depth : {T(0), T(1), T(1e30)}) {
+      const auto seen = reference::waterSeen<T>(m.closures[0], *m.water, {T(1), T(1), T(1), depth}, T(0), V, L, one);
+      if (!finite3(seen)) return *value = seen[0], fmt::format("water body at {:g} m", double(depth));
+    }
+  }
   for (std::size_t k = 0; k < m.closures.size(); ++k) {
     const auto& c = m.closures[k];
     if (std::string f = badField(c); !f.empty()) return *value = NAN, fmt::format("closure {} {}", k, f);
