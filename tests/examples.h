@@ -2,7 +2,9 @@
 // name): all of them, or the surfaces only. A volume (a volumetric fog cloud,
 // isVolumeMaterial) has no surface, closure or pixel: the suites that shade,
 // pack or light one leave it to tests/unit/fog_cloud_test.cc and
-// tests/gpu/fog_cloud_gpu_test.cc.
+// tests/gpu/fog_cloud_gpu_test.cc. `render` draws the surfaces over nothing,
+// so it draws neither a volume nor a single-layer water (whose body needs what
+// lies behind it, isWaterMaterial): Examples::Rendered.
 #pragma once
 #include <algorithm>
 #include <filesystem>
@@ -16,13 +18,13 @@
 
 namespace substratec::test {
 
-enum class Examples { All, Surfaces };
+enum class Examples { All, Surfaces, Rendered };
 
 inline std::vector<std::filesystem::path> exampleFiles(Examples which) {
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(std::filesystem::path(SUBSTRATEC_SOURCE_DIR) / "examples")) {
     if (e.path().extension() != ".json") continue;
-    if (which == Examples::Surfaces) {
+    if (which != Examples::All) {
       std::ifstream in(e.path(), std::ios::binary);
       std::ostringstream read;
       read << in.rdbuf();
@@ -34,6 +36,7 @@ inline std::vector<std::filesystem::path> exampleFiles(Examples which) {
       PassContext c(text, o, d, r);
       runPasses(c, o.stopAfter);
       if (isVolumeMaterial(r.material)) continue;
+      if (which == Examples::Rendered && isWaterMaterial(r.material)) continue;
     }
     files.push_back(e.path());
   }

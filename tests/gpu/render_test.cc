@@ -138,7 +138,7 @@ std::vector<double> relativeDifferences(const render::RenderResult& a, const ren
 
 std::vector<std::string> everyExampleStem() {
   std::vector<std::string> stems;
-  for (const fs::path& e : test::exampleFiles(test::Examples::Surfaces)) stems.push_back(e.stem().string());
+  for (const fs::path& e : test::exampleFiles(test::Examples::Rendered)) stems.push_back(e.stem().string());
   return stems;
 }
 
@@ -250,6 +250,14 @@ TEST(RenderCli, BadInputIsALocatedErrorAndNothingIsWritten) {
   r = cli({"render", missing.string(), "-o", png.string()});
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_NE(r.err.find("missing.bin"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(png));
+  // A single-layer water: its body needs what lies behind it, which render does not draw.
+  r = cli({"render", scenePath().string(), "--material", (kSource / "examples/water_lake.json").string(), "-o",
+           png.string()});
+  EXPECT_EQ(r.status, 1) << r.err;
+  EXPECT_NE(r.err.find("'water_lake' is a single-layer water ('lake'): its body needs what lies behind the water"),
+            std::string::npos)
+      << r.err;
   EXPECT_FALSE(fs::exists(png));
   // A platform nobody defined.
   r = cli({"render", scenePath().string(), "-o", png.string(), "--platform", "moon"});
