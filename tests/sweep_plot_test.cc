@@ -11,6 +11,7 @@
 #include <pugixml.hpp>
 
 #include "sweep/sweep.h"
+#include "sweep/volume_sweep.h"
 
 // A named namespace: cli_tests is a unity build.
 namespace substratec::sweepplottest {
@@ -116,6 +117,29 @@ TEST(SweepPlot, NonAsciiAndXmlSpecialNamesAreEscapedAndMeasuredByCodePoint) {
 
 TEST(SweepPlot, NoRowsStillGivesACanvasWithItsAxes) {
   EXPECT_GE(expectTextsInside(sweep::plotSvg("empty", {})), 1 + 2 + 5);
+}
+
+// A volume's sweep plots the march's largest error against ns per ray, one
+// point per step count, on the same canvas.
+TEST(SweepPlot, AVolumesPlotHasOnePointPerStepCountInsideTheCanvas) {
+  std::vector<sweep::VolumeRow> rows;
+  for (int steps = 4; steps <= 128; steps *= 2) {
+    sweep::VolumeRow r;
+    r.steps = steps;
+    r.gpuNsPerRay = 2.3 * steps;
+    r.error.maxError = 0.5 / (steps * steps);
+    rows.push_back(r);
+  }
+  const std::string svg = sweep::plotVolumeSvg("fog_cloud_puff", rows);
+  EXPECT_GE(expectTextsInside(svg), 1 + 2 + 5 + static_cast<int>(rows.size()));
+  pugi::xml_document doc;
+  ASSERT_TRUE(doc.load_string(svg.c_str()));
+  int points = 0;
+  for ([[maybe_unused]] const pugi::xml_node& c : doc.child("svg").children("circle")) ++points;
+  EXPECT_EQ(points, static_cast<int>(rows.size()));
+  EXPECT_NE(svg.find(">128 steps<"), std::string::npos) << svg;
+  EXPECT_NE(svg.find("lavapipe ns per ray"), std::string::npos) << svg;
+  EXPECT_NE(svg.find("fog_cloud_puff: error against cost"), std::string::npos) << svg;
 }
 
 }  // namespace substratec::sweepplottest

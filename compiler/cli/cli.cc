@@ -1068,15 +1068,15 @@ int printSweep(const SweepArgs& a, const std::string& name, const std::vector<sw
 }
 
 /// A volume's sweep (sweep/volume_sweep.h): nothing simplifies it, so its
-/// rows are step counts of its march, lavapipe ns per ray against the error.
-/// --csv, --plot and --max-error choose among simplification steps: a usage
-/// error here.
-int volumeSweep(const SweepArgs& a, const import::MaterialSource& s, const CompileResult& r, std::ostream& out,
-                std::ostream& err) {
-  if (a.csv || !a.plot.empty() || a.maxError >= 0)
+/// rows are step counts of its march, lavapipe ns per ray against the error,
+/// and --plot draws them. --csv and --max-error choose among simplification
+/// steps: a usage error here.
+int volumeSweep(const SweepArgs& a, const import::MaterialSource& s, const CompileResult& r,
+                const CommandOutputs& outputs, std::ostream& out, std::ostream& err) {
+  if (a.csv || a.maxError >= 0)
     return printError(err, kExitUsage,
-                      fmt::format("{}: '{}' is a volume: its sweep is step counts of its march (the table or --json); "
-                                  "--csv, --plot and --max-error are for surfaces' simplification steps",
+                      fmt::format("{}: '{}' is a volume: its sweep is step counts of its march (the table, --json or "
+                                  "--plot); --csv and --max-error are for surfaces' simplification steps",
                                   s.displayName, r.material.name));
   auto ctx = openGpu(a.precision, "sweep times the generated code on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
@@ -1086,6 +1086,9 @@ int volumeSweep(const SweepArgs& a, const import::MaterialSource& s, const Compi
   std::vector<sweep::VolumeRow> rows;
   Diagnostics failure(r.material.name);
   if (!sweep::measureVolume(*ctx, r, so, &rows, failure)) return printInternalError(err, failure.errorMessages());
+  if (!a.plot.empty())
+    if (int status = outputs.commit({{a.plot, sweep::plotVolumeSvg(r.material.name, rows)}}, err); status != kExitOk)
+      return status;
   out << (a.json ? sweep::formatVolumeJson(r.material.name, rows) : sweep::formatVolumeTable(r.material.name, rows));
   return kExitOk;
 }
@@ -1104,7 +1107,7 @@ int runSweep(const SweepArgs& a, std::ostream& out, std::ostream& err) {
   std::vector<sweep::Step> steps;
   CompileResult full;
   if (int failed = simplificationSteps(sources->front(), o, steps, full, err); failed != kExitOk) return failed;
-  if (isVolumeMaterial(full.material)) return volumeSweep(a, sources->front(), full, out, err);
+  if (isVolumeMaterial(full.material)) return volumeSweep(a, sources->front(), full, outputs, out, err);
   auto ctx = openGpu(a.precision, "sweep times the generated code on Vulkan (Mesa lavapipe)", err);
   if (!ctx) return kExitBadInput;
   sweep::Options so;

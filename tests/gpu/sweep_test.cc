@@ -238,10 +238,21 @@ TEST(Sweep, ABrokenMaterialIsBadInput) {
 
 // A volume: nothing simplifies it, so its rows are step counts of its march,
 // each timed on lavapipe (the cost kernel: one ray an invocation) beside the
-// march's error against a 4,096-step march (accuracy/fog_accuracy.h).
+// march's error against a 4,096-step march (accuracy/fog_accuracy.h); --plot
+// draws one point per step count.
 TEST(Sweep, AVolumeTradesStepsOfItsMarchForError) {
-  CliRun r = cli({"sweep", example("fog_cloud_puff.json"), "--json", "--pixels", "4096", "--runs", "2"});
+  const fs::path svg = fs::temp_directory_path() / "substratec_sweep_volume.svg";
+  fs::remove(svg);
+  CliRun r = cli({"sweep", example("fog_cloud_puff.json"), "--json", "--pixels", "4096", "--runs", "2", "--plot",
+                  svg.string()});
   ASSERT_EQ(r.status, 0) << r.err;
+  std::ifstream in(svg);
+  std::ostringstream plot;
+  plot << in.rdbuf();
+  EXPECT_NE(plot.str().find("lavapipe ns per ray"), std::string::npos) << plot.str();
+  for (const char* steps : {">4 steps<", ">8 steps<", ">16 steps<", ">32 steps<", ">64 steps<", ">128 steps<"})
+    EXPECT_NE(plot.str().find(steps), std::string::npos) << steps << " is a labelled point";
+  fs::remove(svg);
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["domain"], "volume");
   ASSERT_EQ(j["rows"].size(), 6u);  // 4 ... 128 steps

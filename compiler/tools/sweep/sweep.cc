@@ -469,9 +469,9 @@ double plotTextWidth(std::string_view text, double fontSize) {
   return kPlotGlyphWidth * fontSize * static_cast<double>(codePoints(text));
 }
 
-std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
-  // Error (log10 rel_mse, floored at 1e-8: the full budget may be exact)
-  // against cost (ns per pixel). Every text is placed from its estimated
+std::string plotSvg(const Plot& plot) {
+  // Error (log10, floored at 1e-8: the full budget may be exact) against cost.
+  // Every text is placed from its estimated
   // extent (plotTextWidth; a glyph rises a font size above its baseline and
   // descends a quarter of one below it) so that it
   // stays inside the canvas: labels of points near the right edge end left of
@@ -483,15 +483,13 @@ std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
   // stretching them (or making every coordinate NaN).
   auto ly = [](double e) { return std::isnan(e) ? 8.0 : std::clamp(std::log10(std::max(e, 1e-8)), -8.0, 8.0); };
   auto lx = [](double ns) { return std::isfinite(ns) ? std::clamp(ns, 0.0, 1e12) : 1e12; };
-  std::vector<Row> measured;  // a row without code has no time: not plotted
-  std::copy_if(rows.begin(), rows.end(), std::back_inserter(measured), [](const Row& r) { return r.gpuMeasured; });
-  for (const Row& r : measured) {
-    xMin = std::min(xMin, lx(r.gpuNsPerPixel));
-    xMax = std::max(xMax, lx(r.gpuNsPerPixel));
-    yMin = std::min(yMin, ly(r.relMse));
-    yMax = std::max(yMax, ly(r.relMse));
+  for (const PlotPoint& p : plot.points) {
+    xMin = std::min(xMin, lx(p.cost));
+    xMax = std::max(xMax, lx(p.cost));
+    yMin = std::min(yMin, ly(p.error));
+    yMax = std::max(yMax, ly(p.error));
   }
-  if (measured.empty()) xMin = xMax = yMin = yMax = 0;
+  if (plot.points.empty()) xMin = xMax = yMin = yMax = 0;
   if (xMax - xMin < 1e-9) xMax = xMin + 1;
   yMin = std::floor(yMin);
   yMax = std::max(std::ceil(yMax), yMin + 1);
@@ -517,32 +515,39 @@ std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
   const std::string suffix = ": error against cost";
   const auto titlePoints = static_cast<std::size_t>((W - 2 * kPad) / (kPlotGlyphWidth * kTitleFont));
   const std::size_t suffixPoints = codePoints(suffix);
-  s += text(L, 20, truncatedTo(material, titlePoints > suffixPoints + 1 ? titlePoints - suffixPoints : 1) + suffix,
+  s += text(L, 20, truncatedTo(plot.title, titlePoints > suffixPoints + 1 ? titlePoints - suffixPoints : 1) + suffix,
             kTitleFont, "start");
   s += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{2}\" y2=\"{1}\" stroke=\"black\"/>\n", L, H - B, W - R);
   s += fmt::format("<line x1=\"{0}\" y1=\"{1}\" x2=\"{0}\" y2=\"{2}\" stroke=\"black\"/>\n", L, T, H - B);
-  s += text((L + W - R) / 2, H - 12, "lavapipe ns per shading point", kFont, "middle");
+  s += text((L + W - R) / 2, H - 12, plot.costAxis, kFont, "middle");
   // Rotated by -90 degrees about its anchor: its extent runs up and down from
   // (16, middle), its glyphs' height to the left of x = 16.
-  s += fmt::format("<text x=\"16\" y=\"{0}\" transform=\"rotate(-90 16 {0})\" text-anchor=\"middle\">rel_mse vs the "
-                   "authored tree (log10)</text>\n",
-                   (T + H - B) / 2);
+  s += fmt::format("<text x=\"16\" y=\"{0}\" transform=\"rotate(-90 16 {0})\" text-anchor=\"middle\">{1} (log10)</text>\n",
+                   (T + H - B) / 2, xmlEscaped(plot.errorAxis));
   for (int e = static_cast<int>(yMin); e <= static_cast<int>(yMax); ++e)
     s += text(L - 6, py(e) + 4, fmt::format("1e{}", e), kFont, "end");
   for (int k = 0; k <= 4; ++k) {
     const double x = xMin + (xMax - xMin) * k / 4;
     s += text(L + (W - L - R) * k / 4, H - B + 16, fmt::format("{:.0f}", x), kFont, "middle");
   }
-  for (const Row& r : measured) {
-    const double x = px(r.gpuNsPerPixel), y = py(ly(r.relMse));
+  for (const PlotPoint& p : plot.points) {
+    const double x = px(p.cost), y = py(ly(p.error));
     s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"4\" fill=\"#c0392b\"/>\n", x, y);
-    const std::string label = fmt::format("{} ({} B, {} cl)", r.label, r.bytes, r.closures);
     // Right of the point when it fits, else left of it.
-    const bool fitsRight = x + 6 + plotTextWidth(label, kFont) <= W - kPad;
-    s += fitsRight ? text(x + 6, y - 6, label, kFont, "start") : text(x - 6, y - 6, label, kFont, "end");
+    const bool fitsRight = x + 6 + plotTextWidth(p.label, kFont) <= W - kPad;
+    s += fitsRight ? text(x + 6, y - 6, p.label, kFont, "start") : text(x - 6, y - 6, p.label, kFont, "end");
   }
   s += "</svg>\n";
   return s;
+}
+
+std::string plotSvg(const std::string& material, const std::vector<Row>& rows) {
+  Plot plot{material, "lavapipe ns per shading point", "rel_mse vs the authored tree", {}};
+  for (const Row& r : rows)  // a row without code has no time: not plotted
+    if (r.gpuMeasured)
+      plot.points.push_back(
+          {fmt::format("{} ({} B, {} cl)", r.label, r.bytes, r.closures), r.gpuNsPerPixel, r.relMse});
+  return plotSvg(plot);
 }
 
 }  // namespace substratec::sweep

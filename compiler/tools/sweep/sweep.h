@@ -101,6 +101,20 @@ std::string formatJson(const std::string& material, const std::vector<Row>& rows
 std::string formatCsv(const std::vector<Row>& rows);
 std::string plotSvg(const std::string& material, const std::vector<Row>& rows);
 
+/// A plot of error (log scale) against cost: `title` (": error against cost"
+/// is added), the axes' names and one labelled point per measured setting.
+/// The surface sweep's plotSvg and the volume sweep's plotVolumeSvg draw one.
+struct PlotPoint {
+  std::string label;
+  double cost = 0;   // x: linear
+  double error = 0;  // y: log10, floored at 1e-8
+};
+struct Plot {
+  std::string title, costAxis, errorAxis;
+  std::vector<PlotPoint> points;
+};
+std::string plotSvg(const Plot& plot);
+
 /// The plot's canvas (its viewBox is 0 0 kPlotWidth kPlotHeight) and the
 /// estimate of a text's extent every label is placed from: kPlotGlyphWidth
 /// font sizes per code point (wider than sans-serif's average glyph), a font

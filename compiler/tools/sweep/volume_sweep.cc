@@ -50,4 +50,10 @@ std::string formatVolumeJson(const std::string& material, const std::vector<Volu
   return j.dump(2) + "\n";
 }
 
+std::string plotVolumeSvg(const std::string& material, const std::vector<VolumeRow>& rows) {
+  Plot plot{material, "lavapipe ns per ray", "max rel error vs a 4096-step march", {}};
+  for (const VolumeRow& r : rows) plot.points.push_back({fmt::format("{} steps", r.steps), r.gpuNsPerRay, r.error.maxError});
+  return plotSvg(plot);
+}
+
 }  // namespace substratec::sweep

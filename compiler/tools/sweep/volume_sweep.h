@@ -29,4 +29,8 @@ bool measureVolume(gpu::Context& gpu, const CompileResult& r, const Options& opt
 std::string formatVolumeTable(const std::string& material, const std::vector<VolumeRow>& rows);
 std::string formatVolumeJson(const std::string& material, const std::vector<VolumeRow>& rows);
 
+/// The SVG plot of the march's largest relative error (log scale) against
+/// lavapipe ns per ray, one point per step count (sweep.h's Plot).
+std::string plotVolumeSvg(const std::string& material, const std::vector<VolumeRow>& rows);
+
 }  // namespace substratec::sweep
