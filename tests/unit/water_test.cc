@@ -10,6 +10,8 @@
 #include <string>
 
 #include "diag/diagnostics.h"
+#include "emit/kernel_emitter.h"
+#include "emit/syntax.h"
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
 #include "test_util.h"
@@ -82,6 +84,20 @@ TEST(Water, ItsSurfaceIsTheSlabItsTopMaterialAndInterfaceMixTo) {
   EXPECT_EQ(r.after.layoutClass, LayoutClass::Simple);
   EXPECT_EQ(r.after.bytes(), 12);
   EXPECT_EQ(r.material.slabs[r.material.nodes[r.material.root].slab].features, kFeatWater);
+}
+
+// `sweep` times what a water costs: its cost kernel runs the body as well as
+// the surface (a forward pass does both).
+TEST(Water, ItsCostKernelRunsItsBody) {
+  const CompileResult r = compiledWater(material(R"("root": {"kind": "single_layer_water"})"));
+  const CompileResult slab = compiledWater(material(R"("root": {"kind": "slab"})"));
+  for (Target t : {Target::Glsl, Target::Hlsl}) {
+    EXPECT_NE(emitKernel(r.material, r.after, syntaxFor(t), KernelMode::Throughput, {}).find("substrate_water_seen("),
+              std::string::npos);
+    EXPECT_EQ(emitKernel(slab.material, slab.after, syntaxFor(t), KernelMode::Throughput, {})
+                  .find("substrate_water_seen("),
+              std::string::npos);
+  }
 }
 
 reference::Water<double> water(const V3& albedo, const V3& extinction, double g = 0) {

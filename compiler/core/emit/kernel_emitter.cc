@@ -479,6 +479,14 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
       m.name);
   s += includes(m, L, syn, KernelMode::Throughput, precision);
   s += syn.storageBuffer(0, 7, Access::Write, "SubstrateResults", "float4", "results") + "\n";
+  // A water pays for its body too: what lies behind it is a constant grey
+  // kWaterSampleDepth behind the surface (the forward pass reads a texture).
+  const std::string waterBody =
+      isWaterMaterial(m)
+          ? fmt::format("  color += substrate_water_seen(closures[0], water, float4(SUBSTRATE_SPLAT3(0.5), {}), 0.0, "
+                        "g.V, L, SUBSTRATE_SPLAT3(1.0));  // the water's body\n",
+                        dialectLiteral(kWaterSampleDepth))
+          : "";
   s += syn.computeMain(kLocalSize, 1) + fmt::format("  uint i = {}.x;\n", syn.computeId(ComputeId::Dispatch));
   s += fmt::format(R"(  uint3 h = substrate_pcg3d(uint3(i, i * 7919u + 17u, 0x5eedu));
   uint3 k = substrate_pcg3d(h);
@@ -508,10 +516,10 @@ std::string throughputKernel(const Material& m, const StorageLayout& L, const Sy
     color += substrate_closure_view_throughput(closures[c], dot(closures[c].N, g.V), g.V) *
              substrate_env_split_sum(closures[c], g.V, SUBSTRATE_SPLAT3(0.5), SUBSTRATE_SPLAT3(1.5));
   }}
-  results[i] = float4(color, coverage);
+{2}  results[i] = float4(color, coverage);
 }}
 )",
-                   upper, evaluateCall(m));
+                   upper, evaluateCall(m), waterBody);
   return s;
 }
 
