@@ -2,9 +2,7 @@
 // name): all of them, or the surfaces only. A volume (a volumetric fog cloud,
 // isVolumeMaterial) has no surface, closure or pixel: the suites that shade,
 // pack or light one leave it to tests/unit/fog_cloud_test.cc and
-// tests/gpu/fog_cloud_gpu_test.cc. `render` draws the surfaces over nothing,
-// so it draws neither a volume nor a single-layer water (whose body needs what
-// lies behind it, isWaterMaterial): Examples::Rendered.
+// tests/gpu/fog_cloud_gpu_test.cc.
 #pragma once
 #include <algorithm>
 #include <filesystem>
@@ -18,7 +16,7 @@
 
 namespace substratec::test {
 
-enum class Examples { All, Surfaces, Rendered };
+enum class Examples { All, Surfaces };
 
 inline std::vector<std::filesystem::path> exampleFiles(Examples which) {
   std::vector<std::filesystem::path> files;
@@ -36,7 +34,6 @@ inline std::vector<std::filesystem::path> exampleFiles(Examples which) {
       PassContext c(text, o, d, r);
       runPasses(c, o.stopAfter);
       if (isVolumeMaterial(r.material)) continue;
-      if (which == Examples::Rendered && isWaterMaterial(r.material)) continue;
     }
     files.push_back(e.path());
   }

@@ -279,17 +279,6 @@ int rejectVolume(const Material& m, const std::string& where, std::string_view c
                                 where, m.name, m.nodes[m.root].id, command, m.name));
 }
 
-/// `render` draws surfaces over nothing: a single-layer water's body needs what
-/// lies behind the water (set 0, binding 6), which it does not draw.
-int rejectWater(const Material& m, const std::string& where, std::ostream& err) {
-  if (!isWaterMaterial(m)) return kExitOk;
-  return printError(err, kExitBadInput,
-                    fmt::format("{}: '{}' is a single-layer water ('{}'): its body needs what lies behind the water "
-                                "(set 0, binding 6: docs/codegen.md, \"Single-layer water\"), which `render` does not "
-                                "draw; `preview` shows it as a ball of water",
-                                where, m.name, m.nodes[m.root].id));
-}
-
 int simplificationSteps(const import::MaterialSource& s, const CompileOptions& o, std::vector<sweep::Step>& steps,
                         CompileResult& full, std::ostream& err) {
   Diagnostics failure(s.displayName);  // printed as the compile's own diagnostics
@@ -908,7 +897,6 @@ int compileRenderMaterials(const RenderArgs& a, const render::SceneSources& s, c
     err << diags.formatAll();
     if (!r) return compileFailure(src, err);
     if (int volume = rejectVolume(r->material, src.displayName, "render", err); volume != kExitOk) return volume;
-    if (int water = rejectWater(r->material, src.displayName, err); water != kExitOk) return water;
     (*results)[i] = std::move(*r);
     // --texture NAME=PATH binds every material's input NAME; a NAME no material has is an error below.
     TextureFlags flags{{}, a.textures.searchPaths};

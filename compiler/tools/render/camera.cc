@@ -29,6 +29,15 @@ std::array<double, 3> ViewSetup::ray(int x, int y, int width, int height) const 
   return unitOr(d, forward);
 }
 
+double ViewSetup::distance(int x, int y, int width, int height, float depth) const {
+  if (!(depth < 1.0f)) return kSkyDistance;
+  // depth = A + B / z_view (viewSetup's third row over its fourth).
+  const double A = zfar / (zfar - znear), B = -zfar * znear / (zfar - znear);
+  const double z = B / (static_cast<double>(depth) - A);
+  const double cosine = dot(ray(x, y, width, height), forward);
+  return std::clamp(z / std::max(cosine, 1e-6), 0.0, kSkyDistance);
+}
+
 ViewSetup viewSetup(const mesh::Camera& camera, int width, int height, const std::array<double, 3>& boundsMin,
                     const std::array<double, 3>& boundsMax) {
   ViewSetup v;

@@ -20,7 +20,14 @@ struct ViewSetup {
   /// The unit direction from the eye through the centre of pixel (x, y) of a
   /// width x height image, as the scene lighting computes it (negated: toward the scene).
   std::array<double, 3> ray(int x, int y, int width, int height) const;
+  /// The distance from the eye, along ray(x, y, ...), of the point whose depth
+  /// buffer value is `depth`; kSkyDistance where nothing was drawn (depth 1).
+  double distance(int x, int y, int width, int height, float depth) const;
 };
+
+/// How far away the sky is for what lies behind a water (metres): far enough
+/// that any water with extinction hides it.
+inline constexpr double kSkyDistance = 1e5;
 
 /// The view of `camera` for a width x height image whose geometry lies within
 /// [boundsMin, boundsMax]: the far plane just beyond the farthest corner (the

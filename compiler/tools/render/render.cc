@@ -6,6 +6,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -50,9 +51,11 @@ bool timed(double* ns, F&& submit) {
   return ok;
 }
 
-/// How a material is drawn: into the G-buffer, or forward after the lighting.
-enum class DrawKind { Deferred, Masked, Translucent };
+/// How a material is drawn: into the G-buffer, or forward after the lighting
+/// (a single-layer water over what was drawn before it).
+enum class DrawKind { Deferred, Masked, Water, Translucent };
 DrawKind drawKind(const Material& m) {
+  if (isWaterMaterial(m)) return DrawKind::Water;
   if (translucentBlend(m)) return DrawKind::Translucent;
   if (m.settings.blendMode == BlendMode::Masked) return DrawKind::Masked;
   return DrawKind::Deferred;
@@ -184,9 +187,10 @@ gpu::BufferResource energyTables() {
   return {bytesOf(lut.data(), lut.size()), false, false};
 }
 
-/// The resources of a material's draw (every binding its pipeline has but the shared material buffer).
+/// The resources of a material's draw (every binding its pipeline has but the
+/// shared material buffer); `behind` is a water's set 0, binding 6.
 gpu::Resources drawResources(const gpu::RasterPipeline& p, const std::vector<uint32_t>& fragment,
-                             const SceneMaterial& m, const Lighting& l) {
+                             const SceneMaterial& m, const Lighting& l, const gpu::ImageResource* behind = nullptr) {
   const Material& mat = m.result->material;
   const std::vector<gpu::TextureRole> roles = gpu::textureRoles(mat);
   gpu::Resources res;
@@ -199,6 +203,7 @@ gpu::Resources drawResources(const gpu::RasterPipeline& p, const std::vector<uin
     else if (b.set == 0 && b.binding == 3)
       res[key] = gpu::SamplerResource{gpu::Filter::Linear, gpu::Address::ClampToEdge, std::nullopt};
     else if (b.set == 0 && b.binding == 5) res[key] = energyTables();
+    else if (b.set == 0 && b.binding == 6 && behind) res[key] = *behind;
     else if (b.set == 1 && b.binding == 0)
       res[key] = gpu::BufferResource{gpu::inputBlockBytes(mat, gpu::blockMembers(fragment, 1, 0), {}), false, false};
     else if (b.set == 1) res[key] = preview::materialTexture(mat, roles, m.textures, b);
@@ -266,6 +271,7 @@ struct Frame {
   Pipelines pipelines;
   std::vector<float> color;  // RGBA32F, the opaque result, then composited
   std::vector<float> depth;
+  std::optional<gpu::ImageResource> waterBehind;  // while the waters are drawn
   RenderStats stats;
 
   bool prepare(Diagnostics& diags);
@@ -277,6 +283,8 @@ struct Frame {
   bool forwardOpaque(Diagnostics& diags);
   void composite(const std::vector<gpu::ColorAttachment>* gbuffer);
   bool forwardAfter(Diagnostics& diags);
+  bool drawOver(const std::vector<int>& opaque, std::vector<int> translucent, Diagnostics& diags);
+  gpu::ImageResource behindTheWater() const;
   std::vector<int> primitivesOf(std::initializer_list<DrawKind> kinds) const;
 };
 
@@ -485,10 +493,10 @@ void Frame::composite(const std::vector<gpu::ColorAttachment>* gbuffer) {
     }
 }
 
-bool Frame::forwardAfter(Diagnostics& diags) {
-  std::vector<int> masked = o.forward ? std::vector<int>{} : primitivesOf({DrawKind::Masked});
-  std::vector<int> translucent = primitivesOf({DrawKind::Translucent});
-  if (masked.empty() && translucent.empty()) return true;
+/// Draws over the frame so far: masked (and water) primitives first, opaque,
+/// then `translucent` back to front, blended.
+bool Frame::drawOver(const std::vector<int>& opaque, std::vector<int> translucent, Diagnostics& diags) {
+  if (opaque.empty() && translucent.empty()) return true;
   auto distance = [&](int p) {  // of the primitive's bounds centre from the eye
     double d = 0;
     for (int c = 0; c < 3; ++c) {
@@ -504,13 +512,15 @@ bool Frame::forwardAfter(Diagnostics& diags) {
   pass.colors.push_back({gpu::AttachmentFormat::Rgba32Float, {}, bytesOf(color.data(), color.size()), {}});
   pass.depthInitial = depth;
   std::vector<gpu::Draw> draws;
-  for (int p : masked) translucent.insert(translucent.begin(), p);  // masked first (opaque), then back to front
+  translucent.insert(translucent.begin(), opaque.begin(), opaque.end());  // opaque first, then back to front
   for (std::size_t i = 0; i < translucent.size(); ++i) {
     const int p = translucent[i], mi = primitiveMaterial[p];
-    const PassKind kind = i < masked.size() ? kForwardOpaque : kForwardTranslucent;
+    const PassKind kind = i < opaque.size() ? kForwardOpaque : kForwardTranslucent;
     gpu::RasterPipeline* pipe = pipelineFor(ctx, pipelines, mi, kind, materials[mi], list.shaders[mi], diags);
     if (!pipe) return false;
-    draws.push_back({pipe, &list.geometry[p], drawResources(*pipe, list.shaders[mi].forward, materials[mi], lighting)});
+    const gpu::ImageResource* behind = list.kinds[mi] == DrawKind::Water && waterBehind ? &*waterBehind : nullptr;
+    draws.push_back(
+        {pipe, &list.geometry[p], drawResources(*pipe, list.shaders[mi].forward, materials[mi], lighting, behind)});
   }
   stats.draws += static_cast<int>(draws.size());
   if (!timed(&stats.forwardWallNs, [&] { return ctx.render(pass, draws, diags, &stats.forwardNs); })) return false;
@@ -518,6 +528,43 @@ bool Frame::forwardAfter(Diagnostics& diags) {
   depth = std::move(pass.depth);
   for (std::size_t i = 3; i < color.size(); i += 4) color[i] = 1.0f;
   return true;
+}
+
+/// What lies behind the water (set 0, binding 6; docs/codegen.md, "Single-layer
+/// water"): the frame drawn so far, rgb its colour and a its distance from the
+/// eye along the pixel's ray (from the depth buffer; kSkyDistance where nothing
+/// was drawn).
+gpu::ImageResource Frame::behindTheWater() const {
+  const int W = lighting.width, H = lighting.height;
+  gpu::ImageResource image;
+  image.width = static_cast<uint32_t>(W);
+  image.height = static_cast<uint32_t>(H);
+  image.mips.emplace_back(color);
+  std::vector<float>& texels = image.mips[0];
+  for (int y = 0; y < H; ++y)
+    for (int x = 0; x < W; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * W + x;
+      texels[i * 4 + 3] = static_cast<float>(lighting.view.distance(x, y, W, H, depth[i]));
+    }
+  return image;
+}
+
+/// After the opaque frame: masked primitives (the deferred path's base pass
+/// keeps no coverage), then the single-layer waters over everything opaque
+/// (they read it: UE's scene colour and depth without the water), then the
+/// translucent ones back to front. Without a water, one pass.
+bool Frame::forwardAfter(Diagnostics& diags) {
+  std::vector<int> masked = o.forward ? std::vector<int>{} : primitivesOf({DrawKind::Masked});
+  const std::vector<int> water = primitivesOf({DrawKind::Water});
+  if (!water.empty()) {
+    if (!drawOver(masked, {}, diags)) return false;
+    masked.clear();
+    waterBehind = behindTheWater();
+    const bool drawn = drawOver(water, {}, diags);
+    waterBehind.reset();
+    if (!drawn) return false;
+  }
+  return drawOver(masked, primitivesOf({DrawKind::Translucent}), diags);
 }
 
 }  // namespace

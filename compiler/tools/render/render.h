@@ -15,9 +15,12 @@
 //     4. forward pass over that: masked materials (the base pass keeps no
 //        coverage) with `<name>.forward`, then translucent ones back to
 //        front, blended dual-source (colour + background x throughput).
+//        A single-layer water is drawn between the two, with its forward
+//        entry, over what lies behind it: the frame so far as its set 0,
+//        binding 6 (rgb the colour, a the distance from the eye).
 //   --forward
 //     1. every opaque and masked primitive with its `<name>.forward`, depth
-//        test LESS; 3. and 4. as above for the translucent ones.
+//        test LESS; 3. and 4. as above for the waters and translucent ones.
 //
 // One directional light (preview's key light) and the split-sum environment,
 // as the generated lighting expects. GLSL or HLSL: the same passes, the
