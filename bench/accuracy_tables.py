@@ -84,6 +84,36 @@ def accuracy_table(paths, source=False):
     return lines
 
 
+def volume_table(paths):
+    """The examples that are volumes: their march against a converged one (docs/accuracy.md, "Volumes")."""
+    volumes = [json.load(open(p)) for p in paths]
+    volumes = [d for d in volumes if d.get("domain") == "volume"]
+    if not volumes:
+        return []
+    lines = ["", "Volumes (a volumetric fog cloud has no BRDF: its march of N steps against a %d-step march "
+             "of the same %d rays; the last column marches through the froxel payload, whose bytes follow the "
+             "name):" % (volumes[0]["truth_steps"], volumes[0]["rays"]), "",
+             "| material | steps | median rel. err | max rel. err | max throughput err | max rel. err (payload) |",
+             "|---|---:|---:|---:|---:|---:|"]
+    for d in volumes:
+        for r in d["rows"]:
+            lines.append("| %s (%d B) | %d | %.2g | %.2g | %.2g | %.2g |" % (
+                d["material"], d["bytes_per_froxel"], r["steps"], r["median_rel_error"], r["max_rel_error"], r["max_throughput_error"],
+                r["payload_max_rel_error"]))
+    return lines
+
+
+def volume_sweep_lines(stem, doc):
+    """A volume's sweep: lavapipe ns per ray of each step count against the march's error."""
+    lines = ["## %s (a volume)" % stem, "", "![%s](%s.svg)" % (stem, stem), "",
+             "| steps | ns/ray | median rel. err | max rel. err | max rel. err (payload) |",
+             "|---:|---:|---:|---:|---:|"]
+    for r in doc["rows"]:
+        lines.append("| %d | %.1f | %.2g | %.2g | %.2g |" % (r["steps"], r["gpu_ns_per_ray"], r["median_rel_error"],
+                                                          r["max_rel_error"], r["payload_max_rel_error"]))
+    return lines + [""]
+
+
 def main():
     tmp, out, rev, load, samples, eval_samples, pixels, runs, sweep_samples, sweep_eval = sys.argv[1:11]
     examples = sorted(glob.glob(os.path.join(tmp, "examples", "*.json")))
@@ -108,6 +138,7 @@ def main():
              "profile are compared at their mean on both sides.", "",
              "## Examples", ""]
     lines += accuracy_table(examples)
+    lines += volume_table(examples)
     unread_examples = [u for u in open(os.path.join(tmp, "examples_unread.txt")).read().split("\n") if u.strip()]
     if unread_examples:
         lines += ["", "Not measured (`accuracy` cannot measure the example):", ""] + ["- %s" % u for u in unread_examples]
@@ -144,17 +175,22 @@ def main():
              "that changes the size, `full simplification`. Columns: `budget` the byte budget the row was "
              "compiled with; `bytes`/`closures` what it packs; `spirv` the forward shader's SPIR-V "
              "instructions after SPIRV-Tools' performance passes; `ns/px` lavapipe's median time per "
-             "shading point of the throughput kernel (one light + split-sum environment, %s points, median "
+             "shading point of the throughput kernel (one light + split-sum environment, and a water's body; %s points, median "
              "of %s dispatches after a warm-up); `rel_mse` = mean((x − y)² / (y² + 0.01)) of linear "
              "radiance against the authored tree over 1,024 fixed shading points (the CPU reference in "
              "double; the GPU matches it, docs/gpu-tests.md); `max_abs`, `p99_abs` of |x − y|; `ΔE00` the "
              "CIEDE2000 of the packed colours (mean / max); `albedo vs truth` the worst directional-albedo "
              "`rel_error` over NoV (with the NoV) and `p95 vs truth` the worst BRDF p95, against the truth "
              "of the authored material; `albedo vs own` the same against the truth of the row's own "
-             "closures (`docs/accuracy.md`)." % (pixels, runs), ""]
+             "closures (`docs/accuracy.md`). A volume (a fog cloud) has no simplification steps: its rows are "
+             "step counts of its march, lavapipe ns per ray (the same dispatches) against the march's error "
+             "(`docs/accuracy.md`, \"Volumes\"); its plot is the largest error against ns per ray." % (pixels, runs), ""]
     for path in sweeps:
         stem = os.path.splitext(os.path.basename(path))[0]
         doc = json.load(open(path))
+        if doc.get("domain") == "volume":
+            lines += volume_sweep_lines(stem, doc)
+            continue
         lines += ["## %s" % stem, "", "![%s](%s.svg)" % (stem, stem), "",
                   "| row | budget | bytes | closures | spirv | ns/px | rel_mse | max_abs | p99_abs | ΔE00 mean | "
                   "ΔE00 max | albedo vs truth | p95 vs truth | albedo vs own |",
