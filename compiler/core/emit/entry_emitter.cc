@@ -95,10 +95,6 @@ std::string forwardLighting(const Material& m, const StorageLayout& L) {
   return s;
 }
 
-}  // namespace
-
-namespace {
-
 /// A single-layer water's body (substrate_water_seen), added by the forward
 /// pass to its colour and by the base pass to its emissive target: what lies
 /// behind the water is the host's texture at set 0, binding 6 (rgb: the scene's

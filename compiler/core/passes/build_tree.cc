@@ -170,15 +170,16 @@ void checkUnlitPlacement(const Material& m, Diagnostics& diags) {
   }
 }
 
-/// A hair BSDF, an eye BSDF and a volumetric fog cloud are the whole
-/// material: a located error at such a leaf with a parent, naming the
-/// operator. A hair's closure is lit by the fibre's own model (a far field
-/// around the fibre, no interface or diffuse), which no operator can blend,
-/// layer or weigh against a slab's lobes; an eye's iris is lit through its
-/// cornea by a caustic of its own, which no operator's blend of closures
-/// keeps; a fog cloud is a medium sampled through a volume, not a surface
-/// (UE's Substrate keeps all three alone at the root; the fog cloud there
-/// sets the material's domain to volume).
+/// A hair BSDF, an eye BSDF, a single-layer water and a volumetric fog cloud
+/// are the whole material: a located error at such a leaf with a parent,
+/// naming the operator. A hair's closure is lit by the fibre's own model (a
+/// far field around the fibre, no interface or diffuse), which no operator
+/// can blend, layer or weigh against a slab's lobes; an eye's iris is lit
+/// through its cornea by a caustic of its own, which no operator's blend of
+/// closures keeps; a water's body is what lies behind its surface, seen
+/// through the water; a fog cloud is a medium sampled through a volume, not
+/// a surface (UE's Substrate keeps all four alone at the root; the fog cloud
+/// there sets the material's domain to volume).
 void checkWholeMaterialPlacement(const Material& m, Diagnostics& diags) {
   const TreeInfo t = analyzeTree(m);
   std::unordered_set<std::string> reported;

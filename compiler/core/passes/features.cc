@@ -4,6 +4,20 @@
 
 namespace substratec {
 
+namespace {
+
+/// The feature bit of a BSDF whose closure kind is fixed, else 0.
+std::uint16_t wholeKindFeature(BsdfKind kind) {
+  switch (kind) {
+    case BsdfKind::Hair: return kFeatHair;
+    case BsdfKind::Eye: return kFeatEye;
+    case BsdfKind::Water: return kFeatWater;
+    default: return 0;
+  }
+}
+
+}  // namespace
+
 void analyzeFeatures(Material& m) {
   const TreeInfo info = analyzeTree(m);
   const ValueDag& v = m.values;
@@ -17,19 +31,12 @@ void analyzeFeatures(Material& m) {
       s.features = used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0;
       continue;
     }
-    if (s.kind == BsdfKind::Hair) {  // a hair's lobes are one closure kind, with no optional part
+    // A hair's lobes, an eye's cornea, sclera and iris, a water's surface (a
+    // plain slab; its body a forward term): one closure kind each, with no
+    // optional part but emission.
+    if (const std::uint16_t kind = wholeKindFeature(s.kind); kind != 0) {
       s.sssType = SssType::None;
-      s.features = kFeatHair | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
-      continue;
-    }
-    if (s.kind == BsdfKind::Water) {  // its surface is a plain slab (no stored feature); its body a forward term
-      s.sssType = SssType::None;
-      s.features = kFeatWater | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
-      continue;
-    }
-    if (s.kind == BsdfKind::Eye) {  // an eye's cornea, sclera and iris are one closure kind, its fields fixed
-      s.sssType = SssType::None;
-      s.features = kFeatEye | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
+      s.features = kind | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
       continue;
     }
     if (used(SlabPin::F90, 1.0)) f |= kFeatF90;
