@@ -452,6 +452,12 @@ void MaterialOnGpu::deferredAgreesWithForwardWithinTheStorageBounds() {
             bound("hair.cuticle_angle (degrees)", std::abs(std::clamp(f.hair[2], -20.0, 20.0) - d.hair[2]), 20.0 / 127);
             unorm("hair.scatter", f.hair[3], d.hair[3], 8);
           }
+          if (stored.count(pre + "iris_normal")) {  // docs/storage.md, "Eye"
+            bound("iris.normal (degrees)", angleDegrees(f.irisN, d.irisN), 0.0075 + 1e-3);
+            bound("iris.plane_normal (degrees)", angleDegrees(f.irisPlaneN, d.irisPlaneN), 1.91 + 1e-3);
+            unorm("iris.mask", f.iris[0], d.iris[0], 8);
+            unorm("iris.distance", f.iris[1], d.iris[1], 8);
+          }
           if (stored.count(pre + "glint")) {
             unorm("glint.density", f.glintValue, d.glintValue, 8);
             for (int c = 0; c < 2; ++c) bound("glint.uv", std::abs(f.glintUv[c] - d.glintUv[c]), 0.0);
