@@ -37,8 +37,9 @@ TEST(Eye, TakesItsPinsAndNoOther) {
       "iris_distance": 0.4, "emissive": 0})")),
             "");
   const std::string d = diagnosticsOf(material(R"("root": {"kind": "eye", "anisotropy": 0.5})"));
-  EXPECT_NE(d.find("unknown pin \"anisotropy\" for an eye node (pins: diffuse_albedo, roughness, normal, emissive, "
-                   "iris_normal, iris_plane_normal, iris_mask, iris_distance) [/nodes/root/anisotropy]"),
+  EXPECT_NE(d.find("unknown pin \"anisotropy\" for an eye node (pins: diffuse_albedo, roughness, normal, sss_mfp, "
+                   "sss_mfp_scale, sss_phase_anisotropy, emissive, iris_normal, iris_plane_normal, iris_mask, "
+                   "iris_distance) [/nodes/root/anisotropy]"),
             std::string::npos)
       << d;
   EXPECT_NE(diagnosticsOf(material(R"("root": {"kind": "eye", "iris_mask": 2})")).find("/nodes/root/iris_mask"),
@@ -100,6 +101,61 @@ TEST(Eye, WithAConstantIrisMaskOf0ItIsTheSlabItsCorneaAndScleraAre) {
   ASSERT_EQ(r.material.culled.size(), 1u);
   EXPECT_EQ(r.material.culled[0].what, "root (iris)");
   EXPECT_NE(r.material.culled[0].why.find("iris_mask is the constant 0"), std::string::npos);
+}
+
+// UE's eye takes a subsurface profile for its sclera: here its mean free
+// path, as a slab's (docs/format.md). It scatters under a scattering albedo
+// (an eye is always the bottom), stores the slab's SSS field after the iris
+// (+28 bits: 24 bytes) and its SSS type in the header; it pays nothing
+// without it.
+TEST(Eye, ItsScleraScattersUnderTheSurfaceByItsMeanFreePath) {
+  const CompileResult r = compiledEye(material(R"("root": {"kind": "eye", "iris_mask": 0.5,
+      "sss_mfp": [0.008, 0.004, 0.002], "sss_phase_anisotropy": 0.5})"));
+  const Slab& s = r.material.slabs[r.material.nodes[r.material.root].slab];
+  EXPECT_EQ(s.features, kFeatEye | kFeatSss);
+  EXPECT_EQ(s.sssType, SssType::Diffusion);
+  std::string names;
+  for (const auto& f : r.after.fields) names += f.name + ":" + std::to_string(f.bits) + " ";
+  EXPECT_EQ(names,
+            "header:16 closure0.diffuse_albedo:20 closure0.iris_normal:32 closure0.iris:32 closure0.roughness:8 "
+            "closure0.sss:28 ");
+  EXPECT_EQ(r.after.bytes(), 24);
+  ClosureValues v;
+  v.diffuseAlbedo = {0.8, 0.76, 0.72};
+  v.roughness = 0.08;
+  v.irisN = {0.0, 0.6, 0.8};
+  v.iris = {0.5, 0.3};
+  v.sssMfp = {0.008, 0.004, 0.002};
+  v.sssPhaseAnisotropy = 0.5;
+  v.sssType = static_cast<std::uint32_t>(SssType::Diffusion);
+  BasisValues b;
+  b.normal = {0, 0, 1};
+  const auto words = packMaterial(r.after, {v}, {b}, 0.5);
+  EXPECT_EQ((words[0] >> 10) & 3u, static_cast<std::uint32_t>(SssType::Diffusion));
+  EXPECT_NE(words[0] & packfmt::kEyeHeaderBit, 0u);
+  const UnpackedMaterial u = unpackMaterial(words.data(), words.size(), packTopLayer({b.normal, 0.08}, 0.5));
+  ASSERT_EQ(u.closures.size(), 1u);
+  const ClosureValues& g = u.closures[0];
+  EXPECT_EQ(g.sssType, static_cast<std::uint32_t>(SssType::Diffusion));
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(g.sssMfp[k] / v.sssMfp[k], 1.0, 0.091);  // docs/storage.md: 9.1 %
+  EXPECT_NEAR(g.iris[0], 0.5, 0.5 / 255 + 1e-9);  // the iris before it, unmoved
+  EXPECT_NEAR(g.roughness, 0.08, 0.5 / 255 + 1e-9);
+  // Under a budget of 20 bytes simplification turns the sclera's SSS off.
+  CompileOptions o;
+  o.budgetOverride = 20;
+  Diagnostics d("test.json");
+  const auto small = compileText("test.json", material(R"("root": {"kind": "eye", "iris_mask": 0.5,
+      "sss_mfp": [0.008, 0.004, 0.002]})"), o, d);
+  ASSERT_TRUE(small.has_value()) << d.formatAll();
+  EXPECT_EQ(small->after.bytes(), 20);
+  EXPECT_EQ(small->material.slabs[small->material.nodes[small->material.root].slab].features, kFeatEye);
+  // No mean free path, or nothing to scatter: no SSS, 20 bytes.
+  for (const char* pins : {R"("iris_mask": 0.5)", R"("iris_mask": 0.5, "sss_mfp": 0.01, "diffuse_albedo": 0)",
+                           R"("iris_mask": 0.5, "sss_mfp": 0.01, "sss_mfp_scale": 0)"}) {
+    const CompileResult plain = compiledEye(material(std::string(R"("root": {"kind": "eye", )") + pins + "}"));
+    EXPECT_EQ(plain.after.bytes(), 20) << pins;
+    EXPECT_EQ(plain.material.slabs[plain.material.nodes[plain.material.root].slab].sssType, SssType::None) << pins;
+  }
 }
 
 TEST(Eye, HeaderBit13AndTheIrisFieldsRoundTrip) {
@@ -168,18 +224,26 @@ double irisMean(const reference::Closure<double>& c, int n) {
 
 TEST(Eye, AtIrisMask0ItIsTheSlabItsPinsDescribe) {
   // The sclera: the cornea's interface (F0 0.04, F90 1) over the slab's diffuse, bit for bit.
-  reference::Closure<double> e = eye(0, 0.7, {0.3, 0, 0.954}, {-0.2, 0.1, 0.97}), s = e;
-  s.features = 0;
+  // With a scattering sclera too: the slab's medium (the same SSS pins).
   int cases = 0;
-  for (double mv : {1.0, 0.5, 0.1})
-    for (double ml : {1.0, 0.6, 0.2, 0.02}) {
-      const V3 V{std::sqrt(1 - mv * mv), 0, mv}, L{-std::sqrt(1 - ml * ml) * 0.6, std::sqrt(1 - ml * ml) * 0.8, ml};
-      for (int model : {reference::kDiffuseLambert, reference::kDiffuseChan2024}) {
-        EXPECT_EQ(reference::evalClosure<double>(e, V, L, model), reference::evalClosure<double>(s, V, L, model));
-        ++cases;
-      }
+  for (bool sss : {false, true}) {
+    reference::Closure<double> e = eye(0, 0.7, {0.3, 0, 0.954}, {-0.2, 0.1, 0.97});
+    if (sss) {
+      e.sssType = static_cast<std::uint32_t>(SssType::Diffusion);
+      e.sssMfp = {0.008, 0.004, 0.002};
     }
-  EXPECT_EQ(cases, 24);
+    reference::Closure<double> s = e;
+    s.features = 0;
+    for (double mv : {1.0, 0.5, 0.1})
+      for (double ml : {1.0, 0.6, 0.2, 0.02}) {
+        const V3 V{std::sqrt(1 - mv * mv), 0, mv}, L{-std::sqrt(1 - ml * ml) * 0.6, std::sqrt(1 - ml * ml) * 0.8, ml};
+        for (int model : {reference::kDiffuseLambert, reference::kDiffuseChan2024}) {
+          EXPECT_EQ(reference::evalClosure<double>(e, V, L, model), reference::evalClosure<double>(s, V, L, model));
+          ++cases;
+        }
+      }
+  }
+  EXPECT_EQ(cases, 48);
 }
 
 TEST(Eye, TheIrisCausticIsNormalizedToALambertiansLight) {

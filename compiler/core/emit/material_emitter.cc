@@ -258,6 +258,12 @@ class Emitter {
   bool fuzzAboveAny() const;              // the top layer of a vertical holds fuzz (fuzzyLayer)
 
   void line(const std::string& s) { out_ += (s.empty() ? "" : indent_ + s) + "\n"; }
+  /// A slab's or an eye's subsurface scattering into closure c.
+  void emitSssPins(const std::string& c, const Slab& s) {
+    line(fmt::format("{}.sssMfp = {};", c, mfpOf(s)));
+    line(fmt::format("{}.sssPhaseAnisotropy = {};", c, expr(s.pin(SlabPin::SssPhaseAnisotropy))));
+    line(fmt::format("{}.sssType = {}u;", c, static_cast<unsigned>(s.sssType)));
+  }
   /// mfp · sss_mfp_scale, without the multiplication when the scale is 1.
   std::string mfpOf(const Slab& s) {
     ValueId scale = s.pin(SlabPin::SssMfpScale);
@@ -736,9 +742,7 @@ unsigned Emitter::emitFeaturePins(const std::string& c, const Slab& s) {
                      expr(s.pin(SlabPin::Tangent))));
   }
   if (f & kFeatSss) {
-    line(fmt::format("{}.sssMfp = {};", c, mfpOf(s)));
-    line(fmt::format("{}.sssPhaseAnisotropy = {};", c, expr(s.pin(SlabPin::SssPhaseAnisotropy))));
-    line(fmt::format("{}.sssType = {}u;", c, static_cast<unsigned>(s.sssType)));
+    emitSssPins(c, s);
   }
   if (f & kFeatHaze) {
     bits |= SUBSTRATE_FEATURE_HAZE;
@@ -794,6 +798,7 @@ void Emitter::emitEyeClosure(const std::string& c, const Slab& s) {
                    expr(s.pin(SlabPin::IrisPlaneNormal))));
   line(fmt::format("{}.iris = float2({}, {});", c, expr(s.pin(SlabPin::IrisMask)), expr(s.pin(SlabPin::IrisDistance))));
   if (s.features & kFeatEmissive) line(fmt::format("{}.emissive = {};", c, expr(s.pin(SlabPin::Emissive))));
+  if (s.features & kFeatSss) emitSssPins(c, s);  // the sclera's subsurface scattering
   line(fmt::format("{}.features = {}u;", c, SUBSTRATE_FEATURE_EYE));
 }
 

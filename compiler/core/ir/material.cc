@@ -22,9 +22,10 @@ const SlabPinInfo kPins[kSlabPinCount] = {
     // An eye's: the cornea's and sclera's (UE's Cornea Normal).
     {"normal", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Normal), -1, 1, kPinOfSlab | kPinOfUnlit | kPinOfEye | kPinOfWater},
     {"tangent", VType::Vec3, false, 0.0, static_cast<int>(GeometryAttr::Tangent), -1, 1, kSlabHair},  // a hair's fibre
-    {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf},
-    {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf},
-    {"sss_phase_anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1},
+    // An eye's: the sclera's (UE's subsurface profile, by its mean free path).
+    {"sss_mfp", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kSlabEye},
+    {"sss_mfp_scale", VType::Float, false, 1.0, kNoGeo, 0, kInf, kSlabEye},
+    {"sss_phase_anisotropy", VType::Float, false, 0.0, kNoGeo, -1, 1, kSlabEye},
     {"emissive", VType::Vec3, true, 0.0, kNoGeo, 0, kInf, kAll},
     {"second_roughness", VType::Float, false, 0.5, kNoGeo, 0, 1},
     {"second_roughness_weight", VType::Float, false, 0.0, kNoGeo, 0, 1},

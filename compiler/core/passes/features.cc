@@ -31,18 +31,20 @@ void analyzeFeatures(Material& m) {
       s.features = used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0;
       continue;
     }
+    const bool hasMfp = used(SlabPin::SssMfp, 0.0) && used(SlabPin::SssMfpScale, 0.0);
+    const bool sssOff = s.sssTypeExplicit && s.sssType == SssType::None;  // by the author or simplification
     // A hair's lobes, an eye's cornea, sclera and iris, a water's surface (a
     // plain slab; its body a forward term): one closure kind each, with no
-    // optional part but emission.
+    // optional part but emission and an eye's subsurface scattering (its
+    // sclera's mean free path under a scattering albedo: always the bottom).
     if (const std::uint16_t kind = wholeKindFeature(s.kind); kind != 0) {
-      s.sssType = SssType::None;
-      s.features = kind | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0);
+      const bool sss = s.kind == BsdfKind::Eye && hasMfp && !sssOff && used(SlabPin::DiffuseAlbedo, 0.0);
+      s.sssType = !sss ? SssType::None : m.settings.thinSurface ? SssType::SimpleVolume : SssType::Diffusion;
+      s.features = kind | (used(SlabPin::Emissive, 0.0) ? kFeatEmissive : 0) | (sss ? kFeatSss : 0);
       continue;
     }
     if (used(SlabPin::F90, 1.0)) f |= kFeatF90;
     if (used(SlabPin::Anisotropy, 0.0)) f |= kFeatAnisotropy;
-    bool hasMfp = used(SlabPin::SssMfp, 0.0) && used(SlabPin::SssMfpScale, 0.0);
-    bool sssOff = s.sssTypeExplicit && s.sssType == SssType::None;
     if (hasMfp && !info.isBottom[node]) {
       f |= kFeatMedium;  // a coating medium: transmittance only, baked by the tree walk
     } else if (hasMfp && !sssOff && used(SlabPin::DiffuseAlbedo, 0.0)) {

@@ -35,7 +35,8 @@ std::string bytesNote(const StorageLayout& L) {
 }
 
 /// The features line of a closure: a slab's (featureLine); a hair, an eye
-/// and a water have no optional slab feature, so theirs says what they are.
+/// and a water have no optional slab feature (but an eye's subsurface
+/// scattering), so theirs says what they are.
 std::string bsdfFeatureLine(const Slab& s) {
   const int emissive = (s.features & kFeatEmissive) ? 1 : 0;
   switch (s.kind) {
@@ -44,9 +45,10 @@ std::string bsdfFeatureLine(const Slab& s) {
                          "fibre's tangent)",
                          emissive, s.basis);
     case BsdfKind::Eye:
-      return fmt::format("Eye=1 Emissive={} Basis={} (a cornea's GGX interface, F0 0.04, over the sclera's diffuse "
-                         "and an iris of its own normal and caustic)",
-                         emissive, s.basis);
+      return fmt::format("Eye=1 SSS={} Emissive={} Basis={} (a cornea's GGX interface, F0 0.04, over the sclera's "
+                         "diffuse{} and an iris of its own normal and caustic)",
+                         (s.features & kFeatSss) ? 1 : 0, emissive, s.basis,
+                         (s.features & kFeatSss) ? ", scattering under the surface," : "");
     case BsdfKind::Water:
       return fmt::format("Water=1 Emissive={} Basis={} (a water surface, a slab of the water's F0 and its top "
                          "material; its body, what lies behind it through the water, added by the forward and base "

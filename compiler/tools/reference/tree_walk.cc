@@ -436,9 +436,17 @@ class Walk {
     c.irisPlaneN = tangentToWorld(vec3(s.pin(SlabPin::IrisPlaneNormal)), gN_, gT_);
     c.iris = {scalar(s.pin(SlabPin::IrisMask)), scalar(s.pin(SlabPin::IrisDistance))};
     if (has(s.features, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
+    if (has(s.features, kFeatSss)) sssPins(s, c);  // the sclera's subsurface scattering
     c.features = kFeatureEye;
     c.metalnessMix = m_.metalnessMix;
     return c;
+  }
+
+  /// A slab's or an eye's subsurface scattering into c (emitSssPins).
+  void sssPins(const Slab& s, Closure<T>& c) const {
+    c.sssMfp = mfpOf(s);
+    c.sssPhaseAnisotropy = scalar(s.pin(SlabPin::SssPhaseAnisotropy));
+    c.sssType = static_cast<std::uint32_t>(s.sssType);
   }
 
   /// The pins of the slab's features into c; returns their feature bits.
@@ -454,11 +462,7 @@ class Walk {
       c.anisotropy = scalar(s.pin(SlabPin::Anisotropy));
       c.T_ = orthogonalTangent(c.N, tangentToWorld(vec3(s.pin(SlabPin::Tangent)), gN_, gT_));
     }
-    if (has(f, kFeatSss)) {
-      c.sssMfp = mfpOf(s);
-      c.sssPhaseAnisotropy = scalar(s.pin(SlabPin::SssPhaseAnisotropy));
-      c.sssType = static_cast<std::uint32_t>(s.sssType);
-    }
+    if (has(f, kFeatSss)) sssPins(s, c);
     if (has(f, kFeatHaze)) {
       bits |= kFeatureHaze;
       c.secondRoughness = scalar(s.pin(SlabPin::SecondRoughness));

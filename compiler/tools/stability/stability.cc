@@ -90,6 +90,7 @@ struct Rewriter {
       force(node, "diffuse_albedo", "albedo", 0.18);
       force(node, "iris_mask", "coverage", 0.0);
       force(node, "iris_distance", "coverage", 0.0);
+      force(node, "sss_mfp", "mfp", nullptr);  // a scattering sclera's: zero to huge
     } else if (kind == "single_layer_water") {  // its surface's roughness, all foam or none, clear to opaque water
       force(node, "roughness", "roughness", 0.5);
       force(node, "base_color", "albedo", 0.0);
