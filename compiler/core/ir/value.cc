@@ -29,7 +29,7 @@ std::string_view opName(Op op) {
       "max", "lerp", "clamp", "saturate", "one_minus", "abs", "sqrt", "normalize", "length", "pow",
       "dot", "swizzle", "combine", "step", "exp", "metalness_to_diffuse_f0", "ior_to_f0",
       "haziness_to_second_roughness", "transmittance_to_mfp", "thin_film", "rotation_to_tangent",
-      "view_dependent_coverage"};
+      "view_dependent_coverage", "flip_flop"};
   static_assert(sizeof(names) / sizeof(names[0]) == static_cast<std::size_t>(Op::Count_));
   return names[static_cast<int>(op)];
 }

@@ -44,6 +44,7 @@ enum class Op : std::uint8_t {
   ThinFilm,                  // normal, f0, f90, thickness, ior -> 0: f0, 1: f90
   RotationToTangent,         // angle, normal
   ViewDependentCoverage,     // coverage, normal
+  FlipFlop,                  // facing, grazing, falloff, normal: lowered by buildValueDag, never in the DAG
   Count_
 };
 std::string_view opName(Op op);

@@ -29,6 +29,17 @@ ValueId pinToValue(const PinRef& pin, VType want, const ValueTable& table, Mater
 
 namespace {
 
+/// flip_flop as the primitives of its formula (docs/value-nodes.md, "flip_flop"),
+/// lerp(facing, grazing, (1 - saturate(dot(normalize(normal), view)))^max(falloff, 0)),
+/// so every later pass, the emitters and the CPU evaluation see nothing new.
+ValueId flipFlop(ValueDag& dag, VType r, ValueId facing, ValueId grazing, ValueId falloff, ValueId normal) {
+  const ValueId n = dag.make(Op::Normalize, VType::Vec3, {normal});
+  const ValueId nov = dag.make(Op::Dot, VType::Float, {n, dag.geometry(GeometryAttr::View)});
+  const ValueId away = dag.make(Op::OneMinus, VType::Float, {dag.make(Op::Saturate, VType::Float, {nov})});
+  const ValueId t = dag.make(Op::Pow, VType::Float, {away, dag.make(Op::Max, VType::Float, {falloff, dag.scalar(0)})});
+  return dag.make(Op::Lerp, r, {facing, grazing, dag.broadcast(t, r)});
+}
+
 /// The values one resolved value node computes, in `out` (one per output pin),
 /// built from its pins' values (earlier nodes' outputs in `table`).
 void emitValueNodeOutputs(const VNode& v, const ValueTable& table, Material& m, std::vector<ValueId>& out) {
@@ -55,6 +66,11 @@ void emitValueNodeOutputs(const VNode& v, const ValueTable& table, Material& m, 
     case Op::Lerp:
       out = {dag.make(v.op, r, {arg(0, r), arg(1, r), arg(2, r)})};
       break;
+    case Op::FlipFlop: {  // its pins in order (a call's arguments are not sequenced): the same DAG everywhere
+      const ValueId facing = arg(0, r), grazing = arg(1, r), falloff = arg(2, VType::Float), normal = arg(3, VType::Vec3);
+      out = {flipFlop(dag, r, facing, grazing, falloff, normal)};
+      break;
+    }
     case Op::Clamp:
       out = {dag.make(v.op, r, {arg(0, r), arg(1, r), arg(2, r)})};
       break;

@@ -103,6 +103,9 @@ const std::vector<OpSpec>& opSpecs() {
                  {{"angle", PinKind::Float, false, 0, -1}, {"normal", PinKind::Vec3, false, 0, G_N}}, {}});
     v.push_back({"view_dependent_coverage", Op::ViewDependentCoverage,
                  {{"coverage", PinKind::Float, false, 1, -1}, {"normal", PinKind::Vec3, false, 0, G_N}}, {}});
+    v.push_back({"flip_flop", Op::FlipFlop,
+                 {{"facing", PinKind::Value, false, 0, -1}, {"grazing", PinKind::Value, false, 1, -1},
+                  {"falloff", PinKind::Float, false, 1, -1}, {"normal", PinKind::Vec3, false, 0, G_N}}, {}});
     return v;
   }();
   return specs;
@@ -1498,6 +1501,8 @@ void Resolver::typeValueNode(int i) {
   typeOperatorNode(v, spec);
 }
 
+// long: one case per operator's typing rule, the table of docs/value-nodes.md's
+// types (the helpers, whose pins have fixed kinds, are typeHelperNode's).
 void Resolver::typeOperatorNode(VNode& v, const OpSpec* spec) {
   auto err = [&](const std::string& pin, const std::string& msg) {
     d_.error(v.pointer + (pin.empty() ? "" : "/" + pin), msg);
@@ -1529,6 +1534,12 @@ void Resolver::typeOperatorNode(VNode& v, const OpSpec* spec) {
       if (t != VType::Float && t != r) return err("t", fmt::format("expected a float or a {}, got a {}", typeName(r), typeName(t)));
       break;
     }
+    case Op::FlipFlop:  // facing and grazing as a lerp's a and b; falloff and normal by their kinds
+      if (!combine2(v.pins[0].type, v.pins[1].type, "facing", "grazing", r)) return;
+      if (!expectPinType(v.pins[2], PinKind::Float, v.pointer + "/falloff") ||
+          !expectPinType(v.pins[3], PinKind::Vec3, v.pointer + "/normal"))
+        return v.outputTypes.assign(1, VType::Invalid);
+      break;
     case Op::Clamp:
       r = v.pins[0].type;
       for (int k = 1; k <= 2; ++k)
