@@ -578,7 +578,7 @@ bool renderScene(gpu::Context& ctx, const mesh::Scene& scene, const std::vector<
     if (mi < 0 || static_cast<std::size_t>(mi) >= materials.size() || !materials[mi].result)
       return diags.fail("render: a primitive's material index is out of range"), false;
   if (o.width < 1 || o.height < 1) return diags.fail("render: the image needs a size"), false;
-  Frame f{ctx, scene, materials, primitiveMaterial, o, {}, {}, {}, {}, {}, {}};
+  Frame f{ctx, scene, materials, primitiveMaterial, o, {}, {}, {}, {}, {}, {}, {}};
   f.lighting.light = preview::previewLight(o.environment, 0);
   f.lighting.maps = &preview::environmentMaps(o.environment);
   f.lighting.view = viewSetup(camera, o.width, o.height, scene.boundsMin, scene.boundsMax);
