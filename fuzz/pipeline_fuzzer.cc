@@ -1,5 +1,5 @@
 // libFuzzer target: the whole CPU side of `substratec compile`. Arbitrary
-// bytes through compileText (parse, resolve, build-values, build-tree, cull,
+// bytes through compileText (parse, expand-blocks, resolve, build-values, build-tree, cull,
 // features, shared-bases, price, simplify), then the reports and
 // generateFiles (GLSL, HLSL, entry shaders, layout.json). glslang validation
 // is left out: it is slow and it is not code this fuzzer should explore.

@@ -14,7 +14,7 @@ namespace substratec::clitest {
 namespace {
 
 const std::string kPassesExample = std::string(SUBSTRATEC_SOURCE_DIR) + "/examples/worked_example_72.json";
-const std::string kPassesList = "parse, resolve, build-values, build-tree, cull, features, shared-bases, price, simplify";
+const std::string kPassesList = "parse, expand-blocks, resolve, build-values, build-tree, cull, features, shared-bases, price, simplify";
 
 /// How many times `what` occurs in `text`.
 std::size_t occurrences(const std::string& text, const std::string& what) {

@@ -1321,6 +1321,7 @@ struct ImportArgs {
   std::string outDir;
   CompileFlags compile;
   bool force = false;
+  bool expand = false;
 };
 
 void addImportOptions(CLI::App* c, ImportArgs& a) {
@@ -1328,19 +1329,21 @@ void addImportOptions(CLI::App* c, ImportArgs& a) {
   addOutput(c, a.outDir, "Output directory (one <material>.json per material)");
   addMaterialChoice(c, a.in.material, "Import only this material (by name or identifier)");
   c->add_flag("--force", a.force, "Replace files in the output directory that an import of the same source did not write");
+  c->add_flag("--expand", a.expand,
+              "Write each material's building block (gltf_pbr) as the slabs, operators and value nodes it stands for");
   addMaxInputSize(c, a.compile);
 }
 
 /// Every material of the import inputs, named uniquely across the files
 /// (case-insensitively: they become file names), with the input each comes
 /// from in `sourceOf`; false when a file does not import.
-bool importAll(const std::vector<import::ImportInput>& inputs, const ReadLimits& read, std::ostream& err,
-               std::vector<import::ImportedMaterial>& materials, std::vector<std::string>& sourceOf) {
+bool importAll(const std::vector<import::ImportInput>& inputs, const ReadLimits& read, import::ImportForm form,
+               std::ostream& err, std::vector<import::ImportedMaterial>& materials, std::vector<std::string>& sourceOf) {
   import::NameSet names(/*caseInsensitive=*/true);
   bool failed = false;
   for (const import::ImportInput& in : inputs) {
     Diagnostics diags(in.path);
-    auto imported = import::importFile(in.path, read, diags);
+    auto imported = import::importFile(in.path, read, diags, form);
     if (!imported && in.fromDirectory && diags.errorCount() == 1 &&
         diags.all().back().message == "the file holds no material") {
       err << in.path << ": warning: the file holds no material; skipped\n";  // e.g. a MaterialX library
@@ -1422,7 +1425,8 @@ int runImport(const ImportArgs& a, std::ostream& out, std::ostream& err) {
   if (int status = outputs.check(err); status != kExitOk) return status;
   std::vector<import::ImportedMaterial> materials;
   std::vector<std::string> sourceOf;  // the input each material comes from
-  if (!importAll(*inputs, read, err, materials, sourceOf)) return kExitBadInput;
+  if (!importAll(*inputs, read, a.expand ? import::ImportForm::Expanded : import::ImportForm::Blocks, err, materials,
+                 sourceOf)) return kExitBadInput;
   if (!a.in.material.empty())
     if (int status = pickImported(a.in.material, *inputs, materials, sourceOf, err); status != kExitOk) return status;
   std::vector<OutputFile> files;

@@ -28,7 +28,7 @@ CorpusImport importCorpusFile(const CorpusFile& f) {
   auto text = readSourceFile(f.path.string(), limits, diags);
   if (text) {
     auto m = import::importText(import::sourceKindOf(f.display), f.path.filename().string(), *text,
-                                f.path.parent_path().string(), limits, diags);
+                                f.path.parent_path().string(), limits, diags, import::ImportForm::Expanded);
     if (m) {
       r.ok = true;
       r.materials = std::move(*m);

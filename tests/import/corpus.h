@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "import/material_writer.h"
+#include "import/import.h"
 
 namespace substratec::importtest {
 
@@ -25,6 +25,8 @@ struct CorpusImport {
   std::vector<import::ImportedMaterial> materials;
   std::string diagnostics;  // warnings (and errors) as printed
 };
+/// The file imported in the expanded form (ImportForm::Expanded: the nodes the
+/// mapping writes, which the goldens hold).
 CorpusImport importCorpusFile(const CorpusFile& f);
 
 /// The documented exceptions (docs/import.md, "Exceptions"): corpus files that

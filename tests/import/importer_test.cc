@@ -39,7 +39,7 @@ struct Imported {
 Imported importAs(SourceKind kind, const std::string& text, const std::string& file = "test") {
   Diagnostics d(file);
   Imported r;
-  r.materials = importText(kind, file, text, ".", ReadLimits{}, d);
+  r.materials = importText(kind, file, text, ".", ReadLimits{}, d, ImportForm::Expanded);  // the mapping's nodes
   r.diags = d.formatAll();
   return r;
 }

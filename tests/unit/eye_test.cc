@@ -21,13 +21,6 @@ using test::diagnosticsOf;
 using test::material;
 using V3 = reference::V3<double>;
 
-CompileResult compiledEye(const std::string& json) {
-  Diagnostics d("test.json");
-  auto r = compileText("test.json", json, {}, d);
-  EXPECT_TRUE(r.has_value()) << d.formatAll();
-  return r ? *r : CompileResult{};
-}
-
 // ---------------------------------------------------------------------------
 // The node
 
@@ -70,7 +63,7 @@ TEST(Eye, IsTheWholeMaterialNeverAnOperand) {
 // What it stores (docs/storage.md, "Eye")
 
 TEST(Eye, StoresColourTheIrisAndRoughnessIn20Bytes) {
-  const CompileResult r = compiledEye(material(R"("root": {"kind": "eye", "iris_mask": 0.5})"));
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "eye", "iris_mask": 0.5})"));
   const StorageLayout& L = r.after;
   EXPECT_EQ(L.layoutClass, LayoutClass::Special);
   ASSERT_EQ(L.closures.size(), 1u);
@@ -80,7 +73,7 @@ TEST(Eye, StoresColourTheIrisAndRoughnessIn20Bytes) {
   EXPECT_EQ(L.bytes(), 20);  // 108 bits in 4 words, and the top-layer word (the cornea's normal)
   EXPECT_EQ(r.material.slabs[r.material.nodes[r.material.root].slab].features, kFeatEye);
   // An iris mask from an input may be 0 at run time: still an eye.
-  EXPECT_EQ(compiledEye(test::material(R"("root": {"kind": "eye", "iris_mask": "$m"})",
+  EXPECT_EQ(test::compiled(test::material(R"("root": {"kind": "eye", "iris_mask": "$m"})",
                                        R"({"m": {"type": "float", "default": 0}})"))
                 .after.bytes(),
             20);
@@ -90,7 +83,7 @@ TEST(Eye, WithAConstantIrisMaskOf0ItIsTheSlabItsCorneaAndScleraAre) {
   // No iris: culled (it is lit as that slab bit for bit, AtIrisMask0...), and it
   // stores what that slab stores: SIMPLE, 12 bytes, no iris fields.
   const CompileResult r =
-      compiledEye(material(R"("root": {"kind": "eye", "diffuse_albedo": [0.8, 0.76, 0.72], "roughness": 0.08,
+      test::compiled(material(R"("root": {"kind": "eye", "diffuse_albedo": [0.8, 0.76, 0.72], "roughness": 0.08,
                                        "iris_normal": [0, 0.3, 0.95], "iris_distance": 0.5})"));
   const Slab& s = r.material.slabs[r.material.nodes[r.material.root].slab];
   EXPECT_EQ(s.kind, BsdfKind::Slab);
@@ -109,7 +102,7 @@ TEST(Eye, WithAConstantIrisMaskOf0ItIsTheSlabItsCorneaAndScleraAre) {
 // (+28 bits: 24 bytes) and its SSS type in the header; it pays nothing
 // without it.
 TEST(Eye, ItsScleraScattersUnderTheSurfaceByItsMeanFreePath) {
-  const CompileResult r = compiledEye(material(R"("root": {"kind": "eye", "iris_mask": 0.5,
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "eye", "iris_mask": 0.5,
       "sss_mfp": [0.008, 0.004, 0.002], "sss_phase_anisotropy": 0.5})"));
   const Slab& s = r.material.slabs[r.material.nodes[r.material.root].slab];
   EXPECT_EQ(s.features, kFeatEye | kFeatSss);
@@ -152,14 +145,14 @@ TEST(Eye, ItsScleraScattersUnderTheSurfaceByItsMeanFreePath) {
   // No mean free path, or nothing to scatter: no SSS, 20 bytes.
   for (const char* pins : {R"("iris_mask": 0.5)", R"("iris_mask": 0.5, "sss_mfp": 0.01, "diffuse_albedo": 0)",
                            R"("iris_mask": 0.5, "sss_mfp": 0.01, "sss_mfp_scale": 0)"}) {
-    const CompileResult plain = compiledEye(material(std::string(R"("root": {"kind": "eye", )") + pins + "}"));
+    const CompileResult plain = test::compiled(material(std::string(R"("root": {"kind": "eye", )") + pins + "}"));
     EXPECT_EQ(plain.after.bytes(), 20) << pins;
     EXPECT_EQ(plain.material.slabs[plain.material.nodes[plain.material.root].slab].sssType, SssType::None) << pins;
   }
 }
 
 TEST(Eye, HeaderBit13AndTheIrisFieldsRoundTrip) {
-  const CompileResult r = compiledEye(material(R"("root": {"kind": "eye", "iris_mask": 0.5})"));
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "eye", "iris_mask": 0.5})"));
   ClosureValues v;
   v.diffuseAlbedo = {0.3, 0.2, 0.07};
   v.roughness = 0.08;

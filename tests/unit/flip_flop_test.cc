@@ -20,13 +20,6 @@ namespace {
 using test::diagnosticsOf;
 using test::material;
 
-CompileResult compiled(const std::string& json) {
-  Diagnostics d("test.json");
-  auto r = compileText("test.json", json, {}, d);
-  EXPECT_TRUE(r.has_value()) << d.formatAll();
-  return r ? *r : CompileResult{};
-}
-
 /// The diffuse albedo of the one closure of `r` seen along the tangent-space view `V` (normal +Z).
 std::array<double, 3> albedoSeenFrom(const CompileResult& r, const std::array<double, 3>& V) {
   reference::Geometry g;
@@ -37,7 +30,7 @@ std::array<double, 3> albedoSeenFrom(const CompileResult& r, const std::array<do
 }
 
 TEST(FlipFlop, TurnsFromFacingToGrazingByTheFalloffPowerOfOneMinusNoV) {
-  const CompileResult r = compiled(material(R"("root": {"kind": "slab", "diffuse_albedo": {"kind": "flip_flop",
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "slab", "diffuse_albedo": {"kind": "flip_flop",
       "facing": [0.8, 0.1, 0.1], "grazing": [0.1, 0.2, 0.9], "falloff": 2}})"));
   int cases = 0;
   for (double nov : {1.0, 0.8, 0.5, 0.2, 0.05}) {
@@ -55,12 +48,12 @@ TEST(FlipFlop, TurnsFromFacingToGrazingByTheFalloffPowerOfOneMinusNoV) {
 
 TEST(FlipFlop, TakesItsOwnNormalAndBroadcastsAFloat) {
   // The normal tilted toward the view: head-on for it, so the facing value.
-  const CompileResult r = compiled(material(R"("root": {"kind": "slab", "diffuse_albedo": {"kind": "flip_flop",
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "slab", "diffuse_albedo": {"kind": "flip_flop",
       "facing": 0.25, "grazing": [1, 0.5, 0], "normal": [0.6, 0, 0.8]}})"));
   const auto a = albedoSeenFrom(r, {0.6, 0, 0.8});
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], 0.25, 1e-12);
   // Its defaults: facing 0, grazing 1, falloff 1, the geometric normal: t = 1 − NoV.
-  const CompileResult d = compiled(material(R"("root": {"kind": "slab", "roughness": {"kind": "flip_flop"},
+  const CompileResult d = test::compiled(material(R"("root": {"kind": "slab", "roughness": {"kind": "flip_flop"},
       "diffuse_albedo": 0.5})"));
   reference::Geometry g;
   g.V = {0.6, 0, 0.8};
@@ -69,7 +62,7 @@ TEST(FlipFlop, TakesItsOwnNormalAndBroadcastsAFloat) {
 
 TEST(FlipFlop, AFalloffOf0IsGrazingEverywhereAndANegativeOneIsGuarded) {
   for (const char* falloff : {"0", "-3"}) {
-    const CompileResult r = compiled(material(std::string(R"("root": {"kind": "slab", "diffuse_albedo": {"kind":
+    const CompileResult r = test::compiled(material(std::string(R"("root": {"kind": "slab", "diffuse_albedo": {"kind":
         "flip_flop", "facing": 0.2, "grazing": 0.7, "falloff": )") + falloff + "}}"));
     const auto a = albedoSeenFrom(r, {0, 0, 1});
     EXPECT_NEAR(a[0], 0.7, 1e-12) << falloff;

@@ -34,9 +34,9 @@ std::vector<std::string> registryNames() {
 }
 
 TEST(PassRegistry, ListsThePassesInPipelineOrder) {
-  EXPECT_EQ(registryNames(), (std::vector<std::string>{"parse", "resolve", "build-values", "build-tree", "cull",
+  EXPECT_EQ(registryNames(), (std::vector<std::string>{"parse", "expand-blocks", "resolve", "build-values", "build-tree", "cull",
                                                        "features", "shared-bases", "price", "simplify"}));
-  EXPECT_EQ(passNames(), "parse, resolve, build-values, build-tree, cull, features, shared-bases, price, simplify");
+  EXPECT_EQ(passNames(), "parse, expand-blocks, resolve, build-values, build-tree, cull, features, shared-bases, price, simplify");
   for (const Pass& p : passRegistry()) {
     SCOPED_TRACE(std::string(p.name));
     EXPECT_FALSE(p.doc.empty());
@@ -110,7 +110,7 @@ TEST(PassRegistry, AFailingPassStopsThePipeline) {
   PassContext c(text, o, d, result);
   EXPECT_FALSE(runPasses(c));
   EXPECT_TRUE(d.hasErrors());
-  ASSERT_EQ(result.timings.size(), 2u) << "parse, then resolve fails";
+  ASSERT_EQ(result.timings.size(), 3u) << "parse, expand-blocks (nothing to expand), then resolve fails";
   EXPECT_EQ(result.timings.back().pass, "resolve");
 }
 

@@ -45,6 +45,15 @@ inline std::string diagnosticsOf(const std::string& json) {
   return d.formatAll();
 }
 
+/// `json` compiled with the default options (a failure to compile fails the
+/// test, with its diagnostics; the result is then empty).
+inline CompileResult compiled(const std::string& json) {
+  Diagnostics d("test.json");
+  auto r = compileText("test.json", json, {}, d);
+  EXPECT_TRUE(r.has_value()) << d.formatAll();
+  return r ? *r : CompileResult{};
+}
+
 /// Wraps `nodes` (the body of the "nodes" object) and `inputs` into a document.
 inline std::string material(const std::string& nodes, const std::string& inputs = "{}",
                             const std::string& output = "root") {

@@ -23,13 +23,6 @@ using test::diagnosticsOf;
 using test::material;
 using V3 = reference::V3<double>;
 
-CompileResult compiledWater(const std::string& json) {
-  Diagnostics d("test.json");
-  auto r = compileText("test.json", json, {}, d);
-  EXPECT_TRUE(r.has_value()) << d.formatAll();
-  return r ? *r : CompileResult{};
-}
-
 TEST(Water, TakesItsPinsAndNoOther) {
   EXPECT_EQ(diagnosticsOf(material(R"("root": {"kind": "single_layer_water", "base_color": 0.9, "metallic": 0,
       "specular": 0.25, "roughness": 0.05, "normal": [0, 0, 1], "emissive": 0, "top_material_opacity": 0.2,
@@ -66,7 +59,7 @@ TEST(Water, ItsSurfaceIsTheSlabItsTopMaterialAndInterfaceMixTo) {
   // t = 0.4 of the surface is a half-metallic top of base colour b; the rest
   // the water's interface, F0 0.08 x 0.25 = 0.02: diffuse b t (1 - m),
   // F0 0.02 + t m (b - 0.02).
-  const CompileResult r = compiledWater(material(R"("root": {"kind": "single_layer_water",
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "single_layer_water",
       "base_color": [0.8, 0.6, 0.2], "metallic": 0.5, "specular": 0.25, "top_material_opacity": 0.4,
       "roughness": 0.1})"));
   const auto m = reference::evaluateMaterial<double>(r, {}, {}, {});
@@ -89,8 +82,8 @@ TEST(Water, ItsSurfaceIsTheSlabItsTopMaterialAndInterfaceMixTo) {
 // `sweep` times what a water costs: its cost kernel runs the body as well as
 // the surface (a forward pass does both).
 TEST(Water, ItsCostKernelRunsItsBody) {
-  const CompileResult r = compiledWater(material(R"("root": {"kind": "single_layer_water"})"));
-  const CompileResult slab = compiledWater(material(R"("root": {"kind": "slab"})"));
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "single_layer_water"})"));
+  const CompileResult slab = test::compiled(material(R"("root": {"kind": "slab"})"));
   for (Target t : {Target::Glsl, Target::Hlsl}) {
     EXPECT_NE(emitKernel(r.material, r.after, syntaxFor(t), KernelMode::Throughput, {}).find("substrate_water_seen("),
               std::string::npos);
@@ -135,7 +128,7 @@ TEST(Water, ItsBodyIsTheBackgroundThroughTheWaterAndTheLightItScatters) {
 TEST(Water, TheSurfaceLetsThroughWhatItDoesNotReflectOfTheUncoveredWater) {
   // Opacity 1: no water shows. From below the surface: not this model's, 0.
   // Head-on through a smooth interface of F0 0.02: about 98 % of the body.
-  const CompileResult r = compiledWater(material(R"("root": {"kind": "single_layer_water", "specular": 0.25,
+  const CompileResult r = test::compiled(material(R"("root": {"kind": "single_layer_water", "specular": 0.25,
       "roughness": 0.0, "water_extinction": 0})"));
   const auto m = reference::evaluateMaterial<double>(r, {}, {}, {});
   ASSERT_TRUE(m.water.has_value());

@@ -301,6 +301,22 @@ class Resolver {
   /// Slab pin `p` of slab node `index` (the node's JSON `j`) into `dst`: its default when absent.
   void readSlabPin(int index, const Json& j, const std::string& ptr, int p, PinRef& dst);
   bool isSubstrateValue(const Json& j) const;
+  /// The building block of kind `kind` (limits_.blocks), or null.
+  const BlockSignature* blockOf(const std::string& kind) const {
+    if (limits_.blocks)
+      for (const BlockSignature& b : *limits_.blocks)
+        if (kind == b.kind) return &b;
+    return nullptr;
+  }
+  /// The tree op of a Substrate kind: a building block is a (placeholder) slab.
+  std::optional<TreeOp> treeKind(const std::string& kind) const {
+    return blockOf(kind) ? std::optional<TreeOp>(TreeOp::Slab) : substrateKind(kind);
+  }
+  /// A building block's pins, checked against its signature; its Substrate
+  /// pins become the placeholder's children (for the cycle check).
+  void fillBlockNode(int index, const Json& j, const std::string& ptr, const BlockSignature& sig, SNode& node);
+  /// One value pin of a building block (Float, Color, Vec3, Vec2).
+  void readBlockValuePin(int index, const Json& v, const std::string& pp, const BlockPin& pin);
   void checkRange(const PinRef& pin, const Json& j, const std::string& ptr, double lo, double hi,
                   const char* what);
 
@@ -361,11 +377,12 @@ class Resolver {
   std::unordered_map<std::string, int> namedSubstrate_;
   struct DeferredPinCheck {
     int snode;
-    int pin;  // slab pin index, or -1 (a) / -2 (b) for operator values
+    int pin;  // slab pin index, or -1 (a) / -2 (b) for operator values, or -3 - k for blockPins_[k]
     PinKind kind;
     std::string pointer;
   };
   std::vector<DeferredPinCheck> deferred_;  // pins referencing value nodes: typed after typeValueNodes
+  std::deque<PinRef> blockPins_;            // building blocks' value pins (checked, then dropped)
   void checkDeferredPins();
   std::size_t nodeCount_ = 0;
   bool nodeLimitReported_ = false;
@@ -506,7 +523,7 @@ bool Resolver::readNamedNodeBodies() {
       out_.values[index].op = spec->op;
       readValueNodeBody(index, *it, p, *spec);
     } else if (isSubstrateName(id)) {
-      fillSubstrateNode(namedSubstrate_[id], *it, p, kind == "add" ? TreeOp::Add : *substrateKind(kind));
+      fillSubstrateNode(namedSubstrate_[id], *it, p, kind == "add" ? TreeOp::Add : *treeKind(kind));
     }
   }
   return true;
@@ -808,7 +825,7 @@ void Resolver::classifyNodes() {
     if (kind == "add") {
       adds.push_back(id);
       namedKind_[id] = 1;  // decided below
-    } else if (substrateKind(kind)) {
+    } else if (treeKind(kind)) {
       namedKind_[id] = 2;
     } else if (findOpSpec(kind)) {
       namedKind_[id] = 1;
@@ -838,7 +855,7 @@ void Resolver::classifyAdds(const std::vector<std::string>& adds) {
     auto k = j.find("kind");
     if (k == j.end() || !k->is_string()) return false;
     std::string kind = k->get<std::string>();
-    if (substrateKind(kind)) return true;
+    if (treeKind(kind)) return true;
     if (kind != "add") return false;
     bool any = false;
     for (const char* pin : {"a", "b"})
@@ -872,7 +889,7 @@ bool Resolver::isSubstrateValue(const Json& j) const {
   auto k = j.find("kind");
   if (k == j.end() || !k->is_string()) return false;
   std::string kind = k->get<std::string>();
-  if (substrateKind(kind)) return true;
+  if (treeKind(kind)) return true;
   if (kind == "add") {
     for (const char* pin : {"a", "b"})
       if (auto p = j.find(pin); p != j.end() && isSubstrateValue(*p)) return true;
@@ -1204,14 +1221,14 @@ int Resolver::readSubstratePin(const Json& j, const std::string& ptr, const std:
       return -1;
     }
     std::string kind = k->get<std::string>();
-    if (kind == "add" ? isSubstrateValue(j) : substrateKind(kind).has_value())
+    if (kind == "add" ? isSubstrateValue(j) : treeKind(kind).has_value())
     {
       if (!budget(ptr)) return -1;
       int index = static_cast<int>(out_.substrate.size());
       out_.substrate.emplace_back();
       out_.substrate[index].id = nameForInline;
       out_.substrate[index].pointer = ptr;
-      fillSubstrateNode(index, j, ptr, kind == "add" ? TreeOp::Add : *substrateKind(kind));
+      fillSubstrateNode(index, j, ptr, kind == "add" ? TreeOp::Add : *treeKind(kind));
       return index;
     }
     if (findOpSpec(kind))
@@ -1258,7 +1275,9 @@ bool Resolver::expectPinType(PinRef& pin, PinKind kind, const std::string& ptr, 
 void Resolver::fillSubstrateNode(int index, const Json& j, const std::string& ptr, TreeOp op) {
   out_.substrate[index].op = op;
   SNode node;  // filled locally: out_.substrate may reallocate during recursion
-  if (op == TreeOp::Slab)
+  if (const BlockSignature* block = op == TreeOp::Slab ? blockOf(j["kind"].get<std::string>()) : nullptr)
+    fillBlockNode(index, j, ptr, *block, node);
+  else if (op == TreeOp::Slab)
     fillSlabNode(index, j, ptr, node);
   else
     fillOperatorNode(index, j, ptr, op, node);
@@ -1341,6 +1360,71 @@ void Resolver::fillOperatorNode(int index, const Json& j, const std::string& ptr
     case TreeOp::Slab: break;  // fillSlabNode
   }
 }
+
+void Resolver::fillBlockNode(int index, const Json& j, const std::string& ptr, const BlockSignature& sig,
+                             SNode& node) {
+  const std::string id = out_.substrate[index].id.empty() ? std::string("node") : out_.substrate[index].id;
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string& k = it.key();
+    if (k == "kind" || k == "comment") continue;
+    if (std::none_of(sig.pins.begin(), sig.pins.end(), [&](const BlockPin& p) { return k == p.name; })) {
+      std::string list;
+      for (const BlockPin& p : sig.pins) list += (list.empty() ? "" : ", ") + std::string(p.name);
+      d_.error(ptr + "/" + pointerToken(k),
+               fmt::format("unknown pin {} for a {} node (pins: {})", quoteForDiagnostic(k), sig.kind, list));
+    }
+  }
+  node.kind = BsdfKind::Slab;  // a placeholder: every slab pin keeps its default
+  for (int p = 0; p < kSlabPinCount; ++p) readSlabPin(index, Json::object(), ptr, p, node.slabPins[p]);
+  for (const BlockPin& pin : sig.pins) {
+    auto it = j.find(pin.name);
+    if (it == j.end()) {
+      if (pin.required) d_.error(ptr, fmt::format("missing required pin \"{}\"", pin.name));
+      continue;
+    }
+    const std::string pp = ptr + "/" + pin.name;
+    switch (pin.kind) {
+      case BlockPin::Kind::Substrate: {
+        const int child = readSubstratePin(*it, pp, id + "_" + pin.name);
+        (node.left < 0 ? node.left : node.right) = child;
+        break;
+      }
+      case BlockPin::Kind::Number:
+        if (!it->is_number())
+          d_.error(pp, fmt::format("expected a literal number (it decides the {}'s expansion), got {}", sig.kind,
+                                   kindOfJson(*it)));
+        else if (it->get<double>() < pin.lo || it->get<double>() > pin.hi)
+          d_.error(pp, fmt::format("expected a number in [{:g},{:g}], got {}", pin.lo, pin.hi, kindOfJson(*it)));
+        break;
+      case BlockPin::Kind::Choice:
+        if (!it->is_string() || std::none_of(pin.choices.begin(), pin.choices.end(),
+                                             [&](const char* c) { return it->get<std::string>() == c; })) {
+          std::string list;
+          for (const char* c : pin.choices) list += (list.empty() ? "\"" : ", \"") + std::string(c) + "\"";
+          d_.error(pp, fmt::format("expected one of {}, got {}", list, kindOfJson(*it)));
+        }
+        break;
+      case BlockPin::Kind::Flag:
+        if (!it->is_boolean()) d_.error(pp, fmt::format("expected true or false, got {}", kindOfJson(*it)));
+        break;
+      default: readBlockValuePin(index, *it, pp, pin);
+    }
+  }
+}
+
+void Resolver::readBlockValuePin(int index, const Json& v, const std::string& pp, const BlockPin& pin) {
+  const PinKind kind = pin.kind == BlockPin::Kind::Float   ? PinKind::Float
+                       : pin.kind == BlockPin::Kind::Color ? PinKind::Color
+                       : pin.kind == BlockPin::Kind::Vec3  ? PinKind::Vec3
+                                                           : PinKind::Vec2;
+  blockPins_.push_back(readValuePin(v, pp, pin.name));
+  PinRef& dst = blockPins_.back();
+  if (dst.tag == PinRef::Node)
+    deferred_.push_back({index, -3 - static_cast<int>(blockPins_.size() - 1), kind, pp});
+  if (expectPinType(dst, kind, pp) && kind != PinKind::Vec2)
+    checkRange(dst, v, pp, pin.lo, pin.hi, kind == PinKind::Color ? "a color with components" : "a float");
+}
+
 
 namespace {
 /// The pins a BSDF kind other than the slab takes, for "unknown pin" errors.
@@ -1613,7 +1697,10 @@ void Resolver::typeHelperNode(VNode& v, const OpSpec* spec) {
 void Resolver::checkDeferredPins() {
   for (const auto& c : deferred_) {
     SNode& s = out_.substrate[c.snode];
-    PinRef& pin = c.pin >= 0 ? s.slabPins[c.pin] : c.pin == -1 ? s.a : s.b;
+    PinRef& pin = c.pin >= 0    ? s.slabPins[c.pin]
+                  : c.pin == -1 ? s.a
+                  : c.pin == -2 ? s.b
+                                : blockPins_[static_cast<std::size_t>(-3 - c.pin)];
     if (pin.tag != PinRef::Node) continue;
     const VNode& v = out_.values[pin.index];
     if (v.outputTypes.empty()) continue;

@@ -17,11 +17,42 @@
 
 namespace substratec {
 
+/// A pin of a building block (blocks/blocks.h), as the resolver checks it.
+struct BlockPin {
+  enum class Kind : std::uint8_t {
+    Float,      // a scalar value
+    Color,      // vec3, a Float broadcasts to grey
+    Vec3,       // exactly vec3
+    Vec2,       // exactly vec2
+    Substrate,  // a Substrate node (an id or an inline node)
+    Number,     // a literal number: it decides the expansion's shape
+    Choice,     // one of `choices`, a string
+    Flag,       // true or false
+  };
+  const char* name;
+  Kind kind;
+  double lo = -1e300, hi = 1e300;  // a literal's range (Float, Color, Number)
+  bool required = false;
+  std::vector<const char*> choices = {};  // Choice
+};
+
+/// A building block's kind and pins: the resolver checks a block's pins like
+/// any node's (located errors); blocks/expand.h then rewrites it.
+struct BlockSignature {
+  const char* kind;
+  std::vector<BlockPin> pins;
+};
+
 /// The resolver's limits (docs/robustness.md); each has its own diagnostic.
 struct ResolveLimits {
   std::size_t maxNodes = 20000;        // named + inline nodes
   std::size_t maxInputs = 1024;        // inputs (uniform-block members and textures)
   std::size_t maxIdentifierBytes = 128;
+  /// The building blocks the document may use (blocks::signatures()): each is
+  /// checked and stands in the resolved document as a placeholder slab whose
+  /// children are its Substrate pins, which is only fit for checking (the
+  /// pipeline resolves the expanded document). Null: a block's kind is unknown.
+  const std::vector<BlockSignature>* blocks = nullptr;
 };
 
 /// A pin's value after resolution.

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "blocks/expand.h"
 #include "passes/build_tree.h"
 #include "passes/cull.h"
 #include "passes/features.h"
@@ -43,47 +44,58 @@ const std::vector<Pass>& passList() {
       // 1. parse: text -> JSON document (syntax errors carry line:col).
       {"parse", "text -> JSON document (syntax errors at file:line:col)",
        [](PassContext& c) { return bool(c.doc = parseJsonDocument(c.text, c.options.read, c.diags)); }},
-      // 2. resolve: keys, kinds, types, ranges, references, cycles (JSON pointers).
+      // 2. expand-blocks: building blocks -> the slabs, operators and value
+      //    nodes they stand for (a no-op without blocks). Before resolve, so that
+      //    everything after it, culling and feature analysis included, sees
+      //    through the expansion: a block costs what its expansion costs.
+      {"expand-blocks", "building blocks -> the slabs, operators and value nodes they stand for",
+       [](PassContext& c) {
+         if (!blocks::hasBuildingBlocks(*c.doc)) return true;
+         auto expanded = blocks::expandBuildingBlocks(*c.doc, c.diags, c.options.resolve, c.result.blocks);
+         if (expanded) c.doc = std::move(*expanded);
+         return expanded.has_value();
+       }},
+      // 3. resolve: keys, kinds, types, ranges, references, cycles (JSON pointers).
       {"resolve", "JSON -> resolved document: keys, kinds, types, ranges, references, cycles",
        [](PassContext& c) { return bool(c.resolved = resolveDocument(*c.doc, c.diags, c.options.resolve)); }},
-      // 3. value DAG: structural hashing + constant folding. Culling (5) and
-      //    feature analysis (6) rely on folded constants, so this comes first.
+      // 4. value DAG: structural hashing + constant folding. Culling (6) and
+      //    feature analysis (7) rely on folded constants, so this comes first.
       {"build-values", "value nodes -> the hash-consed value DAG, constants folded",
        [](PassContext& c) {
          c.values = buildValueDag(*c.resolved, c.result.material);
          return true;
        }},
-      // 4. Substrate tree: instance the Substrate graph from the output.
+      // 5. Substrate tree: instance the Substrate graph from the output.
       {"build-tree", "Substrate graph -> tree (a node referenced twice is instanced twice)",
        [](PassContext& c) {
          return buildSubstrateTree(*c.resolved, c.values, c.result.material, c.diags, c.options.tree);
        }},
-      // 5. static culling (constant weights, bases under opaque tops): before any
+      // 6. static culling (constant weights, bases under opaque tops): before any
       //    analysis, so culled matter costs nothing.
       {"cull", "removes matter that can never show",
        [](PassContext& c) { return cullStaticMatter(c.result.material, c.diags); }},
-      // 6. features per slab (needs the culled tree: top/bottom positions).
+      // 7. features per slab (needs the culled tree: top/bottom positions).
       {"features", "per-slab opt-in features",
        [](PassContext& c) {
          analyzeFeatures(c.result.material);
          return true;
        },
        analyzeFeatures},
-      // 7. shared local bases (needs the anisotropy flags from 6).
+      // 8. shared local bases (needs the anisotropy flags from 7).
       {"shared-bases", "slabs with equal normals (and tangents) share a basis",
        [](PassContext& c) {
          shareLocalBases(c.result.material);
          return true;
        },
        shareLocalBases},
-      // 8. layout and pricing, against the budget the material asks for.
+      // 9. layout and pricing, against the budget the material asks for.
       {"price", "the storage layout and its bytes per pixel",
        [](PassContext& c) {
          chooseBudget(c);
          c.result.before = computeLayout(c.result.material, analyzeTree(c.result.material));
          return true;
        }},
-      // 9. simplify to the budget (re-runs 6-8 after each step, so it comes last).
+      // 10. simplify to the budget (re-runs 7-9 after each step, so it comes last).
       {"simplify", "collapses operators and disables features until the material fits its budget", simplifyPass},
   };
   return passes;

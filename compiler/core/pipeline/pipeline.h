@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "blocks/expand.h"
 #include "diag/diagnostics.h"
 #include "format/json_document.h"
 #include "ir/material.h"
@@ -53,6 +54,7 @@ struct CompileResult {
   int budgetBytes = 80;
   int maxClosures = 8;
   std::vector<SimplifyStep> steps;
+  std::vector<blocks::ExpandedBlock> blocks;  // the building blocks and what they expanded into
   std::vector<PassTiming> timings;
   std::string debugLog;     // --print-after(-all) output
 };

@@ -98,6 +98,14 @@ std::string formatReportText(const CompileResult& r) {
                        slab && t.isBottom[n] ? 1 : 0, node.id);
     }
   }
+  if (!r.blocks.empty()) {  // the tree above is their expansion (blocks/expand.h)
+    o += fmt::format("----- Building blocks - {} -----\n", m.name);
+    for (const auto& b : r.blocks) {
+      std::string nodes;
+      for (const auto& n : b.nodes) nodes += (nodes.empty() ? "" : ", ") + n;
+      o += fmt::format("{} ({} at {}) expanded into: {}\n", b.id, b.kind, b.pointer, nodes.empty() ? "(its base)" : nodes);
+    }
+  }
   o += fmt::format("----- BSDF features - {} -----\n", m.name);
   for (std::size_t i = 0; i < t.slabOrder.size(); ++i) {
     const Slab& s = m.slabs[t.slabOrder[i]];
@@ -171,6 +179,12 @@ nlohmann::ordered_json reportJson(const CompileResult& r) {
                     {"is_bottom", slab && t.isBottom[n]}});
   }
   j["tree"] = tree;
+  if (!r.blocks.empty()) {
+    J blocks = J::array();
+    for (const auto& b : r.blocks)
+      blocks.push_back({{"id", b.id}, {"kind", b.kind}, {"pointer", b.pointer}, {"nodes", b.nodes}});
+    j["building_blocks"] = blocks;
+  }
   J bsdfs = J::array();
   for (std::size_t i = 0; i < t.slabOrder.size(); ++i) {
     const Slab& s = m.slabs[t.slabOrder[i]];

@@ -8,7 +8,7 @@
 
 #include <fmt/format.h>
 
-#include "import/gltf_pbr.h"
+#include "blocks/gltf_pbr.h"
 #include "import/gltf_resources.h"
 
 namespace substratec::import {
@@ -596,7 +596,7 @@ void MaterialReader::readDiffuseRoughness(const Json& ext, const std::string& xp
 }  // namespace
 
 bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostics& diags,
-                        std::vector<ImportedMaterial>* out, const std::string* glbBin) {
+                        std::vector<ImportedMaterial>* out, const std::string* glbBin, ImportForm form) {
   if (!doc.is_object()) {
     diags.error("", "expected a glTF document (a JSON object)");
     return false;
@@ -634,7 +634,10 @@ bool importGltfDocument(const Json& doc, const std::string& fileName, Diagnostic
       ok = false;
       continue;
     }
-    writeLayeredSurface(gltfPbrSurface(g, w), w);
+    if (form == ImportForm::Expanded)
+      writeLayeredSurface(gltfPbrSurface(g, w), w);
+    else
+      writeGltfPbrBlock(g, w);
     out->push_back({sourceName, name, ptr, w.text(), std::move(reader.images())});
   }
   return ok;

@@ -16,9 +16,13 @@
 #include <string>
 
 #include "diag/diagnostics.h"
-#include "import/material_writer.h"
+#include "blocks/material_writer.h"
 
 namespace substratec::import {
+
+// The value writer, the layered surface and the glTF model live in blocks/,
+// shared with the building blocks' expansion.
+using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
 
 /// Most missing-resource warnings reported one by one (then one line for the rest).
 inline constexpr int kMaxResourceWarnings = 32;

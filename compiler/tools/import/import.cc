@@ -40,7 +40,8 @@ SourceKind sourceKindOf(const std::string& path) {
 
 std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const std::string& fileName,
                                                         const std::string& text, const std::string& baseDir,
-                                                        const ReadLimits& limits, Diagnostics& diags) {
+                                                        const ReadLimits& limits, Diagnostics& diags,
+                                                        ImportForm form) {
   std::vector<ImportedMaterial> out;
   bool ok = false;
   if (kind == SourceKind::MaterialX) {
@@ -61,7 +62,7 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
     if (!doc) return std::nullopt;
     // A .glb's JSON chunk: its lines are not the file's, so its pointers stay unlocated.
     if (glb) diags.setLocator(nullptr);
-    ok = importGltfDocument(*doc, fileName, diags, &out, bin ? &*bin : nullptr);
+    ok = importGltfDocument(*doc, fileName, diags, &out, bin ? &*bin : nullptr, form);
     // The buffers and images a .gltf or .glb refers to (gltf_resources.h);
     // a .materials.json extract has none.
     if (kind != SourceKind::GltfMaterials) ok = checkGltfResources(*doc, baseDir, binBytes, diags) && ok;
@@ -75,11 +76,12 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
 }
 
 std::optional<std::vector<ImportedMaterial>> importFile(const std::string& path, const ReadLimits& limits,
-                                                        Diagnostics& diags) {
+                                                        Diagnostics& diags, ImportForm form) {
   auto text = readSourceFile(path, limits, diags);
   if (!text) return std::nullopt;
   const std::filesystem::path p(path);
-  return importText(sourceKindOf(path), p.filename().string(), *text, p.parent_path().string(), limits, diags);
+  return importText(sourceKindOf(path), p.filename().string(), *text, p.parent_path().string(), limits, diags,
+                    form);
 }
 
 const ImportedMaterial* pickMaterial(const std::vector<ImportedMaterial>& all, const std::string& wanted,

@@ -11,9 +11,13 @@
 
 #include "diag/diagnostics.h"
 #include "format/json_document.h"
-#include "import/material_writer.h"
+#include "blocks/material_writer.h"
 
 namespace substratec::import {
+
+// The value writer, the layered surface and the glTF model live in blocks/,
+// shared with the building blocks' expansion.
+using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
 
 enum class SourceKind { Substrate, Gltf, Glb, GltfMaterials, MaterialX };
 
@@ -24,13 +28,14 @@ SourceKind sourceKindOf(const std::string& path);
 /// `diags`, which should name the file as the user gave it). nullopt on any
 /// error: nothing is returned half-imported.
 std::optional<std::vector<ImportedMaterial>> importFile(const std::string& path, const ReadLimits& limits,
-                                                        Diagnostics& diags);
+                                                        Diagnostics& diags, ImportForm form = ImportForm::Blocks);
 
 /// Imports `text` read from a file named `fileName` (no directories; it goes
 /// into the descriptions). MaterialX includes are read relative to `baseDir`.
 std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const std::string& fileName,
                                                         const std::string& text, const std::string& baseDir,
-                                                        const ReadLimits& limits, Diagnostics& diags);
+                                                        const ReadLimits& limits, Diagnostics& diags,
+                                                        ImportForm form = ImportForm::Blocks);
 
 /// The material called `wanted` (its source name or its identifier), or the
 /// only one when `wanted` is empty; otherwise an error listing the materials

@@ -2,7 +2,7 @@
 // under their MaterialX names, mapped with the glTF formulas (gltf_pbr.h).
 // alpha_mode is 0 opaque, 1 mask, 2 blend; iridescence_thickness is in
 // nanometres; anisotropy_rotation in radians.
-#include "import/gltf_pbr.h"
+#include "blocks/gltf_pbr.h"
 #include "import/mtlx_surfaces.h"
 
 namespace substratec::import {

@@ -26,10 +26,14 @@
 #include <vector>
 
 #include "diag/diagnostics.h"
-#include "import/material_writer.h"
+#include "blocks/material_writer.h"
 #include "import/mtlx_document.h"
 
 namespace substratec::import {
+
+// The value writer, the layered surface and the glTF model live in blocks/,
+// shared with the building blocks' expansion.
+using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
 
 /// How a shading node's own value becomes a Substrate value (as for glTF):
 /// Plain: a material input when the document gives it; Switch: a literal at

@@ -11,9 +11,13 @@
 
 #include "diag/diagnostics.h"
 #include "format/json_document.h"
-#include "import/material_writer.h"
+#include "blocks/material_writer.h"
 
 namespace substratec::import {
+
+// The value writer, the layered surface and the glTF model live in blocks/,
+// shared with the building blocks' expansion.
+using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
 
 /// Appends the materials of the MaterialX document `text` (from `fileName`;
 /// includes read from `baseDir`). False on any error.

@@ -11,10 +11,14 @@
 #pragma once
 #include <pugixml.hpp>
 
-#include "import/layered_surface.h"
+#include "blocks/layered_surface.h"
 #include "import/mtlx_graph.h"
 
 namespace substratec::import {
+
+// The value writer, the layered surface and the glTF model live in blocks/,
+// shared with the building blocks' expansion.
+using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
 
 LayeredSurface standardSurface(pugi::xml_node shader, MtlxValues& v, MaterialWriter& w);
 LayeredSurface openPbrSurface(pugi::xml_node shader, MtlxValues& v, MaterialWriter& w);

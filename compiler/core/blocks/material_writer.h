@@ -1,4 +1,5 @@
-// Writing a substrate-material/1 document from an importer: unique C
+// Writing a substrate-material/1 document (an importer's, or a building
+// block's expansion into a document: NodeWriter): unique C
 // identifiers for inputs and nodes (one namespace, as the format wants),
 // inputs with their source's names and values, named value and Substrate
 // nodes, settings, the output; and small constructors for value expressions
@@ -18,7 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 using Json = nlohmann::ordered_json;
 
@@ -69,6 +70,11 @@ class NameSet {
   std::unordered_map<std::string, std::size_t> next_;  // key(base) -> the next suffix to try
 };
 
+/// What an importer writes: its shading model as the format's building block
+/// (a `gltf_pbr` node; what the author of the source wrote), or that block's
+/// expansion (the slabs, operators and value nodes; `import --expand`).
+enum class ImportForm { Blocks, Expanded };
+
 /// One imported material: what its source calls it, its identifier (the
 /// material's `name`, unique within its source) and its text.
 struct ImportedMaterial {
@@ -93,7 +99,28 @@ std::string descriptionText(std::string_view s, std::size_t maxBytes = 256);
 /// `"` + descriptionText(s) + `"`.
 std::string quoteForDescription(std::string_view s, std::size_t maxBytes = 256);
 
-class MaterialWriter {
+/// Where a shading model's unit writes the nodes it names: a material being
+/// written (MaterialWriter, the importers) or a document whose building
+/// blocks are being expanded (blocks/expand.cc).
+class NodeWriter {
+ public:
+  virtual ~NodeWriter() = default;
+  /// A named node (value or Substrate) like `wantedId`; returns its id as a reference.
+  virtual Value node(std::string_view wantedId, Json body) = 0;
+  /// What a presence that folds to the constant 0 becomes: the literal 0 (a
+  /// block keeps what its author wrote), or, for an importer, an input (the
+  /// source's invisible material is kept as one whose coverage can be raised).
+  virtual Value invisiblePresence() { return Value(0.0); }
+};
+
+/// A NodeWriter that keeps nothing: a unit run for what it decides (the
+/// settings a surface needs), not for its nodes.
+class DiscardingNodeWriter final : public NodeWriter {
+ public:
+  Value node(std::string_view wantedId, Json) override { return std::string(wantedId); }
+};
+
+class MaterialWriter : public NodeWriter {
  public:
   /// `name` is the material's name (sanitized; made unique by the caller).
   explicit MaterialWriter(const std::string& name);
@@ -114,7 +141,9 @@ class MaterialWriter {
                      const std::string& wrapU = "repeat", const std::string& wrapV = "repeat", bool nearest = false);
 
   /// A named node (value or Substrate); returns its id as a reference.
-  Value node(std::string_view wantedId, Json body);
+  Value node(std::string_view wantedId, Json body) override;
+  /// An input "presence" of 0 in [0, 1].
+  Value invisiblePresence() override;
 
   void setDescription(const std::string& text) { description_ = text; }
   void setSetting(const std::string& key, Json value) { settings_[key] = std::move(value); }
@@ -178,8 +207,8 @@ Value textureSample(const Value& textureInput, const Value& uv);
 Value outputOf(const Value& nodeRef, const std::string& name);
 /// An inline expression as a named node of `w` (an expression used more than
 /// once is then written once); references and literals as they are.
-Value namedValue(MaterialWriter& w, const std::string& id, const Value& v);
+Value namedValue(NodeWriter& w, const std::string& id, const Value& v);
 /// ((ior − 1) / (ior + 1))² (the ior_to_f0 helper), folded for a literal.
 Value iorToF0Value(const Value& ior);
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks

@@ -1,4 +1,4 @@
-#include "import/material_writer.h"
+#include "blocks/material_writer.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include "passes/resolve.h"
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 namespace {
 /// The longest description written (the format's string limit is 64 KiB).
@@ -162,6 +162,12 @@ Value MaterialWriter::node(std::string_view wantedId, Json body) {
   std::string id = uniqueId(wantedId);
   nodes_[id] = std::move(body);
   return id;
+}
+
+Value MaterialWriter::invisiblePresence() {
+  return floatInput("presence", 0.0, 0.0, 1.0,
+                    "the source's opacity, 0: a fully transparent surface (an input, not a constant, so that the "
+                    "material keeps its matter)");
 }
 
 std::string MaterialWriter::text() const {
@@ -429,7 +435,7 @@ Value textureSample(const Value& textureInput, const Value& uv) {
 
 Value outputOf(const Value& nodeRef, const std::string& name) { return nodeRef.get<std::string>() + "." + name; }
 
-Value namedValue(MaterialWriter& w, const std::string& id, const Value& v) { return v.is_object() ? w.node(id, v) : v; }
+Value namedValue(NodeWriter& w, const std::string& id, const Value& v) { return v.is_object() ? w.node(id, v) : v; }
 
 Value iorToF0Value(const Value& ior) {
   if (ior.is_number()) {
@@ -440,4 +446,4 @@ Value iorToF0Value(const Value& ior) {
   return Json{{"kind", "ior_to_f0"}, {"ior", ior}};
 }
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks

@@ -1,9 +1,9 @@
-#include "import/layered_surface.h"
+#include "blocks/layered_surface.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 namespace {
 
@@ -48,12 +48,10 @@ Value rotatedTangent(const Value& angle) {
   return Json{{"kind", "rotation_to_tangent"}, {"angle", angle}};
 }
 
-namespace {
-
 /// The base's diffuse albedo, F0 and F90 (null: 1) from the metallic
 /// workflow: the metalness helper node when the dielectric is a plain grey
 /// F0 <= 0.08 (specular = F0 / 0.08), otherwise the same formulas spelled out.
-void baseReflectance(const LayeredSurface& s, MaterialWriter& w, bool metal, Value& diffuse, Value& f0, Value& f90) {
+void baseReflectance(const LayeredSurface& s, NodeWriter& w, bool metal, Value& diffuse, Value& f0, Value& f90) {
   const bool f90Given = !s.specularF90.is_null() || !s.metalF90.is_null();
   const auto greyF0 = literalOf(s.specularF0);
   const bool helper = metal && s.diffuseColor.is_null() &&
@@ -77,8 +75,7 @@ void baseReflectance(const LayeredSurface& s, MaterialWriter& w, bool metal, Val
   }
 }
 
-/// `root` under the coat slab (its presence the coat weight).
-Value coatedRoot(const LayeredSurface& s, MaterialWriter& w, const Value& root) {
+Value coatedRoot(const LayeredSurface& s, NodeWriter& w, const Value& root) {
   Json coat = {{"kind", "slab"}, {"diffuse_albedo", 0}};
   coat["f0"] = s.coatF0.is_null() ? Value(0.04) : s.coatF0;
   coat["roughness"] = s.coatRoughness.is_null() ? Value(0.0) : s.coatRoughness;
@@ -101,18 +98,21 @@ Value coatedRoot(const LayeredSurface& s, MaterialWriter& w, const Value& root) 
   return w.node("coated", Json{{"kind", "vertical"}, {"top", top}, {"base", root}, {"thickness", 0.0001}});
 }
 
+namespace {
+
+bool transmits(const LayeredSurface& s) { return !s.unlit && !absent(s.transmission, 0); }
+
+/// The presence (opacity, alpha mode) over `root`: a coverage weight (the
+/// blend mode is layeredSurfaceSettings').
+Value presenceOver(const LayeredSurface& s, NodeWriter& w, Value root);
+
 }  // namespace
 
-/// The presence (opacity, alpha mode) over `root` and the blend mode: a
-/// coverage weight, translucent or masked.
-void writePresence(const LayeredSurface& s, MaterialWriter& w, Value root, bool transmits);
-
-void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
+Value layeredSurfaceNodes(const LayeredSurface& s, NodeWriter& w) {
   if (s.unlit) {  // no closure: the unlit BSDF, its radiance and its presence
     Json unlit = {{"kind", "unlit"}};
     if (!absent(s.emissive, 0)) unlit["emissive"] = s.emissive;
-    writePresence(s, w, w.node("unlit", unlit), false);
-    return;
+    return presenceOver(s, w, w.node("unlit", unlit));
   }
   const bool metal = !absent(s.metallic, 0);
   Value diffuse, f0, f90;
@@ -127,7 +127,7 @@ void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
     f0 = vlerp(f0, outputOf(filmNode, "f0"), s.filmWeight);
   }
   // Named when used twice (the transmitting copy), so the JSON says it once.
-  const bool transmits = !absent(s.transmission, 0);
+  const bool transmits = substratec::blocks::transmits(s);
   if (transmits && !f0.is_string() && !literalOf(f0)) f0 = w.node("f0", f0);
   if (transmits && !f90.is_null() && !f90.is_string() && !literalOf(f90)) f90 = w.node("f90", f90);
   const Value emissive = transmits ? namedValue(w, "emissive", s.emissive) : s.emissive;
@@ -157,36 +157,61 @@ void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
     }
   }
   if (!absent(s.coatWeight, 0)) root = coatedRoot(s, w, root);
-  writePresence(s, w, root, transmits);
+  return presenceOver(s, w, root);
 }
 
-void writePresence(const LayeredSurface& s, MaterialWriter& w, Value root, bool transmits) {
-  std::string blend = transmits ? "translucent_colored" : "opaque";
-  const bool present = s.alphaMode != AlphaMode::Opaque || !absent(s.opacity, 1);
-  if (present && !s.opacity.is_null()) {
-    Value weight = s.opacity;
-    if (s.alphaMode == AlphaMode::Mask) {
-      // The masked blend mode keeps coverage >= 0.5: a steep ramp puts the
-      // cutoff there and keeps kept texels (nearly) fully covered.
-      weight = saturate(add(mul(sub(s.opacity, s.alphaCutoff), 1000.0), 0.5));
-      blend = "masked";
-    } else if (!transmits) {
-      blend = "translucent_grey";
-    }
-    // A presence that folds to a constant 0 (alpha or opacity 0 given as a
-    // literal, or below a mask's cutoff) would leave the compiler no matter
-    // at all ("no matter is left after static culling"): the source's
-    // invisible material is kept as what it is, a material whose coverage
-    // input is 0, which compiles and which an author can still raise.
-    if (const auto c = literalOf(weight); c && std::all_of(c->begin(), c->end(), [](double x) { return !(x > 0); }))
-      weight = w.floatInput("presence", 0.0, 0.0, 1.0,
-                            "the source's opacity, 0: a fully transparent surface (an input, not a constant, so "
-                            "that the material keeps its matter)");
-    root = w.node("presence", Json{{"kind", "coverage_weight"}, {"a", root}, {"weight", weight}});
-  }
-  if (blend != "opaque") w.setSetting("blend_mode", blend);
-  if (s.thinWalled) w.setSetting("thin_surface", true);
+namespace {
+
+bool hasPresence(const LayeredSurface& s) {
+  return (s.alphaMode != AlphaMode::Opaque || !absent(s.opacity, 1)) && !s.opacity.is_null();
+}
+
+/// The coverage weight of the presence of `s`.
+Value presenceWeight(const LayeredSurface& s) {
+  // The masked blend mode keeps coverage >= 0.5: a steep ramp puts the
+  // cutoff there and keeps kept texels (nearly) fully covered.
+  if (s.alphaMode == AlphaMode::Mask) return saturate(add(mul(sub(s.opacity, s.alphaCutoff), 1000.0), 0.5));
+  return s.opacity;
+}
+
+bool foldsToZero(const Value& weight) {
+  const auto c = literalOf(weight);
+  return c && std::all_of(c->begin(), c->end(), [](double x) { return !(x > 0); });
+}
+
+Value presenceOver(const LayeredSurface& s, NodeWriter& w, Value root) {
+  if (!hasPresence(s)) return root;
+  Value weight = presenceWeight(s);
+  // A presence that folds to a constant 0 (alpha or opacity 0 given as a
+  // literal, or below a mask's cutoff) would leave the compiler no matter at
+  // all ("no matter is left after static culling"): the writer says what it
+  // becomes (an importer keeps the source's invisible material as one whose
+  // coverage input is 0, which compiles and which an author can still raise).
+  if (foldsToZero(weight)) weight = w.invisiblePresence();
+  return w.node("presence", Json{{"kind", "coverage_weight"}, {"a", root}, {"weight", weight}});
+}
+
+}  // namespace
+
+bool presenceFoldsToZero(const LayeredSurface& s) { return hasPresence(s) && foldsToZero(presenceWeight(s)); }
+
+Json layeredSurfaceSettings(const LayeredSurface& s) {
+  Json settings = Json::object();
+  std::string blend = transmits(s) ? "translucent_colored" : "opaque";
+  if (hasPresence(s) && s.alphaMode == AlphaMode::Mask)
+    blend = "masked";
+  else if (hasPresence(s) && !transmits(s))
+    blend = "translucent_grey";
+  if (blend != "opaque") settings["blend_mode"] = blend;
+  if (s.thinWalled) settings["thin_surface"] = true;
+  return settings;
+}
+
+void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
+  const Value root = layeredSurfaceNodes(s, w);
+  const Json settings = layeredSurfaceSettings(s);  // items() holds no temporary alive
+  for (const auto& [key, value] : settings.items()) w.setSetting(key, value);
   w.setOutput(root);
 }
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks

@@ -1,9 +1,11 @@
-#include "import/gltf_pbr.h"
+#include "blocks/gltf_pbr.h"
+
+#include "blocks/blocks.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 namespace {
 
@@ -11,7 +13,7 @@ bool off(const Value& v, double neutral) { return v.is_null() || isLiteral(v, ne
 
 /// KHR_materials_anisotropy's lobe: alpha_t = mix(alpha, 1, strength²) along
 /// the direction, alpha_b = alpha, as the slab's (roughness, anisotropy).
-RoughnessAnisotropy anisotropic(MaterialWriter& w, const std::string& prefix, const Value& roughness,
+RoughnessAnisotropy anisotropic(NodeWriter& w, const std::string& prefix, const Value& roughness,
                                 const Value& strength) {
   const Value r = namedValue(w, prefix + "roughness", roughness);
   const Value alpha = namedValue(w, prefix + "alpha", mul(r, r));
@@ -22,7 +24,7 @@ RoughnessAnisotropy anisotropic(MaterialWriter& w, const std::string& prefix, co
 }
 
 /// The dielectric Fresnel and the specular anisotropy.
-void gltfSpecular(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
+void gltfSpecular(const GltfPbr& g, NodeWriter& w, LayeredSurface& s) {
   // Dielectric Fresnel (KHR_materials_ior, KHR_materials_specular):
   //   F0 = min(((ior − 1)/(ior + 1))² · specularColor, 1) · specular,  F90 = specular.
   if (!g.ior.is_null() || !off(g.specular, 1) || !off(g.specularColor, 1)) {
@@ -58,7 +60,7 @@ void gltfSpecular(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
 }
 
 /// Sheen (KHR_materials_sheen) or fuzz (KHR_materials_fuzz) as the slab's fuzz.
-void gltfFuzz(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
+void gltfFuzz(const GltfPbr& g, NodeWriter& w, LayeredSurface& s) {
   // Sheen: Charlie lobe over the base with albedo scaling
   //   fuzz_amount = max(sheenColor), fuzz_color = sheenColor / fuzz_amount.
   if (!off(g.sheenColor, 0)) {
@@ -82,7 +84,7 @@ void gltfFuzz(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
 }
 
 /// KHR_materials_clearcoat, then KHR_materials_coat over it.
-void gltfCoat(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
+void gltfCoat(const GltfPbr& g, NodeWriter& w, LayeredSurface& s) {
   // Clearcoat: a colourless dielectric (IOR 1.5) on top, its own roughness and normal.
   if (!off(g.clearcoat, 0)) {
     s.coatWeight = g.clearcoat;
@@ -109,7 +111,7 @@ void gltfCoat(const GltfPbr& g, MaterialWriter& w, LayeredSurface& s) {
 
 }  // namespace
 
-LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
+LayeredSurface gltfPbrSurface(const GltfPbr& g, NodeWriter& w) {
   LayeredSurface s;
   const Value baseColor = namedValue(w, "base_color", g.baseColor.is_null() ? literal3(1, 1, 1) : g.baseColor);
   s.baseColor = baseColor;
@@ -168,4 +170,111 @@ LayeredSurface gltfPbrSurface(const GltfPbr& g, MaterialWriter& w) {
   return s;
 }
 
-}  // namespace substratec::import
+namespace {
+
+using Kind = BlockPin::Kind;
+
+/// The Value members of GltfPbr as the block's pins.
+struct GltfValuePin {
+  BlockPin pin;
+  Value GltfPbr::*member;
+};
+
+const std::vector<GltfValuePin>& gltfValuePins() {
+  constexpr double kBig = 1e300;
+  static const std::vector<GltfValuePin> pins = {
+      {{"base_color", Kind::Color, 0, 1}, &GltfPbr::baseColor},
+      {{"alpha", Kind::Float, 0, 1}, &GltfPbr::alpha},
+      {{"metallic", Kind::Float, 0, 1}, &GltfPbr::metallic},
+      {{"roughness", Kind::Float, 0, 1}, &GltfPbr::roughness},
+      {{"normal", Kind::Vec3}, &GltfPbr::normal},
+      {{"emissive", Kind::Color, 0, kBig}, &GltfPbr::emissive},
+      {{"ior", Kind::Float, 1, kBig}, &GltfPbr::ior},
+      {{"specular", Kind::Float, 0, 1}, &GltfPbr::specular},
+      {{"specular_color", Kind::Color, 0, kBig}, &GltfPbr::specularColor},
+      {{"clearcoat", Kind::Float, 0, 1}, &GltfPbr::clearcoat},
+      {{"clearcoat_roughness", Kind::Float, 0, 1}, &GltfPbr::clearcoatRoughness},
+      {{"clearcoat_normal", Kind::Vec3}, &GltfPbr::clearcoatNormal},
+      {{"coat", Kind::Float, 0, 1}, &GltfPbr::coat},
+      {{"coat_roughness", Kind::Float, 0, 1}, &GltfPbr::coatRoughness},
+      {{"coat_ior", Kind::Float, 1, kBig}, &GltfPbr::coatIor},
+      {{"coat_color", Kind::Color, 0, 1}, &GltfPbr::coatColor},
+      {{"coat_normal", Kind::Vec3}, &GltfPbr::coatNormal},
+      {{"coat_anisotropy_strength", Kind::Float, 0, 1}, &GltfPbr::coatAnisotropyStrength},
+      {{"coat_anisotropy_rotation", Kind::Float}, &GltfPbr::coatAnisotropyRotation},
+      {{"sheen_color", Kind::Color, 0, 1}, &GltfPbr::sheenColor},
+      {{"sheen_roughness", Kind::Float, 0, 1}, &GltfPbr::sheenRoughness},
+      {{"fuzz", Kind::Float, 0, 1}, &GltfPbr::fuzz},
+      {{"fuzz_color", Kind::Color, 0, 1}, &GltfPbr::fuzzColor},
+      {{"fuzz_roughness", Kind::Float, 0, 1}, &GltfPbr::fuzzRoughness},
+      {{"transmission", Kind::Float, 0, 1}, &GltfPbr::transmission},
+      {{"thickness", Kind::Float, 0, kBig}, &GltfPbr::thickness},
+      {{"attenuation_color", Kind::Color, 0, 1}, &GltfPbr::attenuationColor},
+      {{"iridescence", Kind::Float, 0, 1}, &GltfPbr::iridescence},
+      {{"iridescence_ior", Kind::Float, 1, kBig}, &GltfPbr::iridescenceIor},
+      {{"iridescence_thickness", Kind::Float, 0, kBig}, &GltfPbr::iridescenceThickness},
+      {{"anisotropy_strength", Kind::Float, 0, 1}, &GltfPbr::anisotropyStrength},
+      {{"anisotropy_direction", Kind::Vec2}, &GltfPbr::anisotropyDirection},
+      {{"diffuse_transmission", Kind::Float, 0, 1}, &GltfPbr::diffuseTransmission},
+      {{"diffuse_transmission_color", Kind::Color, 0, 1}, &GltfPbr::diffuseTransmissionColor},
+  };
+  return pins;
+}
+
+constexpr const char* kAlphaModes[] = {"opaque", "mask", "blend"};
+
+}  // namespace
+
+BlockSignature gltfPbrSignature() {
+  BlockSignature sig{"gltf_pbr", {}};
+  for (const GltfValuePin& p : gltfValuePins()) sig.pins.push_back(p.pin);
+  sig.pins.push_back({"attenuation_distance", Kind::Number, 0, 1e300});
+  sig.pins.push_back({"anisotropy_rotation", Kind::Number});
+  sig.pins.push_back({"unlit", Kind::Flag});
+  sig.pins.push_back({"alpha_mode", Kind::Choice, -1e300, 1e300, false, {kAlphaModes[0], kAlphaModes[1], kAlphaModes[2]}});
+  sig.pins.push_back({"alpha_cutoff", Kind::Number, 0, 1});
+  return sig;
+}
+
+Json gltfPbrBlock(const GltfPbr& g) {
+  Json block = {{"kind", "gltf_pbr"}};
+  for (const GltfValuePin& p : gltfValuePins())
+    if (!(g.*p.member).is_null()) block[p.pin.name] = g.*p.member;
+  if (g.attenuationDistance != 0) block["attenuation_distance"] = g.attenuationDistance;
+  if (g.anisotropyRotation != 0) block["anisotropy_rotation"] = g.anisotropyRotation;
+  if (g.unlit) block["unlit"] = true;
+  if (g.alphaMode != AlphaMode::Opaque) block["alpha_mode"] = kAlphaModes[static_cast<int>(g.alphaMode)];
+  if (g.alphaCutoff != 0.5) block["alpha_cutoff"] = g.alphaCutoff;
+  return block;
+}
+
+BuildingBlock gltfPbrBuildingBlock() {
+  return {gltfPbrSignature(), [](const Json& block, NodeWriter& w) {
+            return layeredSurfaceNodes(gltfPbrSurface(gltfPbrOfBlock(block), w), w);
+          }};
+}
+
+void writeGltfPbrBlock(GltfPbr g, MaterialWriter& w) {
+  DiscardingNodeWriter scratch;  // the surface, for its settings and presence only
+  const LayeredSurface s = gltfPbrSurface(g, scratch);
+  if (presenceFoldsToZero(s)) g.alpha = w.invisiblePresence();
+  const Value root = w.node("surface", gltfPbrBlock(g));
+  const Json settings = layeredSurfaceSettings(s);  // items() holds no temporary alive
+  for (const auto& [key, value] : settings.items()) w.setSetting(key, value);
+  w.setOutput(root);
+}
+
+GltfPbr gltfPbrOfBlock(const Json& block) {
+  GltfPbr g;
+  for (const GltfValuePin& p : gltfValuePins())
+    if (auto it = block.find(p.pin.name); it != block.end()) g.*p.member = *it;
+  g.attenuationDistance = block.value("attenuation_distance", 0.0);
+  g.anisotropyRotation = block.value("anisotropy_rotation", 0.0);
+  g.unlit = block.value("unlit", false);
+  const std::string mode = block.value("alpha_mode", std::string("opaque"));
+  g.alphaMode = mode == "mask" ? AlphaMode::Mask : mode == "blend" ? AlphaMode::Blend : AlphaMode::Opaque;
+  g.alphaCutoff = block.value("alpha_cutoff", 0.5);
+  return g;
+}
+
+}  // namespace substratec::blocks

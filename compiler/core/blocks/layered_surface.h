@@ -21,9 +21,9 @@
 #pragma once
 #include <string>
 
-#include "import/material_writer.h"
+#include "blocks/material_writer.h"
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 enum class AlphaMode { Opaque, Mask, Blend };
 
@@ -70,8 +70,25 @@ struct LayeredSurface {
   bool thinWalled = false;
 };
 
-/// Writes `s` into `w` (nodes, settings, output).
+/// The nodes of `s` in `w`; returns its root (the presence's coverage weight
+/// when it has one). A building block's expansion (blocks.h).
+Value layeredSurfaceNodes(const LayeredSurface& s, NodeWriter& w);
+/// The material settings `s` needs: "blend_mode" (translucent_colored when it
+/// transmits, masked or translucent_grey with a presence; absent when opaque)
+/// and "thin_surface" (when thin-walled).
+Json layeredSurfaceSettings(const LayeredSurface& s);
+/// True when the presence of `s` folds to the constant 0 (an alpha of 0, or
+/// below a mask's cutoff, given as a literal): its nodes then take the
+/// writer's invisiblePresence().
+bool presenceFoldsToZero(const LayeredSurface& s);
+/// Writes `s` into `w`: its nodes, its settings and its root as the output (the importers).
 void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w);
+/// `base` under the coat of `s` (coatWeight, coatF0, coatRoughness,
+/// coatAnisotropy, coatTangent, coatNormal, coatTransmittance): the coat slab,
+/// its coverage weight when coatWeight is not the literal 1, and the vertical.
+Value coatedRoot(const LayeredSurface& s, NodeWriter& w, const Value& base);
+/// The base's diffuse albedo, F0 and F90 (null: none) from the metallic workflow of `s`.
+void baseReflectance(const LayeredSurface& s, NodeWriter& w, bool metal, Value& diffuse, Value& f0, Value& f90);
 
 /// GGX alphas along the tangent and the bitangent, as a (roughness,
 /// anisotropy) pair of the slab: a = (at + ab) / 2, roughness = sqrt(a),
@@ -86,4 +103,4 @@ RoughnessAnisotropy fromAlphas(const Value& alphaT, const Value& alphaB);
 /// (a literal angle gives a literal vector, else rotation_to_tangent).
 Value rotatedTangent(const Value& angle);
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks

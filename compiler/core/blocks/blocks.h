@@ -1,0 +1,45 @@
+// The building blocks (docs/format.md, "Building blocks"): format nodes that
+// stand for the slabs, operators and value nodes an author would otherwise
+// write by hand. Each block is a signature (its pins, checked by the resolver
+// like any node's) and an expansion (the nodes it stands for), one mapping
+// unit per model:
+//   coated_layer                          coated_layer.cc
+//   clear_coat, ue4_default_lit, ue4_unlit   ue4.cc
+//   gltf_pbr                              gltf_pbr.cc (shared with the importers)
+// The expansion pass (blocks/expand.h) rewrites a document's blocks into
+// these nodes before the resolve of the pipeline.
+#pragma once
+#include <string_view>
+#include <vector>
+
+#include "blocks/material_writer.h"
+#include "passes/resolve.h"
+
+namespace substratec::blocks {
+
+struct BuildingBlock {
+  BlockSignature signature;
+  /// Writes the nodes `block` (a checked node of this kind) stands for into
+  /// `w` and returns its root: a reference to one of them, or a Substrate pin
+  /// of the block as it was given (a coat of weight 0 is its base).
+  Value (*expand)(const Json& block, NodeWriter& w);
+};
+
+/// Every building block, in the order docs/format.md lists them.
+const std::vector<BuildingBlock>& buildingBlocks();
+/// Their signatures (ResolveLimits::blocks).
+const std::vector<BlockSignature>& blockSignatures();
+/// The block of kind `kind`, or null.
+const BuildingBlock* findBuildingBlock(std::string_view kind);
+
+/// A block's pin as given, or null when absent.
+Value pinOf(const Json& block, const char* name);
+
+// The units (one per model).
+BuildingBlock coatedLayerBlock();
+BuildingBlock clearCoatBlock();
+BuildingBlock ue4DefaultLitBlock();
+BuildingBlock ue4UnlitBlock();
+BuildingBlock gltfPbrBuildingBlock();
+
+}  // namespace substratec::blocks

@@ -1,0 +1,159 @@
+#include "blocks/expand.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "blocks/blocks.h"
+
+namespace substratec::blocks {
+
+namespace {
+
+const BuildingBlock* blockOf(const Json& j) {
+  if (!j.is_object()) return nullptr;
+  auto k = j.find("kind");
+  return k != j.end() && k->is_string() ? findBuildingBlock(k->get_ref<const std::string&>()) : nullptr;
+}
+
+/// True when `j` or anything in it is a building block. Recursion is bounded
+/// by the reader's nesting limit.
+bool containsBlock(const Json& j) {
+  if (blockOf(j)) return true;
+  if (j.is_object() || j.is_array())
+    for (const Json& e : j)
+      if (containsBlock(e)) return true;
+  return false;
+}
+
+/// Collects the nodes a block's unit names, under "<prefix>_<part>".
+class ExpansionWriter final : public NodeWriter {
+ public:
+  ExpansionWriter(NameSet& names, std::string prefix) : names_(names), prefix_(std::move(prefix)) {}
+  Value node(std::string_view wantedId, Json body) override {
+    std::string id = names_.claim(sanitizeIdentifier(prefix_ + "_" + std::string(wantedId)));
+    nodes_.emplace_back(id, std::move(body));
+    return id;
+  }
+  std::vector<std::pair<std::string, Json>>& nodes() { return nodes_; }
+
+ private:
+  NameSet& names_;
+  std::string prefix_;
+  std::vector<std::pair<std::string, Json>> nodes_;
+};
+
+/// Replaces every string equal to `from` in `j` by `to` (a node renamed).
+void renameReferences(Json& j, const std::string& from, const std::string& to) {
+  if (j.is_string() && j.get_ref<const std::string&>() == from) j = to;
+  if (j.is_object() || j.is_array())
+    for (Json& e : j) renameReferences(e, from, to);
+}
+
+class Expander {
+ public:
+  Expander(const Json& doc, const ResolveLimits& limits, std::vector<ExpandedBlock>& expanded)
+      : limits_(limits), expanded_(expanded) {
+    names_.insert(doc.value("name", std::string()));
+    if (auto in = doc.find("inputs"); in != doc.end() && in->is_object())
+      for (auto it = in->begin(); it != in->end(); ++it) names_.insert(it.key());
+    for (auto it = doc["nodes"].begin(); it != doc["nodes"].end(); ++it) names_.insert(it.key());
+  }
+
+  /// The document's nodes, expanded, in order.
+  Json run(const Json& nodes) {
+    for (auto it = nodes.begin(); it != nodes.end(); ++it) {
+      const std::string ptr = "/nodes/" + pointerToken(it.key());
+      Json body = *it;
+      if (const BuildingBlock* b = blockOf(body)) {
+        const std::size_t record = expanded_.size();
+        Value root = expand(*b, body, it.key(), ptr);
+        if (!(root.is_string() && takeRoot(root.get<std::string>(), it.key(), record, body)))
+          body = Json{{"kind", "coverage_weight"}, {"a", std::move(root)}, {"weight", 1}};  // a pin as given
+      } else {
+        expandInline(body, it.key(), ptr);
+      }
+      out_[it.key()] = std::move(body);
+    }
+    return std::move(out_);
+  }
+
+  bool overLimit() const { return expansions_ > limits_.maxNodes; }
+
+ private:
+  /// Expands block `body` (its unit's nodes, expanded in turn, go to out_);
+  /// returns its root.
+  Value expand(const BuildingBlock& b, const Json& body, const std::string& id, const std::string& ptr) {
+    if (++expansions_ > limits_.maxNodes) return Value(id);  // reported by the caller
+    ExpansionWriter w(names_, id);
+    Value root = b.expand(body, w);
+    const std::size_t record = expanded_.size();
+    expanded_.push_back({id, b.signature.kind, ptr, {}});
+    for (auto& [nodeId, nodeBody] : w.nodes()) {
+      expandInline(nodeBody, nodeId, ptr);  // a block given inline as a pin (a coated_layer's base)
+      expanded_[record].nodes.push_back(nodeId);
+      out_[nodeId] = std::move(nodeBody);
+    }
+    return root;
+  }
+
+  /// When `root` is a node of expanded_[record], it is renamed `id` (its body
+  /// moved into `body`, references to it renamed); false otherwise.
+  bool takeRoot(const std::string& root, const std::string& id, std::size_t record, Json& body) {
+    if (record >= expanded_.size()) return false;
+    auto& nodes = expanded_[record].nodes;
+    auto it = out_.find(root);
+    if (it == out_.end() || std::find(nodes.begin(), nodes.end(), root) == nodes.end()) return false;
+    body = std::move(*it);
+    out_.erase(it);
+    for (auto& n : out_) renameReferences(n, root, id);
+    std::replace(nodes.begin(), nodes.end(), root, id);
+    return true;
+  }
+
+  /// Every inline block inside `j` (a node of id `owner`) replaced by a
+  /// reference to its root.
+  void expandInline(Json& j, const std::string& owner, const std::string& ptr) {
+    if (!j.is_object()) return;
+    for (auto it = j.begin(); it != j.end(); ++it) {
+      if (!it->is_object()) continue;
+      const std::string name = owner + "_" + it.key();
+      const std::string p = ptr + "/" + pointerToken(it.key());
+      if (const BuildingBlock* b = blockOf(*it))
+        *it = expand(*b, *it, name, p);
+      else
+        expandInline(*it, name, p);
+    }
+  }
+
+  const ResolveLimits& limits_;
+  std::vector<ExpandedBlock>& expanded_;
+  NameSet names_;
+  Json out_ = Json::object();
+  std::size_t expansions_ = 0;
+};
+
+}  // namespace
+
+bool hasBuildingBlocks(const Json& doc) {
+  auto nodes = doc.is_object() ? doc.find("nodes") : doc.end();
+  return doc.is_object() && nodes != doc.end() && containsBlock(*nodes);
+}
+
+std::optional<Json> expandBuildingBlocks(const Json& doc, Diagnostics& diags, const ResolveLimits& limits,
+                                         std::vector<ExpandedBlock>& expanded) {
+  ResolveLimits checking = limits;
+  checking.blocks = &blockSignatures();
+  if (!resolveDocument(doc, diags, checking)) return std::nullopt;
+  Expander expander(doc, limits, expanded);
+  Json out = doc;
+  out["nodes"] = expander.run(doc["nodes"]);
+  if (expander.overLimit()) {
+    diags.error("/nodes", fmt::format("the building blocks expand more than {} times (the node-count limit)",
+                                      limits.maxNodes));
+    return std::nullopt;
+  }
+  return out;
+}
+
+}  // namespace substratec::blocks
