@@ -14,6 +14,8 @@
 
 #include <gtest/gtest.h>
 
+#include "blocks/blocks.h"
+#include "blocks/expand.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/generate.h"
 #include "report/report.h"
@@ -96,6 +98,34 @@ TEST(Golden, EveryExampleReport) {
     checkGolden(kSource / "tests/golden" / (stem + ".report.txt"), formatReportText(*r));
     checkGolden(kSource / "tests/golden" / (stem + ".report.json"), reportJson(*r).dump(2) + "\n");
   }
+}
+
+// The building blocks' expansions (docs/format.md, "Building blocks"): each
+// tests/blocks/<block>.json, its document after the expand-blocks pass and
+// its report (the tree the expansion compiles to, and the blocks section that
+// names each block and the nodes it became).
+TEST(Golden, EveryBuildingBlockExpansion) {
+  auto inputs = filesIn(kSource / "tests/blocks", ".json");
+  std::set<std::string> kinds;
+  for (const auto& f : inputs) {
+    SCOPED_TRACE(f.filename().string());
+    const std::string display = "tests/blocks/" + f.filename().string();
+    auto [r, diags] = compileAs(f, display);
+    ASSERT_TRUE(r.has_value()) << diags;
+    EXPECT_EQ(diags, "");
+    Diagnostics d(display);
+    auto doc = parseJsonDocument(readFile(f), {}, d);
+    ASSERT_TRUE(doc);
+    std::vector<blocks::ExpandedBlock> expanded;
+    auto flat = blocks::expandBuildingBlocks(*doc, d, {}, expanded);
+    ASSERT_TRUE(flat) << d.formatAll();
+    for (const auto& b : expanded) kinds.insert(b.kind);
+    checkGolden(kSource / "tests/blocks" / (f.stem().string() + ".expected.txt"),
+                "----- expanded document -----\n" + flat->dump(2) + "\n" + formatReportText(*r));
+  }
+  std::set<std::string> all;
+  for (const auto& b : blocks::buildingBlocks()) all.insert(b.signature.kind);
+  EXPECT_EQ(kinds, all) << "every building block has an expansion golden";
 }
 
 TEST(Golden, EveryBadInputDiagnostic) {

@@ -33,6 +33,11 @@ CliRun cli(std::vector<std::string> args) {
   return {status, out.str(), err.str()};
 }
 
+std::string readText(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
 fs::path scratch(const std::string& name) {
   fs::path p = fs::temp_directory_path() / ("substratec_import_cli_" + std::to_string(::getpid())) / name;
   fs::remove_all(p);
@@ -53,6 +58,32 @@ TEST(ImportCli, WritesOneFilePerMaterialThatCompiles) {
   // What was written is an ordinary material: report reads it back.
   CliRun back = cli({"report", (out / "gold.json").string()});
   EXPECT_EQ(back.status, 0) << back.err;
+}
+
+/// `import` writes each glTF material as what its author wrote, one gltf_pbr
+/// building block (issue 23); `--expand` writes the slabs, operators and value
+/// nodes that block stands for. Both report the same bytes and closures.
+TEST(ImportCli, WritesAGltfPbrBlockOrWithExpandTheNodesItStandsFor) {
+  const fs::path blocks = scratch("blocks"), flat = scratch("flat");
+  const std::string source = (kCorpus / "gltf/ClearCoatTest.materials.json").string();
+  CliRun r = cli({"import", source, "-o", blocks.string(), "--material", "Simple_Coated"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  CliRun e = cli({"import", source, "-o", flat.string(), "--material", "Simple_Coated", "--expand"});
+  ASSERT_EQ(e.status, 0) << e.err;
+  const std::string asBlock = readText(blocks / "Simple_Coated.json"), expanded = readText(flat / "Simple_Coated.json");
+  EXPECT_NE(asBlock.find("\"kind\": \"gltf_pbr\""), std::string::npos) << asBlock;
+  EXPECT_NE(asBlock.find("\"clearcoat\": 1"), std::string::npos) << asBlock;
+  EXPECT_EQ(expanded.find("gltf_pbr"), std::string::npos) << expanded;
+  EXPECT_NE(expanded.find("\"kind\": \"vertical\""), std::string::npos) << expanded;
+  CliRun a = cli({"report", (blocks / "Simple_Coated.json").string(), "--json"});
+  CliRun b = cli({"report", (flat / "Simple_Coated.json").string(), "--json"});
+  ASSERT_EQ(a.status, 0) << a.err;
+  ASSERT_EQ(b.status, 0) << b.err;
+  const auto ja = nlohmann::json::parse(a.out), jb = nlohmann::json::parse(b.out);
+  EXPECT_EQ(ja["after"], jb["after"]);
+  EXPECT_EQ(ja["storage"], jb["storage"]);
+  EXPECT_EQ(ja["building_blocks"][0]["kind"], "gltf_pbr");
+  EXPECT_FALSE(jb.contains("building_blocks"));
 }
 
 /// An imported texture keeps its image as the input's `file` (issue 20), made

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Checks schema/substrate-material.schema.json and every examples/*.json against it.
+"""Checks schema/substrate-material.schema.json and every examples/*.json (and tests/blocks/*.json) against it.
 
 Usage: check_schema.py [REPO_ROOT]   (default: two directories above this script)
 
@@ -107,6 +107,12 @@ NEGATIVES = [
     ("horizontal mix literal out of [0,1]",
      _set(["nodes", "h"], {"kind": "horizontal", "background": "root", "foreground": "root", "mix": 1.5}),
      "/nodes/h/mix"),
+    ("coated_layer without its base",
+     _set(["nodes", "c"], {"kind": "coated_layer", "coat_roughness": 0.1}), "/nodes/c"),
+    ("ue4_default_lit with metallic 2",
+     _set(["nodes", "u"], {"kind": "ue4_default_lit", "metallic": 2}), "/nodes/u/metallic"),
+    ("gltf_pbr with an unknown alpha_mode",
+     _set(["nodes", "g"], {"kind": "gltf_pbr", "alpha_mode": "maybe"}), "/nodes/g/alpha_mode"),
     ("unknown settings key", _set(["settings"], {"bytes_per_pixel": 80, "budget": 3}), "/settings"),
     ("bytes_per_pixel out of range", _set(["settings"], {"bytes_per_pixel": 4}), "/settings/bytes_per_pixel"),
 ]
@@ -156,6 +162,15 @@ def main(argv):
             report(False, str(rel), "name %r is not the file stem %r" % (doc.get("name"), path.stem))
         else:
             report(True, str(rel))
+
+    # The building blocks' expansion inputs (tests/blocks: one per block kind).
+    blocks = sorted((root / "tests" / "blocks").glob("*.json"))
+    if not blocks:
+        report(False, "tests/blocks/*.json", "no building-block inputs found")
+    for path in blocks:
+        rel = path.relative_to(root)
+        err = first_error(load_strict(path))
+        report(err is None, str(rel), "" if err is None else "%s: %s" % (pointer(err.absolute_path), err.message))
 
     err = first_error(BASE)
     report(err is None, "negative: base document is valid",

@@ -7,7 +7,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <set>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "blocks/blocks.h"
 #include "blocks/expand.h"
@@ -214,6 +218,31 @@ TEST(BuildingBlocks, EveryBlockIsListedOnceWithItsPins) {
     EXPECT_EQ(blocks::findBuildingBlock(b.signature.kind), &b);
   }
   EXPECT_EQ(kinds, (std::set<std::string>{"coated_layer", "clear_coat", "ue4_default_lit", "ue4_unlit", "gltf_pbr"}));
+}
+
+TEST(BuildingBlocks, TheSchemaTakesEveryBlockWithTheResolversPins) {
+  std::ifstream in(std::string(SUBSTRATEC_SOURCE_DIR) + "/schema/substrate-material.schema.json");
+  const auto schema = nlohmann::json::parse(in);
+  int checked = 0;
+  for (const auto& b : blocks::buildingBlocks()) {
+    SCOPED_TRACE(b.signature.kind);
+    const auto& def = schema["$defs"]["kind_" + std::string(b.signature.kind)];
+    ASSERT_TRUE(def.is_object()) << "no kind_" << b.signature.kind << " in the schema";
+    std::set<std::string> pins{"kind", "comment"}, required{"kind"}, schemaPins, schemaRequired;
+    for (const auto& p : b.signature.pins) {
+      pins.insert(p.name);
+      if (p.required) required.insert(p.name);
+    }
+    for (const auto& [name, _] : def["properties"].items()) schemaPins.insert(name);
+    for (const auto& r : def["required"]) schemaRequired.insert(r.get<std::string>());
+    EXPECT_EQ(schemaPins, pins);
+    EXPECT_EQ(schemaRequired, required);
+    bool listed = false;
+    for (const auto& k : schema["$defs"]["substrate_node"]["properties"]["kind"]["enum"]) listed = listed || k == b.signature.kind;
+    EXPECT_TRUE(listed) << "substrate_node's kinds";
+    ++checked;
+  }
+  EXPECT_EQ(checked, 5);
 }
 
 }  // namespace
