@@ -6,6 +6,7 @@
 // reference); pricing sees through the expansion.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -16,6 +17,7 @@
 #include "blocks/blocks.h"
 #include "blocks/expand.h"
 #include "reference/reference.h"
+#include "substrate_constants.h"  // runtime_shaders/
 #include "test_util.h"
 
 namespace substratec {
@@ -105,6 +107,73 @@ TEST(BuildingBlocks, AClearCoatIsTheDefaultLitSlabUnderACoatOfIor15) {
   expectNear3(m.closures[1].f0, {0.9, 0.1, 0.1}, 1e-12, "metal f0");
   // clear_coat 0: the default-lit slab, 12 bytes.
   EXPECT_EQ(compiled(material(R"("root": {"kind": "clear_coat", "clear_coat": 0})")).after.bytes(), 12);
+}
+
+TEST(BuildingBlocks, ClothIsTheDefaultLitSlabWithFuzz) {
+  const CompileResult r = compiled(material(R"("root": {"kind": "cloth", "base_color": [0.3, 0.3, 0.6],
+      "roughness": 0.7, "cloth": 0.8, "fuzz_color": [0.9, 0.8, 0.7]})"));
+  ASSERT_EQ(r.after.closures.size(), 1u);
+  const auto m = evaluated(r);
+  EXPECT_NEAR(m.closures[0].fuzzAmount, 0.8, 1e-12);
+  expectNear3(m.closures[0].fuzzColor, {0.9, 0.8, 0.7}, 1e-12, "fuzz colour");
+  EXPECT_NEAR(m.closures[0].fuzzRoughness, 0.7, 1e-12) << "the slab's roughness";
+  EXPECT_EQ(compiled(material(R"("root": {"kind": "cloth", "cloth": 0})")).after.bytes(), 12);
+}
+
+/// legacy_conversion of `model` with `pins` (a JSON fragment, may be empty).
+CompileResult legacy(const std::string& model, const std::string& pins = "") {
+  return compiled(material(R"("root": {"kind": "legacy_conversion", "shading_model": ")" + model + "\"" +
+                           (pins.empty() ? "" : ", " + pins) + "}"));
+}
+
+TEST(BuildingBlocks, ALegacyConversionPricesEachUe4ShadingModelAsTheCourseDoes) {
+  // The course's table: the legacy Disney diffuse/specular/roughness 12 bytes,
+  // the legacy shading models (a subsurface) 16 bytes.
+  const std::string base = R"("base_color": [0.7, 0.4, 0.3], "roughness": 0.45)";
+  EXPECT_EQ(legacy("default_lit", base).after.bytes(), 12);
+  for (const char* sss : {"subsurface", "preintegrated_skin", "two_sided_foliage"}) {
+    const CompileResult r = legacy(sss, base + R"(, "subsurface_color": [0.9, 0.4, 0.2])");
+    EXPECT_EQ(r.after.bytes(), 16) << sss;
+    ASSERT_EQ(r.material.slabs.size(), 1u);
+    EXPECT_EQ(r.material.slabs[0].sssType, SssType::Wrap) << sss;
+  }
+  EXPECT_EQ(legacy("subsurface_profile", base + R"(, "subsurface_mfp": [0.004, 0.002, 0.001])").after.bytes(), 16);
+  EXPECT_EQ(legacy("subsurface_profile", base).after.bytes(), 12) << "no profile MFP: no subsurface";
+  EXPECT_EQ(legacy("cloth", base).after.bytes(), 16);
+  EXPECT_EQ(legacy("unlit", R"("emissive_color": 1)").after.closures.size(), 0u);
+  EXPECT_EQ(legacy("clear_coat", base).after.closures.size(), 2u);
+}
+
+TEST(BuildingBlocks, ALegacyConversionBuildsTheUe4ModelsOwnBsdf) {
+  int models = 0;
+  for (const char* model : {"default_lit", "unlit", "subsurface", "preintegrated_skin", "clear_coat",
+                            "subsurface_profile", "two_sided_foliage", "cloth", "hair", "eye", "single_layer_water",
+                            "thin_translucent"}) {
+    SCOPED_TRACE(model);
+    const CompileResult r = legacy(model, R"("base_color": [0.5, 0.5, 0.5])");
+    EXPECT_FALSE(r.material.nodes.empty());
+    ++models;
+  }
+  EXPECT_EQ(models, 12);
+  EXPECT_EQ(legacy("hair").material.slabs[0].kind, BsdfKind::Hair);
+  EXPECT_EQ(legacy("eye", R"("iris_mask": 0.5)").material.slabs[0].kind, BsdfKind::Eye);
+  // The water: extinction = scattering + absorption, albedo = scattering / extinction.
+  const CompileResult water = legacy("single_layer_water", R"("water_scattering": [0.1, 0.2, 0.3],
+      "water_absorption": [0.3, 0.2, 0.1])");
+  ASSERT_EQ(water.material.slabs.size(), 1u);
+  EXPECT_EQ(water.material.slabs[0].kind, BsdfKind::Water);
+  const auto m = evaluated(water);
+  ASSERT_TRUE(m.water.has_value());
+  expectNear3(m.water->extinction, {0.4, 0.4, 0.4}, 1e-12, "extinction");
+  expectNear3(m.water->albedo, {0.25, 0.5, 0.75}, 1e-12, "albedo");
+  // Subsurface: a wrap of per-channel amount min(subsurface colour, 0.95).
+  // (A medium needs a diffuse albedo to scatter: UE's BaseColor default 0 has none.)
+  const auto sss = evaluated(legacy("subsurface", R"("base_color": 0.8, "subsurface_color": [1, 0.5, 0])"));
+  ASSERT_EQ(sss.closures.size(), 1u);
+  for (int c = 0; c < 3; ++c) {
+    const double w = std::min(std::array<double, 3>{1, 0.5, 0}[c], 0.95);
+    EXPECT_NEAR(sss.closures[0].sssMfp[c], SUBSTRATE_SSS_WRAP_MFP_SCALE * w / (1 - w), 1e-12) << c;
+  }
 }
 
 TEST(BuildingBlocks, AGltfPbrWithoutItsExtensionsCostsAPlainSlab) {
@@ -217,7 +286,8 @@ TEST(BuildingBlocks, EveryBlockIsListedOnceWithItsPins) {
     EXPECT_FALSE(b.signature.pins.empty()) << b.signature.kind;
     EXPECT_EQ(blocks::findBuildingBlock(b.signature.kind), &b);
   }
-  EXPECT_EQ(kinds, (std::set<std::string>{"coated_layer", "clear_coat", "ue4_default_lit", "ue4_unlit", "gltf_pbr"}));
+  EXPECT_EQ(kinds, (std::set<std::string>{"coated_layer", "clear_coat", "cloth", "ue4_default_lit", "ue4_unlit",
+                                          "legacy_conversion", "gltf_pbr"}));
 }
 
 TEST(BuildingBlocks, TheSchemaTakesEveryBlockWithTheResolversPins) {
@@ -242,7 +312,7 @@ TEST(BuildingBlocks, TheSchemaTakesEveryBlockWithTheResolversPins) {
     EXPECT_TRUE(listed) << "substrate_node's kinds";
     ++checked;
   }
-  EXPECT_EQ(checked, 5);
+  EXPECT_EQ(checked, 7);
 }
 
 }  // namespace

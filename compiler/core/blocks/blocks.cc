@@ -3,8 +3,9 @@
 namespace substratec::blocks {
 
 const std::vector<BuildingBlock>& buildingBlocks() {
-  static const std::vector<BuildingBlock> blocks = {coatedLayerBlock(), clearCoatBlock(), ue4DefaultLitBlock(),
-                                                    ue4UnlitBlock(), gltfPbrBuildingBlock()};
+  static const std::vector<BuildingBlock> blocks = {coatedLayerBlock(),   clearCoatBlock(), clothBlock(),
+                                                    ue4DefaultLitBlock(), ue4UnlitBlock(),  legacyConversionBlock(),
+                                                    gltfPbrBuildingBlock()};
   return blocks;
 }
 

@@ -4,7 +4,8 @@
 // like any node's) and an expansion (the nodes it stands for), one mapping
 // unit per model:
 //   coated_layer                          coated_layer.cc
-//   clear_coat, ue4_default_lit, ue4_unlit   ue4.cc
+//   clear_coat, cloth, ue4_default_lit, ue4_unlit,
+//   legacy_conversion                     ue4.cc
 //   gltf_pbr                              gltf_pbr.cc (shared with the importers)
 // The expansion pass (blocks/expand.h) rewrites a document's blocks into
 // these nodes before the resolve of the pipeline.
@@ -39,7 +40,9 @@ Value pinOf(const Json& block, const char* name);
 BuildingBlock coatedLayerBlock();
 BuildingBlock clearCoatBlock();
 BuildingBlock ue4DefaultLitBlock();
+BuildingBlock clothBlock();
 BuildingBlock ue4UnlitBlock();
+BuildingBlock legacyConversionBlock();
 BuildingBlock gltfPbrBuildingBlock();
 
 }  // namespace substratec::blocks
