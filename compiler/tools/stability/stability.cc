@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "blocks/expand.h"
 #include "pipeline/generate.h"
 #include "emit/kernel_emitter.h"
 #include "gpu/sample_run.h"
@@ -473,6 +474,14 @@ bool forceableText(const std::string& text, std::string* rewritten, std::vector<
   if (doc.is_discarded() || !doc.is_object()) {
     diags.fail("the material is not a JSON object");
     return false;
+  }
+  // The forced pins are the slabs' and operators' a building block stands
+  // for: its expansion's (blocks/expand.h), rewritten as a hand-written one.
+  if (blocks::hasBuildingBlocks(doc)) {
+    std::vector<blocks::ExpandedBlock> expanded;
+    auto flat = blocks::expandBuildingBlocks(doc, diags, ResolveLimits{}, expanded);
+    if (!flat) return false;
+    doc = std::move(*flat);
   }
   if (!doc.contains("inputs") || !doc["inputs"].is_object()) doc["inputs"] = json::object();
   Rewriter rw;
