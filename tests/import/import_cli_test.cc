@@ -86,6 +86,25 @@ TEST(ImportCli, WritesAGltfPbrBlockOrWithExpandTheNodesItStandsFor) {
   EXPECT_FALSE(jb.contains("building_blocks"));
 }
 
+/// A MaterialX Standard Surface is written as the standard_surface block, its
+/// given inputs as pins under their MaterialX names; --expand writes its nodes.
+TEST(ImportCli, WritesAStandardSurfaceAsItsBlock) {
+  const fs::path blocks = scratch("mtlx_blocks"), flat = scratch("mtlx_flat");
+  const std::string source = (kCorpus / "materialx/StandardSurface/standard_surface_carpaint.mtlx").string();
+  CliRun r = cli({"import", source, "-o", blocks.string()});
+  ASSERT_EQ(r.status, 0) << r.err;
+  CliRun e = cli({"import", source, "-o", flat.string(), "--expand"});
+  ASSERT_EQ(e.status, 0) << e.err;
+  EXPECT_EQ(r.err, e.err) << "the same warnings either way";
+  std::vector<fs::path> written;
+  for (const auto& f : fs::directory_iterator(blocks)) written.push_back(f.path());
+  ASSERT_EQ(written.size(), 1u);
+  const auto block = nlohmann::json::parse(readText(written[0]));
+  EXPECT_EQ(block["nodes"]["surface"]["kind"], "standard_surface") << block.dump(1);
+  EXPECT_TRUE(block["nodes"]["surface"].contains("coat")) << "a car paint's coat, under its MaterialX name";
+  EXPECT_EQ(readText(flat / written[0].filename()).find("standard_surface\""), std::string::npos);
+}
+
 /// An imported texture keeps its image as the input's `file` (issue 20), made
 /// relative to where the material is written, so that the written material
 /// finds the image the source document named.

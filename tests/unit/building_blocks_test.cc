@@ -176,6 +176,44 @@ TEST(BuildingBlocks, ALegacyConversionBuildsTheUe4ModelsOwnBsdf) {
   }
 }
 
+TEST(BuildingBlocks, AStandardSurfaceIsTheMaterialXImportersUnitOnItsPins) {
+  // Standard Surface's defaults but base_color and a rough specular: one slab,
+  // diffuse = base · base_color, F0 of IOR 1.5, roughness specular_roughness.
+  const CompileResult r = compiled(material(R"("root": {"kind": "standard_surface", "base": 0.9,
+      "base_color": [0.5, 0.25, 0.125], "specular_roughness": 0.35})"));
+  EXPECT_EQ(r.after.bytes(), 12);
+  const auto m = evaluated(r);
+  ASSERT_EQ(m.closures.size(), 1u);
+  expectNear3(m.closures[0].diffuseAlbedo, {0.45, 0.225, 0.1125}, 1e-12, "diffuse");
+  expectNear3(m.closures[0].f0, {0.04, 0.04, 0.04}, 1e-12, "f0");
+  EXPECT_NEAR(m.closures[0].roughness, 0.35, 1e-12);
+  // A coat adds its closure; OpenPBR and Disney principled read their own names.
+  EXPECT_EQ(compiled(material(R"("root": {"kind": "standard_surface", "coat": 1})")).after.closures.size(), 2u);
+  EXPECT_EQ(compiled(material(R"("root": {"kind": "open_pbr_surface", "coat_weight": 1})")).after.closures.size(), 2u);
+  EXPECT_EQ(compiled(material(R"("root": {"kind": "disney_principled", "clearcoat": 1})")).after.closures.size(), 2u);
+}
+
+TEST(BuildingBlocks, AMaterialXBlockReadsAnInputAtItsValueWhereItsModelNeedsAConstant) {
+  // specular_rotation is read as a constant (it decides the tangent): "$rot"
+  // is read at its default, a quarter turn, as MaterialX's import reads it.
+  const std::string inputs = R"({"rot": {"type": "float", "default": 0.25}})";
+  const auto m = evaluated(compiled(material(R"("root": {"kind": "standard_surface", "specular_anisotropy": 0.5,
+      "specular_rotation": "$rot"})", inputs)));
+  ASSERT_EQ(m.closures.size(), 1u);
+  expectNear3(m.closures[0].T_, {0, 1, 0}, 1e-9, "the tangent a quarter turn round the normal");
+}
+
+TEST(BuildingBlocks, WhatAMaterialXBlockCannotRepresentIsAWarningAtTheBlock) {
+  Diagnostics d("test.json");
+  const auto r = compileText("test.json", material(R"("root": {"kind": "standard_surface",
+      "diffuse_roughness": 0.5})"), {}, d);
+  ASSERT_TRUE(r) << d.formatAll();
+  EXPECT_NE(d.formatAll().find("warning: standard_surface: diffuse_roughness: a slab's diffuse roughness is its "
+                               "specular roughness; ignored [/nodes/root]"),
+            std::string::npos)
+      << d.formatAll();
+}
+
 TEST(BuildingBlocks, AGltfPbrWithoutItsExtensionsCostsAPlainSlab) {
   const CompileResult r = compiled(material(R"("root": {"kind": "gltf_pbr", "base_color": [0.7, 0.7, 0.2],
       "metallic": 0, "roughness": 0.5, "clearcoat": 0, "sheen_color": 0, "transmission": 0})"));
@@ -287,7 +325,8 @@ TEST(BuildingBlocks, EveryBlockIsListedOnceWithItsPins) {
     EXPECT_EQ(blocks::findBuildingBlock(b.signature.kind), &b);
   }
   EXPECT_EQ(kinds, (std::set<std::string>{"coated_layer", "clear_coat", "cloth", "ue4_default_lit", "ue4_unlit",
-                                          "legacy_conversion", "gltf_pbr"}));
+                                          "legacy_conversion", "gltf_pbr", "standard_surface", "open_pbr_surface",
+                                          "disney_principled"}));
 }
 
 TEST(BuildingBlocks, TheSchemaTakesEveryBlockWithTheResolversPins) {
@@ -312,7 +351,7 @@ TEST(BuildingBlocks, TheSchemaTakesEveryBlockWithTheResolversPins) {
     EXPECT_TRUE(listed) << "substrate_node's kinds";
     ++checked;
   }
-  EXPECT_EQ(checked, 7);
+  EXPECT_EQ(checked, 10);
 }
 
 }  // namespace

@@ -5,7 +5,8 @@ namespace substratec::blocks {
 const std::vector<BuildingBlock>& buildingBlocks() {
   static const std::vector<BuildingBlock> blocks = {coatedLayerBlock(),   clearCoatBlock(), clothBlock(),
                                                     ue4DefaultLitBlock(), ue4UnlitBlock(),  legacyConversionBlock(),
-                                                    gltfPbrBuildingBlock()};
+                                                    gltfPbrBuildingBlock(), standardSurfaceBlock(),
+                                                    openPbrSurfaceBlock(),  disneyPrincipledBlock()};
   return blocks;
 }
 

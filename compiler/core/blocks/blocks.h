@@ -7,6 +7,9 @@
 //   clear_coat, cloth, ue4_default_lit, ue4_unlit,
 //   legacy_conversion                     ue4.cc
 //   gltf_pbr                              gltf_pbr.cc (shared with the importers)
+//   standard_surface, open_pbr_surface,
+//   disney_principled                     mtlx_blocks.cc over mtlx_surfaces.h's units
+//                                         (shared with the MaterialX importer)
 // The expansion pass (blocks/expand.h) rewrites a document's blocks into
 // these nodes before the resolve of the pipeline.
 #pragma once
@@ -18,12 +21,19 @@
 
 namespace substratec::blocks {
 
+/// What a block's unit is given besides its pins.
+struct BlockContext {
+  NodeWriter& w;                      // where its nodes go
+  const Json& document;               // the document it is in (its inputs' values)
+  std::vector<std::string> warnings;  // what it cannot represent (reported at the block)
+};
+
 struct BuildingBlock {
   BlockSignature signature;
   /// Writes the nodes `block` (a checked node of this kind) stands for into
-  /// `w` and returns its root: a reference to one of them, or a Substrate pin
+  /// c.w and returns its root: a reference to one of them, or a Substrate pin
   /// of the block as it was given (a coat of weight 0 is its base).
-  Value (*expand)(const Json& block, NodeWriter& w);
+  Value (*expand)(const Json& block, BlockContext& c);
 };
 
 /// Every building block, in the order docs/format.md lists them.
@@ -44,5 +54,8 @@ BuildingBlock clothBlock();
 BuildingBlock ue4UnlitBlock();
 BuildingBlock legacyConversionBlock();
 BuildingBlock gltfPbrBuildingBlock();
+BuildingBlock standardSurfaceBlock();
+BuildingBlock openPbrSurfaceBlock();
+BuildingBlock disneyPrincipledBlock();
 
 }  // namespace substratec::blocks

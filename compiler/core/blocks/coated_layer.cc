@@ -10,7 +10,8 @@ namespace {
 
 using Kind = BlockPin::Kind;
 
-Value expandCoatedLayer(const Json& block, NodeWriter& w) {
+Value expandCoatedLayer(const Json& block, BlockContext& c) {
+  NodeWriter& w = c.w;
   LayeredSurface s;
   s.coatWeight = pinOf(block, "coat_weight");
   if (s.coatWeight.is_null()) s.coatWeight = 1.0;

@@ -29,17 +29,28 @@ bool containsBlock(const Json& j) {
 /// Collects the nodes a block's unit names, under "<prefix>_<part>".
 class ExpansionWriter final : public NodeWriter {
  public:
-  ExpansionWriter(NameSet& names, std::string prefix) : names_(names), prefix_(std::move(prefix)) {}
+  ExpansionWriter(NameSet& names, std::string prefix, Json& inputs)
+      : names_(names), prefix_(std::move(prefix)), inputs_(inputs) {}
   Value node(std::string_view wantedId, Json body) override {
     std::string id = names_.claim(sanitizeIdentifier(prefix_ + "_" + std::string(wantedId)));
     nodes_.emplace_back(id, std::move(body));
     return id;
+  }
+  /// An input "<prefix>_presence" of 0, as an importer keeps a source's
+  /// invisible material: it keeps its matter, and its coverage can be raised.
+  Value invisiblePresence() override {
+    const std::string id = names_.claim(sanitizeIdentifier(prefix_ + "_presence"));
+    inputs_[id] = Json{{"type", "float"}, {"default", 0}, {"min", 0}, {"max", 1},
+                       {"description", "the presence of a block whose opacity is 0 (an input, so that the material "
+                                       "keeps its matter)"}};
+    return "$" + id;
   }
   std::vector<std::pair<std::string, Json>>& nodes() { return nodes_; }
 
  private:
   NameSet& names_;
   std::string prefix_;
+  Json& inputs_;
   std::vector<std::pair<std::string, Json>> nodes_;
 };
 
@@ -52,8 +63,8 @@ void renameReferences(Json& j, const std::string& from, const std::string& to) {
 
 class Expander {
  public:
-  Expander(const Json& doc, const ResolveLimits& limits, std::vector<ExpandedBlock>& expanded)
-      : limits_(limits), expanded_(expanded) {
+  Expander(const Json& doc, const ResolveLimits& limits, std::vector<ExpandedBlock>& expanded, Diagnostics& diags)
+      : doc_(doc), limits_(limits), expanded_(expanded), diags_(diags) {
     names_.insert(doc.value("name", std::string()));
     if (auto in = doc.find("inputs"); in != doc.end() && in->is_object())
       for (auto it = in->begin(); it != in->end(); ++it) names_.insert(it.key());
@@ -79,14 +90,18 @@ class Expander {
   }
 
   bool overLimit() const { return expansions_ > limits_.maxNodes; }
+  /// The inputs the expansions added (invisible presences).
+  const Json& addedInputs() const { return inputs_; }
 
  private:
   /// Expands block `body` (its unit's nodes, expanded in turn, go to out_);
   /// returns its root.
   Value expand(const BuildingBlock& b, const Json& body, const std::string& id, const std::string& ptr) {
     if (++expansions_ > limits_.maxNodes) return Value(id);  // reported by the caller
-    ExpansionWriter w(names_, id);
-    Value root = b.expand(body, w);
+    ExpansionWriter w(names_, id, inputs_);
+    BlockContext context{w, doc_, {}};
+    Value root = b.expand(body, context);
+    for (const std::string& warning : context.warnings) diags_.warning(ptr, fmt::format("{}: {}", b.signature.kind, warning));
     const std::size_t record = expanded_.size();
     expanded_.push_back({id, b.signature.kind, ptr, {}});
     for (auto& [nodeId, nodeBody] : w.nodes()) {
@@ -126,10 +141,13 @@ class Expander {
     }
   }
 
+  const Json& doc_;
   const ResolveLimits& limits_;
   std::vector<ExpandedBlock>& expanded_;
+  Diagnostics& diags_;
   NameSet names_;
   Json out_ = Json::object();
+  Json inputs_ = Json::object();
   std::size_t expansions_ = 0;
 };
 
@@ -145,9 +163,13 @@ std::optional<Json> expandBuildingBlocks(const Json& doc, Diagnostics& diags, co
   ResolveLimits checking = limits;
   checking.blocks = &blockSignatures();
   if (!resolveDocument(doc, diags, checking)) return std::nullopt;
-  Expander expander(doc, limits, expanded);
+  Expander expander(doc, limits, expanded, diags);
   Json out = doc;
   out["nodes"] = expander.run(doc["nodes"]);
+  if (!expander.addedInputs().empty()) {
+    if (!out.contains("inputs") || !out["inputs"].is_object()) out["inputs"] = Json::object();
+    for (const auto& [name, input] : expander.addedInputs().items()) out["inputs"][name] = input;
+  }
   if (expander.overLimit()) {
     diags.error("/nodes", fmt::format("the building blocks expand more than {} times (the node-count limit)",
                                       limits.maxNodes));

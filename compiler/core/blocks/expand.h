@@ -8,7 +8,9 @@
 // (references to it are unchanged); an inline block becomes a reference to
 // its root; the other nodes are named "<block id>_<part>" and placed before
 // the block. A block inside a block (a coated_layer's base) is expanded in
-// turn. A document without blocks is left as it is.
+// turn. A block whose presence folds to 0 (a glTF alpha of 0) gets an input
+// "<block id>_presence" of 0, as an imported invisible material does. A
+// document without blocks is left as it is.
 #pragma once
 #include <optional>
 #include <string>

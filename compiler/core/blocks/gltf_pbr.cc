@@ -249,8 +249,8 @@ Json gltfPbrBlock(const GltfPbr& g) {
 }
 
 BuildingBlock gltfPbrBuildingBlock() {
-  return {gltfPbrSignature(), [](const Json& block, NodeWriter& w) {
-            return layeredSurfaceNodes(gltfPbrSurface(gltfPbrOfBlock(block), w), w);
+  return {gltfPbrSignature(), [](const Json& block, BlockContext& c) {
+            return layeredSurfaceNodes(gltfPbrSurface(gltfPbrOfBlock(block), c.w), c.w);
           }};
 }
 

@@ -107,9 +107,10 @@ class NodeWriter {
   virtual ~NodeWriter() = default;
   /// A named node (value or Substrate) like `wantedId`; returns its id as a reference.
   virtual Value node(std::string_view wantedId, Json body) = 0;
-  /// What a presence that folds to the constant 0 becomes: the literal 0 (a
-  /// block keeps what its author wrote), or, for an importer, an input (the
-  /// source's invisible material is kept as one whose coverage can be raised).
+  /// What a presence that folds to the constant 0 becomes: the literal 0 (the
+  /// material has no matter left), or an input of 0 (an importer's, a
+  /// block's expansion: the invisible material is kept as one whose coverage
+  /// can be raised).
   virtual Value invisiblePresence() { return Value(0.0); }
 };
 
@@ -150,6 +151,8 @@ class MaterialWriter : public NodeWriter {
   void setOutput(const Value& root) { output_ = root.get<std::string>(); }
 
   const std::string& name() const { return name_; }
+  /// The inputs written so far (the document's "inputs" object).
+  const Json& inputs() const { return inputs_; }
   /// The document as text (2-space indented JSON, '\n'-terminated).
   std::string text() const;
 

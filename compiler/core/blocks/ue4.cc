@@ -217,25 +217,28 @@ Value expandLegacy(const Json& block, NodeWriter& w) {
 
 }  // namespace
 
-BuildingBlock ue4DefaultLitBlock() { return {{"ue4_default_lit", defaultLitPins()}, expandDefaultLit}; }
+BuildingBlock ue4DefaultLitBlock() {
+  return {{"ue4_default_lit", defaultLitPins()}, [](const Json& b, BlockContext& c) { return expandDefaultLit(b, c.w); }};
+}
 
 BuildingBlock clearCoatBlock() {
   std::vector<BlockPin> pins = defaultLitPins();
   pins.push_back({"clear_coat", Kind::Float, 0, 1});
   pins.push_back({"clear_coat_roughness", Kind::Float, 0, 1});
   pins.push_back({"bottom_normal", Kind::Vec3});
-  return {{"clear_coat", pins}, expandClearCoat};
+  return {{"clear_coat", pins}, [](const Json& b, BlockContext& c) { return expandClearCoat(b, c.w); }};
 }
 
 BuildingBlock clothBlock() {
   std::vector<BlockPin> pins = defaultLitPins();
   pins.push_back({"cloth", Kind::Float, 0, 1});
   pins.push_back({"fuzz_color", Kind::Color, 0, 1});
-  return {{"cloth", pins}, expandCloth};
+  return {{"cloth", pins}, [](const Json& b, BlockContext& c) { return expandCloth(b, c.w); }};
 }
 
 BuildingBlock ue4UnlitBlock() {
-  return {{"ue4_unlit", {{"emissive_color", Kind::Color, 0, kBig}, {"opacity", Kind::Float, 0, 1}}}, expandUnlit};
+  return {{"ue4_unlit", {{"emissive_color", Kind::Color, 0, kBig}, {"opacity", Kind::Float, 0, 1}}},
+          [](const Json& b, BlockContext& c) { return expandUnlit(b, c.w); }};
 }
 
 BuildingBlock legacyConversionBlock() {
@@ -252,7 +255,7 @@ BuildingBlock legacyConversionBlock() {
       {"water_absorption", Kind::Color, 0, kBig}, {"water_phase_g", Kind::Float, -1, 1},
       {"color_scale_behind_water", Kind::Color, 0, kBig}, {"transmittance_color", Kind::Color, 0, 1}};
   pins.insert(pins.end(), more.begin(), more.end());
-  return {{"legacy_conversion", pins}, expandLegacy};
+  return {{"legacy_conversion", pins}, [](const Json& b, BlockContext& c) { return expandLegacy(b, c.w); }};
 }
 
 }  // namespace substratec::blocks

@@ -45,7 +45,7 @@ std::optional<std::vector<ImportedMaterial>> importText(SourceKind kind, const s
   std::vector<ImportedMaterial> out;
   bool ok = false;
   if (kind == SourceKind::MaterialX) {
-    ok = importMaterialXDocument(text, fileName, baseDir, limits, diags, &out);
+    ok = importMaterialXDocument(text, fileName, baseDir, limits, diags, &out, form);
   } else {
     std::string json = text;
     std::optional<std::size_t> binBytes;

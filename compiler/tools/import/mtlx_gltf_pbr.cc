@@ -7,26 +7,26 @@
 
 namespace substratec::import {
 
-LayeredSurface mtlxGltfPbr(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+LayeredSurface mtlxGltfPbr(SurfaceParams& params, NodeWriter& w) {
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   GltfPbr g;
   g.baseColor = P("base_color", "color3", {1, 1, 1});
   g.metallic = P("metallic", "float", {1}, ParamKind::Switch);
   g.roughness = P("roughness", "float", {1});
-  if (v.given(n, "normal")) g.normal = P("normal", "vector3", {0, 0, 1});
-  if (v.given(n, "occlusion"))
-    v.warn(n, "occlusion: ambient occlusion is the renderer's (a Substrate material has no occlusion pin); ignored");
+  if (params.given("normal")) g.normal = P("normal", "vector3", {0, 0, 1});
+  if (params.given("occlusion"))
+    params.warn("occlusion: ambient occlusion is the renderer's (a Substrate material has no occlusion pin); ignored");
   const int mode = static_cast<int>(C("alpha_mode", "integer", {0})[0]);
   g.alphaMode = mode == 1 ? AlphaMode::Mask : mode == 2 ? AlphaMode::Blend : AlphaMode::Opaque;
   g.alphaCutoff = C("alpha_cutoff", "float", {0.5})[0];
   if (g.alphaMode != AlphaMode::Opaque) g.alpha = P("alpha", "float", {1}, ParamKind::Switch);
-  if (v.given(n, "ior")) g.ior = P("ior", "float", {1.5});
+  if (params.given("ior")) g.ior = P("ior", "float", {1.5});
   g.specular = P("specular", "float", {1}, ParamKind::Switch);
   g.specularColor = P("specular_color", "color3", {1, 1, 1});
   g.transmission = P("transmission", "float", {0}, ParamKind::Switch);
   if (!isLiteral(g.transmission, 0))
-    v.warn(n, std::string("transmission: ") + kTransmissionNote);
+    params.warn(std::string("transmission: ") + kTransmissionNote);
   g.thickness = P("thickness", "float", {0});
   g.attenuationDistance = C("attenuation_distance", "float", {0})[0];
   if (g.attenuationDistance >= 1e30) g.attenuationDistance = 0;
@@ -38,16 +38,16 @@ LayeredSurface mtlxGltfPbr(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
   g.sheenRoughness = P("sheen_roughness", "float", {0});
   g.clearcoat = P("clearcoat", "float", {0}, ParamKind::Switch);
   g.clearcoatRoughness = P("clearcoat_roughness", "float", {0});
-  if (v.given(n, "clearcoat_normal")) g.clearcoatNormal = P("clearcoat_normal", "vector3", {0, 0, 1});
+  if (params.given("clearcoat_normal")) g.clearcoatNormal = P("clearcoat_normal", "vector3", {0, 0, 1});
   g.anisotropyStrength = P("anisotropy_strength", "float", {0}, ParamKind::Switch);
   g.anisotropyRotation = C("anisotropy_rotation", "float", {0})[0];
-  if (v.given(n, "emissive")) {
+  if (params.given("emissive")) {
     const Value e = P("emissive", "color3", {0, 0, 0});
     const Value strength = P("emissive_strength", "float", {1});
     if (!isLiteral(e, 0)) g.emissive = mul(e, strength);
   }
   if (C("dispersion", "float", {0})[0] != 0)
-    v.warn(n, "dispersion (an IOR per wavelength) is not represented; one IOR for every colour");
+    params.warn("dispersion (an IOR per wavelength) is not represented; one IOR for every colour");
   return gltfPbrSurface(g, w);
 }
 

@@ -27,6 +27,7 @@
 
 #include "diag/diagnostics.h"
 #include "blocks/material_writer.h"
+#include "blocks/surface_params.h"
 #include "import/mtlx_document.h"
 
 namespace substratec::import {
@@ -34,11 +35,6 @@ namespace substratec::import {
 // The value writer, the layered surface and the glTF model live in blocks/,
 // shared with the building blocks' expansion.
 using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
-
-/// How a shading node's own value becomes a Substrate value (as for glTF):
-/// Plain: a material input when the document gives it; Switch: a literal at
-/// 0 and 1 (a weight's off and fully-on values), else an input.
-enum class ParamKind { Plain, Switch };
 
 class MtlxValues {
  public:

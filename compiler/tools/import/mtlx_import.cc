@@ -12,40 +12,6 @@
 
 namespace substratec::import {
 
-RoughnessAnisotropy mtlxRoughnessAnisotropy(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
-                                            const std::string& prefix) {
-  const Value r = namedValue(w, prefix + "roughness", roughness);
-  const Value a = namedValue(w, prefix + "alpha", vmax(mul(r, r), 1e-6));
-  const Value aspect = namedValue(w, prefix + "aspect", vsqrt(oneMinus(vmin(anisotropy, 0.98))));
-  const Value at = namedValue(w, prefix + "alpha_t", vmin(divide(a, aspect), 1.0));
-  const Value ab = namedValue(w, prefix + "alpha_b", mul(a, aspect));
-  return fromAlphas(at, ab);
-}
-
-RoughnessAnisotropy roughnessPins(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
-                                  const std::string& prefix, AnisotropyModel model) {
-  if (anisotropy.is_null() || isLiteral(anisotropy, 0)) return {roughness, Value()};
-  const RoughnessAnisotropy ra = model(roughness, anisotropy, w, prefix);
-  return {namedValue(w, (prefix == "specular_" ? "" : prefix) + "anisotropic_roughness", ra.roughness), ra.anisotropy};
-}
-
-void mtlxTransmission(pugi::xml_node n, MtlxValues& v, const Value& weight, const char* dispersion,
-                      LayeredSurface& s) {
-  auto C = [&](const char* name, const char* type, std::vector<double> def) {
-    return v.constant(n, name, type, def).value_or(def);
-  };
-  s.transmission = weight;
-  s.transmittance = v.param(n, "transmission_color", "color3", {1, 1, 1});
-  v.warn(n, std::string("transmission: ") + kTransmissionNote);
-  if (C("transmission_depth", "float", {0})[0] > 0)
-    v.warn(n, "transmission_depth: a surface material does not know the object's thickness; transmission_color "
-              "is applied once, as if the light crossed one depth");
-  const auto scatter = C("transmission_scatter", "color3", {0, 0, 0});
-  if (scatter[0] != 0 || scatter[1] != 0 || scatter[2] != 0)
-    v.warn(n, "transmission_scatter: volume scattering inside the transmitting medium is not represented");
-  if (C(dispersion, "float", {0})[0] != 0) v.warn(n, std::string(dispersion) + ": one IOR for every colour; dispersion ignored");
-}
-
 // ---- chiang_hair_bsdf (under a `surface`) as the format's hair node ----
 // The formulas and their sources: mtlx_hair.h. In short:
 //   roughness, azimuthal_roughness = the inverses of chiang_hair_roughness's
@@ -278,7 +244,7 @@ void chiangHairSurface(pugi::xml_node surface, pugi::xml_node bsdf, MtlxValues& 
 
 namespace {
 
-using SurfaceFn = LayeredSurface (*)(pugi::xml_node, MtlxValues&, MaterialWriter&);
+using SurfaceFn = SurfaceUnit;
 
 SurfaceFn modelOf(const std::string& kind) {
   if (kind == "standard_surface") return standardSurface;
@@ -287,6 +253,24 @@ SurfaceFn modelOf(const std::string& kind) {
   if (kind == "UsdPreviewSurface") return usdPreviewSurface;
   if (kind == "disney_principled") return disneyPrincipled;
   return nullptr;
+}
+
+/// A shader whose model is a building block, written as that block (node
+/// "surface", the output): its given parameters as pins, and the settings
+/// and warnings of the block's expansion (run here on a scratch writer: the
+/// unit is the same, so they are the flat import's).
+void writeModelBlock(pugi::xml_node shader, ShaderParams& params, MtlxValues& values, MaterialWriter& w) {
+  const Json block = blockModelBlock(shader.name(), params);
+  std::vector<std::string> warnings;
+  const Json document = {{"inputs", w.inputs()}};
+  BlockParams pins(block, document, warnings);
+  DiscardingNodeWriter scratch;
+  const LayeredSurface s = blockModelUnit(shader.name())(pins, scratch);
+  for (const std::string& warning : warnings) values.warn(shader, warning);
+  const Value root = w.node("surface", block);
+  const Json settings = layeredSurfaceSettings(s);
+  for (const auto& [key, value] : settings.items()) w.setSetting(key, value);
+  w.setOutput(root);
 }
 
 /// The chiang_hair_bsdf a `surface` shader scatters with (its bsdf input), or a null node.
@@ -315,7 +299,8 @@ void unsupportedShader(MtlxValues& values, pugi::xml_node shader, const std::str
 }  // namespace
 
 bool importMaterialXDocument(const std::string& text, const std::string& fileName, const std::string& baseDir,
-                             const ReadLimits& limits, Diagnostics& diags, std::vector<ImportedMaterial>* out) {
+                             const ReadLimits& limits, Diagnostics& diags, std::vector<ImportedMaterial>* out,
+                             ImportForm form) {
   MtlxDocument doc;
   if (!doc.load(text, fileName, baseDir, limits, diags)) return false;
   bool ok = true;
@@ -362,14 +347,17 @@ bool importMaterialXDocument(const std::string& text, const std::string& fileNam
       continue;
     }
     LayeredSurface s;
-    if (model) s = model(shader, values, w);
+    ShaderParams params(shader, values);
+    const bool asBlock = form == ImportForm::Blocks && blockModelUnit(shader.name());
+    if (asBlock) writeModelBlock(shader, params, values, w);
+    else if (model) s = model(params, w);
     else chiangHairSurface(shader, hairBsdf, values, w);
     for (std::size_t i = 0; i < bound.size(); ++i) values.popBinding();
     if (!values.ok()) {
       ok = false;
       continue;
     }
-    if (model) writeLayeredSurface(s, w);
+    if (model && !asBlock) writeLayeredSurface(s, w);
     out->push_back({sourceName, name, fmt::format("line {}", line), w.text(), {}});
   }
   return ok;

@@ -20,8 +20,11 @@ namespace substratec::import {
 using namespace substratec::blocks;  // NOLINT(google-build-using-namespace)
 
 /// Appends the materials of the MaterialX document `text` (from `fileName`;
-/// includes read from `baseDir`). False on any error.
+/// includes read from `baseDir`). A Standard Surface, OpenPBR or Disney
+/// principled shader is written as its building block, or expanded (`form`).
+/// False on any error.
 bool importMaterialXDocument(const std::string& text, const std::string& fileName, const std::string& baseDir,
-                             const ReadLimits& limits, Diagnostics& diags, std::vector<ImportedMaterial>* out);
+                             const ReadLimits& limits, Diagnostics& diags, std::vector<ImportedMaterial>* out,
+                             ImportForm form = ImportForm::Blocks);
 
 }  // namespace substratec::import

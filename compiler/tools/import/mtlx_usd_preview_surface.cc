@@ -11,9 +11,9 @@
 
 namespace substratec::import {
 
-LayeredSurface usdPreviewSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+LayeredSurface usdPreviewSurface(SurfaceParams& params, NodeWriter& w) {
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   (void)w;
   LayeredSurface s;
   s.baseColor = P("diffuseColor", "color3", {0.18, 0.18, 0.18});
@@ -26,7 +26,7 @@ LayeredSurface usdPreviewSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter
     const Value ior = P("ior", "float", {1.5});
     if (!isLiteral(ior, 1.5)) s.specularF0 = iorToF0Value(ior);
   }
-  if (v.given(n, "normal")) s.normal = P("normal", "vector3", {0, 0, 1});
+  if (params.given("normal")) s.normal = P("normal", "vector3", {0, 0, 1});
   const Value emissive = P("emissiveColor", "color3", {0, 0, 0});
   if (!isLiteral(emissive, 0)) s.emissive = emissive;
   const Value clearcoat = P("clearcoat", "float", {0}, ParamKind::Switch);
@@ -46,9 +46,9 @@ LayeredSurface usdPreviewSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter
       s.transmission = oneMinus(opacity);
     }
   }
-  if (v.given(n, "displacement")) v.warn(n, "displacement is geometry, not a surface material; ignored");
-  if (v.given(n, "occlusion"))
-    v.warn(n, "occlusion: ambient occlusion is the renderer's (a Substrate material has no occlusion pin); ignored");
+  if (params.given("displacement")) params.warn("displacement is geometry, not a surface material; ignored");
+  if (params.given("occlusion"))
+    params.warn("occlusion: ambient occlusion is the renderer's (a Substrate material has no occlusion pin); ignored");
   return s;
 }
 

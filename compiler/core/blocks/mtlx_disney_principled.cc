@@ -7,12 +7,12 @@
 //   MaterialX's sheen_bsdf); clearcoat → coat (F0 0.04, roughness 1 −
 //   clearcoatGloss); specTrans → transmission tinted by baseColor;
 //   subsurface → SSS mfp = subsurfaceDistance · subsurface (metres).
-#include "import/mtlx_surfaces.h"
+#include "blocks/mtlx_surfaces.h"
 
-namespace substratec::import {
+namespace substratec::blocks {
 
-LayeredSurface disneyPrincipled(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  const MtlxParam P{n, v};
+LayeredSurface disneyPrincipled(SurfaceParams& params, NodeWriter& w) {
+  const MtlxParam P{params};
   LayeredSurface s;
   const Value baseColor = namedValue(w, "base_color_value", P("baseColor", "color3", {0.16, 0.16, 0.16}));
   s.baseColor = baseColor;
@@ -44,11 +44,11 @@ LayeredSurface disneyPrincipled(pugi::xml_node n, MtlxValues& v, MaterialWriter&
     s.transmittance = baseColor;
     const Value ior = P("ior", "float", {1.5});
     if (!isLiteral(ior, 1.5) && s.specularF0.is_null()) s.specularF0 = iorToF0Value(ior);
-    v.warn(n, std::string("specTrans: ") + kTransmissionNote);
+    params.warn(std::string("specTrans: ") + kTransmissionNote);
   }
   const Value subsurface = P("subsurface", "float", {0}, ParamKind::Switch);
   if (!isLiteral(subsurface, 0)) s.sssMfp = mul(P("subsurfaceDistance", "color3", {1, 1, 1}), subsurface);
   return s;
 }
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks

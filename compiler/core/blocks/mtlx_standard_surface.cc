@@ -15,18 +15,18 @@
 //   opacity (luminance) → presence.
 #include <fmt/format.h>
 
-#include "import/mtlx_surfaces.h"
+#include "blocks/mtlx_surfaces.h"
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 namespace {
 constexpr double kTwoPi = 6.28318530717958647692;
 
 /// The coat (coat not 0): F0(coat_IOR), its roughness, anisotropy and rotation,
 /// normal, and per-pass transmittance sqrt(coat_color).
-void standardCoat(pugi::xml_node n, MtlxValues& v, MaterialWriter& w, const Value& coat, LayeredSurface& s) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+void standardCoat(SurfaceParams& params, NodeWriter& w, const Value& coat, LayeredSurface& s) {
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
   s.coatWeight = coat;
   s.coatF0 = iorToF0Value(P("coat_IOR", "float", {1.5}));
@@ -36,18 +36,18 @@ void standardCoat(pugi::xml_node n, MtlxValues& v, MaterialWriter& w, const Valu
   s.coatRoughness = ra.roughness;
   s.coatAnisotropy = ra.anisotropy;
   if (!off(coatAnisotropy, 0)) s.coatTangent = rotatedTangent(C("coat_rotation", "float", {0})[0] * kTwoPi);
-  if (v.given(n, "coat_normal")) s.coatNormal = P("coat_normal", "vector3", {0, 0, 1});
+  if (params.given("coat_normal")) s.coatNormal = P("coat_normal", "vector3", {0, 0, 1});
   const Value coatColor = P("coat_color", "color3", {1, 1, 1});
   if (!isLiteral(coatColor, 1)) s.coatTransmittance = vsqrt(coatColor);
 }
 
 /// Thin film (thickness in nm), emission and transmission.
-void standardFilmEmissionTransmission(pugi::xml_node n, MtlxValues& v, LayeredSurface& s) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+void standardFilmEmissionTransmission(SurfaceParams& params, LayeredSurface& s) {
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
   const double film = C("thin_film_thickness", "float", {0})[0];
-  if (film > 0 || (v.given(n, "thin_film_thickness") && !v.constant(n, "thin_film_thickness", "float", {0}))) {
+  if (film > 0 || (params.given("thin_film_thickness") && !params.constant("thin_film_thickness", "float", {0}))) {
     s.filmWeight = 1.0;
     s.filmThickness = mul(P("thin_film_thickness", "float", {0}), 1e-9);
     s.filmIor = P("thin_film_IOR", "float", {1.5});
@@ -58,17 +58,17 @@ void standardFilmEmissionTransmission(pugi::xml_node n, MtlxValues& v, LayeredSu
 
   const Value transmission = P("transmission", "float", {0}, ParamKind::Switch);
   if (!off(transmission, 0)) {
-    mtlxTransmission(n, v, transmission, "transmission_dispersion", s);
+    mtlxTransmission(params, transmission, "transmission_dispersion", s);
     if (C("transmission_extra_roughness", "float", {0})[0] != 0)
-      v.warn(n, "transmission_extra_roughness: the transmitted light is not blurred; ignored");
+      params.warn("transmission_extra_roughness: the transmitted light is not blurred; ignored");
   }
 }
 
 }  // namespace
 
-LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+LayeredSurface standardSurface(SurfaceParams& params, NodeWriter& w) {
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
   LayeredSurface s;
   const Value base = P("base", "float", {1}, ParamKind::Switch);
@@ -79,12 +79,12 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
   const Value coat = P("coat", "float", {0}, ParamKind::Switch);
 
   if (C("diffuse_roughness", "float", {0})[0] != 0)
-    v.warn(n, "diffuse_roughness: a slab's diffuse roughness is its specular roughness; ignored");
+    params.warn("diffuse_roughness: a slab's diffuse roughness is its specular roughness; ignored");
 
   const Value metalColor = mul(base, baseColor);
   s.metallic = metalness;
   Value diffuse = baseColor;
-  if (!off(coat, 0) && v.given(n, "coat_affect_color")) {
+  if (!off(coat, 0) && params.given("coat_affect_color")) {
     const Value affect = P("coat_affect_color", "float", {0});
     diffuse = vpow(vmax(baseColor, 0.0), add(1.0, mul(coat, affect)));
   }
@@ -96,7 +96,7 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
     const Value scale = P("subsurface_scale", "float", {1});
     s.sssMfp = mul(mul(radius, scale), subsurface);
     if (C("subsurface_anisotropy", "float", {0})[0] != 0)
-      v.warn(n, "subsurface_anisotropy: the slab's medium scatters isotropically in the runtime; ignored");
+      params.warn("subsurface_anisotropy: the slab's medium scatters isotropically in the runtime; ignored");
   }
   if (!(diffuse == metalColor)) s.diffuseColor = diffuse;
   s.baseColor = namedValue(w, "metal_color", metalColor);
@@ -110,15 +110,15 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
   if (!off(metalness, 0) && !isLiteral(tint, 1)) s.metalF90 = tint;
 
   Value roughness = P("specular_roughness", "float", {0.2});
-  if (!off(coat, 0) && v.given(n, "coat_affect_roughness"))
+  if (!off(coat, 0) && params.given("coat_affect_roughness"))
     roughness = vlerp(roughness, 1.0, mul(mul(coat, P("coat_affect_roughness", "float", {0})), P("coat_roughness", "float", {0.1})));
   const Value anisotropy = P("specular_anisotropy", "float", {0}, ParamKind::Switch);
   const RoughnessAnisotropy ra = roughnessPins(roughness, anisotropy, w, "specular_");
   s.roughness = ra.roughness;
   s.anisotropy = ra.anisotropy;
   if (!off(anisotropy, 0)) s.tangent = rotatedTangent(C("specular_rotation", "float", {0})[0] * kTwoPi);
-  s.normal = v.given(n, "normal") ? P("normal", "vector3", {0, 0, 1}) : Value();
-  if (v.given(n, "tangent")) v.warn(n, "tangent: a connected tangent is not imported; the geometric tangent is used");
+  s.normal = params.given("normal") ? P("normal", "vector3", {0, 0, 1}) : Value();
+  if (params.given("tangent")) params.warn("tangent: a connected tangent is not imported; the geometric tangent is used");
 
   const Value sheen = P("sheen", "float", {0}, ParamKind::Switch);
   if (!off(sheen, 0)) {
@@ -127,11 +127,11 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
     s.fuzzRoughness = P("sheen_roughness", "float", {0.3});
   }
 
-  standardFilmEmissionTransmission(n, v, s);
+  standardFilmEmissionTransmission(params, s);
 
-  if (!off(coat, 0)) standardCoat(n, v, w, coat, s);
+  if (!off(coat, 0)) standardCoat(params, w, coat, s);
 
-  if (v.given(n, "opacity")) {
+  if (params.given("opacity")) {
     const Value opacity = P("opacity", "color3", {1, 1, 1});
     if (!isLiteral(opacity, 1)) {
       s.opacity = vdot(opacity, literal3(0.2126, 0.7152, 0.0722));
@@ -142,4 +142,4 @@ LayeredSurface standardSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& 
   return s;
 }
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks

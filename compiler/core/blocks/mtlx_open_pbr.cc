@@ -14,13 +14,13 @@
 //            thin_film_thickness (µm), thin_film_ior; emission_luminance (nits) ·
 //            emission_color; transmission_weight tinted by transmission_color;
 //            geometry_opacity → presence; geometry_thin_walled → thin surface.
-#include "import/mtlx_surfaces.h"
+#include "blocks/mtlx_surfaces.h"
 
-namespace substratec::import {
+namespace substratec::blocks {
 
 namespace {
 
-RoughnessAnisotropy openPbrAnisotropy(const Value& roughness, const Value& anisotropy, MaterialWriter& w,
+RoughnessAnisotropy openPbrAnisotropy(const Value& roughness, const Value& anisotropy, NodeWriter& w,
                                       const std::string& prefix) {
   const Value r = namedValue(w, prefix + "roughness", roughness);
   const Value inv = namedValue(w, prefix + "anisotropy_invert", oneMinus(anisotropy));
@@ -30,29 +30,29 @@ RoughnessAnisotropy openPbrAnisotropy(const Value& roughness, const Value& aniso
 
 /// The coat (coat_weight not 0): F0(coat_ior), its roughness and anisotropy,
 /// normal, per-pass transmittance sqrt(coat_color).
-void openPbrCoat(pugi::xml_node n, MtlxValues& v, MaterialWriter& w, const Value& coat, const Value& coatRoughness,
+void openPbrCoat(SurfaceParams& params, NodeWriter& w, const Value& coat, const Value& coatRoughness,
                  LayeredSurface& s) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   s.coatWeight = coat;
   s.coatF0 = iorToF0Value(P("coat_ior", "float", {1.6}));
   const Value coatAnisotropy = P("coat_roughness_anisotropy", "float", {0}, ParamKind::Switch);
   const RoughnessAnisotropy ra = roughnessPins(coatRoughness, coatAnisotropy, w, "coat_", openPbrAnisotropy);
   s.coatRoughness = ra.roughness;
   s.coatAnisotropy = ra.anisotropy;
-  if (v.given(n, "geometry_coat_normal")) s.coatNormal = P("geometry_coat_normal", "vector3", {0, 0, 1});
+  if (params.given("geometry_coat_normal")) s.coatNormal = P("geometry_coat_normal", "vector3", {0, 0, 1});
   const Value coatColor = P("coat_color", "color3", {1, 1, 1});
   if (!isLiteral(coatColor, 1)) s.coatTransmittance = vsqrt(coatColor);
   if (C("coat_darkening", "float", {1})[0] > 0)
-    v.warn(n, "coat_darkening: light trapped under the coat by internal reflection is not modelled; the base is "
+    params.warn("coat_darkening: light trapped under the coat by internal reflection is not modelled; the base is "
               "seen through the coat's transmittance only");
 }
 
 }  // namespace
 
-LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w) {
-  const MtlxParam P{n, v};
-  const MtlxConstant C{n, v};
+LayeredSurface openPbrSurface(SurfaceParams& params, NodeWriter& w) {
+  const MtlxParam P{params};
+  const MtlxConstant C{params};
   auto off = [](const Value& x, double neutral) { return x.is_null() || isLiteral(x, neutral); };
   LayeredSurface s;
   const Value weight = P("base_weight", "float", {1}, ParamKind::Switch);
@@ -60,7 +60,7 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   const Value metalColor = mul(weight, color);
   s.metallic = P("base_metalness", "float", {0}, ParamKind::Switch);
   if (C("base_diffuse_roughness", "float", {0})[0] != 0)
-    v.warn(n, "base_diffuse_roughness: a slab's diffuse roughness is its specular roughness; ignored");
+    params.warn("base_diffuse_roughness: a slab's diffuse roughness is its specular roughness; ignored");
   Value diffuse = metalColor;
   const Value subsurface = P("subsurface_weight", "float", {0}, ParamKind::Switch);
   if (!off(subsurface, 0)) {
@@ -68,7 +68,7 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
     s.sssMfp = mul(mul(P("subsurface_radius_scale", "color3", {1, 0.5, 0.25}), P("subsurface_radius", "float", {1})),
                    subsurface);
     if (C("subsurface_scatter_anisotropy", "float", {0})[0] != 0)
-      v.warn(n, "subsurface_scatter_anisotropy: the slab's medium scatters isotropically in the runtime; ignored");
+      params.warn("subsurface_scatter_anisotropy: the slab's medium scatters isotropically in the runtime; ignored");
   }
   if (!(diffuse == metalColor)) s.diffuseColor = diffuse;
   s.baseColor = namedValue(w, "metal_color", metalColor);
@@ -96,9 +96,9 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   const RoughnessAnisotropy ra = roughnessPins(roughness, anisotropy, w, "specular_", openPbrAnisotropy);
   s.roughness = ra.roughness;
   s.anisotropy = ra.anisotropy;
-  if (v.given(n, "geometry_normal")) s.normal = P("geometry_normal", "vector3", {0, 0, 1});
+  if (params.given("geometry_normal")) s.normal = P("geometry_normal", "vector3", {0, 0, 1});
   for (const char* t : {"geometry_tangent", "geometry_coat_tangent"})
-    if (v.given(n, t)) v.warn(n, std::string(t) + ": a connected tangent is not imported; the geometric tangent is used");
+    if (params.given(t)) params.warn(std::string(t) + ": a connected tangent is not imported; the geometric tangent is used");
 
   const Value fuzz = P("fuzz_weight", "float", {0}, ParamKind::Switch);
   if (!off(fuzz, 0)) {
@@ -116,9 +116,9 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   if (!off(luminance, 0)) s.emissive = mul(luminance, P("emission_color", "color3", {1, 1, 1}));
 
   const Value transmission = P("transmission_weight", "float", {0}, ParamKind::Switch);
-  if (!off(transmission, 0)) mtlxTransmission(n, v, transmission, "transmission_dispersion_scale", s);
+  if (!off(transmission, 0)) mtlxTransmission(params, transmission, "transmission_dispersion_scale", s);
 
-  if (!off(coat, 0)) openPbrCoat(n, v, w, coat, coatRoughness, s);
+  if (!off(coat, 0)) openPbrCoat(params, w, coat, coatRoughness, s);
 
   const Value opacity = P("geometry_opacity", "float", {1}, ParamKind::Switch);
   if (!isLiteral(opacity, 1)) {
@@ -129,4 +129,4 @@ LayeredSurface openPbrSurface(pugi::xml_node n, MtlxValues& v, MaterialWriter& w
   return s;
 }
 
-}  // namespace substratec::import
+}  // namespace substratec::blocks
