@@ -170,6 +170,12 @@ std::optional<Json> expandBuildingBlocks(const Json& doc, Diagnostics& diags, co
     if (!out.contains("inputs") || !out["inputs"].is_object()) out["inputs"] = Json::object();
     for (const auto& [name, input] : expander.addedInputs().items()) out["inputs"][name] = input;
   }
+  // What the resolve and the later passes say of an expansion's nodes is said
+  // at the block the author wrote.
+  for (const ExpandedBlock& b : expanded)
+    for (const std::string& node : b.nodes)
+      diags.mapPointers("/nodes/" + pointerToken(node), b.pointer,
+                        fmt::format("in what {} {} expands into", b.kind, quoteForDiagnostic(b.id)));
   if (expander.overLimit()) {
     diags.error("/nodes", fmt::format("the building blocks expand more than {} times (the node-count limit)",
                                       limits.maxNodes));

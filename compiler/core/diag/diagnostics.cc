@@ -50,7 +50,17 @@ void Diagnostics::located(Severity severity, std::string file, int line, int col
   push(std::move(d));
 }
 
+void Diagnostics::mapPointers(std::string generated, std::string source, std::string what) {
+  mapped_.push_back({std::move(generated), std::move(source), std::move(what)});
+}
+
 void Diagnostics::pointed(Severity severity, std::string pointer, std::string message) {
+  for (const MappedPointers& m : mapped_)
+    if (pointer == m.generated || pointer.starts_with(m.generated + "/")) {
+      message += fmt::format(" ({}, at {})", m.what, pointer);
+      pointer = m.source;
+      break;
+    }
   int line = 0, column = 0;
   if (locator_ && !locator_->locate(pointer, line, column)) line = column = 0;
   located(severity, file_, line, column, std::move(message), std::move(pointer));

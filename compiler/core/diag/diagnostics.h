@@ -70,6 +70,11 @@ class Diagnostics {
   /// vkCreateDevice failed: ..."). Prints like any unlocated diagnostic (`file: error: msg`).
   void fail(std::string message);
 
+  /// Pointers into what a rewrite generated (a building block's expansion):
+  /// a later diagnostic at `generated` or under it is reported at `source`,
+  /// its message saying `what` it was about and the pointer it had.
+  void mapPointers(std::string generated, std::string source, std::string what);
+
   /// The document later pointers are located in (the reader sets it after a
   /// successful parse; nullptr: pointers stay unlocated).
   void setLocator(std::shared_ptr<const SourceLocator> locator) { locator_ = std::move(locator); }
@@ -98,6 +103,10 @@ class Diagnostics {
   std::size_t dropped_ = 0;
   std::vector<Diagnostic> list_;
   std::shared_ptr<const SourceLocator> locator_;
+  struct MappedPointers {
+    std::string generated, source, what;
+  };
+  std::vector<MappedPointers> mapped_;
 };
 
 /// Escapes one reference token for a JSON pointer ("~" -> "~0", "/" -> "~1").

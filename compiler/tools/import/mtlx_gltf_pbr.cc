@@ -7,7 +7,7 @@
 
 namespace substratec::import {
 
-LayeredSurface mtlxGltfPbr(SurfaceParams& params, NodeWriter& w) {
+GltfPbr mtlxGltfPbrParams(SurfaceParams& params) {
   const MtlxParam P{params};
   const MtlxConstant C{params};
   GltfPbr g;
@@ -48,7 +48,9 @@ LayeredSurface mtlxGltfPbr(SurfaceParams& params, NodeWriter& w) {
   }
   if (C("dispersion", "float", {0})[0] != 0)
     params.warn("dispersion (an IOR per wavelength) is not represented; one IOR for every colour");
-  return gltfPbrSurface(g, w);
+  return g;
 }
+
+LayeredSurface mtlxGltfPbr(SurfaceParams& params, NodeWriter& w) { return gltfPbrSurface(mtlxGltfPbrParams(params), w); }
 
 }  // namespace substratec::import

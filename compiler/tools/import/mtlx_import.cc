@@ -348,8 +348,10 @@ bool importMaterialXDocument(const std::string& text, const std::string& fileNam
     }
     LayeredSurface s;
     ShaderParams params(shader, values);
-    const bool asBlock = form == ImportForm::Blocks && blockModelUnit(shader.name());
-    if (asBlock) writeModelBlock(shader, params, values, w);
+    const bool gltfBlock = form == ImportForm::Blocks && std::string(shader.name()) == "gltf_pbr";
+    const bool asBlock = gltfBlock || (form == ImportForm::Blocks && blockModelUnit(shader.name()));
+    if (gltfBlock) writeGltfPbrBlock(mtlxGltfPbrParams(params), w);
+    else if (asBlock) writeModelBlock(shader, params, values, w);
     else if (model) s = model(params, w);
     else chiangHairSurface(shader, hairBsdf, values, w);
     for (std::size_t i = 0; i < bound.size(); ++i) values.popBinding();

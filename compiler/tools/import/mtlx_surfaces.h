@@ -3,13 +3,14 @@
 // the others, one unit each, each turning its shader node's inputs (through
 // SurfaceParams) into a LayeredSurface with its own formulas (docs/import.md,
 // "MaterialX"):
-//   mtlx_gltf_pbr.cc              MaterialX's gltf_pbr (through gltf_pbr.h)
+//   mtlx_gltf_pbr.cc              MaterialX's gltf_pbr (through gltf_pbr.h; block gltf_pbr)
 //   mtlx_usd_preview_surface.cc   UsdPreviewSurface
 // and a `surface` of MaterialX's chiang_hair_bsdf, written straight as the
 // format's hair node (chiangHairSurface in mtlx_import.cc; mtlx_hair.h).
 #pragma once
 #include <pugixml.hpp>
 
+#include "blocks/gltf_pbr.h"
 #include "blocks/mtlx_surfaces.h"
 #include "import/mtlx_graph.h"
 
@@ -40,6 +41,8 @@ class ShaderParams final : public SurfaceParams {
 };
 
 LayeredSurface mtlxGltfPbr(SurfaceParams& params, NodeWriter& w);
+/// MaterialX's gltf_pbr as the glTF parameters (the gltf_pbr block's pins).
+GltfPbr mtlxGltfPbrParams(SurfaceParams& params);
 LayeredSurface usdPreviewSurface(SurfaceParams& params, NodeWriter& w);
 /// A `surface` whose bsdf is a chiang_hair_bsdf: the hair node, the output of `w`.
 void chiangHairSurface(pugi::xml_node surface, pugi::xml_node bsdf, MtlxValues& v, MaterialWriter& w);
