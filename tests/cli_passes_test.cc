@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "cli/cli.h"
 #include "cli_util.h"
@@ -39,6 +40,18 @@ TEST(CliPasses, PrintAfterDumpsThatPassOnStderrAndChangesNothingElse) {
   const CliResult last = cli({"report", "--print-after", "simplify", kPassesExample});
   EXPECT_NE(last.err.find("SLAB"), std::string::npos) << "the tree is dumped\n" << last.err;
   std::printf("[ passes   ] report --print-after: %zu passes dumped\n", checked);
+}
+
+TEST(CliPasses, PrintAfterExpandBlocksShowsTheFlatFormOfAnAuthoredMaterial) {
+  const std::string blocks = std::string(SUBSTRATEC_SOURCE_DIR) + "/tests/blocks/clear_coat.json";
+  const CliResult r = cli({"report", "--print-after=expand-blocks", "--stop-after=expand-blocks", blocks});
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "") << "stopped: no report";
+  ASSERT_EQ(r.err.rfind("; document after expand-blocks\n", 0), 0u) << r.err;
+  const auto doc = nlohmann::ordered_json::parse(r.err.substr(r.err.find('\n') + 1));
+  EXPECT_EQ(doc["nodes"]["root"]["kind"], "vertical") << "the clear_coat block's root, under its id";
+  EXPECT_EQ(doc["nodes"]["root_slab"]["kind"], "slab");
+  EXPECT_EQ(r.err.find("\"clear_coat\""), std::string::npos) << "no block is left";
 }
 
 TEST(CliPasses, StopAfterEmitsNothingAndExitsZero) {

@@ -109,7 +109,11 @@ bool runPass(const Pass& pass, PassContext& c) {
     double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     c.result.timings.push_back({std::string(pass.name), ms});
   }
-  if (c.options.printAfterAll || pass.name == c.options.printAfter)
+  // Before build-tree the material is empty: after expand-blocks, the
+  // document the blocks expanded into is what there is to see.
+  if ((c.options.printAfterAll || pass.name == c.options.printAfter) && pass.name == "expand-blocks" && c.doc)
+    c.result.debugLog += fmt::format("; document after {}\n{}\n", pass.name, c.doc->dump(2));
+  else if (c.options.printAfterAll || pass.name == c.options.printAfter)
     c.result.debugLog += fmt::format("; IR after {}\n{}\n", pass.name, dumpMaterial(c.result.material));
   return ok;
 }
