@@ -54,13 +54,6 @@ class ExpansionWriter final : public NodeWriter {
   std::vector<std::pair<std::string, Json>> nodes_;
 };
 
-/// Replaces every string equal to `from` in `j` by `to` (a node renamed).
-void renameReferences(Json& j, const std::string& from, const std::string& to) {
-  if (j.is_string() && j.get_ref<const std::string&>() == from) j = to;
-  if (j.is_object() || j.is_array())
-    for (Json& e : j) renameReferences(e, from, to);
-}
-
 class Expander {
  public:
   Expander(const Json& doc, const ResolveLimits& limits, std::vector<ExpandedBlock>& expanded, Diagnostics& diags)
@@ -113,7 +106,8 @@ class Expander {
   }
 
   /// When `root` is a node of expanded_[record], it is renamed `id` (its body
-  /// moved into `body`, references to it renamed); false otherwise.
+  /// moved into `body`); false otherwise. Nothing refers to it by its old
+  /// name: it is the top of its expansion, and the name was new.
   bool takeRoot(const std::string& root, const std::string& id, std::size_t record, Json& body) {
     if (record >= expanded_.size()) return false;
     auto& nodes = expanded_[record].nodes;
@@ -121,7 +115,6 @@ class Expander {
     if (it == out_.end() || std::find(nodes.begin(), nodes.end(), root) == nodes.end()) return false;
     body = std::move(*it);
     out_.erase(it);
-    for (auto& n : out_) renameReferences(n, root, id);
     std::replace(nodes.begin(), nodes.end(), root, id);
     return true;
   }
@@ -164,7 +157,8 @@ std::optional<Json> expandBuildingBlocks(const Json& doc, Diagnostics& diags, co
   checking.blocks = &blockSignatures();
   if (!resolveDocument(doc, diags, checking)) return std::nullopt;
   Expander expander(doc, limits, expanded, diags);
-  Json out = doc;
+  Json out = Json::object();  // the document's members in order, its nodes expanded
+  for (auto it = doc.begin(); it != doc.end(); ++it) out[it.key()] = it.key() == "nodes" ? Json() : *it;
   out["nodes"] = expander.run(doc["nodes"]);
   if (!expander.addedInputs().empty()) {
     if (!out.contains("inputs") || !out["inputs"].is_object()) out["inputs"] = Json::object();

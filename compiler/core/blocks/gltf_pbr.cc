@@ -1,9 +1,9 @@
 #include "blocks/gltf_pbr.h"
 
-#include "blocks/blocks.h"
-
 #include <algorithm>
 #include <cmath>
+
+#include "blocks/blocks.h"
 
 namespace substratec::blocks {
 
