@@ -1330,7 +1330,8 @@ void addImportOptions(CLI::App* c, ImportArgs& a) {
   addMaterialChoice(c, a.in.material, "Import only this material (by name or identifier)");
   c->add_flag("--force", a.force, "Replace files in the output directory that an import of the same source did not write");
   c->add_flag("--expand", a.expand,
-              "Write each material's building block (gltf_pbr) as the slabs, operators and value nodes it stands for");
+              "Write each material's building block (gltf_pbr, standard_surface, open_pbr_surface, disney_principled) "
+              "as the slabs, operators and value nodes it stands for");
   addMaxInputSize(c, a.compile);
 }
 

@@ -258,10 +258,7 @@ void writeGltfPbrBlock(GltfPbr g, MaterialWriter& w) {
   DiscardingNodeWriter scratch;  // the surface, for its settings and presence only
   const LayeredSurface s = gltfPbrSurface(g, scratch);
   if (presenceFoldsToZero(s)) g.alpha = w.invisiblePresence();
-  const Value root = w.node("surface", gltfPbrBlock(g));
-  const Json settings = layeredSurfaceSettings(s);  // items() holds no temporary alive
-  for (const auto& [key, value] : settings.items()) w.setSetting(key, value);
-  w.setOutput(root);
+  writeSurfaceOutput(s, w.node("surface", gltfPbrBlock(g)), w);
 }
 
 GltfPbr gltfPbrOfBlock(const Json& block) {

@@ -207,11 +207,12 @@ Json layeredSurfaceSettings(const LayeredSurface& s) {
   return settings;
 }
 
-void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) {
-  const Value root = layeredSurfaceNodes(s, w);
+void writeSurfaceOutput(const LayeredSurface& s, const Value& root, MaterialWriter& w) {
   const Json settings = layeredSurfaceSettings(s);  // items() holds no temporary alive
   for (const auto& [key, value] : settings.items()) w.setSetting(key, value);
   w.setOutput(root);
 }
+
+void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w) { writeSurfaceOutput(s, layeredSurfaceNodes(s, w), w); }
 
 }  // namespace substratec::blocks

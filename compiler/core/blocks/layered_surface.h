@@ -81,6 +81,9 @@ Json layeredSurfaceSettings(const LayeredSurface& s);
 /// below a mask's cutoff, given as a literal): its nodes then take the
 /// writer's invisiblePresence().
 bool presenceFoldsToZero(const LayeredSurface& s);
+/// `root` as the output of `w`, with the settings `s` needs
+/// (layeredSurfaceSettings): the end of every importer's material.
+void writeSurfaceOutput(const LayeredSurface& s, const Value& root, MaterialWriter& w);
 /// Writes `s` into `w`: its nodes, its settings and its root as the output (the importers).
 void writeLayeredSurface(const LayeredSurface& s, MaterialWriter& w);
 /// `base` under the coat of `s` (coatWeight, coatF0, coatRoughness,

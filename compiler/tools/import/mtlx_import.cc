@@ -244,9 +244,7 @@ void chiangHairSurface(pugi::xml_node surface, pugi::xml_node bsdf, MtlxValues& 
 
 namespace {
 
-using SurfaceFn = SurfaceUnit;
-
-SurfaceFn modelOf(const std::string& kind) {
+SurfaceUnit modelOf(const std::string& kind) {
   if (kind == "standard_surface") return standardSurface;
   if (kind == "open_pbr_surface") return openPbrSurface;
   if (kind == "gltf_pbr") return mtlxGltfPbr;
@@ -267,10 +265,7 @@ void writeModelBlock(pugi::xml_node shader, ShaderParams& params, MtlxValues& va
   DiscardingNodeWriter scratch;
   const LayeredSurface s = blockModelUnit(shader.name())(pins, scratch);
   for (const std::string& warning : warnings) values.warn(shader, warning);
-  const Value root = w.node("surface", block);
-  const Json settings = layeredSurfaceSettings(s);
-  for (const auto& [key, value] : settings.items()) w.setSetting(key, value);
-  w.setOutput(root);
+  writeSurfaceOutput(s, w.node("surface", block), w);
 }
 
 /// The chiang_hair_bsdf a `surface` shader scatters with (its bsdf input), or a null node.
@@ -339,7 +334,7 @@ bool importMaterialXDocument(const std::string& text, const std::string& fileNam
       shader = node;
     }
     // The shading models, or a surface of a hair BSDF (written as the hair node).
-    const SurfaceFn model = modelOf(shader.name());
+    const SurfaceUnit model = modelOf(shader.name());
     const pugi::xml_node hairBsdf = model ? pugi::xml_node() : hairBsdfOf(values, shader);
     if (!model && !hairBsdf) {
       unsupportedShader(values, shader, sourceName);
