@@ -232,7 +232,7 @@ BlockSignature gltfPbrSignature() {
   sig.pins.push_back({"anisotropy_rotation", Kind::Number});
   sig.pins.push_back({"unlit", Kind::Flag});
   sig.pins.push_back({"alpha_mode", Kind::Choice, -1e300, 1e300, false, {kAlphaModes[0], kAlphaModes[1], kAlphaModes[2]}});
-  sig.pins.push_back({"alpha_cutoff", Kind::Number, 0, 1});
+  sig.pins.push_back({"alpha_cutoff", Kind::Number, 0, 1e300});  // glTF's: at least 0, no maximum
   return sig;
 }
 

@@ -2,10 +2,18 @@
 // under their MaterialX names, mapped with the glTF formulas (gltf_pbr.h).
 // alpha_mode is 0 opaque, 1 mask, 2 blend; iridescence_thickness is in
 // nanometres; anisotropy_rotation in radians.
+#include <fmt/format.h>
+
 #include "blocks/gltf_pbr.h"
 #include "import/mtlx_surfaces.h"
 
 namespace substratec::import {
+
+namespace {
+/// The largest alpha_cutoff the gltf_pbr block takes (a literal pin; any
+/// cutoff above 1 masks every texel).
+constexpr double kMaxCutoff = 1e300;
+}  // namespace
 
 GltfPbr mtlxGltfPbrParams(SurfaceParams& params) {
   const MtlxParam P{params};
@@ -20,6 +28,11 @@ GltfPbr mtlxGltfPbrParams(SurfaceParams& params) {
   const int mode = static_cast<int>(C("alpha_mode", "integer", {0})[0]);
   g.alphaMode = mode == 1 ? AlphaMode::Mask : mode == 2 ? AlphaMode::Blend : AlphaMode::Opaque;
   g.alphaCutoff = C("alpha_cutoff", "float", {0.5})[0];
+  if (!(g.alphaCutoff >= 0 && g.alphaCutoff <= kMaxCutoff)) {  // the gltf_pbr block's range: glTF's, at least 0
+    const double used = g.alphaCutoff > kMaxCutoff ? kMaxCutoff : 0.0;
+    params.warn(fmt::format("alpha_cutoff: {} is outside [0, {}]; {} is used", g.alphaCutoff, kMaxCutoff, used));
+    g.alphaCutoff = used;
+  }
   if (g.alphaMode != AlphaMode::Opaque) g.alpha = P("alpha", "float", {1}, ParamKind::Switch);
   if (params.given("ior")) g.ior = P("ior", "float", {1.5});
   g.specular = P("specular", "float", {1}, ParamKind::Switch);
@@ -29,7 +42,9 @@ GltfPbr mtlxGltfPbrParams(SurfaceParams& params) {
     params.warn(std::string("transmission: ") + kTransmissionNote);
   g.thickness = P("thickness", "float", {0});
   g.attenuationDistance = C("attenuation_distance", "float", {0})[0];
-  if (g.attenuationDistance >= 1e30) g.attenuationDistance = 0;
+  // 0 is glTF's "no attenuation": what the expansion makes of a distance
+  // that is not positive and finite too, so the block holds that.
+  if (!(g.attenuationDistance > 0 && g.attenuationDistance < 1e30)) g.attenuationDistance = 0;
   g.attenuationColor = P("attenuation_color", "color3", {1, 1, 1});
   g.iridescence = P("iridescence", "float", {0}, ParamKind::Switch);
   g.iridescenceIor = P("iridescence_ior", "float", {1.3});
