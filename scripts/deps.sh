@@ -14,6 +14,7 @@ PACKAGES=(
   libpugixml-dev
   libxxhash-dev
   bazel-bootstrap       # tests/bazel_example: the persistent worker under Debian's Bazel 4 (a headless JDK with it)
+  chromium tidy         # tests/html: the HTML report in headless Chromium, checked by HTML Tidy
 )
 
 missing=()

@@ -75,7 +75,9 @@ if [ "$SANITIZERS" != 0 ]; then
   # emitters from every example as a seed (stage 3).
   # bazel_example (46 s of this stage on 2026-12-06) is Bazel's JVM driving the
   # worker; the worker's own code runs here in cli_tests' Worker suites.
-  heavy="${heavy_gpu}|^unit_tests:Furnace$|^golden_tests$|^bazel_example$"
+  # html_report_browser (11 s) is Chromium's time; the page's code runs here in
+  # cli_tests' HtmlReport suite.
+  heavy="${heavy_gpu}|^unit_tests:Furnace$|^golden_tests$|^bazel_example$|^html_report_browser$"
   exclude="${SUBSTRATEC_ASAN_EXCLUDE-$heavy}"
   status=0
   ctest --preset asan -E "${gpu_regex}${exclude:+|$exclude}" || status=1

@@ -224,6 +224,15 @@ TEST(OutputsAreNotInputs, SweepRefusesAPlotOverItsInput) {
                 "output '" + (dir / "shader.mtlx").string() + "' is an input");
 }
 
+TEST(OutputsAreNotInputs, ReportHtmlRefusesAPageOverItsInputOrAnIncludedFile) {
+  const fs::path dir = freshDir("report_html");
+  const fs::path r = material(dir, "r.json");
+  expectRefused({"report", r.string(), "--html", r.string()}, dir, "output '" + r.string() + "' is an input");
+  const fs::path gold = mtlxWithInclude(dir);
+  expectRefused({"report", gold.string(), "--html", (dir / "shader.mtlx").string()}, dir,
+                "output '" + (dir / "shader.mtlx").string() + "' is an input");
+}
+
 TEST(OutputsAreNotInputs, ImportRefusesToWriteOverItsInput) {
   const fs::path dir = freshDir("import");
   const fs::path gold = mtlxWithInclude(dir);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <regex>
 #include <set>
 #include <filesystem>
 #include <fstream>
@@ -18,6 +19,7 @@
 #include "blocks/expand.h"
 #include "pipeline/pipeline.h"
 #include "pipeline/generate.h"
+#include "report/html_report.h"
 #include "report/report.h"
 #include "import/import.h"
 
@@ -97,6 +99,76 @@ TEST(Golden, EveryExampleReport) {
     const std::string stem = e.stem().string();
     checkGolden(kSource / "tests/golden" / (stem + ".report.txt"), formatReportText(*r));
     checkGolden(kSource / "tests/golden" / (stem + ".report.json"), reportJson(*r).dump(2) + "\n");
+  }
+}
+
+// The HTML report's structure (report/html_report.h): the page of every
+// example, and of tests/html/*.json (culled matter, simplification), reduced
+// to its elements' nesting with their ids, classes and data-* attributes (no
+// text, no coordinates): tests/golden/<name>.report.html.txt.
+
+/// `page` as one line per element: indented by depth, the tag, then `#id`,
+/// `.class` and `data-*=value` (text, styles and coordinates left out).
+std::string htmlStructure(const std::string& page) {
+  static const std::set<std::string> kVoid = {"meta", "img", "br", "link", "hr", "input"};
+  static const std::set<std::string> kKept = {"id", "class", "data-node", "data-op", "data-view", "data-material",
+                                              "data-culled"};
+  std::string out;
+  int depth = 0;
+  for (std::size_t i = page.find('<'); i != std::string::npos; i = page.find('<', i + 1)) {
+    const std::size_t end = page.find('>', i);
+    if (end == std::string::npos) return out + "<unterminated tag>\n";
+    const std::string tag = page.substr(i + 1, end - i - 1);
+    if (tag.empty() || tag[0] == '!') continue;
+    if (tag[0] == '/') {
+      --depth;
+      continue;
+    }
+    std::istringstream words(tag);
+    std::string name, line;
+    words >> name;
+    line = std::string(2 * std::max(depth, 0), ' ') + name;
+    static const std::regex kAttribute(R"re(([a-z:-]+)="([^"]*)")re");
+    for (std::sregex_iterator it(tag.begin(), tag.end(), kAttribute), e; it != e; ++it) {
+      const std::string key = (*it)[1], value = (*it)[2];
+      if (!kKept.count(key)) continue;
+      line += key == "id" ? " #" + value : key == "class" ? " ." + value : " " + key + "=" + value;
+    }
+    out += line + "\n";
+    if (!kVoid.count(name) && tag.back() != '/') ++depth;
+  }
+  return out + (depth == 0 ? "" : "<unbalanced: depth " + std::to_string(depth) + ">\n");
+}
+
+/// The page `report --html` writes for the material at `path` (named `display`).
+std::string htmlPageOf(const fs::path& path, const std::string& display) {
+  html::Page page;
+  page.title = "substratec report: " + display;
+  html::MaterialPage m;
+  m.file = display;
+  Diagnostics diags(display);
+  if (auto text = readSourceFile(path.string(), {}, diags)) {
+    m.sourceText = *text;
+    m.result = compileText(display, *text, {}, diags);
+    m.locator = diags.locator();
+    Diagnostics same(display);  // it compiled with a budget: it compiles without one
+    if (m.result && !m.result->steps.empty()) m.authored = compileText(display, *text, unsimplifiedOptions({}), same);
+  }
+  m.diagnostics = diags.all();
+  page.materials.push_back(std::move(m));
+  return html::formatPage(page);
+}
+
+TEST(Golden, EveryExampleHtmlReportStructure) {
+  auto inputs = filesIn(kSource / "examples", ".json");
+  for (const auto& f : filesIn(kSource / "tests/html", ".json")) inputs.push_back(f);
+  ASSERT_GE(inputs.size(), 17u);
+  for (const auto& f : inputs) {
+    SCOPED_TRACE(f.filename().string());
+    const std::string page = htmlPageOf(f, f.parent_path().filename().string() + "/" + f.filename().string());
+    const std::string structure = htmlStructure(page);
+    EXPECT_EQ(structure.find("<un"), std::string::npos) << structure;
+    checkGolden(kSource / "tests/golden" / (f.stem().string() + ".report.html.txt"), structure);
   }
 }
 

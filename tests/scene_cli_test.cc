@@ -169,7 +169,7 @@ TEST(Scene, TheOutputIsTheSameWhateverJobsCompileIt) {
   ASSERT_EQ(cli({"scene", scene("street.json"), "-o", one.string(), "-j", "1"}).status, 0);
   ASSERT_EQ(cli({"scene", scene("street.json"), "-o", two.string(), "-j", "2"}).status, 0);
   const auto a = filesOf(one), b = filesOf(two);
-  EXPECT_EQ(a.size(), 4u * 7 + 2 + 2 * 3 + 1);  // materials, classification, 3 lighting classes, scene.json
+  EXPECT_EQ(a.size(), 4u * 7 + 2 + 2 * 3 + 2);  // materials, classification, 3 lighting classes, scene.json, report.html
   EXPECT_TRUE(a == b);
   const auto j = sceneJson(one);
   for (const auto& m : j["materials"])

@@ -40,6 +40,7 @@
 #include "preview/render.h"
 #include "render/materials.h"
 #include "render/render.h"
+#include "report/html_report.h"
 #include "report/report.h"
 #include "scene/scene.h"
 #include "stability/stability.h"
@@ -315,6 +316,61 @@ int writeOutputs(const CommandOutputs& outputs, const std::string& dir, const st
   return kExitOk;
 }
 
+// ----- textures (report --previews, preview, render) ------------------------------
+
+/// --texture NAME=PATH and --search-path DIR: the images a render binds.
+struct TextureFlags {
+  std::vector<std::string> textures;  // NAME=PATH
+  std::vector<std::string> searchPaths;
+};
+
+void addTextureOptions(CLI::App* c, TextureFlags& f) {
+  c->add_option("--texture", f.textures,
+                "Bind the image PATH (PNG or JPEG) to texture input NAME, instead of the input's own file "
+                "(repeatable; an input with neither is bound to a neutral texel)")
+      ->type_name("NAME=PATH")
+      ->check([](const std::string& v) {
+        const std::size_t eq = v.find('=');
+        return eq == std::string::npos || eq == 0 || eq + 1 == v.size() ? std::string("expected NAME=PATH, got " + v)
+                                                                          : std::string();
+      });
+  c->add_option("--search-path", f.searchPaths,
+                "A directory a texture's relative file is looked for in when it is not beside the material file "
+                "(repeatable, in order)")
+      ->type_name("DIR");
+}
+
+/// The sources of `s`'s textures from the flags; kExitUsage (with the message)
+/// for a texture input named twice.
+int textureSources(const TextureFlags& f, const import::MaterialSource& s, preview::TextureSources* out,
+                   std::ostream& err) {
+  out->baseDir = s.baseDir;
+  out->searchPaths = f.searchPaths;
+  for (const std::string& t : f.textures) {
+    const std::size_t eq = t.find('=');
+    if (!out->overrides.emplace(t.substr(0, eq), t.substr(eq + 1)).second)
+      return printError(err, kExitUsage, fmt::format("--texture binds {} twice", t.substr(0, eq)));
+  }
+  return kExitOk;
+}
+
+/// Binds `m`'s textures (preview::bindTextures) from the flags, its notes and
+/// errors located in `s` and printed; every image read is an input of
+/// `outputs`. kExitBadInput when an image cannot be used.
+int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, const Material& m, const ReadLimits& read,
+                       CommandOutputs& outputs, preview::BoundTextures* out, std::ostream& err) {
+  preview::TextureSources sources;
+  if (int status = textureSources(f, s, &sources, err); status != kExitOk) return status;
+  sources.embedded = &s.images;
+  sources.imported = s.imported;
+  Diagnostics diags(s.displayName);
+  if (!s.imported) parseJsonDocument(s.text, read, diags);  // only for the locator: it compiled already
+  const bool ok = preview::bindTextures(m, sources, out, diags);
+  err << diags.formatAll();
+  for (const std::string& path : out->files) outputs.input(path);
+  return ok ? kExitOk : kExitBadInput;
+}
+
 // ----- report ------------------------------------------------------------------
 
 struct ReportArgs {
@@ -322,6 +378,9 @@ struct ReportArgs {
   CompileFlags compile;
   bool json = false;
   bool spirv = false;
+  std::string html;       // --html: the page to write
+  bool previews = false;  // --previews: each simplification step rendered (lavapipe)
+  bool sweep = false;     // --sweep: each step's cost and error (lavapipe)
 };
 
 void addReportOptions(CLI::App* c, ReportArgs& a) {
@@ -335,9 +394,20 @@ void addReportOptions(CLI::App* c, ReportArgs& a) {
   c->add_flag("--print-after-all", a.compile.printAfterAll, "Dump the IR after every pass (stderr)");
   c->add_flag("--time-passes", a.compile.timePasses, "Print the time of every pass (stderr)");
   addPassOptions(c, a.compile);
-  c->add_flag("--spirv", a.spirv,
-              "Also compile every entry shader and print its SPIR-V instruction count (before and after "
-              "SPIRV-Tools' performance passes)");
+  CLI::Option* spirv = c->add_flag("--spirv", a.spirv,
+                                    "Also compile every entry shader and print its SPIR-V instruction count (before "
+                                    "and after SPIRV-Tools' performance passes)");
+  CLI::Option* html =
+      c->add_option("--html", a.html,
+                    "Write the report as one self-contained HTML page instead (tree diagrams, byte budget, layout, "
+                    "diagnostics; docs/report.md, \"HTML\")")
+          ->type_name("OUT.html")->excludes(spirv);
+  html->excludes(c->get_option("--json"))->excludes(c->get_option("--stop-after"));
+  c->add_flag("--previews", a.previews,
+              "With --html: a preview of the material at each simplification step (renders on lavapipe)")->needs(html);
+  c->add_flag("--sweep", a.sweep,
+              "With --html: each simplification step's cost and error (sweep's rows, on lavapipe) and the "
+              "error-against-cost plot")->needs(html);
 }
 
 /// Every material of every file (all of a glTF or MaterialX file without
@@ -388,13 +458,151 @@ void reportMaterial(const ReportArgs& a, const CompileResult& r, const std::vect
                        e.instructions, e.optimizedInstructions);
 }
 
+// --html: the report as a page (report/html_report.h). Every material is
+// compiled as `report` compiles it, and again unsimplified when its budget
+// simplified it (the authored tree beside the simplified one); --previews and
+// --sweep add each simplification step rendered and measured on lavapipe.
+
+/// One material's part of the page: compiled (its diagnostics, after `fileDiags`,
+/// the import's), and unsimplified when simplification changed it.
+html::MaterialPage htmlMaterial(const import::MaterialSource& s, const std::vector<Diagnostic>& fileDiags,
+                                const CompileOptions& options, std::ostream& err, int& status) {
+  html::MaterialPage p;
+  p.file = s.displayName;
+  p.sourceText = s.text;
+  Diagnostics diags(s.displayName);
+  p.result = compileText(s.displayName, s.text, options, diags);
+  err << diags.formatAll();
+  p.diagnostics = fileDiags;
+  p.diagnostics.insert(p.diagnostics.end(), diags.all().begin(), diags.all().end());
+  p.locator = diags.locator();
+  if (p.result) err << p.result->debugLog;  // --print-after(-all)
+  if (!p.result) {
+    status = std::max(status, compileFailure(s, err));
+    return p;
+  }
+  if (!p.result->steps.empty()) {
+    Diagnostics same(s.displayName);  // it compiled with a budget: it compiles without one
+    p.authored = compileText(s.displayName, s.text, unsimplifiedOptions(options), same);
+  }
+  return p;
+}
+
+/// --previews: `steps` rendered as 128-pixel spheres into the page's steps.
+int previewImages(const import::MaterialSource& s, const std::vector<sweep::Step>& steps, const ReadLimits& read,
+                  gpu::Context& ctx, CommandOutputs& outputs, html::MaterialPage& p, std::ostream& err) {
+  preview::BoundTextures textures;
+  if (int failed = bindRenderTextures(TextureFlags{}, s, steps.front().result.material, read, outputs, &textures, err);
+      failed != kExitOk)
+    return failed;
+  preview::RenderOptions ro;
+  ro.textures = &textures;
+  ro.size = 128;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    preview::Image hdr;
+    Diagnostics failure(s.displayName);
+    if (!preview::renderSphere(ctx, steps[i].result, ro, &hdr, failure))
+      return printInternalError(err, failure.errorMessages());
+    const preview::Image image = preview::tonemap(hdr, 0, preview::calibrationGains(ro.environment));
+    const preview::Srgb8 srgb = preview::encodeSrgb8(image);
+    std::vector<std::uint8_t> png;
+    if (srgb.nanCount > 0 || !preview::encodePng(image.width, image.height, srgb.rgba, png, failure))
+      return printInternalError(err, fmt::format("{}: the preview of '{}' cannot be encoded ({} NaN pixels) {}",
+                                                 s.displayName, steps[i].label, srgb.nanCount, failure.errorMessages()));
+    p.steps[i].png.assign(png.begin(), png.end());
+  }
+  return kExitOk;
+}
+
+/// --sweep: `steps` measured (sweep::measure) into the page's cells and plot.
+int sweepCells(const std::vector<sweep::Step>& steps, const CompileResult& full, gpu::Context& ctx,
+               html::MaterialPage& p, std::ostream& err) {
+  std::vector<sweep::Row> rows;
+  Diagnostics failure(full.material.name);
+  if (!sweep::measure(ctx, steps, full, sweep::Options{}, &rows, failure))
+    return printInternalError(err, failure.errorMessages());
+  if (rows.size() != steps.size())
+    return printInternalError(err, fmt::format("{} sweep rows for {} steps", rows.size(), steps.size()));
+  p.stepColumns = sweep::cellColumns();
+  for (std::size_t i = 0; i < rows.size(); ++i) p.steps[i].cells = sweep::cells(rows[i]);
+  p.errorPlotSvg = sweep::plotSvg(full.material.name, rows);
+  return kExitOk;
+}
+
+/// --previews, --sweep: the material's simplification steps (sweep::simplificationSteps)
+/// rendered and/or measured into `p`.
+int measuredSteps(const ReportArgs& a, const import::MaterialSource& s, const CompileOptions& o, gpu::Context& ctx,
+                  CommandOutputs& outputs, html::MaterialPage& p, std::ostream& err) {
+  std::vector<sweep::Step> steps;
+  CompileResult full;
+  if (int failed = simplificationSteps(s, o, steps, full, err); failed != kExitOk) return failed;
+  if (isVolumeMaterial(full.material)) {
+    p.stepsNote = "A volume: nothing simplifies it, so it has no steps to preview or measure.";
+    return kExitOk;
+  }
+  std::erase_if(steps, [&](const sweep::Step& e) {  // no code for a tree the storage format cannot hold
+    if (static_cast<int>(e.result.after.closures.size()) <= packfmt::kMaxClosures) return false;
+    p.stepsNote = fmt::format("'{}' ({} closures) is not measured: the storage format packs at most {}.", e.label,
+                              e.result.after.closures.size(), packfmt::kMaxClosures);
+    return true;
+  });
+  for (const auto& e : steps)
+    p.steps.push_back({e.label, e.budget, e.result.after.bytes(), static_cast<int>(e.result.after.closures.size()), "",
+                       {}});
+  if (a.previews)
+    if (int failed = previewImages(s, steps, o.read, ctx, outputs, p, err); failed != kExitOk) return failed;
+  if (a.sweep)
+    if (int failed = sweepCells(steps, full, ctx, p, err); failed != kExitOk) return failed;
+  return kExitOk;
+}
+
+/// `report --html OUT`: the page of every material of every file (a file
+/// that does not load shows its diagnostics), written atomically; its path on stdout.
+int runHtmlReport(const ReportArgs& a, const CompileOptions& options, CommandOutputs& outputs, std::ostream& out,
+                  std::ostream& err) {
+  std::unique_ptr<gpu::Context> ctx;
+  if (a.previews || a.sweep) {
+    ctx = openGpu("float", "report --previews and --sweep render on Vulkan (Mesa lavapipe)", err);
+    if (!ctx) return kExitBadInput;
+  }
+  html::Page page;
+  page.title = a.in.files.size() == 1 ? "substratec report: " + a.in.files.front()
+                                       : fmt::format("substratec report: {} files", a.in.files.size());
+  int status = kExitOk;
+  for (const auto& file : a.in.files) {
+    Diagnostics diags(file);
+    auto loaded = import::loadMaterialSources(file, a.in.material, true, options.read, diags);
+    err << diags.formatAll();
+    if (!loaded) {
+      status = kExitBadInput;
+      html::MaterialPage unread;  // its diagnostics alone
+      unread.file = file;
+      unread.diagnostics = diags.all();
+      page.materials.push_back(std::move(unread));
+      continue;
+    }
+    for (const auto& s : *loaded) {
+      page.materials.push_back(htmlMaterial(s, diags.all(), options, err, status));
+      if (ctx && page.materials.back().result)
+        if (int failed = measuredSteps(a, s, options, *ctx, outputs, page.materials.back(), err); failed != kExitOk)
+          return failed;
+    }
+  }
+  if (int usage = outputs.check(err); usage != kExitOk) return usage;  // includes and images are inputs too
+  if (int failed = outputs.commit({{a.html, html::formatPage(page)}}, err); failed != kExitOk) return failed;
+  out << a.html << "\n";
+  return status;
+}
+
 /// `report`: every material's tree, features, budget and layout; with
-/// --stop-after only the passes' dumps.
+/// --stop-after only the passes' dumps; with --html the page instead.
 int runReport(const ReportArgs& a, std::ostream& out, std::ostream& err) {
   const CompileOptions options = toCompileOptions(a.compile);
-  CommandOutputs outputs(out);  // writes only standard output
+  CommandOutputs outputs(out);  // writes only standard output, or the --html page
+  outputs.namedFile(a.html);
   for (const auto& file : a.in.files) outputs.input(file);
   if (int status = outputs.check(err); status != kExitOk) return status;
+  if (!a.html.empty() && options.stopAfter.empty()) return runHtmlReport(a, options, outputs, out, err);
   int status = kExitOk;
   const std::vector<import::MaterialSource> sources = loadEvery(a, options.read, err, status);
   if (int usage = outputs.check(err); usage != kExitOk) return usage;
@@ -561,59 +769,6 @@ int runCompile(const CompileArgs& a, std::ostream& out, std::ostream& err) {
 }
 
 // ----- preview -----------------------------------------------------------------
-
-/// --texture NAME=PATH and --search-path DIR: the images a render binds.
-struct TextureFlags {
-  std::vector<std::string> textures;  // NAME=PATH
-  std::vector<std::string> searchPaths;
-};
-
-void addTextureOptions(CLI::App* c, TextureFlags& f) {
-  c->add_option("--texture", f.textures,
-                "Bind the image PATH (PNG or JPEG) to texture input NAME, instead of the input's own file "
-                "(repeatable; an input with neither is bound to a neutral texel)")
-      ->type_name("NAME=PATH")
-      ->check([](const std::string& v) {
-        const std::size_t eq = v.find('=');
-        return eq == std::string::npos || eq == 0 || eq + 1 == v.size() ? std::string("expected NAME=PATH, got " + v)
-                                                                          : std::string();
-      });
-  c->add_option("--search-path", f.searchPaths,
-                "A directory a texture's relative file is looked for in when it is not beside the material file "
-                "(repeatable, in order)")
-      ->type_name("DIR");
-}
-
-/// The sources of `s`'s textures from the flags; kExitUsage (with the message)
-/// for a texture input named twice.
-int textureSources(const TextureFlags& f, const import::MaterialSource& s, preview::TextureSources* out,
-                   std::ostream& err) {
-  out->baseDir = s.baseDir;
-  out->searchPaths = f.searchPaths;
-  for (const std::string& t : f.textures) {
-    const std::size_t eq = t.find('=');
-    if (!out->overrides.emplace(t.substr(0, eq), t.substr(eq + 1)).second)
-      return printError(err, kExitUsage, fmt::format("--texture binds {} twice", t.substr(0, eq)));
-  }
-  return kExitOk;
-}
-
-/// Binds `m`'s textures (preview::bindTextures) from the flags, its notes and
-/// errors located in `s` and printed; every image read is an input of
-/// `outputs`. kExitBadInput when an image cannot be used.
-int bindRenderTextures(const TextureFlags& f, const import::MaterialSource& s, const Material& m, const ReadLimits& read,
-                       CommandOutputs& outputs, preview::BoundTextures* out, std::ostream& err) {
-  preview::TextureSources sources;
-  if (int status = textureSources(f, s, &sources, err); status != kExitOk) return status;
-  sources.embedded = &s.images;
-  sources.imported = s.imported;
-  Diagnostics diags(s.displayName);
-  if (!s.imported) parseJsonDocument(s.text, read, diags);  // only for the locator: it compiled already
-  const bool ok = preview::bindTextures(m, sources, out, diags);
-  err << diags.formatAll();
-  for (const std::string& path : out->files) outputs.input(path);
-  return ok ? kExitOk : kExitBadInput;
-}
 
 /// --env: a procedural environment by name, or a Radiance file (lat-long).
 void addEnvironmentOption(CLI::App* c, std::string& environment) {

@@ -523,3 +523,31 @@ TEST(PreviewCalibration, ASpecularProfileTintsTheSpecularItIsBoundTo) {
 }
 
 }  // namespace
+
+// `report --html --previews --sweep` (issue 24): every simplification step of
+// the page has its preview (a PNG data URI) and its row of sweep's cells, and
+// the error-against-cost plot is in the page. tests/html/culled_and_simplified
+// has two steps: the authored tree (28 B) and the budget's (16 B).
+TEST(ReportHtmlOnGpu, PreviewsAndSweepGiveEveryStepAnImageAndItsCostAndError) {
+  const fs::path page = workDir() / "report.html";
+  CliRun r = cli({"report", (kSource / "tests/html/culled_and_simplified.json").string(), "--html", page.string(),
+                  "--previews", "--sweep"});
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string html = bytesOf(page);
+  std::size_t images = 0, rows = 0;
+  for (std::size_t i = html.find("src=\"data:image/png;base64,"); i != std::string::npos;
+       i = html.find("src=\"data:image/png;base64,", i + 1)) {
+    EXPECT_EQ(html.compare(i + 27, 11, "iVBORw0KGgo"), 0) << "a PNG's signature";
+    ++images;
+  }
+  const std::size_t table = html.find("<h3>Simplification steps, measured</h3>");
+  ASSERT_NE(table, std::string::npos);
+  const std::size_t tableEnd = html.find("</table>", table);
+  for (std::size_t i = html.find("<tr><td>", table); i < tableEnd; i = html.find("<tr><td>", i + 1)) ++rows;
+  EXPECT_EQ(images, 2u);
+  EXPECT_EQ(rows, 2u);
+  for (const std::string& column : substratec::sweep::cellColumns())
+    EXPECT_NE(html.find("<th>" + column + "</th>", table), std::string::npos) << column;
+  EXPECT_NE(html.find("<tr><td>authored</td><td class=\"num\">28</td>"), std::string::npos);
+  EXPECT_NE(html.find("error against cost"), std::string::npos) << "the plot";
+}

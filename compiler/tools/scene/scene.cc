@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "report/html_report.h"
 #include "scene/manifest.h"
 
 namespace substratec {
@@ -187,6 +188,47 @@ J sceneReport(const SceneOptions& o, const SceneManifest& scene, const std::opti
   return report;
 }
 
+/// DIR/report.html: the scene's sorted byte chart and every material's page
+/// (report/html_report.h), each compiled again as the batch compiled it (the
+/// batch keeps summaries, and a cache hit not even that) and unsimplified
+/// where its budget simplified it. Called once every material compiled.
+std::string sceneHtml(const SceneManifest& scene, const BatchOptions& batch, const std::vector<std::string>& paths) {
+  html::Page page;
+  page.title = "substratec scene report: " + scene.name;
+  html::SceneHeader header{scene.name, "", 0, 0};
+  if (batch.compile.platform) {
+    header.platform = batch.compile.platform->name;
+    header.budgetBytes = batch.compile.platform->bytesPerPixel;
+    header.maxClosures = batch.compile.platform->maxClosures;
+  }
+  for (const std::string& path : paths) {
+    html::MaterialPage p;
+    p.file = path;
+    Diagnostics diags(path);
+    std::optional<BatchSource> source;
+    if (batch.load) source = batch.load(path, batch.compile.read, diags);
+    else if (auto text = readSourceFile(path, batch.compile.read, diags)) source = BatchSource{path, *text, false};
+    if (source) {
+      p.file = source->displayName;
+      p.sourceText = source->text;
+      p.result = compileText(source->displayName, source->text, batch.compile, diags);
+      p.locator = diags.locator();
+      if (p.result && !p.result->steps.empty()) {
+        Diagnostics same(path);
+        p.authored = compileText(source->displayName, source->text, unsimplifiedOptions(batch.compile), same);
+      }
+    }
+    p.diagnostics = diags.all();
+    if (!batch.compile.platform && p.result && header.budgetBytes == 0) {  // no platform: the first one's budget
+      header.budgetBytes = p.result->budgetBytes;
+      header.maxClosures = p.result->maxClosures;
+    }
+    page.materials.push_back(std::move(p));
+  }
+  page.scene = header;
+  return html::formatPage(page);
+}
+
 }  // namespace
 
 SceneBuild buildScene(const SceneOptions& o) {
@@ -262,6 +304,7 @@ SceneBuild buildScene(const SceneOptions& o) {
   }
   for (OutputFile& f : lighting.files) b.files.push_back(std::move(f));
   b.files.push_back({"scene.json", report.dump(2) + "\n"});
+  b.files.push_back({"report.html", sceneHtml(*scene, batch, paths)});
   return b;
 }
 

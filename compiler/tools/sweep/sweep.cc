@@ -348,6 +348,26 @@ nlohmann::ordered_json truthJson(const std::optional<accuracy::Comparison>& c) {
 
 }  // namespace
 
+std::vector<std::string> cellColumns() {
+  return {"spirv_instr", "ns/pixel", "rel_mse", "max_abs", "p99_abs", "dE00_avg", "dE00_max", "alb_vs_gt", "p95_vs_gt",
+          "alb_vs_own"};
+}
+
+std::vector<std::string> cells(const Row& r) {
+  const auto [albTruth, p95Truth] = worstText(r.vsAuthoredTruth, "-");
+  const auto [albOwn, p95Own] = worstText(r.vsOwnTruth, "-");
+  return {r.gpuMeasured ? std::to_string(r.spirvInstructions) : "-",
+          r.gpuMeasured ? fmt::format("{:.1f}", r.gpuNsPerPixel) : "-",
+          fmt::format("{:.3e}", r.relMse),
+          fmt::format("{:.3e}", r.maxAbs),
+          fmt::format("{:.3e}", r.p99Abs),
+          fmt::format("{:.3f}", r.deltaE2000Mean),
+          fmt::format("{:.3f}", r.deltaE2000Max),
+          albTruth,
+          p95Truth,
+          albOwn};
+}
+
 std::string formatTable(const std::string& material, const std::vector<Row>& rows) {
   const bool half = halfColumns(rows);
   std::string s = fmt::format("----- SWEEP - {}{} -----\n", material, half ? " (half precision)" : "");
@@ -356,14 +376,9 @@ std::string formatTable(const std::string& material, const std::vector<Row>& row
                    "dE00_avg", "dE00_max", "alb_vs_gt", "p95_vs_gt", "alb_vs_own");
   s += half ? fmt::format(" {:>10} {:>10}\n", "mse_vs_f32", "abs_vs_f32") : "\n";
   for (const Row& r : rows) {
-    const auto [albTruth, p95Truth] = worstText(r.vsAuthoredTruth, "-");
-    const auto [albOwn, p95Own] = worstText(r.vsOwnTruth, "-");
-    s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10.3e} {:>10.3e} {:>10.3e} {:>8.3f} {:>8.3f} {:>10} "
-                     "{:>10} {:>10}",
-                     r.label, r.budget, r.bytes, r.closures,
-                     r.gpuMeasured ? std::to_string(r.spirvInstructions) : "-",
-                     r.gpuMeasured ? fmt::format("{:.1f}", r.gpuNsPerPixel) : "-", r.relMse, r.maxAbs, r.p99Abs,
-                     r.deltaE2000Mean, r.deltaE2000Max, albTruth, p95Truth, albOwn);
+    const std::vector<std::string> c = cells(r);
+    s += fmt::format("{:<20} {:>6} {:>5} {:>8} {:>11} {:>10} {:>10} {:>10} {:>10} {:>8} {:>8} {:>10} {:>10} {:>10}",
+                     r.label, r.budget, r.bytes, r.closures, c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7], c[8], c[9]);
     s += half ? fmt::format(" {:>10.3e} {:>10.3e}\n", r.relMseVsFloat32.value_or(0), r.maxAbsVsFloat32.value_or(0))
               : "\n";
   }

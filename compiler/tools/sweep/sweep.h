@@ -97,6 +97,11 @@ std::optional<std::size_t> cheapestWithin(const std::vector<Row>& rows, double m
 /// plot of error (rel_mse, log scale) against cost (ns per pixel), one
 /// labelled point per row.
 std::string formatTable(const std::string& material, const std::vector<Row>& rows);
+/// The table's columns after row, budget, bytes and closures (float
+/// precision's), and a row's cells for them, as formatTable prints them:
+/// what another page of the rows (the HTML report) shows.
+std::vector<std::string> cellColumns();
+std::vector<std::string> cells(const Row& r);
 std::string formatJson(const std::string& material, const std::vector<Row>& rows);
 std::string formatCsv(const std::vector<Row>& rows);
 std::string plotSvg(const std::string& material, const std::vector<Row>& rows);
