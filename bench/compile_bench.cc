@@ -28,6 +28,7 @@
 #include "format/json_document.h"
 #include "pipeline/generate.h"
 #include "pipeline/pipeline.h"
+#include "report/html_report.h"
 
 namespace fs = std::filesystem;
 using namespace substratec;
@@ -185,6 +186,38 @@ void BM_CompileAll(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(list.size()));
 }
 
+/// `report --html` over every example (issue 24): each compiled, again
+/// unsimplified where its budget simplified it, and one page of them all
+/// formatted; the time per material against CompileAll's is the page's cost.
+void BM_HtmlReportAll(benchmark::State& state) {
+  const CompileOptions options;
+  const auto& list = examples();
+  LoopClock clock;
+  std::size_t bytes = 0;
+  for (auto _ : state) {
+    html::Page page;
+    page.title = "all examples";
+    for (const Example& ex : list) {
+      html::MaterialPage m;
+      m.file = ex.path;
+      m.sourceText = ex.text;
+      Diagnostics diags(ex.path);
+      m.result = compileText(ex.path, ex.text, options, diags);
+      m.locator = diags.locator();
+      if (m.result && !m.result->steps.empty())
+        m.authored = compileText(ex.path, ex.text, unsimplifiedOptions(options), diags);
+      m.diagnostics = diags.all();
+      page.materials.push_back(std::move(m));
+    }
+    const std::string html = html::formatPage(page);
+    bytes = html.size();
+    benchmark::DoNotOptimize(html);
+  }
+  clock.report(state, static_cast<double>(list.size()));
+  state.counters["page_bytes"] = static_cast<double>(bytes);
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(list.size()));
+}
+
 /// Loads and validates every example; returns false (after printing why) if
 /// there is none or any of them does not compile.
 bool loadExamples(const fs::path& dir) {
@@ -235,6 +268,7 @@ int main(int argc, char** argv) {
   benchmark::RegisterBenchmark(("Compile/parse_only/" + largest->stem).c_str(), BM_ParseOnly, largest)
       ->Unit(benchmark::kMicrosecond);
   benchmark::RegisterBenchmark("CompileAll", BM_CompileAll)->Unit(benchmark::kMicrosecond);
+  benchmark::RegisterBenchmark("HtmlReportAll", BM_HtmlReportAll)->Unit(benchmark::kMicrosecond);
   // The deepest tree: the most operators to collapse.
   const Example* deepest = nullptr;
   std::size_t mostOps = 0;
