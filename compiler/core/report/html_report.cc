@@ -120,17 +120,25 @@ TreeLayout layoutTree(const Material& m, const TreeInfo& t) {
 
 constexpr double kSlotWidth = 176, kBoxWidth = 162, kRowHeight = 108, kBoxHeight = 78, kMargin = 10;
 
-/// The badges of a tree box: a slab's features and its basis.
-std::vector<std::pair<std::string, std::string>> boxBadges(const Material& m, const TreeNode& node) {
-  std::vector<std::pair<std::string, std::string>> badges;  // text, fill
+/// A badge of a tree box: its text, its fill, and whether the text is white.
+struct Badge {
+  std::string text;
+  const char* fill;
+  bool dark;
+};
+
+/// The badges of a tree box: a slab's features and its basis (a shared
+/// basis in its own colour).
+std::vector<Badge> boxBadges(const Material& m, const TreeNode& node) {
+  std::vector<Badge> badges;
   if (node.op != TreeOp::Slab || node.slab < 0) return badges;
   const Slab& s = m.slabs[node.slab];
   for (int b = 0; b < kFeatureCount; ++b)
-    if (s.features & (1u << b)) badges.emplace_back(std::string(featureName(b)), "#e4ecfb");
+    if (s.features & (1u << b)) badges.push_back({std::string(featureName(b)), "#e4ecfb", false});
   if (s.basis >= 0 && s.basis < static_cast<int>(m.bases.size())) {
     const bool shared = m.bases[s.basis].slabs.size() > 1;
-    badges.emplace_back(fmt::format("basis {}{}", s.basis, shared ? " shared" : ""),
-                        shared ? kBasisColours[s.basis % kBasisColours.size()] : "#eef0f3");
+    badges.push_back({fmt::format("basis {}{}", s.basis, shared ? " shared" : ""),
+                      shared ? kBasisColours[s.basis % kBasisColours.size()] : "#eef0f3", shared});
   }
   return badges;
 }
@@ -158,15 +166,14 @@ std::string treeBox(const MaterialPage& p, int index, std::string_view view, con
   o += fmt::format(R"(<text x="{:.1f}" y="{:.1f}" font-size="13" font-weight="600">{}</text>)", left + 6, top + 31,
                    escape(shortId(node.id)));
   double bx = left + 6, by = top + 40;
-  for (const auto& [text, fill] : boxBadges(m, node)) {
-    const double w = 7.0 * static_cast<double>(text.size()) + 8;
+  for (const Badge& badge : boxBadges(m, node)) {
+    const double w = 6.2 * static_cast<double>(badge.text.size()) + 8;
     if (bx + w > left + kBoxWidth - 4 && bx > left + 6) bx = left + 6, by += 17;
     if (by + 14 > top + kBoxHeight) break;  // the rest are in the feature lines
-    const bool dark = fill[0] == '#' && fill != std::string("#e4ecfb") && fill != std::string("#eef0f3");
     o += fmt::format(R"(<rect class="badge" x="{:.1f}" y="{:.1f}" width="{:.1f}" height="14" rx="7" fill="{}"/>)", bx,
-                     by, w, fill);
+                     by, w, badge.fill);
     o += fmt::format(R"(<text x="{:.1f}" y="{:.1f}" font-size="10.5" fill="{}">{}</text>)", bx + 4, by + 10.5,
-                     dark ? "#fff" : "#1d232b", escape(text));
+                     badge.dark ? "#fff" : "#1d232b", escape(badge.text));
     bx += w + 3;
   }
   return o + "</g>";
