@@ -197,18 +197,7 @@ void BM_HtmlReportAll(benchmark::State& state) {
   for (auto _ : state) {
     html::Page page;
     page.title = "all examples";
-    for (const Example& ex : list) {
-      html::MaterialPage m;
-      m.file = ex.path;
-      m.sourceText = ex.text;
-      Diagnostics diags(ex.path);
-      m.result = compileText(ex.path, ex.text, options, diags);
-      m.locator = diags.locator();
-      if (m.result && !m.result->steps.empty())
-        m.authored = compileText(ex.path, ex.text, unsimplifiedOptions(options), diags);
-      m.diagnostics = diags.all();
-      page.materials.push_back(std::move(m));
-    }
+    for (const Example& ex : list) page.materials.push_back(html::compiledMaterial(ex.path, ex.text, options));
     const std::string html = html::formatPage(page);
     bytes = html.size();
     benchmark::DoNotOptimize(html);

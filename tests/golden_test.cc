@@ -144,18 +144,7 @@ std::string htmlStructure(const std::string& page) {
 std::string htmlPageOf(const fs::path& path, const std::string& display) {
   html::Page page;
   page.title = "substratec report: " + display;
-  html::MaterialPage m;
-  m.file = display;
-  Diagnostics diags(display);
-  if (auto text = readSourceFile(path.string(), {}, diags)) {
-    m.sourceText = *text;
-    m.result = compileText(display, *text, {}, diags);
-    m.locator = diags.locator();
-    Diagnostics same(display);  // it compiled with a budget: it compiles without one
-    if (m.result && !m.result->steps.empty()) m.authored = compileText(display, *text, unsimplifiedOptions({}), same);
-  }
-  m.diagnostics = diags.all();
-  page.materials.push_back(std::move(m));
+  page.materials.push_back(html::compiledMaterial(display, readFile(path), {}));
   return html::formatPage(page);
 }
 

@@ -288,6 +288,20 @@ int simplificationSteps(const import::MaterialSource& s, const CompileOptions& o
   return compileFailure(s, err);
 }
 
+/// Removes the steps whose tree the storage format cannot hold (more than
+/// packfmt::kMaxClosures closures: an authored tree; no code to render or
+/// time) and says which ("'authored' (9 closures)"), or "" when none was.
+std::string dropUnpackableSteps(std::vector<sweep::Step>& steps) {
+  std::string dropped;
+  std::erase_if(steps, [&](const sweep::Step& e) {
+    const int closures = static_cast<int>(e.result.after.closures.size());
+    if (closures <= packfmt::kMaxClosures) return false;
+    dropped = fmt::format("'{}' ({} closures)", e.label, closures);
+    return true;
+  });
+  return dropped;
+}
+
 /// --json of report and stability: the one material's object, or an array of them.
 void printJson(const nlohmann::ordered_json& all, bool one, std::ostream& out) {
   out << (one ? all[0] : all).dump(2) << "\n";
@@ -467,24 +481,12 @@ void reportMaterial(const ReportArgs& a, const CompileResult& r, const std::vect
 /// the import's), and unsimplified when simplification changed it.
 html::MaterialPage htmlMaterial(const import::MaterialSource& s, const std::vector<Diagnostic>& fileDiags,
                                 const CompileOptions& options, std::ostream& err, int& status) {
-  html::MaterialPage p;
-  p.file = s.displayName;
-  p.sourceText = s.text;
-  Diagnostics diags(s.displayName);
-  p.result = compileText(s.displayName, s.text, options, diags);
-  err << diags.formatAll();
-  p.diagnostics = fileDiags;
-  p.diagnostics.insert(p.diagnostics.end(), diags.all().begin(), diags.all().end());
-  p.locator = diags.locator();
+  std::string messages;
+  html::MaterialPage p = html::compiledMaterial(s.displayName, s.text, options, &messages);
+  err << messages;
+  p.diagnostics.insert(p.diagnostics.begin(), fileDiags.begin(), fileDiags.end());
   if (p.result) err << p.result->debugLog;  // --print-after(-all)
-  if (!p.result) {
-    status = std::max(status, compileFailure(s, err));
-    return p;
-  }
-  if (!p.result->steps.empty()) {
-    Diagnostics same(s.displayName);  // it compiled with a budget: it compiles without one
-    p.authored = compileText(s.displayName, s.text, unsimplifiedOptions(options), same);
-  }
+  else status = std::max(status, compileFailure(s, err));
   return p;
 }
 
@@ -540,12 +542,9 @@ int measuredSteps(const ReportArgs& a, const import::MaterialSource& s, const Co
     p.stepsNote = "A volume: nothing simplifies it, so it has no steps to preview or measure.";
     return kExitOk;
   }
-  std::erase_if(steps, [&](const sweep::Step& e) {  // no code for a tree the storage format cannot hold
-    if (static_cast<int>(e.result.after.closures.size()) <= packfmt::kMaxClosures) return false;
-    p.stepsNote = fmt::format("'{}' ({} closures) is not measured: the storage format packs at most {}.", e.label,
-                              e.result.after.closures.size(), packfmt::kMaxClosures);
-    return true;
-  });
+  if (const std::string dropped = dropUnpackableSteps(steps); !dropped.empty())
+    p.stepsNote = fmt::format("{} is not rendered nor measured: the storage format packs at most {}.", dropped,
+                              packfmt::kMaxClosures);
   for (const auto& e : steps)
     p.steps.push_back({e.label, e.budget, e.result.after.bytes(), static_cast<int>(e.result.after.closures.size()), "",
                        {}});
@@ -846,14 +845,10 @@ int previewSteps(const PreviewArgs& a, const import::MaterialSource& s, const Co
   if (a.sweep) {
     CompileResult full;
     if (int failed = simplificationSteps(s, o, steps, full, err); failed != kExitOk) return failed;
-    // An authored tree the storage format cannot hold has no code to render.
-    std::erase_if(steps, [&](const sweep::Step& e) {
-      const int closures = static_cast<int>(e.result.after.closures.size());
-      if (closures <= packfmt::kMaxClosures) return false;
-      err << fmt::format("note: '{}' ({} closures) is not rendered: the storage format packs at most {}\n", e.label,
-                         closures, packfmt::kMaxClosures);
-      return true;
-    });
+    const std::string dropped = dropUnpackableSteps(steps);
+    if (!dropped.empty())
+      err << fmt::format("note: {} is not rendered: the storage format packs at most {}\n", dropped,
+                         packfmt::kMaxClosures);
     return kExitOk;
   }
   Diagnostics diags(s.displayName);

@@ -510,6 +510,23 @@ std::string sceneSection(const Page& page) {
 
 }  // namespace
 
+MaterialPage compiledMaterial(const std::string& file, const std::string& text, const CompileOptions& options,
+                              std::string* messages) {
+  MaterialPage p;
+  p.file = file;
+  p.sourceText = text;
+  Diagnostics diags(file);
+  p.result = compileText(file, text, options, diags);
+  p.diagnostics = diags.all();
+  p.locator = diags.locator();
+  if (messages) *messages = diags.formatAll();
+  if (p.result && !p.result->steps.empty()) {
+    Diagnostics same(file);  // it compiled with a budget: it compiles without one, with the same diagnostics
+    p.authored = compileText(file, text, unsimplifiedOptions(options), same);
+  }
+  return p;
+}
+
 ByteBreakdown byteBreakdown(const StorageLayout& L) {
   ByteBreakdown b;
   for (const auto& f : L.fields) {

@@ -46,6 +46,15 @@ struct MaterialPage {
   std::string stepsNote;                         // why there are no measured steps, when asked for but none
 };
 
+/// A material's part of the page, compiled from `text` (named `file` in its
+/// diagnostics) with `options`, and again unsimplified (pipeline's
+/// unsimplifiedOptions) when its budget simplified it; its diagnostics and
+/// their locator kept. `messages`, when given, receives the diagnostics as
+/// they print (Diagnostics::formatAll). What `report --html`, `scene` and the
+/// tests build a page from.
+MaterialPage compiledMaterial(const std::string& file, const std::string& text, const CompileOptions& options,
+                              std::string* messages = nullptr);
+
 /// A scene page's header: its name, platform and budget; every material of
 /// the page is one of its materials.
 struct SceneHeader {

@@ -202,23 +202,14 @@ std::string sceneHtml(const SceneManifest& scene, const BatchOptions& batch, con
     header.maxClosures = batch.compile.platform->maxClosures;
   }
   for (const std::string& path : paths) {
-    html::MaterialPage p;
-    p.file = path;
     Diagnostics diags(path);
     std::optional<BatchSource> source;
     if (batch.load) source = batch.load(path, batch.compile.read, diags);
     else if (auto text = readSourceFile(path, batch.compile.read, diags)) source = BatchSource{path, *text, false};
-    if (source) {
-      p.file = source->displayName;
-      p.sourceText = source->text;
-      p.result = compileText(source->displayName, source->text, batch.compile, diags);
-      p.locator = diags.locator();
-      if (p.result && !p.result->steps.empty()) {
-        Diagnostics same(path);
-        p.authored = compileText(source->displayName, source->text, unsimplifiedOptions(batch.compile), same);
-      }
-    }
-    p.diagnostics = diags.all();
+    html::MaterialPage p;
+    if (source) p = html::compiledMaterial(source->displayName, source->text, batch.compile);
+    if (!source) p.file = path;
+    p.diagnostics.insert(p.diagnostics.begin(), diags.all().begin(), diags.all().end());
     if (!batch.compile.platform && p.result && header.budgetBytes == 0) {  // no platform: the first one's budget
       header.budgetBytes = p.result->budgetBytes;
       header.maxClosures = p.result->maxClosures;
