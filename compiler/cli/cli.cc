@@ -330,6 +330,20 @@ int writeOutputs(const CommandOutputs& outputs, const std::string& dir, const st
   return kExitOk;
 }
 
+/// `image` (tone-mapped) as an 8-bit sRGB PNG into `png`; kExitInternal, the
+/// error printed ("N pixels of the <what> are NaN", or the encoder's), when
+/// it cannot be. What preview, render and report --previews write.
+int srgbPng(const preview::Image& image, std::string_view what, std::string* png, std::ostream& err) {
+  const preview::Srgb8 srgb = preview::encodeSrgb8(image);
+  if (srgb.nanCount > 0) return printInternalError(err, fmt::format("{} pixels of the {} are NaN", srgb.nanCount, what));
+  std::vector<std::uint8_t> bytes;
+  Diagnostics failure(std::string{what});
+  if (!preview::encodePng(image.width, image.height, srgb.rgba, bytes, failure))
+    return printInternalError(err, "cannot encode the PNG: " + failure.errorMessages());
+  png->assign(bytes.begin(), bytes.end());
+  return kExitOk;
+}
+
 // ----- textures (report --previews, preview, render) ------------------------------
 
 /// --texture NAME=PATH and --search-path DIR: the images a render binds.
@@ -506,12 +520,7 @@ int previewImages(const import::MaterialSource& s, const std::vector<sweep::Step
     if (!preview::renderSphere(ctx, steps[i].result, ro, &hdr, failure))
       return printInternalError(err, failure.errorMessages());
     const preview::Image image = preview::tonemap(hdr, 0, preview::calibrationGains(ro.environment));
-    const preview::Srgb8 srgb = preview::encodeSrgb8(image);
-    std::vector<std::uint8_t> png;
-    if (srgb.nanCount > 0 || !preview::encodePng(image.width, image.height, srgb.rgba, png, failure))
-      return printInternalError(err, fmt::format("{}: the preview of '{}' cannot be encoded ({} NaN pixels) {}",
-                                                 s.displayName, steps[i].label, srgb.nanCount, failure.errorMessages()));
-    p.steps[i].png.assign(png.begin(), png.end());
+    if (int failed = srgbPng(image, "preview", &p.steps[i].png, err); failed != kExitOk) return failed;
   }
   return kExitOk;
 }
@@ -912,14 +921,9 @@ int runPreview(const PreviewArgs& a, std::ostream& out, std::ostream& err) {
   if (!ctx) return kExitBadInput;
   std::optional<preview::Image> image = renderPreview(a, *ctx, steps, textures, err);
   if (!image) return kExitInternal;
-  preview::Srgb8 srgb = preview::encodeSrgb8(*image);
-  if (srgb.nanCount > 0) return printInternalError(err, fmt::format("{} pixels of the preview are NaN", srgb.nanCount));
-  std::vector<uint8_t> png;
-  Diagnostics failure(a.output);
-  if (!preview::encodePng(image->width, image->height, srgb.rgba, png, failure))
-    return printInternalError(err, "cannot encode the PNG: " + failure.errorMessages());
-  if (int failed = outputs.commit({{a.output, std::string(png.begin(), png.end())}}, err); failed != kExitOk)
-    return failed;
+  std::string png;
+  if (int failed = srgbPng(*image, "preview", &png, err); failed != kExitOk) return failed;
+  if (int failed = outputs.commit({{a.output, png}}, err); failed != kExitOk) return failed;
   out << a.output << "\n";
   return kExitOk;
 }
@@ -1120,13 +1124,9 @@ int runRender(const RenderArgs& a, std::ostream& out, std::ostream& err) {
   const std::array<double, 3> toCamera{-camera.forward[0], -camera.forward[1], -camera.forward[2]};
   const preview::Image image =
       preview::tonemap(result.hdr, a.exposure, render::renderCalibrationGains(a.environment, toCamera));
-  preview::Srgb8 srgb = preview::encodeSrgb8(image);
-  if (srgb.nanCount > 0) return printInternalError(err, fmt::format("{} pixels of the render are NaN", srgb.nanCount));
-  std::vector<uint8_t> png;
-  if (!preview::encodePng(image.width, image.height, srgb.rgba, png, failure))
-    return printInternalError(err, "cannot encode the PNG: " + failure.errorMessages());
-  if (int failed = outputs.commit({{a.output, std::string(png.begin(), png.end())}}, err); failed != kExitOk)
-    return failed;
+  std::string png;
+  if (int failed = srgbPng(image, "render", &png, err); failed != kExitOk) return failed;
+  if (int failed = outputs.commit({{a.output, png}}, err); failed != kExitOk) return failed;
   out << a.output << "\n";
   if (a.timings) {
     const render::RenderStats& st = result.stats;
