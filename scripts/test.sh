@@ -76,8 +76,10 @@ if [ "$SANITIZERS" != 0 ]; then
   # bazel_example (46 s of this stage on 2026-12-06) is Bazel's JVM driving the
   # worker; the worker's own code runs here in cli_tests' Worker suites.
   # html_report_browser (11 s) is Chromium's time; the page's code runs here in
-  # cli_tests' HtmlReport suite.
-  heavy="${heavy_gpu}|^unit_tests:Furnace$|^golden_tests$|^bazel_example$|^html_report_browser$"
+  # cli_tests' HtmlReport suite. gpu_tests:ReportHtmlOnGpu (16 s here on
+  # 2026-12-07) is sweep's and preview's host code, run here by the Sweep and
+  # Preview suites, around that page.
+  heavy="${heavy_gpu}|^unit_tests:Furnace$|^golden_tests$|^bazel_example$|^html_report_browser$|^gpu_tests:ReportHtmlOnGpu$"
   exclude="${SUBSTRATEC_ASAN_EXCLUDE-$heavy}"
   status=0
   ctest --preset asan -E "${gpu_regex}${exclude:+|$exclude}" || status=1
