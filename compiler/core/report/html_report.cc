@@ -61,14 +61,6 @@ constexpr std::array<const char*, 6> kPartNames = {"header", "closure data", "fe
 constexpr std::array<const char*, 8> kBasisColours = {"#2e9e5b", "#8e44ad", "#c0392b", "#16a085",
                                                       "#d35400", "#2c3e50", "#7f8c8d", "#b7950b"};
 
-bool isFeatureField(std::string_view name) {
-  const std::size_t dot = name.rfind('.');
-  const std::string_view leaf = dot == std::string_view::npos ? name : name.substr(dot + 1);
-  for (std::string_view f : {"f90", "sss", "haze", "fuzz", "anisotropy", "specular_profile", "glint", "hair",
-                             "iris_normal", "iris"})
-    if (leaf == f) return true;
-  return false;
-}
 
 /// A node id for an element id or fragment: material index, view and the id.
 std::string elementId(int material, std::string_view view, std::string_view node) {
@@ -143,10 +135,9 @@ std::vector<Badge> boxBadges(const Material& m, const TreeNode& node) {
   return badges;
 }
 
-/// One box: the operator, the node id (linked to its source line), the
-/// closure it becomes and its badges.
-std::string treeBox(const MaterialPage& p, int index, std::string_view view, const CompileResult& r, int n, double cx,
-                    double top) {
+/// One box: the operator, the node id, the closure it becomes and its badges
+/// (the node's link to its source line is in the feature lines: featureTable).
+std::string treeBox(int index, std::string_view view, const CompileResult& r, int n, double cx, double top) {
   const Material& m = r.material;
   const TreeInfo& t = r.tree;
   const TreeNode& node = m.nodes[n];
@@ -200,7 +191,7 @@ std::string culledBoxes(const Material& m, int index, std::string_view view, dou
 }
 
 /// The tree of `r` as an SVG diagram, with the culled matter under it when asked.
-std::string treeSvg(const MaterialPage& p, int index, std::string_view view, const CompileResult& r, bool withCulled) {
+std::string treeSvg(int index, std::string_view view, const CompileResult& r, bool withCulled) {
   const Material& m = r.material;
   const TreeLayout L = layoutTree(m, r.tree);
   const double treeHeight = L.rows * kRowHeight;
@@ -216,7 +207,7 @@ std::string treeSvg(const MaterialPage& p, int index, std::string_view view, con
       if (c >= 0)
         o += fmt::format(R"(<line x1="{:.1f}" y1="{:.1f}" x2="{:.1f}" y2="{:.1f}" stroke="#9aa5b1" stroke-width="1.5"/>)",
                          centre(n), top(n) + kBoxHeight, centre(c), top(c));
-  for (int n : r.tree.preorder) o += treeBox(p, index, view, r, n, centre(n), top(n));
+  for (int n : r.tree.preorder) o += treeBox(index, view, r, n, centre(n), top(n));
   if (withCulled) o += culledBoxes(m, index, view, kMargin + treeHeight, width);
   return o + "</svg>";
 }
@@ -457,11 +448,11 @@ std::string materialSection(const MaterialPage& p, int index) {
   o += byteSection(p);
   o += "<h3>Tree</h3><div class=\"trees\">";
   if (p.authored) {
-    o += "<figure><figcaption>Authored</figcaption>" + treeSvg(p, index, "authored", *p.authored, true) + "</figure>";
-    o += "<figure><figcaption>After simplification</figcaption>" + treeSvg(p, index, "simplified", r, false) + "</figure>";
+    o += "<figure><figcaption>Authored</figcaption>" + treeSvg(index, "authored", *p.authored, true) + "</figure>";
+    o += "<figure><figcaption>After simplification</figcaption>" + treeSvg(index, "simplified", r, false) + "</figure>";
   } else {
     o += "<figure><figcaption>Authored (it fits its budget: nothing simplified)</figcaption>" +
-         treeSvg(p, index, "authored", r, true) + "</figure>";
+         treeSvg(index, "authored", r, true) + "</figure>";
   }
   o += "</div>";
   o += blocksTable(r) + featureTable(p, index, r) + stepsTable(p, index) + storageTable(r) + sourceListing(p, index);
@@ -532,7 +523,7 @@ ByteBreakdown byteBreakdown(const StorageLayout& L) {
   for (const auto& f : L.fields) {
     if (f.name == "header" || f.name.ends_with(".header")) b.header += f.bits;
     else if (f.basis >= 0) b.bases += f.bits;
-    else if (isFeatureField(f.name)) b.featureData += f.bits;
+    else if (f.feature != 0) b.featureData += f.bits;
     else b.closureData += f.bits;
   }
   b.padding = L.words() * 32 - L.totalBits;

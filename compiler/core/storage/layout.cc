@@ -37,8 +37,9 @@ void finishLayout(StorageLayout& L) {
     if (c.isTop && c.basis != 0) topShare = false;
   L.basis0NormalElided = topShare;
 
-  auto add = [&](std::string name, int b, std::string enc, int closure = -1, int basis = -1) {
-    L.fields.push_back({std::move(name), b, std::move(enc), closure, basis});
+  auto add = [&](std::string name, int b, std::string enc, int closure = -1, int basis = -1,
+                 std::uint16_t feature = 0) {
+    L.fields.push_back({std::move(name), b, std::move(enc), closure, basis, feature});
     L.totalBits += b;
   };
   add("header", bits::kHeader,
@@ -56,10 +57,12 @@ void finishLayout(StorageLayout& L) {
     add(p + "diffuse_albedo", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);  // a hair's base colour
     if (c.storedFeatures & kFeatHair) {  // a fibre has no F0: its lobes' own parameters instead
       add(p + "hair", bits::kHair,
-          "azimuthal roughness unorm8 | (ior - 1) / 2 unorm8 | cuticle angle snorm8 over 20 deg | scatter unorm8", i);
+          "azimuthal roughness unorm8 | (ior - 1) / 2 unorm8 | cuticle angle snorm8 over 20 deg | scatter unorm8", i,
+          -1, kFeatHair);
     } else if (c.storedFeatures & kFeatEye) {  // a cornea's F0 is fixed (0.04): the iris instead
-      add(p + "iris_normal", bits::kIrisNormal, "octahedral 2 x snorm16", i);
-      add(p + "iris", bits::kIris, "iris plane normal octahedral 2 x unorm8 | iris mask unorm8 | iris distance unorm8", i);
+      add(p + "iris_normal", bits::kIrisNormal, "octahedral 2 x snorm16", i, -1, kFeatEye);
+      add(p + "iris", bits::kIris, "iris plane normal octahedral 2 x unorm8 | iris mask unorm8 | iris distance unorm8",
+          i, -1, kFeatEye);
     } else {
       add(p + "f0", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
     }
@@ -68,14 +71,17 @@ void finishLayout(StorageLayout& L) {
     if (!c.isTop) add(p + "top_transmittance", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
     if (c.storesCoverageAbove) add(p + "coverage_above", bits::kCoverageAbove, "unorm8", i);
     const std::uint16_t f = c.storedFeatures;
-    if (f & kFeatF90) add(p + "f90", bits::kColor, "unorm 7/7/6 of sqrt(c)", i);
-    if (f & kFeatSss) add(p + "sss", bits::kSss, "mfp: 3 x unorm8 of log2(mfp) in [-24, 8]; phase: snorm4", i);
-    if (f & kFeatHaze) add(p + "haze", bits::kHaze, "second roughness unorm8 | weight unorm8", i);
-    if (f & kFeatFuzz) add(p + "fuzz", bits::kFuzz, "amount unorm6 | color 7/7/6 sqrt | roughness unorm6", i);
-    if (f & kFeatAnisotropy) add(p + "anisotropy", bits::kAnisotropy, "snorm8", i);
-    if (f & kFeatSpecularProfile) add(p + "specular_profile", bits::kSpecularProfile, "profile index uint8", i);
+    if (f & kFeatF90) add(p + "f90", bits::kColor, "unorm 7/7/6 of sqrt(c)", i, -1, kFeatF90);
+    if (f & kFeatSss)
+      add(p + "sss", bits::kSss, "mfp: 3 x unorm8 of log2(mfp) in [-24, 8]; phase: snorm4", i, -1, kFeatSss);
+    if (f & kFeatHaze) add(p + "haze", bits::kHaze, "second roughness unorm8 | weight unorm8", i, -1, kFeatHaze);
+    if (f & kFeatFuzz)
+      add(p + "fuzz", bits::kFuzz, "amount unorm6 | color 7/7/6 sqrt | roughness unorm6", i, -1, kFeatFuzz);
+    if (f & kFeatAnisotropy) add(p + "anisotropy", bits::kAnisotropy, "snorm8", i, -1, kFeatAnisotropy);
+    if (f & kFeatSpecularProfile)
+      add(p + "specular_profile", bits::kSpecularProfile, "profile index uint8", i, -1, kFeatSpecularProfile);
     if (f & kFeatGlint)
-      add(p + "glint", bits::kGlint, "density unorm8 | uv 2 x float32 | duv/dx, duv/dy 4 x half", i);
+      add(p + "glint", bits::kGlint, "density unorm8 | uv 2 x float32 | duv/dx, duv/dy 4 x half", i, -1, kFeatGlint);
   }
   for (int b = 0; b < L.basisCount; ++b) {
     const std::string p = fmt::format("basis{}.", b);

@@ -49,6 +49,7 @@ struct LayoutField {
   std::string encoding;  // e.g. "unorm7/7/6 sqrt", "log2 unorm8 x3 + snorm4"
   int closure = -1;      // closure index, or -1
   int basis = -1;        // basis index, or -1
+  std::uint16_t feature = 0;  // the kFeat* bit whose data the field holds (0: a field every closure has)
 };
 
 struct ClosureLayout {
