@@ -93,7 +93,7 @@ int main(int argc, char** argv) {
         V3<double> one{1, 1, 1}, specAlbedo;
         double dielectric = 0;
         const double w =
-            specularEnergyAniso<double>(one, one, fresnelShare(1.0), V2<double>{1, 1}, one, mu, r, A, specAlbedo,
+            specularEnergyAniso<double>(one, one, fresnelShare(1.0), V2<double>{1, 1}, one, 0.0, mu, r, A, specAlbedo,
                                         dielectric)[0];
         for (int k = 0; k < kPhis; ++k) {
           const double today = e[k] * w, ideal = e[k] / eMax;

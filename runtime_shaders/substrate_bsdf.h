@@ -564,8 +564,21 @@ float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
   return float2(dot(f, SUBSTRATE_SPLAT3(1.0 / 3.0)), dot(g, SUBSTRATE_SPLAT3(1.0 / 3.0)));
 }
 
+// What a closure's dielectric lobe scatters between and through its facets,
+// per unit of perceptual roughness (SUBSTRATE_DIELECTRIC_MS; issue 19, step
+// 20): the lobe and its albedo take 1 + share rate r. None for a top over
+// layers (coversLayers): the layers' interface term under it (1 - chi, or
+// under a rough top its floor) is what a single-scattering top does not
+// reflect, so a top that reflected more would still let that through (a white
+// base under a stretched clear coat returned 1.008 of a white furnace).
+float substrate_closure_dielectric_ms(SubstrateClosure c) {
+  return c.coversLayers ? 0.0 : SUBSTRATE_DIELECTRIC_MS;
+}
+
 // Turquin 2019 multiple-scattering compensation W = 1 + F0w (1 - E) / E (F0w
-// the closure's F0, or a metalness mix's substrate_closure_compensated_f0) and the
+// the closure's F0, or a metalness mix's substrate_closure_compensated_f0),
+// times 1 + share msRate r (substrate_closure_dielectric_ms: a dielectric's
+// multiple scattering), and the
 // compensated lobe's directional albedo E_spec = (F0 E + (F90 - F0) B_chi) W,
 // from the tables at (NoV, r) (upper bounds of E - B and B; E = their sum
 // clamped to [1e-3, 1]; B_chi bounded from them, substrate_fresnel_b and
@@ -573,14 +586,15 @@ float2 substrate_diffuse_interface(mfloat3 f0, mfloat3 f90, float2 fd) {
 // energy: W E <= 1 and E_spec is never below the compensated lobe's true
 // albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
 // (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float NoV,
-                                  float roughness, out mfloat3 albedo, out float dielectric) {
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float msRate,
+                                  float NoV, float roughness, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
-  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e);
+  float ms = msRate * roughness;
+  mfloat3 w = (SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e)) * SUBSTRATE_M(1.0 + share * ms);
   float2 b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
   albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
-  dielectric = substrate_dielectric_albedo(fd, e, b.y);
+  dielectric = saturate(substrate_dielectric_albedo(fd, e, b.y) * (1.0 + ms));
   return w;
 }
 
@@ -597,8 +611,9 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 f
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float NoV,
-                                        float roughness, float anisotropy, out mfloat3 albedo, out float dielectric) {
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float msRate,
+                                        float NoV, float roughness, float anisotropy, out mfloat3 albedo,
+                                        out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float pull = substrate_fresnel_pull(roughness);
@@ -611,10 +626,11 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, fl
     pull = 1.0;
   }
 #endif
-  mfloat3 w = SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e);
+  float ms = msRate * roughness;
+  mfloat3 w = (SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e)) * SUBSTRATE_M(1.0 + share * ms);
   float2 b = substrate_fresnel_b(dfg, e, pull, share);
   albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
-  dielectric = substrate_dielectric_albedo(fd, e, b.y);
+  dielectric = saturate(substrate_dielectric_albedo(fd, e, b.y) * (1.0 + ms));
   return w;
 }
 
@@ -1375,10 +1391,11 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   // Specular: energy terms (needed by the diffuse even when NoL <= 0).
   float2 fd = substrate_closure_dielectric_part(c, f0, f90);
   mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
+  float msRate = substrate_closure_dielectric_ms(c);
   mfloat3 specAlbedo;
   float dielectric;
   mfloat3 w1 =
-      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
+      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo, dielectric);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE
@@ -1391,7 +1408,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (hazeWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2,
+    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, f0w, msRate, NoV, hazeRoughness, anisotropy, specAlbedo2,
                                          dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
     dielectric = lerp(dielectric, dielectric2, hazeWeight);

@@ -78,6 +78,9 @@ struct SubstrateClosure {
                               // a stretched top), per pixel like coatFloor; 0 under a smooth top
   uint features;              // SUBSTRATE_FEATURE_* bits
   bool isTop;                 // nothing layered above
+  bool coversLayers;          // on top of a pixel where some closure lies under layers (not stored:
+                              // set per pixel from the closure headers): its lobe takes no
+                              // dielectric multiple scattering (substrate_closure_dielectric_ms)
 };
 
 // The shading point as the generated material function sees it.
@@ -231,6 +234,7 @@ void substrate_closure_init(out SubstrateClosure c) {
   c.coatShare = 0.0;
   c.features = 0u;
   c.isTop = true;
+  c.coversLayers = false;
 }
 
 // What the rough top of the layers above a closure lets through at grazing

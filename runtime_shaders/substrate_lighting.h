@@ -71,12 +71,14 @@ mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfl
                                              float NoV, out float dielectric) {
   mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
   mfloat3 specAlbedo;
-  substrate_specular_energy(f0, f90, share, fd, f0w, NoV, saturate(c.roughness), specAlbedo, dielectric);
+  float msRate = substrate_closure_dielectric_ms(c);
+  substrate_specular_energy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.roughness), specAlbedo, dielectric);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    substrate_specular_energy(f0, f90, share, fd, f0w, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
+    substrate_specular_energy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.secondRoughness), specAlbedo2,
+                              dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
     dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }

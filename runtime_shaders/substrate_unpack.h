@@ -261,6 +261,7 @@ uint substrate_unpack_material(uint words[SUBSTRATE_MAX_WORDS], uint topLayer,
       closures[j].coatFloor = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatFloor;
       closures[j].coatInterface = !closures[j].isTop && tops == 1u ? coatInterface : SUBSTRATE_COAT_T_0;
       closures[j].coatShare = closures[j].isTop || closures[j].extraInterfaces != 0u ? 0.0 : coatShare;
+      closures[j].coversLayers = closures[j].isTop && tops < count;  // substrate_closure_dielectric_ms
     }
   }
 #if SUBSTRATE_USE_COAT_ANISO

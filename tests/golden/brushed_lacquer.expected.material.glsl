@@ -87,6 +87,7 @@ void brushed_lacquer_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

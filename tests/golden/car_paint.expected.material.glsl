@@ -98,6 +98,7 @@ void car_paint_evaluate(SubstrateGeometry g, out SubstrateClosure closures[CAR_P
   closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -89,6 +89,7 @@ void clear_coat_over_glints_evaluate(SubstrateGeometry g, out SubstrateClosure c
   closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -141,6 +141,7 @@ void coated_carbon_fiber_evaluate(SubstrateGeometry g, out SubstrateClosure clos
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
   closures[2].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

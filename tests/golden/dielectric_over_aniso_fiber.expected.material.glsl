@@ -88,6 +88,7 @@ void dielectric_over_aniso_fiber_evaluate(SubstrateGeometry g, out SubstrateClos
   closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -136,6 +136,7 @@ void silk_in_plastic_evaluate(SubstrateGeometry g, out SubstrateClosure closures
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
   closures[2].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_root;
   transmittance = T_root;

@@ -90,6 +90,7 @@ void ue4_clear_coat_paint_evaluate(SubstrateGeometry g, out SubstrateClosure clo
   closures[1].coatShare = coatShare;
   float coatInterface = substrate_coat_interface(closures[0].f0);  // of the top closure
   closures[1].coatInterface = coatInterface;
+  closures[0].coversLayers = true;
 
   coverage = C_paint;
   transmittance = T_paint;

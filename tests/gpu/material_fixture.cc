@@ -117,6 +117,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.coatShare = static_cast<T>(c.coatShare);
   o.features = c.features;
   o.isTop = c.isTop;
+  o.coversLayers = c.coversLayers;
   o.metalnessMix = c.metalnessMix;
   return o;
 }
@@ -236,6 +237,7 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   c.coatStretch = {p[kClosureCoatStretch], p[kClosureCoatStretch + 1]};
   c.coatTangent = v3(kClosureCoatTangent);
   c.coatShare = p[kClosureCoatShare];
+  c.coversLayers = p[kClosureCoversLayers] != 0.0f;
   if (c.features & reference::kFeatureHair)  // else the kernel has no hair field (SUBSTRATE_USE_HAIR 0)
     c.hair = {p[kClosureHair], p[kClosureHair + 1], p[kClosureHair + 2], p[kClosureHair + 3]};
   if (c.features & reference::kFeatureEye) {  // else the kernel has no iris fields (SUBSTRATE_USE_EYE 0)

@@ -255,6 +255,7 @@ void MaterialOnGpu::expectMatchesReference(const std::vector<std::vector<float>>
           check("coatStretch", at + kClosureCoatStretch + c, c64.coatStretch[c], c32.coatStretch[c]);
         field3("coatTangent", kClosureCoatTangent, c64.coatTangent, c32.coatTangent);
         check("coatShare", at + kClosureCoatShare, c64.coatShare, c32.coatShare);
+        check("coversLayers", at + kClosureCoversLayers, c64.coversLayers ? 1 : 0, c64.coversLayers ? 1 : 0);
         if (c64.features & reference::kFeatureHair)  // the field exists where a hair may be (SUBSTRATE_USE_HAIR)
           for (int c = 0; c < 4; ++c) check("hair", at + kClosureHair + c, c64.hair[c], c32.hair[c]);
         if (c64.features & reference::kFeatureEye) {  // the fields exist where an eye may be (SUBSTRATE_USE_EYE)

@@ -183,6 +183,44 @@ TEST(Accuracy, ADarkBaseUnderASmoothInterfaceFollowsExactFresnel) {
   EXPECT_EQ(rows, 6);
 }
 
+TEST(Accuracy, ARoughDielectricReflectsWhatItsFacetsScatterMoreThanOnce) {
+  // Issue 19, step 20 (bench/materials/rough_black_dielectric.json): a rough
+  // dielectric over a black base returns only what its interface reflects, and
+  // the truth's microsurface scatters light between its facets and through
+  // them and out again. The single-scattering lobe with Turquin's W read, as the
+  // mean over NoV 1 .. 0.1, -6.7 % at roughness 0.7 and -13.4 % at 1 (F0 0.04),
+  // -8.0 % at 0.7 for F0 0.08 (65,536 walks); with 1 + 0.125 r on a
+  // dielectric's lobe the means are within 3 % and every NoV within the goal
+  // but for the truth's own noise (a black base lets few walks back out: its
+  // standard error is 1 ... 2 % of the albedo at 131,072 walks).
+  int rows = 0;
+  for (const char* slab : {R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.7, "sss_mfp": 0})",
+                           R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 1, "sss_mfp": 0})",
+                           R"({"kind": "slab", "diffuse_albedo": 0, "f0": 0.08, "roughness": 0.7, "sss_mfp": 0})"}) {
+    SCOPED_TRACE(slab);
+    const CompileResult r = compileSlab(slab);
+    accuracy::Options o = cheap(2);
+    o.samples = 131072;
+    const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(r, o), accuracy::truthOf(r, o));
+    ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+    double mean = 0;
+    for (const auto& row : c.rows) {
+      SCOPED_TRACE(row.nov);
+      ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+      const double sigma = row.truthStderr[1] / row.truth[1];  // grey: every channel alike
+      EXPECT_LE(std::fabs(*row.relError), (row.nov >= 0.2 ? 0.05 : 0.08) + 2 * sigma);
+      // Turquin's W reads the view only: 1.071 at roughness 1, before this step
+      // as after (its factor is the same at every view, so the lobe keeps its reciprocity).
+      EXPECT_LE(row.reciprocityMaxRatio, 1.08);
+      for (int k = 0; k < 3; ++k) EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+      mean += *row.relError / static_cast<double>(c.rows.size());
+      ++rows;
+    }
+    EXPECT_LE(std::fabs(mean), 0.03);
+  }
+  EXPECT_EQ(rows, 18);
+}
+
 TEST(Accuracy, AScatteringMediumReturnsLessHeadOnThanAtGrazing) {
   // Issue 19, step 12: a semi-infinite medium of albedo 0.35 under an interface
   // of F0 0.04. Light that enters head-on goes deep and less of it returns than

@@ -491,6 +491,7 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.coatShare = static_cast<To>(c.coatShare);
   o.features = c.features;
   o.isTop = c.isTop;
+  o.coversLayers = c.coversLayers;
   o.metalnessMix = c.metalnessMix;
   return o;
 }

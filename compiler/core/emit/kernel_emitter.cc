@@ -107,7 +107,8 @@ std::string dumpClosure(const std::string& c, const std::string& base) {
   s += "#else\n";
   for (int at = kClosureIrisN; at < kClosureIris + 2; ++at) put(at, "0.0");
   s += "#endif\n";
-  for (int at = kClosureIris + 2; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 68)
+  put(kClosureCoversLayers, c + ".coversLayers ? 1.0 : 0.0");
+  for (int at = kClosureCoversLayers + 1; at < kClosureFloats; ++at) put(at, "0.0");  // padding (none at 69)
   return s;
 }
 

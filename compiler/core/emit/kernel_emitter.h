@@ -64,7 +64,7 @@ inline constexpr int kResultEmissive = 16;       // rgb: sum of view throughput 
                                                  // metres below the surface
 inline constexpr double kWaterSampleDepth = 0.5;
 /// Each closure's SubstrateClosure fields, in this order (floats):
-inline constexpr int kClosureFloats = 68;
+inline constexpr int kClosureFloats = 69;
 inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6, kClosureRoughness = 9,
                      kClosureAnisotropy = 10, kClosureN = 11, kClosureT = 14, kClosureSssMfp = 17,
                      kClosureSssPhase = 20, kClosureSssType = 21, kClosureSecondRoughness = 22,
@@ -75,7 +75,8 @@ inline constexpr int kClosureDiffuseAlbedo = 0, kClosureF0 = 3, kClosureF90 = 6,
                      kClosureFeatures = 45, kClosureIsTop = 46, kClosureExtraInterfaces = 47,
                      kClosureCoatFloor = 48, kClosureCoatInterface = 49,
                      kClosureCoatStretch = 50, kClosureCoatTangent = 52, kClosureCoatShare = 55,
-                     kClosureHair = 56, kClosureIrisN = 60, kClosureIrisPlaneN = 63, kClosureIris = 66;
+                     kClosureHair = 56, kClosureIrisN = 60, kClosureIrisPlaneN = 63, kClosureIris = 66,
+                     kClosureCoversLayers = 68;
 
 /// Preview parameters (set 0, binding 0, std140 / cbuffer, float4 each):
 ///   camera: xyz eye position, w tan(vertical half field of view)

@@ -241,6 +241,7 @@ class Emitter {
                            const std::string& t);  // substrate_op_* of a binary operator (emitTree)
   void emitClosures();
   void emitCoatFloor();
+  void emitCoversLayers();
   void emitCoatInterface();
   std::string pathWeight(int node, const std::string& id, std::vector<std::pair<int, int>>& layers);
   std::string walkUp(const ClosureLayout& cl, int node, const std::string& id);
@@ -868,6 +869,17 @@ void Emitter::emitEmission() {
 /// deferred one does) and its mean share; under a stretched top, its GGX
 /// alphas and tangent (the floor follows a direction's azimuth,
 /// substrate_coat_floor_along) and the azimuths' mean share.
+/// SubstrateClosure.coversLayers of every closure on top when some closure lies
+/// under layers, as the deferred unpacker derives it from the closure headers:
+/// such a top's lobe takes no dielectric multiple scattering, which the layers'
+/// interface term under it does not take away (substrate_closure_dielectric_ms).
+void Emitter::emitCoversLayers() {
+  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
+  if (std::all_of(L_.closures.begin(), L_.closures.end(), isTop)) return;
+  for (std::size_t i = 0; i < L_.closures.size(); ++i)
+    if (L_.closures[i].isTop) line(fmt::format("closures[{}].coversLayers = true;", i));
+}
+
 void Emitter::emitCoatFloor() {
   const std::vector<std::size_t> under = coatFloorClosures(m_, L_);
   if (under.empty()) return;
@@ -986,6 +998,7 @@ std::string Emitter::run() {
   emitWaterBody();
   emitCoatFloor();
   emitCoatInterface();
+  emitCoversLayers();
   emitNoClosureSlot();
   emitEmission();
   line("");

@@ -171,6 +171,7 @@ GbufferPixel packPixel(const CompileResult& r, const reference::Geometry& g, con
   const UnpackedMaterial back = unpackMaterial(p.words.data(), p.words.size(), p.topLayer);
   for (const ClosureValues& c : back.closures) p.closures.push_back(closureOf(c, back.bases.at(c.basis)));
   reference::setCoatFloor(p.closures, back.topLayer.roughness);  // substrate_unpack_material: the word's roughness
+  reference::setCoversLayers(p.closures);
   reference::setCoatInterface(p.closures);                        // from the unpacked top closure's F0
   return p;
 }

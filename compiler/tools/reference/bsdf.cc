@@ -150,15 +150,22 @@ T dielectricAlbedo(const V2<T>& d, T e, T b) {
   return saturate((d[0] * e + std::max(d[1] - d[0], T(0)) * b) * (T(1) + d[0] * ((T(1) - e) / e)));
 }
 
+// substrate_closure_dielectric_ms: no dielectric multiple scattering for a top over layers.
+template <class T>
+T closureDielectricMs(const Closure<T>& c) {
+  return c.coversLayers ? T(0) : T(SUBSTRATE_DIELECTRIC_MS);
+}
+
 // substrate_specular_energy_aniso: e = clamp(E - B + B, 1e-3, 1) from the dfg
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
 // B -> min(B_max, e), pull 1 (else fresnelPull(r));
-// W = 1 + F0w (1 - e) / e, E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
-// the dielectric part's (ends fd) dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)).
+// W = (1 + F0w (1 - e) / e)(1 + share msRate r), E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
+// the dielectric part's (ends fd) sat(dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)) (1 + msRate r)),
+// msRate = closureDielectricMs.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
-                          T roughness, T anisotropy, V3<T>& albedo, T& dielectric) {
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate,
+                          T NoV, T roughness, T anisotropy, V3<T>& albedo, T& dielectric) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
   T pull = fresnelPull(roughness);
@@ -169,17 +176,18 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T
     dfg[1] = std::min(eb[1], e);
     pull = T(1);
   }
-  V3<T> w = splat3(T(1)) + f0w * ((T(1) - e) / e);
+  const T ms = msRate * roughness;
+  V3<T> w = (splat3(T(1)) + f0w * ((T(1) - e) / e)) * (T(1) + share * ms);
   albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull, share)) * w);
-  dielectric = dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, T(1)));
+  dielectric = saturate(dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, T(1))) * (T(1) + ms));
   return w;
 }
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric) {
-  return specularEnergyAniso(f0, f90, share, fd, f0w, NoV, roughness, T(0), albedo, dielectric);
+  return specularEnergyAniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, T(0), albedo, dielectric);
 }
 
 // substrate_diffuse_transmission: min(1 - min(E_spec, E_d), (1 - E_spec) / max(albedo, 1e-3)).
@@ -601,6 +609,13 @@ T closureCoatTopAlpha(const Closure<T>& c) {
                   (std::sqrt(c.coatStretch[0]) + std::sqrt(c.coatStretch[0] + c.coatStretch[1])) / T(2));
 }
 
+// substrate_unpack_material / the emitter's emitCoversLayers: on top, when some closure is not.
+template <class T>
+void setCoversLayers(std::vector<Closure<T>>& closures) {
+  const bool under = std::any_of(closures.begin(), closures.end(), [](const Closure<T>& c) { return !c.isTop; });
+  for (Closure<T>& c : closures) c.coversLayers = c.isTop && under;
+}
+
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR) {
   int tops = 0;
@@ -989,7 +1004,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   const V3<T> f0w = closureCompensatedF0(c, f0, fd);
   V3<T> specAlbedo;
   T dielectric;
-  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, f0w, NoV, roughness, anisotropy, specAlbedo, dielectric);
+  const T msRate = closureDielectricMs(c);
+  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo, dielectric);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -1000,7 +1016,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    w2 = specularEnergyAniso(f0, f90, share, fd, f0w, NoV, hazeRoughness, anisotropy, specAlbedo2, dielectric2);
+    w2 = specularEnergyAniso(f0, f90, share, fd, f0w, msRate, NoV, hazeRoughness, anisotropy, specAlbedo2,
+                             dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
   }
@@ -1131,14 +1148,17 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> coatMeanDirection<T>(const Closure<T>&, T);                                           \
   template T coatInterface<T>(const V3<T>&);                                                           \
   template void setCoatFloor<T>(std::vector<Closure<T>>&, T);                                         \
+  template void setCoversLayers<T>(std::vector<Closure<T>>&);                                         \
   template void setCoatInterface<T>(std::vector<Closure<T>>&);                                        \
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template T fresnelShare<T>(T);                                                                       \
   template T fresnelPull<T>(T);                                                                        \
   template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, V3<T>&, T&);    \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
+  template T closureDielectricMs<T>(const Closure<T>&);                                                 \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, T, V3<T>&, \
+                                        T&);                                                            \
   template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
   template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \
   template V2<T> closureDielectricPart<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                \

@@ -60,15 +60,18 @@ template <class T> T fresnelPull(T roughness);                                  
 template <class T>
 V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
 template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH);        // substrate_fresnel
-/// substrate_specular_energy: returns W = 1 + F0w (1 - E) / E; E_spec in `albedo`, and in
-/// `dielectric` the albedo of the closure's dielectric part (ends fd, closureDielectricPart).
+/// substrate_closure_dielectric_ms: SUBSTRATE_DIELECTRIC_MS, 0 for a top over layers (coversLayers).
+template <class T> T closureDielectricMs(const Closure<T>& c);
+/// substrate_specular_energy: returns W = (1 + F0w (1 - E) / E)(1 + share msRate r); E_spec in
+/// `albedo`, and in `dielectric` the albedo of the closure's dielectric part (ends fd,
+/// closureDielectricPart), times 1 + msRate r.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T NoV,
-                          T roughness, T anisotropy, V3<T>& albedo, T& dielectric);
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate,
+                          T NoV, T roughness, T anisotropy, V3<T>& albedo, T& dielectric);
 /// substrate_dielectric_albedo: the compensated albedo of a grey interface of ends d.
 template <class T> T dielectricAlbedo(const V2<T>& d, T e, T b);
 /// substrate_diffuse_transmission: what the interface lets through to the diffuse along the view,

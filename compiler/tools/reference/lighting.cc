@@ -42,11 +42,12 @@ V3<T> specularAlbedo(const Closure<T>& c, T NoV, T& dielectric) {
   const V2<T> fd = closureDielectricPart(c, f0, f90);
   const V3<T> f0w = closureCompensatedF0(c, f0, fd);
   V3<T> specAlbedo;
-  specularEnergy(f0, f90, share, fd, f0w, NoV, saturate(c.roughness), specAlbedo, dielectric);
+  const T msRate = closureDielectricMs(c);
+  specularEnergy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.roughness), specAlbedo, dielectric);
   if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    specularEnergy(f0, f90, share, fd, f0w, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
+    specularEnergy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
     dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }

@@ -90,6 +90,7 @@ struct Closure {
   T coatShare = T(0);  // coatMeanShare of the floor (coatAnisoShare under a stretched top): setCoatFloor
   std::uint32_t features = 0;
   bool isTop = true;
+  bool coversLayers = false;  // on top of a pixel where some closure lies under layers: setCoversLayers
   /// SUBSTRATE_USE_METALNESS_MIX of the shader that lights it (Material::metalnessMix;
   /// the deferred scene lighting always has it): false reads the diffuse under the whole
   /// interface (closureDielectricPart (1, 1)).
@@ -143,6 +144,12 @@ T topRoughness(const std::vector<Closure<T>>& closures) {
 /// its tangent and coatShare = coatAnisoShare(coatStretch) (coatFloor 0).
 template <class T>
 void setCoatFloor(std::vector<Closure<T>>& closures, T topR);
+
+/// SubstrateClosure.coversLayers of every closure, as the material function and
+/// the unpacker set it: true on top when some closure of the pixel is not (its
+/// lobe takes no dielectric multiple scattering: closureDielectricMs).
+template <class T>
+void setCoversLayers(std::vector<Closure<T>>& closures);
 
 /// SubstrateClosure.coatInterface of every closure, as the material function
 /// and the unpacker set it (substrate_coat_interface): 1 - the mean F0 of the

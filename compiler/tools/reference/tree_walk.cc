@@ -177,6 +177,7 @@ class Walk {
     if (isWaterMaterial(m_)) out.water = water(m_.slabs[m_.nodes[m_.root].slab]);
     // What the layers' top lets through at grazing angles (the emitter's emitCoatFloor).
     setCoatFloor(out.closures, topRoughness(out.closures));
+    setCoversLayers(out.closures);  // the emitter's emitCoversLayers
     setCoatInterface(out.closures);  // the emitter's emitCoatInterface
     return out;
   }
