@@ -1395,7 +1395,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   mfloat3 specAlbedo;
   float dielectric;
   mfloat3 w1 =
-      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo, dielectric);
+      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo,
+                                      dielectric);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
 #if SUBSTRATE_USE_HAZE

@@ -12,8 +12,9 @@ top of the single-scattering lobe, truth / model_ss - 1, is fitted by weighted
 least squares (weights: the truth's standard error) as c r^p for p = 1, 1.5, 2,
 as r (a + b (1 - NoV)), and as a r + b r^2; then it prints the model's error
 with the shipped MS at every point, and F0 0.02 (left out of the fit: the
-low-F0 curve of step 17 lies above the truth there). Writes nothing but a
-temporary directory; about 30 s on two cores at the default 65,536 walks.
+low-F0 curve of step 17 lies above the truth there). Pure Python 3 (no
+numpy), deterministic; writes nothing but a temporary directory; about 10 s on
+two cores at the default 65,536 walks.
 
 usage: scripts/fit_dielectric_ms.py [--bin BIN] [--samples N] [--jobs J]
 """
@@ -21,14 +22,13 @@ usage: scripts/fit_dielectric_ms.py [--bin BIN] [--samples N] [--jobs J]
 import argparse
 import itertools
 import json
+import math
 import os
 import re
 import subprocess
 import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
-
-import numpy as np
 
 ROOT = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 ROUGHNESS = (0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
@@ -64,34 +64,43 @@ def main():
     grid = list(itertools.product(ROUGHNESS, F0S))
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(args.jobs) as pool:
         rows = list(pool.map(lambda rf: measure(args.bin, tmp, args.samples, *rf), grid))
-    x, y, w = [], [], []
-    for (r, f0), points in zip(grid, rows):
+    points = []  # (r, NoV, needed factor - 1, weight)
+    for (r, f0), measured in zip(grid, rows):
         if f0 == 0.02:
             continue
-        for nov, model, truth, err in points:
+        for nov, model, truth, err in measured:
             single = model / (1 + ms * r)  # the build's factor divided out
-            x.append((r, nov))
-            y.append(truth / single - 1)
-            w.append(1 / ((err / single) ** 2 + 1e-4))
-    x, y, w = np.array(x), np.array(y), np.array(w)
-    sw = np.sqrt(w)
+            points.append((r, nov, truth / single - 1, 1 / ((err / single) ** 2 + 1e-4)))
+    total = sum(p[3] for p in points)
 
-    def rms(residual):
-        return np.sqrt((w * residual ** 2).sum() / w.sum())
+    def rms(model):
+        return math.sqrt(sum(w * (y - model(r, nov)) ** 2 for r, nov, y, w in points) / total)
 
-    print("what the truth needs on the single-scattering lobe, %d points (F0 0.04, 0.08):" % len(y))
+    def fit2(f, g):
+        """Weighted least squares of y on a f + b g: the 2 x 2 normal equations."""
+        sff = sum(w * f(r, n) ** 2 for r, n, _, w in points)
+        sgg = sum(w * g(r, n) ** 2 for r, n, _, w in points)
+        sfg = sum(w * f(r, n) * g(r, n) for r, n, _, w in points)
+        sfy = sum(w * f(r, n) * y for r, n, y, w in points)
+        sgy = sum(w * g(r, n) * y for r, n, y, w in points)
+        det = sff * sgg - sfg * sfg
+        return (sfy * sgg - sgy * sfg) / det, (sgy * sff - sfy * sfg) / det
+
+    print("what the truth needs on the single-scattering lobe, %d points (F0 0.04, 0.08):" % len(points))
     for p in (1.0, 1.5, 2.0):
-        g = x[:, 0] ** p
-        c = (w * g * y).sum() / (w * g * g).sum()
-        print("  c r^%.1f:              c = %.4f, rms %.4f, largest %.4f" % (p, c, rms(y - c * g), abs(y - c * g).max()))
-    for label, basis in (("r (a + b (1 - NoV))", np.stack([x[:, 0], x[:, 0] * (1 - x[:, 1])], 1)),
-                         ("a r + b r^2", np.stack([x[:, 0], x[:, 0] ** 2], 1))):
-        sol = np.linalg.lstsq(basis * sw[:, None], y * sw, rcond=None)[0]
-        print("  %-21s a = %.4f, b = %.4f, rms %.4f" % (label + ":", sol[0], sol[1], rms(y - basis @ sol)))
+        c = sum(w * r ** p * y for r, _, y, w in points) / sum(w * r ** (2 * p) for r, _, _, w in points)
+        largest = max(abs(y - c * r ** p) for r, _, y, _ in points)
+        print("  c r^%.1f:              c = %.4f, rms %.4f, largest %.4f"
+              % (p, c, rms(lambda r, n: c * r ** p), largest))
+    for label, f, g in (("r (a + b (1 - NoV))", lambda r, n: r, lambda r, n: r * (1 - n)),
+                        ("a r + b r^2", lambda r, n: r, lambda r, n: r * r)):
+        a, b = fit2(f, g)
+        print("  %-21s a = %.4f, b = %.4f, rms %.4f" % (label + ":", a, b,
+                                                          rms(lambda r, n: a * f(r, n) + b * g(r, n))))
     print("\nthe build (MS %.4f): model / truth - 1 %% at NoV 1 / 0.8 / 0.6 / 0.4 / 0.2 / 0.1 (truth's stderr %%)" % ms)
-    for (r, f0), points in zip(grid, rows):
+    for (r, f0), measured in zip(grid, rows):
         print("  r %.1f F0 %.2f  %s" % (r, f0, " ".join("%+5.1f (%.1f)" % (100 * (m / t - 1), 100 * e / t)
-                                                        for _, m, t, e in points)))
+                                                        for _, m, t, e in measured)))
     return 0
 
 

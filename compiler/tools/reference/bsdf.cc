@@ -160,7 +160,8 @@ T closureDielectricMs(const Closure<T>& c) {
 // pair (the shader sums the pair back); an anisotropic lobe, with
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
 // B -> min(B_max, e), pull 1 (else fresnelPull(r));
-// W = (1 + F0w (1 - e) / e)(1 + share msRate r), E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
+// W = (1 + F0w (1 - e) / e)(1 + share msRate r),
+// E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
 // the dielectric part's (ends fd) sat(dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)) (1 + msRate r)),
 // msRate = closureDielectricMs.
 template <class T>
