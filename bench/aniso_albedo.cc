@@ -12,12 +12,15 @@
 // [1e-3, 1]). The shipped compensation W is the reference's mirror of the
 // shader, reference::specularEnergyAniso, so the returned albedo is E W.
 // Not a test: `build/bin/aniso_albedo [n]` prints a markdown table
-// (docs/accuracy.md, "Anisotropy: what the compensation returns").
+// (docs/accuracy.md, "Anisotropy: what the compensation returns");
+// `build/bin/aniso_albedo --case R A` prints one lobe's 1 / W and E per NoV and
+// view azimuth (docs/accuracy.md, step 21).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
+#include <string_view>
 #include <vector>
 
 #include "reference/bsdf.h"
@@ -66,6 +69,29 @@ double albedo(double mu, double phi, double ax, double ay, int n) {
 
 int main(int argc, char** argv) {
   using namespace substratec::reference;
+  if (argc == 4 && std::string_view(argv[1]) == "--case") {
+    // One lobe: per NoV, the shipped compensation's 1 / W and E at azimuths 0, 10 .. 90 degrees.
+    char* end2 = nullptr;
+    char* end3 = nullptr;
+    const double rIn = std::strtod(argv[2], &end2), aIn = std::strtod(argv[3], &end3);
+    if (*end2 != '\0' || *end3 != '\0' || !(rIn >= 0 && rIn <= 1) || !(std::fabs(aIn) <= 1)) {
+      std::fprintf(stderr, "aniso_albedo: --case takes a roughness in [0, 1] and an anisotropy in [-1, 1]\n");
+      return 2;
+    }
+    const double r = rIn, A = std::fabs(aIn);
+    const double a = r * r;
+    const double ax = std::clamp(a * (1 + A), 1e-3, 1.0), ay = std::clamp(a * (1 - A), 1e-3, 1.0);
+    for (double mu : {1.0, 0.8, 0.6, 0.4, 0.2, 0.1}) {
+      V3<double> one{1, 1, 1}, specAlbedo;
+      double dielectric = 0;
+      const double w = specularEnergyAniso<double>(one, one, fresnelShare(1.0), V2<double>{1, 1}, one, 0.0, mu, r, A,
+                                                   specAlbedo, dielectric)[0];
+      std::printf("NoV %.1f  1/W %.4f  E:", mu, 1 / w);
+      for (int k = 0; k < 10; ++k) std::printf(" %.4f", albedo(mu, k * std::numbers::pi / 18, ax, ay, 256));
+      std::printf("\n");
+    }
+    return 0;
+  }
   const int n = argc > 1 ? std::clamp(std::atoi(argv[1]), 8, 1024) : 128;
   const double mus[] = {1.0, 0.8, 0.6, 0.4, 0.2, 0.1};
   const double rs[] = {0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 1.0};
