@@ -7,7 +7,7 @@
 // bilinear on [0, 1]^2 (inputs clamped); the outer half cell is extrapolated
 // linearly from the last two centres, and results are clamped to range.
 // A fourth, E_max(NoV, r, |A|) and B_max of anisotropic lobes, 15 x 16 uint4 of
-// eight halves (substrate_energy_aniso), is read only by shaders compiled with
+// twelve 10-bit values (substrate_energy_aniso), is read only by shaders compiled with
 // SUBSTRATE_USE_ANISOTROPY: the others declare (or inline) the first three only.
 //
 // Where the values live (choose before including this file):
@@ -143,17 +143,20 @@ float2 substrate_energy_dfg(float NoV, float roughness) {
 // (E_max, B_max)(NoV, r, |A|): the largest directional albedo and the largest
 // B (the (1 - VoH)^5 part), over the view's azimuth, of the GGX lobe of
 // anisotropy |A| with F = 1 (scripts/gen_energy_lut.py: upper bounds at every
-// lookup). Nodes at sqrt(NoV) = i / 15 and r = j / 15 hold both at |A| = 0.5
-// and 1 as halves; one uint4 holds two nodes neighbouring in NoV, so the
-// bilinear lookup in (sqrt(NoV), r) is two fetches (as many words as the E and
-// B lookups at the smooth axis' alpha it replaces). Across |A|: hat weights at
-// 0.5 and 1, with `iso`, the isotropic (E, B) at (NoV, r), at |A| = 0.
-// E clamped to [1e-3, 1], B to [0, 1].
+// lookup). Nodes at sqrt(NoV) = i / 15 and r = j / 15 hold both at |A| = 1/3,
+// 2/3 and 1 as 10-bit counts of 1/960, three to a word; one uint4 holds
+// two nodes neighbouring in NoV, so the bilinear lookup in (sqrt(NoV), r) is
+// two fetches (as many words as the E and B lookups at the smooth axis' alpha
+// it replaces). Across |A|: hat weights at 1/3, 2/3 and 1, with `iso`, the
+// isotropic (E, B) at (NoV, r), at |A| = 0 (issue 19, step 21: the largest
+// albedo bends across |A|, so two slices at 0.5 and 1 were raised up to 8 %
+// above it between them). E clamped to [1e-3, 1], B to [0, 1].
 #if SUBSTRATE_USE_ANISOTROPY
-// One row of the lookup: (E at 0.5, E at 1, B at 0.5, B at 1), lerped in NoV.
-float4 substrate_energy_aniso_row(uint4 n, float f) {
-  return lerp(float4(substrate_unpack_half2(n.x), substrate_unpack_half2(n.y)),
-              float4(substrate_unpack_half2(n.z), substrate_unpack_half2(n.w)), f);
+// One row of the lookup: (E, B) at |A| (w: the slices' hat weights over 960,
+// the unit of the counts), lerped in NoV between the row's two nodes.
+float2 substrate_energy_aniso_row(uint4 n, float3 w, float f) {
+  float4 v = float4(n & 1023u) * w.x + float4((n >> 10u) & 1023u) * w.y + float4((n >> 20u) & 1023u) * w.z;
+  return lerp(v.xy, v.zw, f);
 }
 
 float2 substrate_energy_aniso(float NoV, float roughness, float absAnisotropy, float2 iso) {
@@ -161,11 +164,12 @@ float2 substrate_energy_aniso(float NoV, float roughness, float absAnisotropy, f
   float2 p0 = min(floor(p), SUBSTRATE_SPLAT2(14.0));
   float2 f = p - p0;
   int k = int(p0.y) * (SUBSTRATE_LUT_ANISO_SIZE - 1) + int(p0.x);
-  float4 v = lerp(substrate_energy_aniso_row(SUBSTRATE_LUT_FETCH_ANISO(k), f.x),
-                  substrate_energy_aniso_row(SUBSTRATE_LUT_FETCH_ANISO(k + SUBSTRATE_LUT_ANISO_SIZE - 1), f.x), f.y);
-  float a = saturate(absAnisotropy) * 2.0;
-  float2 w = float2(1.0 - abs(a - 1.0), max(a - 1.0, 0.0));
-  float2 r = float2(dot(v.xy, w), dot(v.zw, w)) + iso * max(1.0 - a, 0.0);
+  float a = saturate(absAnisotropy) * 3.0;
+  float3 w = max(SUBSTRATE_SPLAT3(1.0) - abs(SUBSTRATE_SPLAT3(a) - float3(1.0, 2.0, 3.0)), SUBSTRATE_SPLAT3(0.0)) *
+             (1.0 / 960.0);
+  float2 r0 = substrate_energy_aniso_row(SUBSTRATE_LUT_FETCH_ANISO(k), w, f.x);
+  float2 r1 = substrate_energy_aniso_row(SUBSTRATE_LUT_FETCH_ANISO(k + SUBSTRATE_LUT_ANISO_SIZE - 1), w, f.x);
+  float2 r = lerp(r0, r1, f.y) + iso * max(1.0 - a, 0.0);
   return float2(clamp(r.x, 1e-3, 1.0), saturate(r.y));
 }
 #endif

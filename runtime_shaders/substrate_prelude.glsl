@@ -37,8 +37,6 @@
 // float <-> half bits (low 16 bits).
 #define substrate_f32tof16(v_) (packHalf2x16(vec2((v_), 0.0)) & 0xffffu)
 #define substrate_f16tof32(h_) (unpackHalf2x16(uint(h_)).x)
-// The two IEEE halves of a uint (low bits first) as a float2.
-#define substrate_unpack_half2(u_) unpackHalf2x16(u_)
 // A constant array: SUBSTRATE_CONST float NAME[4] = SUBSTRATE_ARRAY_BEGIN(float, 4) a, b, c, d SUBSTRATE_ARRAY_END;
 #define SUBSTRATE_ARRAY_BEGIN(T, N) T[N](
 #define SUBSTRATE_ARRAY_END )

@@ -11,8 +11,6 @@
 #define SUBSTRATE_SPLAT4(x) ((float4)(x))
 #define substrate_f32tof16(x) (f32tof16(x) & 0xffffu)
 #define substrate_f16tof32(x) f16tof32(uint(x))
-// The two IEEE halves of a uint (low bits first) as a float2.
-#define substrate_unpack_half2(u_) float2(f16tof32(u_), f16tof32((u_) >> 16))
 #define SUBSTRATE_ARRAY_BEGIN(T, N) {
 #define SUBSTRATE_ARRAY_END }
 // Textures and storage images (see substrate_prelude.glsl).

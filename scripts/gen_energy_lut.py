@@ -23,9 +23,10 @@ centres):
                                directional albedo and the largest B, over the view's
                                azimuth, of the anisotropic GGX lobe with F = 1
                                (alphas r^2 (1 +- |A|), clamped as the runtime does),
-                               on 16 x 16 nodes in (sqrt(mu), r) at |A| = 0.5 and 1,
-                               as IEEE halves rounded up (pack_aniso: one uint4 per
-                               two nodes neighbouring in mu); the runtime compensates an
+                               on 16 x 16 nodes in (sqrt(mu), r) at |A| = 1/3, 2/3
+                               and 1, as 1/960ths rounded up, three of 10 bits
+                               per word (pack_aniso: one uint4 per two nodes
+                               neighbouring in mu); the runtime compensates an
                                anisotropic lobe with W = 1 / E_max (issue 19), which
                                gains energy at no azimuth, and bounds its B by
                                B_max. Raised to an envelope of its lookup as the
@@ -46,13 +47,13 @@ bound for any F0, F90 in [0, 1]: compensation never adds energy and the
 diffuse below never receives more than 1 - E_spec of the true lobe.
 
 Pure Python 3 (no numpy). Writes the header (default path, or argv[1]) and prints
-nothing; two runs give identical files (about 3 minutes on 2 cores).
+the largest anisotropic nodes (10 bits of 1/960 hold up to 1.066); two runs give
+identical files (about 5 minutes on 2 cores).
 """
 
 import math
 import multiprocessing
 import os
-import struct
 import sys
 
 N = 32                 # table resolution per axis
@@ -196,11 +197,13 @@ def fuzz_cell(mu, r, pts):
 # --- The anisotropic table (issue 19): E_max(NoV, r, |A|) ---------------------
 
 ANISO_N = 16            # nodes per axis in (sqrt(NoV), r), at i / 15 and j / 15
-ANISO_SLICES = 2        # |A| = 0.5, 1 (|A| = 0 is the E and B tables)
+ANISO_SLICES = 3        # |A| = 1/3, 2/3, 1 (|A| = 0 is the E and B tables)
+ANISO_SCALE = 960.0     # a packed value is a count of 1/960ths (10 bits: up to 1.066; raised nodes exceed 1)
 ANISO_PHIS = 9          # view azimuths from the tangent to the bitangent, 0 .. pi/2
 ANISO_SAMPLES = 1024    # Hammersley points per azimuth at a node
-ANISO_CHECK_SAMPLES = 512  # and at an envelope check point
-ANISO_MARGIN = 5e-4     # absolute slack over the integrated value (integration noise)
+ANISO_CHECK_SAMPLES = 2048  # and at an envelope check point (512 read up to 2.5e-3 low)
+ANISO_MARGIN = 1e-3     # absolute slack over the integrated value (2048 points read up to 7e-4 low)
+ANISO_CHECK_A = [1 / 24.0, 1 / 12.0, 1 / 8.0] + [k / 12.0 for k in range(2, 13)]  # |A| of the checks
 
 
 def ggx_alpha(r, a_abs):
@@ -296,22 +299,29 @@ def iso_lookup(tab, mu, r, lo):
     return min(max(sum(tab[i] * w for i, w in lookup_weights(px, py)), lo), 1.0)
 
 
-def half_up(v):
-    """The smallest IEEE half >= v (v >= 0), as its 16 bits."""
-    h = struct.unpack("<H", struct.pack("<e", v))[0]
-    if struct.unpack("<e", struct.pack("<H", h))[0] < v:
-        h += 1
-    return h
+def units_up(v):
+    """The smallest count q of 1 / ANISO_SCALE with q / ANISO_SCALE >= v (v >= 0), 10 bits."""
+    q = max(int(math.ceil(v * ANISO_SCALE)), 0)
+    if q / ANISO_SCALE < v:
+        q += 1
+    if q > 1023:
+        raise RuntimeError("anisotropic node %g does not fit 10 bits of 1/960ths" % v)
+    return q
 
 
 def pack_aniso(e_nodes, b_nodes):
     """One uint4 per pair of nodes neighbouring in NoV, (i, j) and (i + 1, j),
     i < 15, at [(j * 15 + i) * 4]: (E(i), B(i), E(i + 1), B(i + 1)), each word
-    the value at |A| 0.5 | the value at 1 << 16 as halves rounded up (a bound
-    stays a bound). The lookup reads one word group per roughness row."""
+    the values at |A| 1/3 | 2/3 << 10 | 1 << 20 as 1/960ths rounded up (a
+    bound stays a bound). The lookup reads one word group per roughness row.
+    A host passes the words through a float buffer, so no word may read as a
+    denormal float (some paths flush those to zero): where bits 23-30 would
+    all be 0 (the value at |A| 1 below 0.008), bit 30 is set; the lookup
+    masks each value to its 10 bits."""
     def word(nodes, i, j):
         n = (j * ANISO_N + i) * ANISO_SLICES
-        return half_up(nodes[n]) | half_up(nodes[n + 1]) << 16
+        w = units_up(nodes[n]) | units_up(nodes[n + 1]) << 10 | units_up(nodes[n + 2]) << 20
+        return w | (1 << 30) if (w >> 23) == 0 else w
     out = []
     for j in range(ANISO_N):
         for i in range(ANISO_N - 1):
@@ -338,12 +348,46 @@ def raise_aniso(nodes, checks, values, iso_tab, lo):
     raise RuntimeError("anisotropic envelope did not converge")
 
 
+def lower_aniso(nodes, checks, values, iso_tab, lo):
+    """Lowers each node of `nodes` (raised by raise_aniso) as far as every
+    check it takes part in allows (the lookup stays at least value +
+    ANISO_MARGIN), one node at a time, until no node moves by more than 1e-7
+    (at most 100 passes; every step keeps every check): raise_aniso lifts every
+    node of a short check together, so a node may be left higher than any
+    check needs (the largest albedo bends across |A| and r), and every point of
+    a node's cells loses what it is too high."""
+    have, need, uses = [], [], [[] for _ in nodes]
+    for c, ((mu, r, a_abs, _n), value) in enumerate(zip(checks, values)):
+        ws, w_iso = aniso_weights(mu, r, a_abs)
+        have.append(w_iso * iso_lookup(iso_tab, mu, r, lo) + sum(nodes[k] * w for k, w in ws))
+        need.append(value + ANISO_MARGIN)
+        for k, w in ws:
+            if w > 0.0:
+                uses[k].append((c, w))
+    for _ in range(100):
+        moved = 0.0
+        for k, used in enumerate(uses):
+            if not used:
+                continue
+            slack = min((have[c] - need[c]) / w for c, w in used)
+            step = min(slack, nodes[k])
+            if step > 1e-7:
+                nodes[k] -= step
+                for c, w in used:
+                    have[c] -= step * w
+                moved = max(moved, step)
+        if moved <= 1e-7:
+            return
+
+
 def aniso_table(e_tab, b_tab, pool):
     """The E_max and B_max nodes, each raised until the lookup bounds it (plus
     ANISO_MARGIN) at every check point: the nodes themselves, the midpoints
-    between nodes in sqrt(NoV) and r, at |A| = 1/16 .. 1 in steps of 1/8 and
-    1/16 below 1/4 (where the isotropic tables take part), NoV >= 1e-4; then
-    packed as halves rounded up (pack_aniso)."""
+    between nodes in sqrt(NoV) and r, at |A| = 1/24, 1/12, 1/8 and 1/6 .. 1 in
+    steps of 1/12 (ANISO_CHECK_A; finer where the isotropic tables take part),
+    NoV >= 1e-4; then
+    lowered where no check needs them (lower_aniso) and packed as 1/960ths
+    rounded up (pack_aniso)."""
     nodes_args = []
     for j in range(ANISO_N):
         for i in range(ANISO_N):
@@ -354,15 +398,16 @@ def aniso_table(e_tab, b_tab, pool):
     e_nodes = [e for e, _ in nodes]
     b_nodes = [b for _, b in nodes]
     us = [k / (2.0 * (ANISO_N - 1)) for k in range(2 * ANISO_N - 1)]
-    check_a = [1 / 16.0, 1 / 8.0, 3 / 16.0, 1 / 4.0, 3 / 8.0, 1 / 2.0, 5 / 8.0, 3 / 4.0, 7 / 8.0, 1.0]
     checks = []
     for y in us:
         for x in us:
-            for a_abs in check_a:
+            for a_abs in ANISO_CHECK_A:
                 checks.append((max(x * x, MIN_NOV), y, a_abs, ANISO_CHECK_SAMPLES))
     values = pool.map(aniso_max, checks, chunksize=32)
-    raise_aniso(e_nodes, checks, [e for e, _ in values], e_tab, 1e-3)
-    raise_aniso(b_nodes, checks, [b for _, b in values], b_tab, 0.0)
+    for nodes, tab, lo, k in ((e_nodes, e_tab, 1e-3, 0), (b_nodes, b_tab, 0.0, 1)):
+        raise_aniso(nodes, checks, [v[k] for v in values], tab, lo)
+        lower_aniso(nodes, checks, [v[k] for v in values], tab, lo)
+    print("anisotropic nodes: E up to %.4f, B up to %.4f" % (max(e_nodes), max(b_nodes)))
     return pack_aniso(e_nodes, b_nodes)
 
 
@@ -382,7 +427,8 @@ def emit_table(out, name, index, values, comment):
 def emit_aniso_table(out, values):
     out.append(ANISO_TOP)
     out.append("  // [(j * 15 + i) * 4 + c]: nodes (sqrt(NoV) = i / 15 and (i + 1) / 15, r = j / 15); c = 0, 1:")
-    out.append("  // E_max, B_max at node i, c = 2, 3 at node i + 1; each word: |A| 0.5 | |A| 1 << 16 (halves)")
+    out.append("  // E_max, B_max at node i, c = 2, 3 at node i + 1; each word: |A| 1/3 | 2/3 << 10 | 1 << 20")
+    out.append("  // (10 bits each, counts of 1/960)")
     row = (ANISO_N - 1) * 4
     for j in range(ANISO_N):
         line = ", ".join("0x%08xu" % v for v in values[j * row:(j + 1) * row])
@@ -399,8 +445,8 @@ HEADER_TOP = """\
 // cell and j the perceptual-roughness cell; NoV = (i + 0.5) / 32 and
 // r = (j + 0.5) / 32 at cell centres. Then, for shaders with anisotropy and for
 // hosts (SUBSTRATE_USE_ANISOTROPY undefined or 1), SUBSTRATE_LUT_ANISO_TABLE:
-// 15 x 16 uint4 of two IEEE halves per uint (low bits first), one per pair
-// of nodes neighbouring in NoV, [(j * 15 + i) * 4 + c]: nodes at
+// 15 x 16 uint4 of three 10-bit counts of 1/960 per uint (low bits first),
+// one per pair of nodes neighbouring in NoV, [(j * 15 + i) * 4 + c]: nodes at
 // NoV = (i / 15)^2 and ((i + 1) / 15)^2, r = j / 15. The host uploads the two
 // arrays' bits in that order (SUBSTRATE_LUT_FLOATS 32-bit words in all).
 //
@@ -423,14 +469,16 @@ HEADER_TOP = """\
 //                       r^2 (1 +- |A|) clamped to [1e-3, 1]), for the energy
 //                       terms of anisotropic lobes (substrate_energy_aniso):
 //                       bounds at every azimuth. Components 0, 1: E_max and B_max
-//                       at node i, 2, 3 at node i + 1; each word holds |A| = 0.5
-//                       in its low and |A| = 1 in its high half.
+//                       at node i, 2, 3 at node i + 1; each word holds |A| = 1/3,
+//                       2/3 and 1 in bits 0-9, 10-19 and 20-29 (1/960ths;
+//                       bit 30 set where the word would read as a denormal float).
 //                       %d azimuths per point, %d points per azimuth at the nodes;
 //                       raised until the lookup (bilinear in sqrt(NoV) and r, by
 //                       hat weights over |A| with the E and B tables at |A| = 0)
 //                       is at least the value + %g at the nodes, the midpoints
-//                       between them and 10 values of |A| (%d points per
-//                       azimuth), then rounded up to halves.
+//                       between them and %d values of |A| (%d points per
+//                       azimuth), each node then lowered as far as those checks
+//                       allow, then rounded up to 1/960ths.
 //
 // Integration: %d (GGX, visible-normal sampling, Heitz 2018) and %d (sheen, NDF
 // sampling) Hammersley points per cell.
@@ -560,8 +608,9 @@ def main():
     with multiprocessing.Pool() as pool:
         a_tab = aniso_table(e_tab, b_tab, pool)
     steps = N * ENVELOPE_STEPS + 1
-    out = [HEADER_TOP % (ANISO_PHIS, ANISO_SAMPLES, ANISO_MARGIN, ANISO_CHECK_SAMPLES, GGX_SAMPLES, FUZZ_SAMPLES,
-                         steps, steps, len(ENVELOPE_EXTRA_NOV), ENVELOPE_MARGIN, ENVELOPE_FUZZ_RELATIVE_MARGIN)]
+    out = [HEADER_TOP % (ANISO_PHIS, ANISO_SAMPLES, ANISO_MARGIN, len(ANISO_CHECK_A), ANISO_CHECK_SAMPLES,
+                         GGX_SAMPLES, FUZZ_SAMPLES, steps, steps, len(ENVELOPE_EXTRA_NOV), ENVELOPE_MARGIN,
+                         ENVELOPE_FUZZ_RELATIVE_MARGIN)]
     emit_table(out, "SUBSTRATE_LUT_E", 0, e_tab, "E(NoV, r), F = 1")
     emit_table(out, "SUBSTRATE_LUT_B", 1, b_tab, "B(NoV, r), the (1 - VoH)^5 part of E")
     emit_table(out, "SUBSTRATE_LUT_FUZZ", 2, f_tab, "E_fuzz(NoV, r), Charlie sheen")

@@ -597,9 +597,11 @@ TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   // microsurface scatters multiply. Its energy compensation reads the lobe's
   // largest albedo over the view's azimuth (substrate_energy_aniso); before, it
   // was widened toward none and the control read -23.1 / -21.1 / -12.4 / -8.1 %
-  // (NoV 1 / 0.6 / 0.2 / 0.1), a white furnace of 0.73 head-on; now -2.1 / -1.8 /
-  // -2.4 / -2.4 % (the table's slices at |A| 0.5 and 1, raised to bound
-  // |A| 0.8 between them, give back a little). Reciprocity is
+  // (NoV 1 / 0.6 / 0.2 / 0.1), a white furnace of 0.73 head-on; then -2.1 / -1.8 /
+  // -2.4 / -2.4 % and a furnace of 0.973 (the table's slices at |A| 0.5 and 1,
+  // raised to bound |A| 0.8 between them, gave back a little); since step 21
+  // (slices at 1/3, 2/3 and 1, each node as low as the bound allows) -0.2 /
+  // -0.3 / -0.5 / -0.4 % at 32,768 walks, a furnace of 0.996. Reciprocity is
   // not bounded here: Turquin's W depends on the view alone (1.16-1.20 for this
   // lobe, 1.05-1.11 for the isotropic one).
   const CompileResult r = compileSlab(
@@ -612,9 +614,9 @@ TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   for (const auto& row : c.rows) {
     SCOPED_TRACE(row.nov);
     ASSERT_TRUE(row.relError && row.furnaceAnalytic);
-    EXPECT_LE(std::fabs(*row.relError), 0.04);
+    EXPECT_LE(std::fabs(*row.relError), 0.03);
     for (int k = 0; k < 3; ++k) {
-      EXPECT_GE((*row.furnaceAnalytic)[k], 0.97);
+      EXPECT_GE((*row.furnaceAnalytic)[k], 0.985);
       EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
     }
     ++rows;

@@ -4,7 +4,9 @@
 // index = roughness cell * 32 + NoV cell; E then B then E_fuzz.
 #include <gtest/gtest.h>
 
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "validate/runtime_files.h"
 
@@ -50,6 +52,27 @@ TEST(EnergyLut, KnownValues) {
   EXPECT_LE(E(31, 31), 0.32579f + 2e-3f);
   // Row order: E falls with roughness at normal incidence (within the envelope's slack).
   for (int r = 1; r < kEnergyLutSize; ++r) EXPECT_LT(E(31, r), E(31, r - 1) + 1e-3f) << r;
+}
+
+TEST(EnergyLut, TheAnisotropicWordsSurviveAFloatBuffer) {
+  // The anisotropic table's words are bits (three 10-bit counts of 1/960 each)
+  // that a host uploads, and a shader may fetch, as floats: none may be a
+  // denormal (which some paths flush to zero), an infinity or a NaN (which
+  // some canonicalize). The generator sets bit 30 where the counts alone would
+  // make a denormal; the lookup masks it off.
+  const auto words = energyLutTables().subspan(3u * kCells);
+  ASSERT_EQ(words.size(), 960u);
+  int checked = 0, lifted = 0;
+  for (std::size_t k = 0; k < words.size(); ++k) {
+    const float f = words[k];
+    const auto bits = std::bit_cast<std::uint32_t>(f);
+    EXPECT_EQ(std::fpclassify(f), FP_NORMAL) << "word " << k << " = 0x" << std::hex << bits;
+    EXPECT_EQ(bits >> 31, 0u) << "word " << k;
+    lifted += (bits >> 30) & 1u;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 960);
+  EXPECT_GT(lifted, 0);  // the table has small B values: the rule is exercised
 }
 
 }  // namespace

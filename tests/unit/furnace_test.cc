@@ -723,11 +723,12 @@ TEST(Furnace, AnisotropicLobesNeverGainEnergyAtAnyAzimuth) {
   // (substrate_specular_energy_aniso); this sweeps |A| (small values too: the
   // Schlick part B rises fastest there), the view azimuth and NoV more finely
   // than the furnace grid, for the conductor and the dielectric over white
-  // diffuse.
+  // diffuse. |A| 0.85 lies between the table's checks (step 21's first table,
+  // checked on 512 points per azimuth, read 1.0017 there at r 1, head-on).
   const auto t0 = std::chrono::steady_clock::now();
   double worst = 0;
   std::string where;
-  for (double A : {0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0})
+  for (double A : {0.05, 0.1, 0.2, 0.3, 0.5, 0.75, 0.85, 1.0})
     for (double r : {0.05, 0.25, 0.5, 0.75, 1.0})
       for (double NoV : {1.0, 0.5, 0.2, 0.1, 0.03, 1e-3})
         for (double phi : {0.0, std::numbers::pi / 8, std::numbers::pi / 4, std::numbers::pi / 2})
@@ -748,11 +749,13 @@ TEST(Furnace, AStretchedWhiteConductorIsCompensatedByItsLargestAlbedo) {
   // Issue 19, item 1: W = 1 / E_max(NoV, r, |A|), the lobe's largest albedo
   // over the view's azimuth (substrate_energy_aniso). Head-on the albedo does
   // not depend on the azimuth, so a white conductor returns nearly all of it
-  // (0.53 at r 0.75, |A| 1 with the compensation widened toward 1; the table's
-  // nodes at |A| 0.5 and 1, raised to bound the values between, leave at least
-  // 0.909, at |A| 0.25); away from it the azimuths below the largest keep
-  // E / E_max (0.66 at worst at NoV 0.2, bench/aniso_albedo), so the mean over
-  // them is what is bounded (lowest 0.815).
+  // (0.53 at r 0.75, |A| 1 with the compensation widened toward 1; 0.909 at
+  // |A| 0.25 with the table's nodes at |A| 0.5 and 1, raised to bound the
+  // values between; since step 21 its nodes at |A| 1/3, 2/3 and 1, each as low
+  // as the bound allows, leave at least 0.956); away from it the azimuths below
+  // the largest keep E / E_max (0.66 at worst at NoV 0.2, bench/aniso_albedo),
+  // so the mean over them is what is bounded (lowest 0.876; 0.815 before
+  // step 21).
   const auto t0 = std::chrono::steady_clock::now();
   double lowestHeadOn = 2, lowestMean = 2;
   std::string whereHeadOn, whereMean;
@@ -764,7 +767,7 @@ TEST(Furnace, AStretchedWhiteConductorIsCompensatedByItsLargestAlbedo) {
       c.anisotropy = A;
       const Config head{"anisotropy", c, kDiffuseLambert, 1.0, 0.3};
       const double a = albedoOf(head, kSamples);
-      EXPECT_GE(a, 0.90) << describe(head);
+      EXPECT_GE(a, 0.95) << describe(head);
       EXPECT_LE(a, kTolerance) << describe(head);
       if (a < lowestHeadOn) lowestHeadOn = a, whereHeadOn = describe(head);
       ++cases;
@@ -779,7 +782,7 @@ TEST(Furnace, AStretchedWhiteConductorIsCompensatedByItsLargestAlbedo) {
           ++cases;
         }
         const double mean = sum / kPhis;
-        EXPECT_GE(mean, 0.80) << "mean over the azimuths, r " << r << ", A " << A << ", NoV " << NoV;
+        EXPECT_GE(mean, 0.86) << "mean over the azimuths, r " << r << ", A " << A << ", NoV " << NoV;
         if (mean < lowestMean) lowestMean = mean, whereMean = fmt::format("r {} A {} NoV {}", r, A, NoV);
       }
     }

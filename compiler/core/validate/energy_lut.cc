@@ -9,7 +9,7 @@
 #include <cstdint>
 #include <iterator>
 
-// The anisotropic table is 32-bit words of two halves each (uint in the shaders).
+// The anisotropic table is 32-bit words of three 10-bit values each (uint in the shaders).
 using uint = std::uint32_t;
 #define SUBSTRATE_CONST static const
 #define SUBSTRATE_ARRAY_BEGIN(T, N) {

@@ -1,7 +1,7 @@
 // Mirrors runtime_shaders/substrate_energy_lut.h: the tables are the same
 // 4032 words (validate/runtime_files.h, energyLutTables(): E, then B, then
 // E_fuzz, each row-major with index = roughness cell * 32 + NoV cell, then the
-// anisotropic E_max and B_max, 15 x 16 words of four, as halves), read
+// anisotropic E_max and B_max, 15 x 16 words of four, three 10-bit values each), read
 // through the shader's substrate_lut_coords / substrate_lut_blend and clamps.
 #include "reference/energy_lut.h"
 
@@ -67,9 +67,10 @@ V2<T> energyDfg(T NoV, T roughness) {
 }
 
 // substrate_energy_aniso: p = (sqrt(sat(NoV)), sat(r)) * 15, p0 = min(floor(p), 14),
-// k = p0.y * 15 + p0.x; rows k and k + 15, each (E(0.5), E(1), B(0.5), B(1))
-// lerped in NoV between its two nodes, lerped in r; then hat weights over
-// a = 2 sat(|A|) (0.5 at a = 1, 1 at a = 2) plus `iso` at a = 0.
+// k = p0.y * 15 + p0.x; hat weights over a = 3 sat(|A|) (1/3 at a = 1, 2/3 at
+// a = 2, 1 at a = 3) plus `iso` at a = 0; rows k and k + 15, each (E, B) at
+// |A| (the words' three 10-bit counts of 1/960 by those weights) lerped in NoV
+// between its two nodes, lerped in r.
 template <class T>
 V2<T> energyAniso(T NoV, T roughness, T absAnisotropy, const V2<T>& iso) {
   const T px = std::sqrt(saturate(NoV)) * T(15), py = saturate(roughness) * T(15);
@@ -77,24 +78,25 @@ V2<T> energyAniso(T NoV, T roughness, T absAnisotropy, const V2<T>& iso) {
   const T fx = px - x0, fy = py - y0;
   const int k = static_cast<int>(y0) * 15 + static_cast<int>(x0);
   const auto table = energyLutTables();
-  auto halves = [&](int element, int c) {
+  const T a = saturate(absAnisotropy) * T(3);
+  std::array<T, 3> w;
+  for (int s = 0; s < 3; ++s) w[s] = std::max(T(1) - std::fabs(a - T(s + 1)), T(0)) * T(1.0 / 960.0);
+  // The value of word c of `element` at |A|: its three slices by the weights.
+  auto value = [&](int element, int c) {
     const auto word = std::bit_cast<std::uint32_t>(table[static_cast<std::size_t>(3 * 1024 + element * 4 + c)]);
-    return std::array<T, 2>{static_cast<T>(halfToFloat(static_cast<std::uint16_t>(word & 0xffffu))),
-                            static_cast<T>(halfToFloat(static_cast<std::uint16_t>(word >> 16)))};
+    T v = 0;
+    for (int s = 0; s < 3; ++s) v += static_cast<T>((word >> (10 * s)) & 1023u) * w[s];
+    return v;
   };
-  // substrate_energy_aniso_row: lerp((E_i, B_i), (E_i+1, B_i+1), fx) as (E.5, E1, B.5, B1).
+  // substrate_energy_aniso_row: (E, B) lerped in NoV between (E_i, B_i) and (E_i+1, B_i+1).
   auto row = [&](int element) {
-    const auto e0 = halves(element, 0), b0 = halves(element, 1), e1 = halves(element, 2), b1 = halves(element, 3);
-    return std::array<T, 4>{lerp(e0[0], e1[0], fx), lerp(e0[1], e1[1], fx), lerp(b0[0], b1[0], fx),
-                            lerp(b0[1], b1[1], fx)};
+    return std::array<T, 2>{lerp(value(element, 0), value(element, 2), fx),
+                            lerp(value(element, 1), value(element, 3), fx)};
   };
   const auto r0 = row(k), r1 = row(k + 15);
-  std::array<T, 4> v;
-  for (int c = 0; c < 4; ++c) v[c] = lerp(r0[c], r1[c], fy);
-  const T a = saturate(absAnisotropy) * T(2);
-  const T w0 = T(1) - std::fabs(a - T(1)), w1 = std::max(a - T(1), T(0)), wIso = std::max(T(1) - a, T(0));
-  const T e = v[0] * w0 + v[1] * w1 + iso[0] * wIso;
-  const T b = v[2] * w0 + v[3] * w1 + iso[1] * wIso;
+  const T wIso = std::max(T(1) - a, T(0));
+  const T e = lerp(r0[0], r1[0], fy) + iso[0] * wIso;
+  const T b = lerp(r0[1], r1[1], fy) + iso[1] * wIso;
   return {clampT(e, T(1e-3), T(1)), clampT(b, T(0), T(1))};
 }
 

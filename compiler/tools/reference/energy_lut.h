@@ -24,7 +24,7 @@ template <class T>
 V2<T> energyDfg(T NoV, T roughness);
 
 /// substrate_energy_aniso: (E_max, B_max)(NoV, r, |A|) of an anisotropic lobe,
-/// the largest albedo and B over the view's azimuth (the fourth table, halves),
+/// the largest albedo and B over the view's azimuth (the fourth table),
 /// with `iso` (the isotropic E, B) at |A| = 0; E clamped to [1e-3, 1], B to [0, 1].
 template <class T>
 V2<T> energyAniso(T NoV, T roughness, T absAnisotropy, const V2<T>& iso);
