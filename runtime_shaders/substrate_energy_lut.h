@@ -149,8 +149,9 @@ float2 substrate_energy_dfg(float NoV, float roughness) {
 // two fetches (as many words as the E and B lookups at the smooth axis' alpha
 // it replaces). Across |A|: hat weights at 1/3, 2/3 and 1, with `iso`, the
 // isotropic (E, B) at (NoV, r), at |A| = 0 (issue 19, step 21: the largest
-// albedo bends across |A|, so two slices at 0.5 and 1 were raised up to 8 %
-// above it between them). E clamped to [1e-3, 1], B to [0, 1].
+// albedo bends across |A|, and two slices at 0.5 and 1 had to be raised 9 %
+// above it head-on at r 0.71, |A| 0.51 to bound it). E clamped to [1e-3, 1],
+// B to [0, 1].
 #if SUBSTRATE_USE_ANISOTROPY
 // One row of the lookup: (E, B) at |A| (w: the slices' hat weights over 960,
 // the unit of the counts), lerped in NoV between the row's two nodes.

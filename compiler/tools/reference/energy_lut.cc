@@ -11,7 +11,6 @@
 
 #include "reference/common.h"
 #include "substrate_constants.h"  // runtime_shaders/
-#include "storage/pack.h"
 #include "validate/runtime_files.h"
 
 namespace substratec::reference {
