@@ -6,9 +6,8 @@
 // cell and j the perceptual-roughness cell; NoV = (i + 0.5) / 32 and
 // r = (j + 0.5) / 32 at cell centres. Then, for shaders with anisotropy and for
 // hosts (SUBSTRATE_USE_ANISOTROPY undefined or 1), SUBSTRATE_LUT_ANISO_TABLE:
-// 15 x 16 uint4 of three 10-bit counts of 1/960 per uint (low bits
-// first), one per pair
-// of nodes neighbouring in NoV, [(j * 15 + i) * 4 + c]: nodes at
+// 15 x 16 uint4 of three 10-bit counts of 1/960 per uint (low bits first),
+// one per pair of nodes neighbouring in NoV, [(j * 15 + i) * 4 + c]: nodes at
 // NoV = (i / 15)^2 and ((i + 1) / 15)^2, r = j / 15. The host uploads the two
 // arrays' bits in that order (SUBSTRATE_LUT_FLOATS 32-bit words in all).
 //
