@@ -88,8 +88,9 @@ if [ "$SANITIZERS" != 0 ]; then
     examples='row12_simple car_paint worked_example_72'
     filter=''
     for e in $examples; do filter="${filter:+$filter:}Examples/MaterialOnGpu.*/${e}_*"; done
-    # As ctest runs it (the asan preset's environment: the default build's kernel cache).
-    ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" MESA_SHADER_CACHE_DIR="$PWD/build/mesa-shader-cache" \
+    # As ctest runs it: the binary itself points lavapipe at the default build's
+    # kernel cache, at the tests' vector width (tests/gpu/lavapipe_environment.cc).
+    ASAN_OPTIONS="$ASAN_OPTIONS:detect_leaks=0" \
       build-asan/bin/gpu_tests --gtest_filter="$filter" --gtest_brief=1 || status=1
   fi
   [ "$status" -eq 0 ]

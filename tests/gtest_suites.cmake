@@ -14,7 +14,7 @@
 # the longest suites, so that `ctest -j 2` keeps both cores busy to the end.
 #
 # Called by tests/CMakeLists.txt (substratec_add_gtest_suites) with
-#   -DEXE=<binary> -DNAME=<binary name> -DOUT=<file to write> [-DENVIRONMENT=<k=v;...>]
+#   -DEXE=<binary> -DNAME=<binary name> -DOUT=<file to write> [-DENVIRONMENT=<k=v|k=v...>]
 #   [-DSPLIT=<suite>,<suite>...]
 cmake_minimum_required(VERSION 3.25)  # script mode: IN_LIST and the other policies of the project
 execute_process(COMMAND "${EXE}" --gtest_list_tests OUTPUT_VARIABLE listing RESULT_VARIABLE status
@@ -24,6 +24,7 @@ if(NOT status EQUAL 0)
 endif()
 string(REPLACE "\n" ";" lines "${listing}")
 string(REPLACE "," ";" split "${SPLIT}")
+string(REPLACE "|" ";" ENVIRONMENT "${ENVIRONMENT}")
 set(script "")
 foreach(line IN LISTS lines)
   # A suite line has no leading space and ends in '.' (a "# TypeParam" comment may follow).
@@ -35,7 +36,9 @@ foreach(line IN LISTS lines)
         set(env ${ENVIRONMENT})
         list(APPEND env GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=${shard})
         string(APPEND script "add_test([=[${test}]=] [=[${EXE}]=] [=[--gtest_filter=${suite}.*]=])\n")
-        string(APPEND script "set_tests_properties([=[${test}]=] PROPERTIES ENVIRONMENT [=[${env}]=])\n")
+        # COST: started first even without ctest's timing history (a clean clone),
+        # so that the longest tests do not end the run on one core.
+        string(APPEND script "set_tests_properties([=[${test}]=] PROPERTIES ENVIRONMENT [=[${env}]=] COST 1000)\n")
       endforeach()
       continue()
     endif()
