@@ -11,6 +11,7 @@
 # CI's budget, 3 x 30 s on top of 2 x 60 s); image_fuzzer (the PNG and JPEG
 # decoders; seeds examples/textures/*.png and fuzz/image_seeds) for
 # IMPORT_SECONDS too.
+# The targets run FUZZ_JOBS at a time (default: one per core).
 # Fails if any target finds a crash, a leak, a timeout (> 10 s per input) or
 # an out-of-memory (> 2 GiB); the input is kept in build-asan/fuzz/artifacts/.
 # Prints the executions each target ran. docs/robustness.md describes it.
@@ -84,8 +85,10 @@ done
 mkdir -p "$SEEDS/image_fuzzer"
 cp examples/textures/*.png fuzz/image_seeds/* "$SEEDS/image_fuzzer/"
 
-status=0
-for t in $TARGETS; do
+# One target: fuzz it, then write what it found to $BUILD/$t.result (the
+# report line, then the exit status).
+fuzz_one() {
+  local t="$1" dict secs
   case "$t" in
     mtlx_fuzzer) dict=fuzz/mtlx.dict; secs="$IMPORT_SECONDS" ;;
     gltf_fuzzer) dict=fuzz/gltf.dict; secs="$IMPORT_SECONDS" ;;
@@ -93,25 +96,50 @@ for t in $TARGETS; do
     image_fuzzer) dict=""; secs="$IMPORT_SECONDS" ;;
     *) dict=fuzz/substrate.dict; secs="$SECONDS_EACH" ;;
   esac
-  corpus="$BUILD/corpus/$t"
+  local corpus="$BUILD/corpus/$t" log="$BUILD/$t.log" result="$BUILD/$t.result"
   mkdir -p "$corpus"
-  log="$BUILD/$t.log"
   echo "fuzz: $t for ${secs}s (log: $log)"
   set +e
   build-asan/bin/$t -max_total_time="$secs" ${dict:+-dict="$dict"} -timeout=10 -rss_limit_mb=2048 \
     -max_len=16384 -print_final_stats=1 -artifact_prefix="$BUILD/artifacts/$t-" \
     "$corpus" "$SEEDS/$t" >"$log" 2>&1
-  rc=$?
+  local rc=$?
   set -e
+  local execs units
   execs="$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)"
   units="$(ls "$corpus" | wc -l)"
   if [ "$rc" -ne 0 ]; then
-    echo "fuzz: $t FAILED (exit $rc) after ${execs:-?} executions; the last lines of $log:" >&2
-    grep -E "ERROR|SUMMARY|Test unit written|runtime error" "$log" | head -20 >&2 || true
-    tail -40 "$log" >&2
-    status=1
+    { echo "fuzz: $t FAILED (exit $rc) after ${execs:-?} executions; the last lines of $log:"
+      grep -E "ERROR|SUMMARY|Test unit written|runtime error" "$log" | head -20 || true
+      tail -40 "$log"; } >"$result.text"
   else
-    echo "fuzz: $t ran ${execs:-?} executions in ${secs}s, no crash (corpus: $units inputs)"
+    echo "fuzz: $t ran ${execs:-?} executions in ${secs}s, no crash (corpus: $units inputs)" >"$result.text"
+  fi
+  echo "$rc" >"$result"
+}
+
+# FUZZ_JOBS targets at a time (default: one per core). Each target is one
+# process for its own time, so two at a time on 2 cores fuzz as many inputs in
+# half the wall time; the longest targets start first.
+JOBS="${FUZZ_JOBS:-$(nproc)}"
+running=0
+for t in $TARGETS; do
+  rm -f "$BUILD/$t.result" "$BUILD/$t.result.text"
+  if [ "$running" -ge "$JOBS" ]; then wait -n || true; running=$((running - 1)); fi
+  fuzz_one "$t" &
+  running=$((running + 1))
+done
+wait || true
+
+status=0
+for t in $TARGETS; do
+  if [ ! -f "$BUILD/$t.result" ]; then
+    echo "fuzz: $t did not report" >&2; status=1; continue
+  fi
+  if [ "$(cat "$BUILD/$t.result")" -ne 0 ]; then
+    cat "$BUILD/$t.result.text" >&2; status=1
+  else
+    cat "$BUILD/$t.result.text"
   fi
 done
 exit $status
