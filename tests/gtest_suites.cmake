@@ -15,7 +15,10 @@
 #
 # Called by tests/CMakeLists.txt (substratec_add_gtest_suites) with
 #   -DEXE=<binary> -DNAME=<binary name> -DOUT=<file to write> [-DENVIRONMENT=<k=v|k=v...>]
-#   [-DSPLIT=<suite>,<suite>...]
+#   [-DSPLIT=<suite>,<suite>...] [-DLONG=<suite>,<suite>...]
+#
+# LONG suites (tens of seconds) get a COST, as the split ones do, so that ctest
+# starts them early in a clean clone, where it has no timing history to go by.
 cmake_minimum_required(VERSION 3.25)  # script mode: IN_LIST and the other policies of the project
 execute_process(COMMAND "${EXE}" --gtest_list_tests OUTPUT_VARIABLE listing RESULT_VARIABLE status
                 TIMEOUT 60)
@@ -24,6 +27,7 @@ if(NOT status EQUAL 0)
 endif()
 string(REPLACE "\n" ";" lines "${listing}")
 string(REPLACE "," ";" split "${SPLIT}")
+string(REPLACE "," ";" long "${LONG}")
 string(REPLACE "|" ";" ENVIRONMENT "${ENVIRONMENT}")
 set(script "")
 foreach(line IN LISTS lines)
@@ -45,6 +49,9 @@ foreach(line IN LISTS lines)
     string(APPEND script "add_test([=[${NAME}:${suite}]=] [=[${EXE}]=] [=[--gtest_filter=${suite}.*]=])\n")
     if(ENVIRONMENT)
       string(APPEND script "set_tests_properties([=[${NAME}:${suite}]=] PROPERTIES ENVIRONMENT [=[${ENVIRONMENT}]=])\n")
+    endif()
+    if(suite IN_LIST long)  # started after the split suites, before the short ones
+      string(APPEND script "set_tests_properties([=[${NAME}:${suite}]=] PROPERTIES COST 100)\n")
     endif()
   endif()
 endforeach()
