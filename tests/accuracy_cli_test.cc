@@ -9,7 +9,7 @@
 
 #include "cli_util.h"
 
-namespace {
+namespace accuracy_cli_test {
 
 using substratec::clitest::cli;
 using substratec::clitest::CliResult;
@@ -78,7 +78,6 @@ TEST(AccuracyCli, ABadFileFailsWithAMessage) {
   EXPECT_NE(cycle.err.find("282_include_cycle"), std::string::npos) << cycle.err;
 }
 
-}  // namespace
 
 // A volume (a volumetric fog cloud) has no BRDF: its accuracy is its march
 // against step counts and its froxel payload's error (accuracy/fog_accuracy.h).
@@ -109,3 +108,5 @@ TEST(AccuracyCli, SurfaceCommandsRefuseAVolumeAndSayWhy) {
   EXPECT_NE(csv.err.find("'fog_neon_haze' is a volume: its sweep is step counts of its march"), std::string::npos)
       << csv.err;
 }
+
+}  // namespace accuracy_cli_test

@@ -23,7 +23,7 @@ using substratec::clitest::CliResult;
 using substratec::clitest::filesOf;
 using substratec::clitest::slurp;
 
-namespace {
+namespace build_pipeline_test {
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
@@ -211,4 +211,4 @@ TEST(BuildPipeline, ASceneTakesItsMaterialsFromTheCache) {
   EXPECT_TRUE(filesOf(dir / "cold") == filesOf(dir / "warm"));
 }
 
-}  // namespace
+}  // namespace build_pipeline_test

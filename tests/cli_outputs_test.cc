@@ -28,7 +28,7 @@ using substratec::clitest::cli;
 using substratec::clitest::CliResult;
 using substratec::clitest::slurp;
 
-namespace {
+namespace cli_outputs_test {
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
@@ -99,7 +99,6 @@ void expectUnwritable(const std::vector<std::string>& args, const fs::path& dir,
   EXPECT_EQ(tree(dir), before);
 }
 
-}  // namespace
 
 // --- an output that is an input: exit 2, nothing written ---------------------
 
@@ -406,7 +405,6 @@ TEST(AllOrNone, WritePathsAtomicallyCommitsAcrossFoldersOrNothing) {
   EXPECT_EQ(slurp(dir / "b/new.txt"), "new");
 }
 
-namespace {
 
 // Probing a destination before the work creates nothing another process could
 // see: a probe that made a missing folder and removed it again raced with a
@@ -439,4 +437,4 @@ TEST(AllOrNone, AProbeOfADestinationInAMissingFolderCreatesNothing) {
   EXPECT_NE(substratec::checkWritable({(dir / "f/x.d").string()}).find("is not a directory"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace cli_outputs_test

@@ -17,7 +17,7 @@
 using substratec::clitest::cli;
 using substratec::clitest::CliResult;
 
-namespace {
+namespace cli_usage_test {
 
 const std::string kRow12 = std::string(SUBSTRATEC_SOURCE_DIR) + "/examples/row12_simple.json";
 const std::vector<std::string> kCommands = {"report", "compile", "preview", "sweep", "accuracy", "stability", "import", "scene"};
@@ -37,7 +37,6 @@ std::vector<std::string> optionLines(const std::string& command) {
   return lines;
 }
 
-}  // namespace
 
 // Every option that takes a number or a choice shows its default ("=256",
 // "=chan2024", or what decides it: "=the file's settings.bytes_per_pixel"),
@@ -122,3 +121,5 @@ TEST(CliUsage, AnUnknownCommandIsNamedAndTheCommandsListed) {
   }
   EXPECT_EQ(cli({"--version"}).status, 0);  // an option first is not a command
 }
+
+}  // namespace cli_usage_test

@@ -9,9 +9,9 @@
 
 #include "cli_util.h"
 
-using namespace substratec::clitest;
 
-namespace {
+namespace html_report_cli_test {
+using namespace substratec::clitest;
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
@@ -23,7 +23,6 @@ std::size_t count(const std::string& text, const std::string& what) {
   return n;
 }
 
-}  // namespace
 
 TEST(HtmlReport, WritesOnePageOfEveryMaterialAndPrintsItsPath) {
   const fs::path dir = freshDir("html_report", "two");
@@ -94,3 +93,5 @@ TEST(HtmlReport, SceneWritesReportHtmlWithItsMaterialsSortedAgainstThePlatformBu
   EXPECT_GE(bytes.size(), 10u);
   EXPECT_TRUE(std::is_sorted(bytes.rbegin(), bytes.rend()));
 }
+
+}  // namespace html_report_cli_test

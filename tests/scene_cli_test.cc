@@ -22,7 +22,7 @@ using substratec::clitest::CliResult;
 using substratec::clitest::filesOf;
 using substratec::clitest::slurp;
 
-namespace {
+namespace scene_cli_test {
 
 const fs::path kSource = SUBSTRATEC_SOURCE_DIR;
 
@@ -283,4 +283,4 @@ TEST(Scene, EveryErrorOfOneRunIsReported) {
   EXPECT_FALSE(fs::exists(out)) << "nothing written";
 }
 
-}  // namespace
+}  // namespace scene_cli_test

@@ -13,7 +13,7 @@
 #include "cli/worker.h"
 #include "cli_util.h"
 
-namespace {
+namespace worker_test {
 
 using namespace substratec;
 using namespace substratec::clitest;
@@ -208,4 +208,4 @@ TEST(ArgumentFiles, AShellQuotedLineIsUnquotedAndAnyOtherIsTakenAsItIs) {
   EXPECT_EQ(argumentFromLine("--target=glsl"), "--target=glsl");
 }
 
-}  // namespace
+}  // namespace worker_test

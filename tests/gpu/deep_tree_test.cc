@@ -40,7 +40,7 @@
 #include "material_fixture.h"
 
 namespace substratec::gputest {
-namespace {
+namespace deep_tree_test {
 
 namespace fs = std::filesystem;
 using json = nlohmann::ordered_json;
@@ -429,5 +429,5 @@ TEST(DeepTrees, ForwardKernelsMatchTheCpuReferenceOnLavapipe) {
   }
 }
 
-}  // namespace
+}  // namespace deep_tree_test
 }  // namespace substratec::gputest

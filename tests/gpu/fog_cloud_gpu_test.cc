@@ -58,7 +58,7 @@
 #include "validate/shader_validate.h"
 
 namespace substratec::gputest {
-namespace {
+namespace fog_cloud_gpu_test {
 
 namespace fs = std::filesystem;
 using reference::FogCloudSample;
@@ -806,5 +806,5 @@ TEST_F(FogCloudOnGpu, MarchStepInFloatFollowsTheDoubleMarch) {
   EXPECT_EQ(failed, 0) << failed << " of " << compared << " values; first: " << first;
 }
 
-}  // namespace
+}  // namespace fog_cloud_gpu_test
 }  // namespace substratec::gputest

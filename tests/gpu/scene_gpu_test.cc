@@ -40,7 +40,7 @@
 #include "validate/runtime_files.h"
 
 namespace substratec::gputest {
-namespace {
+namespace scene_gpu_test {
 
 namespace fs = std::filesystem;
 using namespace kernel;
@@ -454,5 +454,5 @@ TEST_F(SceneOnGpu, ASpecialTileLightsEyesAndHairAsTheReference) {
   EXPECT_EQ(litSpecial, 64);
 }
 
-}  // namespace
+}  // namespace scene_gpu_test
 }  // namespace substratec::gputest

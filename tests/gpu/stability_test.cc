@@ -25,7 +25,7 @@
 #include "stability/stability.h"
 #include "sweep/precision.h"
 
-namespace {
+namespace stability_test {
 
 namespace fs = std::filesystem;
 using namespace substratec;
@@ -567,4 +567,4 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
   ASSERT_GT(stacked, 0);
 }
 
-}  // namespace
+}  // namespace stability_test

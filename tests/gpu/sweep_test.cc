@@ -13,7 +13,7 @@
 #include "cli/cli.h"
 #include "sweep/sweep.h"
 
-namespace {
+namespace sweep_test {
 
 namespace fs = std::filesystem;
 using substratec::runCli;
@@ -265,4 +265,4 @@ TEST(Sweep, AVolumeTradesStepsOfItsMarchForError) {
   }
 }
 
-}  // namespace
+}  // namespace sweep_test

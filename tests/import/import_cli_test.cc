@@ -18,7 +18,7 @@
 namespace fs = std::filesystem;
 using substratec::runCli;
 
-namespace {
+namespace import_cli_test {
 
 const fs::path kCorpus = fs::path(SUBSTRATEC_SOURCE_DIR) / "tests/import/corpus";
 
@@ -44,7 +44,6 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
-}  // namespace
 
 TEST(ImportCli, WritesOneFilePerMaterialThatCompiles) {
   const fs::path out = scratch("compare_volume");
@@ -266,7 +265,6 @@ TEST(ImportCli, SimpleHairImportsAsAHairNode) {
 
 // --- issue 16 ----------------------------------------------------------------
 
-namespace {
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -287,7 +285,6 @@ std::vector<std::string> listing(const fs::path& dir) {
   return names;
 }
 
-}  // namespace
 
 TEST(ImportCli, ReplacesOnlyWhatAnImportOfTheSameSourceWrote) {
   const fs::path out = scratch("replace");
@@ -410,3 +407,5 @@ TEST(ImportCli, AMaterialNameTwoMaterialsAnswerToIsAnErrorListingBoth) {
   EXPECT_EQ(ok.status, 0) << ok.err;
   EXPECT_EQ(listing(out), std::vector<std::string>{"Gold_2.json"});
 }
+
+}  // namespace import_cli_test

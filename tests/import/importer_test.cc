@@ -26,10 +26,10 @@
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
 
+
+namespace importer_test {
 using namespace substratec;
 using namespace substratec::import;
-
-namespace {
 
 struct Imported {
   std::optional<std::vector<ImportedMaterial>> materials;
@@ -89,7 +89,6 @@ std::string glb(const std::string& json, bool pad = true, std::uint32_t version 
   return "glTF" + le(version) + le(static_cast<std::uint32_t>(12 + body.size() + lengthDelta)) + body;
 }
 
-}  // namespace
 
 // --- .glb -------------------------------------------------------------------
 
@@ -582,7 +581,6 @@ TEST(MaterialXImport, ImagesAreTextureInputsAndProceduralsAreBaked) {
 // chiang_hair_bsdf under a surface: the format's hair node (docs/import.md,
 // "chiang_hair_bsdf"); the expected values from the formulas of MaterialX's
 // genglsl implementation and of the hair node, worked here.
-namespace {
 
 /// Chiang 2016's eq. 9 denominator.
 double chiangP(double b) { return 5.969 - 0.215 * b + 2.532 * b * b - 10.73 * b * b * b + 5.574 * std::pow(b, 4) + 0.245 * std::pow(b, 5); }
@@ -615,7 +613,6 @@ const char* const kLobesOfRough = R"(    <input name="roughness_R" type="vector2
     <input name="roughness_TRT" type="vector2" nodename="rough" output="roughness_TRT" />
 )";
 
-}  // namespace
 
 TEST(MaterialXImport, ChiangHairIsAHairNodeWithChiangsParameters) {
   Imported r = mtlx(hairRoughness("value=\"0.3\"", "0.4") + R"(  <deon_hair_absorption_from_melanin name="melanin" type="vector3">
@@ -843,7 +840,6 @@ TEST(GltfImport, ATextureWithoutAnImageIsAnError) {
 
 // --- Buffers and images a .gltf or .glb refers to (issue 16) -----------------
 
-namespace {
 
 /// A .glb with a binary chunk of `bin` bytes (zeros) after the JSON.
 std::string glbWithBin(const std::string& json, std::uint32_t bin) {
@@ -866,7 +862,6 @@ const char* kTwoImages = R"({"asset": {"version": "2.0"},
   "buffers": [{"uri": "geometry.bin", "byteLength": 10}, {"uri": "data:application/octet-stream;base64,AAAA", "byteLength": 3},
               {"uri": "data:application/octet-stream;base64,A$AA", "byteLength": 3}]})";
 
-}  // namespace
 
 TEST(GltfResources, AMissingFileIsAWarningAndAnErrorWhereAMaterialSamplesIt) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("substratec_res_" + std::to_string(::getpid()));
@@ -963,3 +958,5 @@ TEST(ImportFuzzRegressions, EveryInputThatOnceCrashedIsImportedOrRejected) {
   }
   EXPECT_GE(checked, 1);
 }
+
+}  // namespace importer_test

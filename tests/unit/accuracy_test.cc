@@ -17,7 +17,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace accuracy_test {
 
 CompileResult compileSlab(const std::string& slab) {
   Diagnostics d("slab.json");
@@ -726,5 +726,5 @@ TEST(Accuracy, TheJsonHasEveryKeyOfEveryRow) {
   EXPECT_NE(accuracy::formatTable(report).find("rel_err"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace accuracy_test
 }  // namespace substratec

@@ -21,7 +21,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace building_blocks_test {
 
 using test::compiled;
 using test::material;
@@ -354,5 +354,5 @@ TEST(BuildingBlocks, TheSchemaTakesEveryBlockWithTheResolversPins) {
   EXPECT_EQ(checked, 10);
 }
 
-}  // namespace
+}  // namespace building_blocks_test
 }  // namespace substratec

@@ -10,7 +10,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace cull_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -781,5 +781,5 @@ TEST_F(CullTest, NothingLeftThroughOperatorsIsAnError) {
             "test.json:11:73: error: no matter is left after static culling (every slab is under a constant zero weight) [/output]\n");
 }
 
-}  // namespace
+}  // namespace cull_test
 }  // namespace substratec

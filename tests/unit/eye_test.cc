@@ -15,7 +15,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace eye_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -313,5 +313,5 @@ TEST(Eye, NeverReturnsNonFiniteValuesOnDegenerateNormals) {
   EXPECT_EQ(cases, 27);
 }
 
-}  // namespace
+}  // namespace eye_test
 }  // namespace substratec

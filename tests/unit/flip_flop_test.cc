@@ -15,7 +15,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace flip_flop_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -85,5 +85,5 @@ TEST(FlipFlop, BadPinsAreLocatedErrors) {
             std::string::npos);
 }
 
-}  // namespace
+}  // namespace flip_flop_test
 }  // namespace substratec

@@ -15,7 +15,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace fog_cloud_format_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -158,5 +158,5 @@ TEST(FogCloudAccuracy, NothingToMeasureIsNoRay) {
   EXPECT_EQ(accuracy::fogAccuracy(r->material, r->after.bytes()).rays, 0) << "black: no radiance to compare";
 }
 
-}  // namespace
+}  // namespace fog_cloud_format_test
 }  // namespace substratec

@@ -21,7 +21,7 @@
 #include "validate/shader_validate.h"
 
 namespace substratec {
-namespace {
+namespace fog_cloud_test {
 
 using reference::FogCloudSample;
 using D3 = std::array<double, 3>;
@@ -408,5 +408,5 @@ TEST(FogCloudShader, CompilesAndValidatesInGlslAndHlsl) {
   }
 }
 
-}  // namespace
+}  // namespace fog_cloud_test
 }  // namespace substratec

@@ -37,7 +37,7 @@
 #include "reference/reference.h"
 
 namespace substratec {
-namespace {
+namespace furnace_test {
 
 using namespace reference;
 using D3 = V3<double>;
@@ -926,5 +926,5 @@ TEST(Furnace, FuzzTakesWhatItReflectsOfTheLightOutOfTheBase) {
   EXPECT_EQ(over, 0);
 }
 
-}  // namespace
+}  // namespace furnace_test
 }  // namespace substratec

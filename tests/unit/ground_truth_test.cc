@@ -19,7 +19,7 @@
 #include "../examples.h"
 
 namespace substratec {
-namespace {
+namespace ground_truth_test {
 
 using namespace reference;
 using D3 = V3<double>;
@@ -354,5 +354,5 @@ TEST(RandomWalkGroundTruth, FurnaceMetalnessSlabIsWhiteAtGrazingToo) {
 }
 
 
-}  // namespace
+}  // namespace ground_truth_test
 }  // namespace substratec

@@ -18,7 +18,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace hair_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -169,5 +169,5 @@ TEST(Hair, MatchesTheTruthsAlbedoAndReportsItsShapeError) {
   EXPECT_LE(c.p95Rel, 0.7);
 }
 
-}  // namespace
+}  // namespace hair_test
 }  // namespace substratec

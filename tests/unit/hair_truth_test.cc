@@ -17,7 +17,7 @@
 #include "reference/hair_truth.h"
 
 namespace substratec::reference {
-namespace {
+namespace hair_truth_test {
 
 using Rgb = std::array<double, 3>;
 constexpr double kPi = std::numbers::pi;
@@ -293,5 +293,5 @@ TEST(HairTruth, CompareWithTruth) {
                std::runtime_error);
 }
 
-}  // namespace
+}  // namespace hair_truth_test
 }  // namespace substratec::reference

@@ -15,7 +15,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace layout_test {
 
 using test::buildMaterial;
 using test::material;
@@ -370,5 +370,5 @@ TEST(Layout, BytesAreWordsTimesFourPlusTheTopLayerWord) {
   EXPECT_EQ(L.bytes(), 16);
 }
 
-}  // namespace
+}  // namespace layout_test
 }  // namespace substratec

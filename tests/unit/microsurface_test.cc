@@ -18,7 +18,7 @@
 #include "reference/microsurface.h"
 
 namespace substratec {
-namespace {
+namespace microsurface_test {
 
 using namespace reference;
 using D3 = V3<double>;
@@ -384,5 +384,5 @@ TEST(Microsurface, SmoothLimitAndHardCases) {
   EXPECT_EQ(cases, 4 + 8 * 7 * 7);
 }
 
-}  // namespace
+}  // namespace microsurface_test
 }  // namespace substratec

@@ -31,7 +31,7 @@
 #include "storage/pack.h"
 
 namespace substratec {
-namespace {
+namespace pack_bounds_test {
 
 constexpr double kDithers[] = {0.0, 0.25, 0.5, 0.999999};
 constexpr double kSlop = 1e-12;  // double rounding in the bound itself
@@ -380,5 +380,5 @@ TEST(PackBounds, NormalsOverTheWholeSphereStayWithinTheirBound) {
   worst.print();
 }
 
-}  // namespace
+}  // namespace pack_bounds_test
 }  // namespace substratec

@@ -23,7 +23,7 @@
 #include "pipeline/pipeline.h"
 
 namespace substratec {
-namespace {
+namespace pack_test {
 
 constexpr double kDithers[] = {0.0, 0.5, 0.999};
 constexpr double kEps = 1e-9;
@@ -909,5 +909,5 @@ TEST(PackMaterial, RejectsWhatTheFormatCannotHoldAndMalformedStreams) {
   EXPECT_THROW(unpackMaterial(bad.data(), bad.size(), 0u), std::runtime_error);
 }
 
-}  // namespace
+}  // namespace pack_test
 }  // namespace substratec

@@ -29,7 +29,7 @@
 #include "validate/runtime_files.h"
 
 namespace substratec {
-namespace {
+namespace reference_test {
 
 using namespace reference;
 using D3 = std::array<double, 3>;
@@ -1356,7 +1356,6 @@ TEST(ReferenceExamples, EveryExampleEvaluatesToFiniteClosures) {
   }
 }
 
-}  // namespace
 TEST(ReferenceOperators, TheClearCoatExampleLetsThePaintShow) {
   // Issue 16: examples/clear_coat_over_glints.json renders as a clear coat:
   // the paint under it receives all but the coat's interface (1 - F0 = 0.96
@@ -1384,4 +1383,5 @@ TEST(ReferenceOperators, TheClearCoatExampleLetsThePaintShow) {
   EXPECT_EQ(opaque.material.slabs[opaque.after.closures[0].slab].id, "coat");
 }
 
+}  // namespace reference_test
 }  // namespace substratec

@@ -10,7 +10,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace shared_bases_test {
 
 using test::material;
 using test::runUntil;
@@ -467,5 +467,5 @@ TEST_F(SharedBasesTest, RunningThePassTwiceGivesTheSameResult) {
   EXPECT_EQ(m.bases.size(), 2u);
 }
 
-}  // namespace
+}  // namespace shared_bases_test
 }  // namespace substratec

@@ -10,6 +10,7 @@
 
 #include "ir/value_eval.h"
 #include "passes/blend.h"
+#include "passes/features.h"
 #include "passes/simplify.h"
 #include "pipeline/pipeline.h"
 #include "ir/dump.h"

@@ -17,7 +17,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace unlit_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -195,5 +195,5 @@ TEST(Unlit, TheReportNamesItUnlitAndItsFeatureEmissive) {
   EXPECT_EQ(r.tree.interfaces[unlit], 0);  // no interface
 }
 
-}  // namespace
+}  // namespace unlit_test
 }  // namespace substratec

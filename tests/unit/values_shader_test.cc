@@ -26,7 +26,7 @@
 #include <string>
 
 namespace substratec {
-namespace {
+namespace values_shader_test {
 
 namespace fs = std::filesystem;
 
@@ -310,5 +310,5 @@ TEST(ValuesShader, VarianceToRoughnessGuards) {
   }
 }
 
-}  // namespace
+}  // namespace values_shader_test
 }  // namespace substratec

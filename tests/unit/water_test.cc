@@ -17,7 +17,7 @@
 #include "test_util.h"
 
 namespace substratec {
-namespace {
+namespace water_test {
 
 using test::diagnosticsOf;
 using test::material;
@@ -157,5 +157,5 @@ TEST(Water, NeverReturnsNonFiniteValuesOnHardInputs) {
   EXPECT_EQ(cases, 100);
 }
 
-}  // namespace
+}  // namespace water_test
 }  // namespace substratec
