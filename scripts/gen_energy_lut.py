@@ -329,14 +329,22 @@ def pack_aniso(e_nodes, b_nodes):
     return out
 
 
+def aniso_lookup_at(check, nodes, iso_tab, lo):
+    """What substrate_energy_aniso returns at one check (mu, r, |A|, _): the
+    isotropic table `iso_tab`'s share (its weight at |A| = 0) plus the
+    weighted `nodes`; with the (node index, weight) pairs it used."""
+    mu, r, a_abs, _n = check
+    ws, w_iso = aniso_weights(mu, r, a_abs)
+    return w_iso * iso_lookup(iso_tab, mu, r, lo) + sum(nodes[k] * w for k, w in ws), ws
+
+
 def raise_aniso(nodes, checks, values, iso_tab, lo):
-    """Raises `nodes` until the lookup (aniso_weights, the isotropic table
-    `iso_tab` at |A| = 0) is at least value + ANISO_MARGIN at every check."""
+    """Raises `nodes` until the lookup (aniso_lookup_at) is at least value +
+    ANISO_MARGIN at every check."""
     for _ in range(200):
         worst = 0.0
-        for (mu, r, a_abs, _n), value in zip(checks, values):
-            ws, w_iso = aniso_weights(mu, r, a_abs)
-            have = w_iso * iso_lookup(iso_tab, mu, r, lo) + sum(nodes[k] * w for k, w in ws)
+        for check, value in zip(checks, values):
+            have, ws = aniso_lookup_at(check, nodes, iso_tab, lo)
             d = value + ANISO_MARGIN - have
             if d > 1e-9:
                 worst = max(worst, d)
@@ -357,9 +365,9 @@ def lower_aniso(nodes, checks, values, iso_tab, lo):
     check needs (the largest albedo bends across |A| and r), and every point of
     a node's cells loses what it is too high."""
     have, need, uses = [], [], [[] for _ in nodes]
-    for c, ((mu, r, a_abs, _n), value) in enumerate(zip(checks, values)):
-        ws, w_iso = aniso_weights(mu, r, a_abs)
-        have.append(w_iso * iso_lookup(iso_tab, mu, r, lo) + sum(nodes[k] * w for k, w in ws))
+    for c, (check, value) in enumerate(zip(checks, values)):
+        at, ws = aniso_lookup_at(check, nodes, iso_tab, lo)
+        have.append(at)
         need.append(value + ANISO_MARGIN)
         for k, w in ws:
             if w > 0.0:
