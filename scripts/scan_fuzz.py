@@ -18,7 +18,7 @@ step 17 measured the Fresnel curve of low-F0 interfaces on all of them).
 
 Writes nothing but a temporary directory; about 45 s per build on two cores at
 the default 32,768 walks per albedo (the truth is cached between builds), about
-7 minutes per build with --all (562 materials).
+7 minutes per build with --all (565 materials).
 
 usage: scripts/scan_fuzz.py [--bin BIN] [--before BIN] [--samples N] [--jobs J] [--all]
 """
