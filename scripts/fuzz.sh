@@ -120,7 +120,7 @@ fuzz_one() {
 
 # FUZZ_JOBS targets at a time (default: one per core). Each target is one
 # process for its own time, so two at a time on 2 cores fuzz as many inputs in
-# half the wall time; the longest targets start first.
+# half the wall time; in the default order the longest targets start first.
 JOBS="${FUZZ_JOBS:-$(nproc)}"
 running=0
 for t in $TARGETS; do

@@ -14,7 +14,7 @@
 # the longest suites, so that `ctest -j 2` keeps both cores busy to the end.
 #
 # Called by tests/CMakeLists.txt (substratec_add_gtest_suites) with
-#   -DEXE=<binary> -DNAME=<binary name> -DOUT=<file to write> [-DENVIRONMENT=<k=v|k=v...>]
+#   -DEXE=<binary> -DNAME=<binary name> -DOUT=<file to write>
 #   [-DSPLIT=<suite>,<suite>...] [-DLONG=<suite>,<suite>...]
 #
 # LONG suites (tens of seconds) get a COST, as the split ones do, so that ctest
@@ -28,7 +28,6 @@ endif()
 string(REPLACE "\n" ";" lines "${listing}")
 string(REPLACE "," ";" split "${SPLIT}")
 string(REPLACE "," ";" long "${LONG}")
-string(REPLACE "|" ";" ENVIRONMENT "${ENVIRONMENT}")
 set(script "")
 foreach(line IN LISTS lines)
   # A suite line has no leading space and ends in '.' (a "# TypeParam" comment may follow).
@@ -37,8 +36,7 @@ foreach(line IN LISTS lines)
     if(suite IN_LIST split)
       foreach(shard 0 1)
         set(test "${NAME}:${suite}:${shard}")
-        set(env ${ENVIRONMENT})
-        list(APPEND env GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=${shard})
+        set(env GTEST_TOTAL_SHARDS=2 GTEST_SHARD_INDEX=${shard})
         string(APPEND script "add_test([=[${test}]=] [=[${EXE}]=] [=[--gtest_filter=${suite}.*]=])\n")
         # COST: started first even without ctest's timing history (a clean clone),
         # so that the longest tests do not end the run on one core.
@@ -47,9 +45,6 @@ foreach(line IN LISTS lines)
       continue()
     endif()
     string(APPEND script "add_test([=[${NAME}:${suite}]=] [=[${EXE}]=] [=[--gtest_filter=${suite}.*]=])\n")
-    if(ENVIRONMENT)
-      string(APPEND script "set_tests_properties([=[${NAME}:${suite}]=] PROPERTIES ENVIRONMENT [=[${ENVIRONMENT}]=])\n")
-    endif()
     if(suite IN_LIST long)  # started after the split suites, before the short ones
       string(APPEND script "set_tests_properties([=[${NAME}:${suite}]=] PROPERTIES COST 100)\n")
     endif()
