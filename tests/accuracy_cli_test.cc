@@ -78,7 +78,6 @@ TEST(AccuracyCli, ABadFileFailsWithAMessage) {
   EXPECT_NE(cycle.err.find("282_include_cycle"), std::string::npos) << cycle.err;
 }
 
-
 // A volume (a volumetric fog cloud) has no BRDF: its accuracy is its march
 // against step counts and its froxel payload's error (accuracy/fog_accuracy.h).
 TEST(AccuracyCli, AVolumeReportsItsMarchAgainstStepCounts) {

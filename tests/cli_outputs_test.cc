@@ -99,7 +99,6 @@ void expectUnwritable(const std::vector<std::string>& args, const fs::path& dir,
   EXPECT_EQ(tree(dir), before);
 }
 
-
 // --- an output that is an input: exit 2, nothing written ---------------------
 
 TEST(OutputsAreNotInputs, CompileRefusesADepfileThatIsItsInputHoweverSpelled) {
@@ -404,7 +403,6 @@ TEST(AllOrNone, WritePathsAtomicallyCommitsAcrossFoldersOrNothing) {
   EXPECT_EQ(slurp(dir / "a/kept.txt"), "new");
   EXPECT_EQ(slurp(dir / "b/new.txt"), "new");
 }
-
 
 // Probing a destination before the work creates nothing another process could
 // see: a probe that made a missing folder and removed it again raced with a

@@ -37,7 +37,6 @@ std::vector<std::string> optionLines(const std::string& command) {
   return lines;
 }
 
-
 // Every option that takes a number or a choice shows its default ("=256",
 // "=chan2024", or what decides it: "=the file's settings.bytes_per_pixel"),
 // unless it is required or has none (--max-error); numbers state their range.

@@ -9,7 +9,6 @@
 
 #include "cli_util.h"
 
-
 namespace html_report_cli_test {
 using namespace substratec::clitest;
 
@@ -22,7 +21,6 @@ std::size_t count(const std::string& text, const std::string& what) {
   for (std::size_t i = text.find(what); i != std::string::npos; i = text.find(what, i + 1)) ++n;
   return n;
 }
-
 
 TEST(HtmlReport, WritesOnePageOfEveryMaterialAndPrintsItsPath) {
   const fs::path dir = freshDir("html_report", "two");

@@ -44,7 +44,6 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
-
 TEST(ImportCli, WritesOneFilePerMaterialThatCompiles) {
   const fs::path out = scratch("compare_volume");
   CliRun r = cli({"import", (kCorpus / "gltf/CompareVolume.materials.json").string(), "-o", out.string()});
@@ -265,7 +264,6 @@ TEST(ImportCli, SimpleHairImportsAsAHairNode) {
 
 // --- issue 16 ----------------------------------------------------------------
 
-
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   std::ostringstream s;
@@ -284,7 +282,6 @@ std::vector<std::string> listing(const fs::path& dir) {
   std::sort(names.begin(), names.end());
   return names;
 }
-
 
 TEST(ImportCli, ReplacesOnlyWhatAnImportOfTheSameSourceWrote) {
   const fs::path out = scratch("replace");

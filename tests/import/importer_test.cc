@@ -26,7 +26,6 @@
 #include "pipeline/pipeline.h"
 #include "reference/reference.h"
 
-
 namespace importer_test {
 using namespace substratec;
 using namespace substratec::import;
@@ -88,7 +87,6 @@ std::string glb(const std::string& json, bool pad = true, std::uint32_t version 
   std::string body = le(static_cast<std::uint32_t>(chunk.size())) + "JSON" + chunk;
   return "glTF" + le(version) + le(static_cast<std::uint32_t>(12 + body.size() + lengthDelta)) + body;
 }
-
 
 // --- .glb -------------------------------------------------------------------
 
@@ -613,7 +611,6 @@ const char* const kLobesOfRough = R"(    <input name="roughness_R" type="vector2
     <input name="roughness_TRT" type="vector2" nodename="rough" output="roughness_TRT" />
 )";
 
-
 TEST(MaterialXImport, ChiangHairIsAHairNodeWithChiangsParameters) {
   Imported r = mtlx(hairRoughness("value=\"0.3\"", "0.4") + R"(  <deon_hair_absorption_from_melanin name="melanin" type="vector3">
     <input name="melanin_concentration" type="float" value="0.8" />
@@ -840,7 +837,6 @@ TEST(GltfImport, ATextureWithoutAnImageIsAnError) {
 
 // --- Buffers and images a .gltf or .glb refers to (issue 16) -----------------
 
-
 /// A .glb with a binary chunk of `bin` bytes (zeros) after the JSON.
 std::string glbWithBin(const std::string& json, std::uint32_t bin) {
   std::string chunk = json;
@@ -861,7 +857,6 @@ const char* kTwoImages = R"({"asset": {"version": "2.0"},
   "images": [{"uri": "used%20image.png"}, {"uri": "unused.png"}],
   "buffers": [{"uri": "geometry.bin", "byteLength": 10}, {"uri": "data:application/octet-stream;base64,AAAA", "byteLength": 3},
               {"uri": "data:application/octet-stream;base64,A$AA", "byteLength": 3}]})";
-
 
 TEST(GltfResources, AMissingFileIsAWarningAndAnErrorWhereAMaterialSamplesIt) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / ("substratec_res_" + std::to_string(::getpid()));
