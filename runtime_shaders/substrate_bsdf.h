@@ -160,7 +160,8 @@ float substrate_fuzz_pair_margin(float roughness) {
 // substrate_coat_mean_share, h(f): substrate_closure.h (set per pixel in SubstrateClosure.coatShare).
 
 // What the diffuse of a closure under layers gets back from them, per
-// channel: 1 / lerp(1, D, coverageAbove), with
+// channel: 1 / D under a full coverage, lerp(D, P, C) / (D lerp(1, P, C))
+// under a coverage C = coverageAbove, P = (T_N G)^2 (below), with
 //   D = G_k T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4).
 // The adding formula for a Lambertian under a smooth interface of IOR n over
 // a medium of transmittance T_m (along the normal), with the slab's albedo A
@@ -233,10 +234,18 @@ float3 substrate_closure_coat_diffuse(SubstrateClosure c, float2 ends) {
   float3 ti = max(tn, SUBSTRATE_SPLAT3(ifc));
   float3 tm = saturate(tn / ifc);  // ifc >= 0.82 * 0.96^3
   float3 tm2 = tm * tm;
-  float own = saturate(ends.y - ends.x);
-  float3 d = (g * (1.0 + SUBSTRATE_COAT_COVARIANCE * own)) * ti * (1.0 - SUBSTRATE_COAT_BEND * (1.0 - ti)) +
+  g *= 1.0 + SUBSTRATE_COAT_COVARIANCE * saturate(ends.y - ends.x);  // the closure's own interface
+  float3 d = g * ti * (1.0 - SUBSTRATE_COAT_BEND * (1.0 - ti)) +
              SUBSTRATE_COAT_TRAP * saturate(c.diffuseAlbedo) * (1.0 - tm2 * tm2);
-  return 1.0 / lerp(SUBSTRATE_SPLAT3(1.0), d, cover);
+  // Under a partial coverage only the covered part gives back or absorbs what
+  // its top traps (issue 19, step 22): the lighting lets lerp(1, P, C)
+  // through (P = t_V t_L, substrate_light_closure) where (1 - C) + C P / D is
+  // due, so the factor is lerp(D, P, C) / (D lerp(1, P, C)), P read as the
+  // mean round trip (T_N G)^2, G the light-side interface term's mean above
+  // (floored so that an opaque layer keeps the quotient); 1 / D under a full
+  // coverage, 1 at coverage 0.
+  float3 p = max(tn * g * (tn * g), SUBSTRATE_SPLAT3(1e-30));
+  return lerp(d, p, cover) / (d * lerp(SUBSTRATE_SPLAT3(1.0), p, cover));
 #endif
 }
 
@@ -413,26 +422,46 @@ float substrate_coat_path_length(float mu) {
   return 1.5 * rsqrt(1.25 + m * m);
 }
 
-// lerp(1, T_N^(1/mu_t) * g(mu)^(1 + extraInterfaces), coverageAbove), g the
-// layers' interface term under their top (substrate_coat_transmission):
-// the transmittance of the layers above along a direction at
-// cosine mu (their media along the refracted path 1 / mu_t =
-// substrate_coat_path_length(mu), T_N clamped to [1e-30, 1] as
-// substrate_transmittance_at_cosine does, and their interfaces), blended by their coverage. No
-// transcendental when nothing covers the closure (top layers). The remap
-// (exp, log) and the interface term (1 - chi(mu) cancels at grazing) are
-// float; the throughput, in [0, 1], is mfloat.
+// T_N^(1/mu_t) * g(mu)^(1 + extraInterfaces), g the layers' interface term
+// under their top (substrate_coat_transmission): what the layers above let
+// through along a direction at cosine mu where they cover the closure (their
+// media along the refracted path 1 / mu_t = substrate_coat_path_length(mu),
+// T_N clamped to [1e-30, 1] as substrate_transmittance_at_cosine does, and
+// their interfaces). Float: the remap (exp, log) and the interface term
+// (1 - chi(mu) cancels at grazing). Callers take it only under layers
+// (coverageAbove > 0): a closure on top pays no transcendental.
+float3 substrate_closure_layers_crossing(SubstrateClosure c, float mu, float3 w) {
+  float3 t = clamp(c.topTransmittance, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE), SUBSTRATE_SPLAT3(1.0));
+  return exp(log(t) * substrate_coat_path_length(mu)) *
+         substrate_interfaces_transmission(mu, c.extraInterfaces, substrate_coat_floor_along(c, mu, w));
+}
+
+// lerp(1, substrate_closure_layers_crossing(c, mu, w), coverageAbove): the
+// throughput of the layers above along one direction, blended by their
+// coverage (in [0, 1], mfloat); 1 with no transcendental on top.
 mfloat3 substrate_closure_above_throughput(SubstrateClosure c, float mu, float3 w) {
 #if SUBSTRATE_USE_LAYERS
   float cover = saturate(c.coverageAbove);
   if (cover > 0.0) {
-    float3 t = clamp(c.topTransmittance, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE), SUBSTRATE_SPLAT3(1.0));
-    float3 through = exp(log(t) * substrate_coat_path_length(mu)) *
-                     substrate_interfaces_transmission(mu, c.extraInterfaces, substrate_coat_floor_along(c, mu, w));
-    return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(through), SUBSTRATE_M(cover));
+    return mlerp(SUBSTRATE_MSPLAT3(1.0), SUBSTRATE_M3(substrate_closure_layers_crossing(c, mu, w)), SUBSTRATE_M(cover));
   }
 #endif
   return SUBSTRATE_MSPLAT3(1.0);
+}
+
+// Issue 19, step 22: the view and the light cross the same covering. Where
+// layers cover a closure in part (coverageAbove C < 1: a coat under a weight),
+// a path either meets them on both sides or on neither: its throughput is
+// (1 - C) + C t_V t_L, not the product of the two blends, which is lower by
+// C (1 - C)(1 - t_V)(1 - t_L) (with it, and the diffuse darkened alike by what
+// only the covered part traps, substrate_closure_coat_diffuse, a tinted coat
+// over half the surface lost 20 %).
+// So the light meets the layers with the coverage that the view's crossing
+// t_V leaves: C t_V / ((1 - C) + C t_V), per channel, in [0, 1]; C itself
+// where C is 0 or 1 (t_V / t_V is exactly 1 in float) and where t_V is 1.
+float3 substrate_cover_given_view(float cover, float3 viewCrossing) {
+  float3 seen = cover * viewCrossing;
+  return seen / max(SUBSTRATE_SPLAT3(1.0 - cover) + seen, SUBSTRATE_SPLAT3(1e-30));
 }
 
 // The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH),
@@ -687,14 +716,18 @@ mfloat3 substrate_diffuse_transmission(mfloat3 albedo, mfloat3 specAlbedo, float
 // below the critical cosine, at twice the path or more (issue 19, step 14:
 // with T_m^2 a white conductor of roughness 0.7 under a smooth coat of
 // transmittance 0.7 returned +19.8 % head-on, +6.3 % with T_m^4). With R' = t R
-// and g' = lerp(1, T_i g, t), t = coverageAbove (1 - share):
+// and g' = lerp(1, T_i g, t), t = 1 - share (under a full coverage; below):
 //   k = (1 - R') / (1 - e T_m^2 (R' T_m^2 + (1 - R') (1 - g'))).
 // A white closure under clear layers gets 1 / g'. The light-side throughput
 // is at most T_m g' (in every channel), and T_m h / (1 - T_m^2 (1 - h)) <= 1
 // for h = (1 - R') g' in [0, 1] (T_m^4 R' <= T_m^2 R' only lowers k), so the
 // lobe returns no more than the view's
 // throughput lets in, as without the factor; the media's scattering is the
-// layers' own albedo and is not given back.
+// layers' own albedo and is not given back. All of this is the part the layers
+// cover; under a coverage C < 1 the factor is lerp(1, P k, C) / lerp(1, P, C),
+// P = (T_N g)^2 (issue 19, step 22: the lighting lets (1 - C) + C t_V t_L
+// through, and only the covered part gets its light back; with t blended by C
+// instead, the part the layers leave bare was given light back too).
 // Under one rough top (coatFloor f > 0; issue 19, step 14) two more terms:
 // R is read at a - TOP_SPREAD coverageAbove a_t (a_t the top's alpha,
 // substrate_coat_top_alpha), because the closure's roughness holds the top's
@@ -750,7 +783,7 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
 #else
   // No branch: at coverageAbove 0 (or share 1) the factor is exactly 1.
   float cover = saturate(c.coverageAbove);
-  float t = cover * (1.0 - share);
+  float t = 1.0 - share;  // where the layers cover the closure
   float r = saturate(roughness);
   float a = r * r;
 #if SUBSTRATE_USE_COAT_FLOOR || SUBSTRATE_USE_COAT_ANISO
@@ -775,7 +808,8 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
   float3 tm = saturate(tn / c.coatInterface);  // coatInterface >= 0.82
   float3 tm2 = tm * tm;
   float3 ti = max(tn, SUBSTRATE_SPLAT3(c.coatInterface));
-  float3 gl = lerp(SUBSTRATE_SPLAT3(1.0), ti * substrate_coat_transmission(max(v, l), c.coatFloor), t);
+  float g = substrate_coat_transmission(max(v, l), c.coatFloor);
+  float3 gl = lerp(SUBSTRATE_SPLAT3(1.0), ti * g, t);
   float3 back = tm2 * (trapped * tm2 + (1.0 - trapped) * (SUBSTRATE_SPLAT3(1.0) - gl));
   float3 k = (1.0 - trapped) / (SUBSTRATE_SPLAT3(1.0) - e * back);
 #if SUBSTRATE_USE_COAT_FLOOR
@@ -786,7 +820,10 @@ float3 substrate_closure_coat_specular(SubstrateClosure c, mfloat3 f0, mfloat3 f
                 (substrate_coat_path_length(v) * (mv * mv) + substrate_coat_path_length(l) * (ml * ml));
   k *= exp(log(max(tm, SUBSTRATE_SPLAT3(SUBSTRATE_MIN_TRANSMITTANCE))) * extra);
 #endif
-  return k;
+  // The covered part alone gets k (issue 19, step 22): lerp(1, P k, C) / lerp(1, P, C),
+  // P = (T_N g)^2 the round trip the lighting lets through where the layers cover.
+  float3 p = max(tn * g * (tn * g), SUBSTRATE_SPLAT3(1e-30));
+  return lerp(SUBSTRATE_SPLAT3(1.0), p * k, cover) / lerp(SUBSTRATE_SPLAT3(1.0), p, cover);
 #endif
 }
 

@@ -22,27 +22,45 @@ mfloat3 substrate_closure_view_throughput(SubstrateClosure c, float NoV, float3 
   return SUBSTRATE_M_CLAMPED(max(c.weight, 0.0)) * substrate_closure_above_throughput(c, NoV, V);
 }
 
-// Along the light: substrate_closure_above_throughput(c, NoL, L). The closure's
-// weight is counted once, in the view throughput. L: the unit light direction
-// (substrate_coat_mean_direction for light with no one direction).
-mfloat3 substrate_closure_light_throughput(SubstrateClosure c, float NoL, float3 L) {
-  return substrate_closure_above_throughput(c, NoL, L);
+// Along the light, given what the layers above let through along the view
+// (viewCrossing = substrate_closure_layers_crossing(c, NoV, V)) and along the
+// light (lightCrossing, at the light's cosine and direction; the azimuths'
+// mean, substrate_coat_mean_direction, for light with no one direction):
+// lerp(1, lightCrossing, substrate_cover_given_view(coverageAbove, viewCrossing)),
+// the layers met only where the view met them (substrate_bsdf.h, issue 19,
+// step 22). The closure's weight is counted once, in the view throughput; the
+// product of the two is (1 - C) + C t_V t_L. Exactly 1 on top (C = 0), where
+// the crossings need not be taken.
+mfloat3 substrate_closure_light_throughput(SubstrateClosure c, float3 viewCrossing, float3 lightCrossing) {
+  return SUBSTRATE_M3(lerp(SUBSTRATE_SPLAT3(1.0), lightCrossing,
+                           substrate_cover_given_view(saturate(c.coverageAbove), viewCrossing)));
 }
 
 // One closure lit by one light of radiance `radiance` (the light's radiance
 // times its solid angle / attenuation, i.e. what multiplies BSDF * NoL):
-// view throughput * light throughput * BSDF * NoL * radiance. Emissive is not
-// added here (the base pass adds it once). A closure whose weight is 0 at this
-// pixel (a mix or a coverage that hides it) is skipped: nothing is evaluated.
+// max(weight, 0) ((1 - C) + C t_V t_L) * BSDF * NoL * radiance, t_V and t_L
+// what the layers above let through along the view and the light
+// (substrate_closure_layers_crossing; a wrap lobe's light crosses them at its
+// own cosine, substrate_wrap_light_cosine), C their coverage: a path meets
+// them on both sides or on neither (issue 19, step 22), which is the view
+// throughput times the light's given the view's. Emissive is not added here
+// (the base pass adds it once). A closure whose weight is 0 at this pixel (a
+// mix or a coverage that hides it) is skipped: nothing is evaluated.
 float3 substrate_light_closure(SubstrateClosure c, float3 V, float3 L, float3 radiance) {
   if (!substrate_closure_visible(c)) {
     return SUBSTRATE_SPLAT3(0.0);
   }
   float3 N = substrate_closure_normal(c);
   float3 f = substrate_eval_closure(c, V, L);
-  // A wrap lobe's light crosses the layers above at its own cosine (substrate_wrap_light_cosine).
-  mfloat3 throughput = substrate_closure_view_throughput(c, dot(N, V), V) *
-                       substrate_closure_light_throughput(c, substrate_wrap_light_cosine(c, dot(N, L)), L);
+  mfloat3 throughput = SUBSTRATE_MSPLAT3(SUBSTRATE_M_CLAMPED(max(c.weight, 0.0)));
+#if SUBSTRATE_USE_LAYERS
+  float cover = saturate(c.coverageAbove);
+  if (cover > 0.0) {
+    float3 pair = substrate_closure_layers_crossing(c, dot(N, V), V) *
+                  substrate_closure_layers_crossing(c, substrate_wrap_light_cosine(c, dot(N, L)), L);
+    throughput *= SUBSTRATE_M3(lerp(SUBSTRATE_SPLAT3(1.0), pair, cover));
+  }
+#endif
   return SUBSTRATE_F3(throughput) * f * radiance;
 }
 
@@ -219,9 +237,19 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
 #endif
   // The mirror direction's azimuth is the view's (cos^2 alike); the diffuse's light has
   // none: the azimuths' mean (substrate_coat_mean_direction).
-  mfloat3 specLight = substrate_closure_light_throughput(c, NoV, V);
-  mfloat3 diffuseLight = substrate_closure_light_throughput(
-      c, SUBSTRATE_DIFFUSE_MEAN_COS, substrate_coat_mean_direction(c, SUBSTRATE_DIFFUSE_MEAN_COS));
+  // The light meets the layers only where the view met them (substrate_closure_light_throughput).
+  mfloat3 specLight = SUBSTRATE_MSPLAT3(1.0);
+  mfloat3 diffuseLight = SUBSTRATE_MSPLAT3(1.0);
+#if SUBSTRATE_USE_LAYERS
+  if (saturate(c.coverageAbove) > 0.0) {
+    float3 viewCrossing = substrate_closure_layers_crossing(c, NoV, V);
+    specLight = substrate_closure_light_throughput(c, viewCrossing, viewCrossing);
+    diffuseLight = substrate_closure_light_throughput(
+        c, viewCrossing,
+        substrate_closure_layers_crossing(c, SUBSTRATE_DIFFUSE_MEAN_COS,
+                                          substrate_coat_mean_direction(c, SUBSTRATE_DIFFUSE_MEAN_COS)));
+  }
+#endif
   float3 result = spec * SUBSTRATE_F3(specLight) + diffuse * SUBSTRATE_F3(diffuseLight);
 #if SUBSTRATE_USE_FUZZ
   if ((c.features & SUBSTRATE_FEATURE_FUZZ) != 0u) {

@@ -624,6 +624,43 @@ TEST(Accuracy, AStretchedConductorKeepsItsEnergy) {
   EXPECT_EQ(rows, 6);
 }
 
+TEST(Accuracy, AHalfCoatIsCrossedOnBothSidesOrOnNeither) {
+  // Issue 19, step 22 (bench/materials/tinted_half_coat_over_lambert.json): a
+  // coat absorbing green and blue (transmittance 1 / 0.59 / 0.32 along the
+  // normal) over half the surface. A path meets it on the way in and out or
+  // not at all: the base is lit by (1 - C) + C t_V t_L, and only the covered
+  // half loses what the coat's top traps. The lighting took the product of the
+  // view's and the light's blends (lower by C (1 - C)(1 - t_V)(1 - t_L)) and
+  // darkened the whole diffuse by what the covered half absorbs: -19.6 / -20.4
+  // / -20.8 / -20.9 / -20.1 / -19.4 % (NoV 1 / 0.8 / 0.6 / 0.4 / 0.2 / 0.1)
+  // against the walk (which picks the coat's presence per path), now -0.4 /
+  // -1.0 / -1.5 / -2.4 / -3.3 / -3.9 % (32,768 walks).
+  Diagnostics d("half_coat.json");
+  CompileOptions co;
+  co.budgetOverride = 1024;
+  co.maxClosuresOverride = 8;
+  auto compiled = compileText("half_coat.json", test::material(R"(
+      "coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.04, "roughness": 0.06, "sss_mfp": [1000, 0.19, 0.088]},
+      "half_coat": {"kind": "coverage_weight", "a": "coat", "weight": 0.5},
+      "base": {"kind": "slab", "diffuse_albedo": 0.8, "f0": 0.04, "roughness": 0.4},
+      "root": {"kind": "vertical", "top": "half_coat", "base": "base", "thickness": 0.1})"),
+                              co, d);
+  ASSERT_TRUE(compiled) << d.formatAll();
+  accuracy::Options o = cheap(2);
+  o.samples = 8192;
+  const accuracy::Comparison c = accuracy::compare(accuracy::analyticOf(*compiled, o), accuracy::truthOf(*compiled, o));
+  ASSERT_EQ(c.rows.size(), accuracy::kNoV.size());
+  int rows = 0;
+  for (const auto& row : c.rows) {
+    SCOPED_TRACE(row.nov);
+    ASSERT_TRUE(row.relError && row.furnaceAnalytic);
+    EXPECT_LE(std::fabs(*row.relError), row.nov >= 0.2 ? 0.05 : 0.08);
+    for (int k = 0; k < 3; ++k) EXPECT_LE((*row.furnaceAnalytic)[k], 1.001);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 6);
+}
+
 TEST(Accuracy, SameSamplesSameBitsWhateverTheThreads) {
   const CompileResult r =
       compileSlab(R"({"kind": "slab", "diffuse_albedo": [0.6, 0.3, 0.2], "f0": 0.04, "roughness": 0.3})");

@@ -356,7 +356,9 @@ TEST(Furnace, StackClosuresCarryUpToFourInterfacesAndFoldTheRest) {
       const double want = std::pow(c.topTransmittance[0], 1 / mut) * std::pow(gmu, 1 + extra);
       const reference::V3<double> w = stackfurnace::viewAt(mu);
       EXPECT_NEAR(reference::viewThroughput<double>(c, mu, w)[0], want, 1e-9) << k;
-      EXPECT_NEAR(reference::lightThroughput<double>(c, mu, w)[0], want, 1e-9) << k;
+      const auto crossing = reference::layersCrossing<double>(c, mu, w);
+      EXPECT_NEAR(crossing[0], want, 1e-9) << k;
+      EXPECT_NEAR(reference::lightThroughput<double>(c, crossing, crossing)[0], want, 1e-9) << k;
     }
     ++checked;
   }

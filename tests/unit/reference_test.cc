@@ -411,7 +411,8 @@ TEST(ReferenceOperators, NestedLayersComposeFromTheRootDown) {
       c.extraInterfaces = k;
       const V3<double> w{std::sqrt(1 - mu * mu), 0, mu};
       const auto a = viewThroughput<double>(c, mu, w), b = viewThroughput<double>(one, mu, w);
-      const auto l = lightThroughput<double>(c, mu, w), lb = lightThroughput<double>(one, mu, w);
+      const auto l = lightThroughput<double>(c, layersCrossing(c, mu, w), layersCrossing(c, mu, w)),
+                 lb = lightThroughput<double>(one, layersCrossing(one, mu, w), layersCrossing(one, mu, w));
       for (int ch = 0; ch < 3; ++ch) {
         EXPECT_NEAR(a[ch], b[ch] * std::pow(g, k), 1e-9) << "mu " << mu << ", k " << k;
         EXPECT_NEAR(l[ch], lb[ch] * std::pow(g, k), 1e-9) << "mu " << mu << ", k " << k;
@@ -1138,11 +1139,17 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
     e3 += mu * std::exp(-tau / refracted(mu)) * stackfurnace::interfaceTerm(mu) / 100000;
   }
   // What the diffuse gets back from the coat's underside (substrate_closure_coat_diffuse):
-  // 1 / lerp(1, D, 0.6), D = G_0 T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4) with
-  // T_i = 0.96 (the interface's share), T_m = 0.5 / 0.96 (the medium's), A = 0.7; the
-  // closure's own interface (F0 0, F90 0) adds no covariance term.
-  const double ti = 0.96, tm = 0.5 / 0.96;
-  const double back = 1 / (0.4 + 0.6 * (0.94642 * ti * (1 - 0.12 * (1 - ti)) + 1.34177 * 0.7 * (1 - std::pow(tm, 4))));
+  // lerp(D, P, 0.6) / (D lerp(1, P, 0.6)), P = (0.5 G_0)^2 the mean round trip,
+  // D = G_0 T_i (1 - 0.12 (1 - T_i)) + TRAP A (1 - T_m^4) with T_i = 0.96 (the
+  // interface's share), T_m = 0.5 / 0.96 (the medium's), A = 0.7; the closure's own
+  // interface (F0 0, F90 0) adds no covariance term.
+  const double ti = 0.96, tm = 0.5 / 0.96, p = (0.5 * 0.94642) * (0.5 * 0.94642);
+  const double d = 0.94642 * ti * (1 - 0.12 * (1 - ti)) + 1.34177 * 0.7 * (1 - std::pow(tm, 4));
+  const double back = (0.4 * d + 0.6 * p) / (d * (0.4 + 0.6 * p));
+  // The light meets the coat only where the view did (substrate_cover_given_view):
+  // with probability 0.6 t_V / (0.4 + 0.6 t_V), t_V its crossing at NoV 0.8.
+  const double tv = std::pow(0.5, 1 / refracted(0.8)) * stackfurnace::interfaceTerm(0.8);
+  const double given = 0.6 * tv / (0.4 + 0.6 * tv);
   Closure<double> c;
   c.diffuseAlbedo = {0.7, 0.7, 0.7};
   c.f0 = {0, 0, 0};
@@ -1153,9 +1160,10 @@ TEST(ReferenceSplitSum, ThroughLayersItsCosinesAreApproximations) {
   c.topTransmittance = {0.5, 0.5, 0.5};
   const D3 V = directionAt({0, 0, 1}, 0.8, 0);
   const V3<double> ref = envIntegrated(c, V, [&](const V3<double>&) { return one; }, kDiffuseLambert, 8192, 6);
-  EXPECT_NEAR(ref[0], 0.7 * (0.4 + 0.6 * 2 * e3) * back, 2e-3);
+  EXPECT_NEAR(ref[0], 0.7 * (1 - given + given * 2 * e3) * back, 2e-3);
   EXPECT_NEAR(envSplitSum(c, V, one, pi, kDiffuseLambert)[0],
-              0.7 * (0.4 + 0.6 * std::pow(0.5, 1 / refracted(0.5)) * stackfurnace::interfaceTerm(0.5)) * back, 1e-9);
+              0.7 * (1 - given + given * std::pow(0.5, 1 / refracted(0.5)) * stackfurnace::interfaceTerm(0.5)) * back,
+              1e-9);
 }
 
 // ---------------------------------------------------------------------------
@@ -1172,7 +1180,8 @@ void expectFiniteLighting(const Closure<T>& c, const V3<T>& V, const V3<T>& L, c
   const V3<T> N = closureNormal(c);
   T NoV = N[0] * V[0] + N[1] * V[1] + N[2] * V[2];
   EXPECT_TRUE(finite(viewThroughput(c, NoV, V))) << what;
-  EXPECT_TRUE(finite(lightThroughput(c, N[0] * L[0] + N[1] * L[1] + N[2] * L[2], L))) << what;
+  EXPECT_TRUE(finite(lightThroughput(c, layersCrossing(c, NoV, V), layersCrossing(c, N[0] * L[0] + N[1] * L[1] + N[2] * L[2], L))))
+      << what;
   EXPECT_TRUE(finite(reflectionDir(c, V))) << what;
   EXPECT_TRUE(std::isfinite(envMip(c.roughness, T(8)))) << what;
   T cov;
@@ -1385,3 +1394,4 @@ TEST(ReferenceOperators, TheClearCoatExampleLetsThePaintShow) {
 
 }  // namespace reference_test
 }  // namespace substratec
+

@@ -702,21 +702,38 @@ T coatPathLength(T mu) {
   return T(1.5) / std::sqrt(T(1.25) + m * m);
 }
 
-// substrate_closure_above_throughput: lerp(1, T_N^coatPathLength(mu) *
-// coatTransmission(mu, coatFloor)^(1 + extraInterfaces), sat(coverageAbove)), and exactly 1 (no
-// transcendental) when nothing covers the closure.
+// substrate_closure_layers_crossing: T_N^coatPathLength(mu) *
+// coatTransmission(mu, coatFloor)^(1 + extraInterfaces) where the layers above
+// cover the closure, and exactly 1 (no transcendental) when nothing covers it.
+template <class T>
+V3<T> layersCrossing(const Closure<T>& c, T mu, const V3<T>& w) {
+  if (!(saturate(c.coverageAbove) > T(0))) return splat3(T(1));
+  const T path = coatPathLength(mu);
+  V3<T> t;
+  for (int k = 0; k < 3; ++k)
+    t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
+  const T i = interfacesTransmission(mu, c.extraInterfaces, coatFloorAlong(c, mu, w));
+  return V3<T>{t[0] * i, t[1] * i, t[2] * i};
+}
+
+// substrate_closure_above_throughput: lerp(1, layersCrossing(c, mu, w), sat(coverageAbove)).
 template <class T>
 V3<T> aboveThroughput(const Closure<T>& c, T mu, const V3<T>& w) {
-  T cover = saturate(c.coverageAbove);
-  if (cover > T(0)) {
-    const T path = coatPathLength(mu);
-    V3<T> t;
-    for (int k = 0; k < 3; ++k)
-      t[k] = std::exp(std::log(clampT(c.topTransmittance[k], K<T>::minTransmittance, T(1))) * path);
-    const T i = interfacesTransmission(mu, c.extraInterfaces, coatFloorAlong(c, mu, w));
-    return lerp(splat3(T(1)), V3<T>{t[0] * i, t[1] * i, t[2] * i}, cover);
-  }
+  const T cover = saturate(c.coverageAbove);
+  if (cover > T(0)) return lerp(splat3(T(1)), layersCrossing(c, mu, w), cover);
   return splat3(T(1));
+}
+
+// substrate_cover_given_view: C t_V / max((1 - C) + C t_V, 1e-30) per channel,
+// the coverage the light meets given the view's crossing (issue 19, step 22).
+template <class T>
+V3<T> coverGivenView(T cover, const V3<T>& viewCrossing) {
+  V3<T> r;
+  for (int k = 0; k < 3; ++k) {
+    const T seen = cover * viewCrossing[k];
+    r[k] = seen / std::max(T(1) - cover + seen, T(1e-30));
+  }
+  return r;
 }
 
 // substrate_wrap_light_cosine: the cosine the layers above are crossed at by
@@ -884,25 +901,28 @@ V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90,
     const T tm = saturate(tn / ifc);
     const T tm2 = tm * tm;
     const T d = g * ti * (T(1) - T(SUBSTRATE_COAT_BEND) * (T(1) - ti)) + kCoatTrap<T> * saturate(c.diffuseAlbedo[i]) * (T(1) - tm2 * tm2);
-    r[i] = T(1) / lerp(T(1), d, cover);
+    // The covered part alone gives back what the top traps (issue 19, step 22).
+    const T p = std::max(tn * g * (tn * g), T(1e-30));
+    r[i] = lerp(d, p, cover) / (d * lerp(T(1), p, cover));
   }
   return r;
 }
 
 // substrate_closure_coat_specular: (1 - R') / (1 - e T_m^2 (R' T_m^2 + (1 - R') (1 - g'))) per channel,
-// with t = sat(coverageAbove) (1 - share), R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2 -
+// with t = 1 - share, R' = t (P1 a^2 / (a^2 + P2 dV dL) + P3 a^2) (a = max(r^2 -
 // TOP_SPREAD sat(coverageAbove) closureCoatTopAlpha(c), 1e-3), d = max(mu_i - mu_c, 0) along the view
 // and along the light), g' = lerp(1, T_i coatTransmission(max(NoV, NoL), coatFloor), t), T_i =
 // max(T_N, I) the interface's own (I = coatInterface), T_m = sat(T_N / I) and e the closure's hemispherical albedo,
 // F_avg + A diffuseTransmission(A, F_avg, d_avg) (F_avg = F0 + (F90 - F0) / 21 per channel, d_avg the
 // same of the dielectric part fd); times max(T_m, 1e-30)^x, x = ROUGH_PATH f^3 t (coatPathLength(NoV)
-// (1 - NoV)^2 + coatPathLength(NoL) (1 - NoL)^2), f = sat(coatFloor).
+// (1 - NoV)^2 + coatPathLength(NoL) (1 - NoL)^2), f = sat(coatFloor): k, the covered part's; under a coverage
+// C = sat(coverageAbove), lerp(1, P k, C) / lerp(1, P, C), P = max((T_N g)^2, 1e-30) (issue 19, step 22).
 template <class T>
 V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, const V2<T>& fd, T share, T NoV,
                           T NoL, T roughness) {
   // No branch, as in the shader: at coverageAbove 0 (or share 1) the factor is exactly 1.
   const T cover = saturate(c.coverageAbove);
-  const T t = cover * (T(1) - share);
+  const T t = T(1) - share;  // where the layers cover the closure
   const T r = saturate(roughness);
   const T a = std::max(r * r - T(SUBSTRATE_COAT_TOP_SPREAD) * cover * closureCoatTopAlpha(c), kMinAlpha<T>);
   const T a2 = a * a;
@@ -932,6 +952,9 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
     const T back = tm2 * (trapped * tm2 + (T(1) - trapped) * (T(1) - lerp(T(1), ti * g, t)));
     k[i] = (T(1) - trapped) / (T(1) - e[i] * back);
     k[i] *= std::exp(std::log(std::max(tm, K<T>::minTransmittance)) * extra);
+    // The covered part alone gets it (issue 19, step 22; closureCoatDiffuse).
+    const T p = std::max(tn * g * (tn * g), T(1e-30));
+    k[i] = lerp(T(1), p * k[i], cover) / lerp(T(1), p, cover);
   }
   return k;
 }
@@ -1129,6 +1152,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
   template V3<T> aboveThroughput<T>(const Closure<T>&, T, const V3<T>&);                               \
+  template V3<T> layersCrossing<T>(const Closure<T>&, T, const V3<T>&);                                \
+  template V3<T> coverGivenView<T>(T, const V3<T>&);                                                   \
   template T wrapLightCosine<T>(const Closure<T>&, T);                                                 \
   template T fuzzCosine<T>(const Closure<T>&, T);                                                      \
   template void closureFrame<T>(const Closure<T>&, const V3<T>&, V3<T>&, V3<T>&);                      \

@@ -16,7 +16,7 @@ template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>&
 /// substrate_closure_fresnel_ends: F0 and F90 (white without the F90 feature),
 /// relative to the layers above by coverageAbove, and the share of the dielectric curve (fresnelShare).
 template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share);
-/// substrate_closure_coat_diffuse: 1 / lerp(1, D, coverageAbove), what the diffuse gets back.
+/// substrate_closure_coat_diffuse: lerp(D, P, C) / (D lerp(1, P, C)), P = (T_N G)^2, C = coverageAbove: what the diffuse gets back (1 / D under a full coverage).
 template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, int diffuseModel);
 /// substrate_closure_coat_specular: what a conductor's lobe under layers keeps, given back what their top
 /// sends down (the trapped share R) and the closure reflects again (its hemispherical albedo).
@@ -27,6 +27,10 @@ V3<T> closureCoatSpecular(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90
 /// (their media along the refracted path, their interfaces), blended by coverageAbove; 1 on top.
 /// w: the unit direction (its azimuth about a stretched top: coatFloorAlong; coatMeanDirection for none).
 template <class T> V3<T> aboveThroughput(const Closure<T>& c, T mu, const V3<T>& w);
+/// substrate_closure_layers_crossing: the same where the layers cover the closure, unblended (1 on top).
+template <class T> V3<T> layersCrossing(const Closure<T>& c, T mu, const V3<T>& w);
+/// substrate_cover_given_view: the coverage the light meets given the view's crossing, C t_V / ((1 - C) + C t_V).
+template <class T> V3<T> coverGivenView(T cover, const V3<T>& viewCrossing);
 /// substrate_wrap_light_cosine: the cosine a wrap lobe's light crosses the layers above at.
 template <class T> T wrapLightCosine(const Closure<T>& c, T NoL);
 /// substrate_fuzz_cosine: the cosine a fuzz under layers sees (refracted into them); mu on top.

@@ -189,6 +189,8 @@ V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
   }
   if (c.sssType == kSssWrap) strategies.push_back({Kind::Sphere, {}});
 
+  // The light meets the layers above only where the view met them (lightThroughput).
+  const D3 viewCrossing = layersCrossing(c, dot(fr.n, V), V);
   std::uint64_t state = seed;
   for (const Strategy& s : strategies) {
     // the rotations from the seed (splitmix64, util/random.h)
@@ -207,7 +209,7 @@ V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
       const D3 L = fr.toWorld(l);
       const D3 f = evalClosure(c, V, L, diffuseModel);
       if (f[0] == 0 && f[1] == 0 && f[2] == 0) continue;
-      acc = acc + radiance(L) * lightThroughput(c, wrapLightCosine(c, dot(fr.n, L)), L) * f / pdfSum;
+      acc = acc + radiance(L) * lightThroughput(c, viewCrossing, layersCrossing(c, wrapLightCosine(c, dot(fr.n, L)), L)) * f / pdfSum;
     }
     sum = sum + acc / static_cast<double>(samples);
   }

@@ -61,16 +61,31 @@ V3<T> viewThroughput(const Closure<T>& c, T NoV, const V3<T>& V) {
   return aboveThroughput(c, NoV, V) * std::max(c.weight, T(0));  // max(weight, 0) * above
 }
 
+// substrate_closure_light_throughput: lerp(1, lightCrossing, coverGivenView(C,
+// viewCrossing)), the layers met only where the view met them; the weight
+// counts once, on the view side; 1 on top.
 template <class T>
-V3<T> lightThroughput(const Closure<T>& c, T NoL, const V3<T>& L) {
-  return aboveThroughput(c, NoL, L);  // the weight counts once, on the view side
+V3<T> lightThroughput(const Closure<T>& c, const V3<T>& viewCrossing, const V3<T>& lightCrossing) {
+  const T cover = saturate(c.coverageAbove);
+  if (!(cover > T(0))) return splat3(T(1));
+  const V3<T> given = coverGivenView(cover, viewCrossing);
+  V3<T> r;
+  for (int k = 0; k < 3; ++k) r[k] = T(1) + (lightCrossing[k] - T(1)) * given[k];
+  return r;
 }
 
+// substrate_light_closure: max(weight, 0) lerp(1, t_V t_L, C) f radiance (a
+// path meets the layers above on both sides or on neither).
 template <class T>
 V3<T> lightClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, const V3<T>& radiance, int diffuseModel) {
   V3<T> N = closureNormal(c);
   V3<T> f = evalClosure(c, V, L, diffuseModel);
-  V3<T> throughput = viewThroughput(c, dot(N, V), V) * lightThroughput(c, wrapLightCosine(c, dot(N, L)), L);
+  V3<T> throughput = splat3(std::max(c.weight, T(0)));
+  const T cover = saturate(c.coverageAbove);
+  if (cover > T(0)) {
+    const V3<T> pair = layersCrossing(c, dot(N, V), V) * layersCrossing(c, wrapLightCosine(c, dot(N, L)), L);
+    throughput = throughput * lerp(splat3(T(1)), pair, cover);
+  }
   return throughput * f * radiance;
 }
 
@@ -139,9 +154,13 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
     const V3<T> s2 = closureMedium(c, albedo, saturate(c.roughness), p);
     diff = diff * mediumWeight(s2, T(SUBSTRATE_MEDIUM_MEAN_COS), p, NoV);
   }
-  V3<T> specLight = lightThroughput(c, NoV, V);  // the mirror direction's azimuth is the view's
-  // no one direction: the azimuths' mean (coatMeanDirection)
-  V3<T> diffuseLight = lightThroughput(c, kDiffuseMeanCos<T>, coatMeanDirection(c, kDiffuseMeanCos<T>));
+  // The light meets the layers only where the view met them; the mirror
+  // direction's azimuth is the view's; the diffuse's light has no one
+  // direction: the azimuths' mean (coatMeanDirection).
+  const V3<T> viewCrossing = layersCrossing(c, NoV, V);
+  V3<T> specLight = lightThroughput(c, viewCrossing, viewCrossing);
+  V3<T> diffuseLight =
+      lightThroughput(c, viewCrossing, layersCrossing(c, kDiffuseMeanCos<T>, coatMeanDirection(c, kDiffuseMeanCos<T>)));
   V3<T> result = spec * specLight + diff * diffuseLight;
   if (c.features & kFeatureFuzz) {
     T amount = saturate(c.fuzzAmount);
@@ -225,7 +244,7 @@ V3<T> waterSeen(const Closure<T>& c, const Water<T>& w, const V4<T>& behind, T s
 
 #define SUBSTRATEC_INSTANTIATE(T)                                                                         \
   template V3<T> viewThroughput<T>(const Closure<T>&, T, const V3<T>&);                                                 \
-  template V3<T> lightThroughput<T>(const Closure<T>&, T, const V3<T>&);                                                \
+  template V3<T> lightThroughput<T>(const Closure<T>&, const V3<T>&, const V3<T>&);                       \
   template V3<T> lightClosure<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V3<T>&, int);       \
   template V3<T> reflectionDir<T>(const Closure<T>&, const V3<T>&);                                       \
   template T envMip<T>(T, T);                                                                             \

@@ -206,10 +206,13 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 /// substrate_closure_view_throughput / substrate_closure_light_throughput.
 template <class T>
 V3<T> viewThroughput(const Closure<T>& c, T NoV, const V3<T>& V);
+/// The light's given what the layers above let through along the view and the light
+/// (layersCrossing(c, N.V, V) and layersCrossing(c, N.L, L), L unit; coatMeanDirection: no one).
 template <class T>
-V3<T> lightThroughput(const Closure<T>& c, T NoL, const V3<T>& L);  // L unit (coatMeanDirection: no one)
+V3<T> lightThroughput(const Closure<T>& c, const V3<T>& viewCrossing, const V3<T>& lightCrossing);
 
-/// substrate_light_closure: viewT(NoV) * lightT(NoL) * evalClosure * radiance.
+/// substrate_light_closure: max(weight, 0) lerp(1, t_V t_L, coverageAbove) * evalClosure * radiance,
+/// which is viewThroughput times lightThroughput.
 template <class T>
 V3<T> lightClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, const V3<T>& radiance, int diffuseModel);
 
