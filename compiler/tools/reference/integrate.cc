@@ -1,6 +1,6 @@
 // The reference for environment lighting (no shader counterpart: it measures
 // the error of substrate_env_split_sum, runtime_shaders/substrate_lighting.h):
-//   integral over the sphere of radiance(L) lightThroughput(c, N.L) evalClosure(c, V, L) dL
+//   integral over the sphere of radiance(L) lightThroughput(c, t_V, t_L) evalClosure(c, V, L) dL
 // by multiple importance sampling with the balance heuristic. Strategies, each
 // with `samples` points of a Hammersley set under its own Cranley-Patterson
 // rotation (drawn from the seed): GGX visible normals (Heitz 2018, "Sampling
@@ -209,7 +209,8 @@ V3<double> envIntegrated(const Closure<double>& c, const V3<double>& V,
       const D3 L = fr.toWorld(l);
       const D3 f = evalClosure(c, V, L, diffuseModel);
       if (f[0] == 0 && f[1] == 0 && f[2] == 0) continue;
-      acc = acc + radiance(L) * lightThroughput(c, viewCrossing, layersCrossing(c, wrapLightCosine(c, dot(fr.n, L)), L)) * f / pdfSum;
+      const D3 lightCrossing = layersCrossing(c, wrapLightCosine(c, dot(fr.n, L)), L);
+      acc = acc + radiance(L) * lightThroughput(c, viewCrossing, lightCrossing) * f / pdfSum;
     }
     sum = sum + acc / static_cast<double>(samples);
   }

@@ -68,10 +68,7 @@ template <class T>
 V3<T> lightThroughput(const Closure<T>& c, const V3<T>& viewCrossing, const V3<T>& lightCrossing) {
   const T cover = saturate(c.coverageAbove);
   if (!(cover > T(0))) return splat3(T(1));
-  const V3<T> given = coverGivenView(cover, viewCrossing);
-  V3<T> r;
-  for (int k = 0; k < 3; ++k) r[k] = T(1) + (lightCrossing[k] - T(1)) * given[k];
-  return r;
+  return splat3(T(1)) + (lightCrossing - splat3(T(1))) * coverGivenView(cover, viewCrossing);
 }
 
 // substrate_light_closure: max(weight, 0) lerp(1, t_V t_L, C) f radiance (a

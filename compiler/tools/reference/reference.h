@@ -234,7 +234,7 @@ template <class T>
 void translucency(const Closure<T>& c, T NoV, const V3<T>& V, T& coverage, V3<T>& transmittance);
 
 /// The reference for environment lighting: the integral over the sphere of
-/// radiance(L) * lightThroughput(c, N.L) * evalClosure(c, V, L) dL (the
+/// radiance(L) * lightThroughput(c, t_V, t_L) * evalClosure(c, V, L) dL (the
 /// light-side throughput is what envSplitSum includes: 1 for a top closure), by
 /// importance sampling with the balance heuristic: `samples` points per strategy
 /// (GGX visible normals of the primary lobe and of the haze lobe when it has
