@@ -66,6 +66,51 @@ float substrate_fresnel_share(float f0max) {
   return 1.0 - saturate((f0max - SUBSTRATE_COAT_DIELECTRIC_F0) * SUBSTRATE_COAT_CONDUCTOR_BLEND);
 }
 
+// How much of a closure of largest F0 f0max is read as a metalness mix (0 up
+// to SUBSTRATE_MIX_START, 1 from 0.25; substrate_closure_dielectric_part).
+float substrate_mix_share(float f0max) {
+  return saturate((f0max - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND);
+}
+
+// The Fresnel curve of a closure's interface between its ends: the share of
+// chi (substrate_fresnel_share) and, per channel, the coefficients (a, b) of
+// w(t) = t + (1 - t) s (a + b s), s = sqrt(t), t = (1 - c)^5 (chi's form,
+// substrate_fresnel_delta). With SUBSTRATE_USE_CONDUCTOR_CURVE 0 the curve is
+// t + share D(t) and a, b are unused.
+struct SubstrateFresnelCurve {
+  float share;
+  float3 a;
+  float3 b;
+};
+
+// The curve of an interface of F0 f0 (per channel, in [0, 1]) and chi's share
+// (issue 19, step 23): chi where the share is 1 (a dielectric), each channel's
+// conductor curve where it is 0 (SUBSTRATE_CONDUCTOR_CURVE_*: the ground
+// truth's Gulbrandsen conductor of that F0, within 0.0063 in reflectance from
+// F0 0.02; Schlick's curve, which conductors followed before, reflected up to
+// 16 % less than it at cosine 0.4 for F0 0.14, 6 % for 0.3, so a grey
+// conductor of F0 0.14 read -11.6 % albedo at NoV 0.4), the coefficients
+// linear between. Once per closure. `conductor` (in [0, 1]) is how much of
+// the conductor's own curve replaces Schlick's (substrate_closure_fresnel_ends).
+SubstrateFresnelCurve substrate_fresnel_curve(float3 f0, float share, float conductor) {
+  SubstrateFresnelCurve k;
+  k.share = share;
+#if SUBSTRATE_USE_CONDUCTOR_CURVE
+  float3 x = sqrt(max(f0, SUBSTRATE_SPLAT3(SUBSTRATE_CONDUCTOR_CURVE_MIN_F0)));
+  float3 a = max(SUBSTRATE_CONDUCTOR_CURVE_A0 +
+                     x * (SUBSTRATE_CONDUCTOR_CURVE_A1 + x * (SUBSTRATE_CONDUCTOR_CURVE_A2 + x * SUBSTRATE_CONDUCTOR_CURVE_A3)),
+                 SUBSTRATE_SPLAT3(0.0));
+  float3 b = SUBSTRATE_CONDUCTOR_CURVE_B0 +
+             x * (SUBSTRATE_CONDUCTOR_CURVE_B1 + x * (SUBSTRATE_CONDUCTOR_CURVE_B2 + x * SUBSTRATE_CONDUCTOR_CURVE_B3));
+  k.a = lerp(a * conductor, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_A), share);
+  k.b = lerp(b * conductor, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_B), share);
+#else
+  k.a = SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_A);
+  k.b = SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_B);
+#endif
+  return k;
+}
+
 // F90 as Substrate defines it: "F90 can only change the chromaticity, not the
 // intensity" (the course notes: it does not take energy away at grazing
 // angles). A conductor's F90 (F0 from 0.2: substrate_fresnel_share 0) gives
@@ -84,9 +129,23 @@ float3 substrate_f90_effective(float3 f0, float3 f90) {
 
 // The Fresnel ends of a closure: its reflectance at normal incidence, and at
 // grazing incidence (white unless it has the F90 feature; then
-// substrate_f90_effective), and the share of
-// the dielectric curve between them (substrate_fresnel_share, from the
-// largest channel of the relative F0).
+// substrate_f90_effective), and the curve between them
+// (substrate_fresnel_curve: the share of the dielectric curve from the
+// largest channel of the relative F0, each channel's conductor curve from its own).
+// The conductor's own curve (issue 19, step 23) where the truth walks a
+// conductor: a closure of no diffuse and no medium (an opaque slab of diffuse
+// 0 and F0 above 0.1 is Gulbrandsen's conductor there), or a metalness mix's
+// (substrate_mix_share: the mix's conductor part, read at the mixed F0).
+// Elsewhere Schlick's, as before: a slab of F0 above 0.1 over a diffuse or a
+// medium is a dielectric of high IOR in the truth, nearer Schlick's in albedo
+// (glTF IORTestGrid's transmitting IOR 2.42 sphere read +3.6 / +10.7 % at NoV
+// 0.6 / 0.4 with the conductor's curve, -4.6 / -0.8 % with Schlick's). And not under
+// layers (by 1 - coverageAbove): the lobe reads the Fresnel at the outside
+// angles where the truth's light reaches it refracted by the layers (at
+// cosines from 0.745 for IOR 1.5, where every curve is near F0), and the
+// layers' terms for it (substrate_closure_coat_specular) were built on
+// Schlick's; with its own curve the control conductor_under_clear_coat rose
+// from +3.3 to +5.1 % at NoV 0.4.
 //
 // Under layers (coverageAbove > 0) the interface is relative to the layers
 // above, read as a dielectric of F0 0.04 (SUBSTRATE_COAT_SQRT_F0): a slab's F0
@@ -105,7 +164,8 @@ float3 substrate_f90_effective(float3 f0, float3 f90) {
 // (substrate_closure_coat_diffuse) the clear coat control read +4.5 .. +7.3 %
 // over the truth and a white Lambertian under a clear coat of the same IOR
 // returned up to 1.003 of the light head-on.
-void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mfloat3 f90, out float share) {
+void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mfloat3 f90,
+                                    out SubstrateFresnelCurve curve) {
   float3 f0f = saturate(c.f0);
   float3 f90f = SUBSTRATE_SPLAT3(1.0);
 #if SUBSTRATE_USE_F90
@@ -114,7 +174,12 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   }
 #endif
   float f = substrate_max3(f0f);
+  float conductor = max(substrate_max3(saturate(c.diffuseAlbedo)), substrate_max3(c.sssMfp)) > 0.0 ? 0.0 : 1.0;
+#if SUBSTRATE_USE_METALNESS_MIX
+  conductor = max(conductor, substrate_mix_share(f));
+#endif
 #if SUBSTRATE_USE_LAYERS
+  conductor *= 1.0 - saturate(c.coverageAbove);
   // No branch: at coverageAbove 0 the scale is exactly 1. In float: one
   // conversion per end in half precision.
   float s = sqrt(f);
@@ -126,7 +191,7 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   f90f *= scale;
   f *= scale;
 #endif
-  share = substrate_fresnel_share(f);
+  curve = substrate_fresnel_curve(f0f, substrate_fresnel_share(f), conductor);
   f0 = SUBSTRATE_M3(f0f);
   f90 = SUBSTRATE_M3(f90f);
 }
@@ -464,13 +529,20 @@ float3 substrate_cover_given_view(float cover, float3 viewCrossing) {
   return seen / max(SUBSTRATE_SPLAT3(1.0 - cover) + seen, SUBSTRATE_SPLAT3(1e-30));
 }
 
-// The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH),
-// w = t + share D(t) (chi for a dielectric, Schlick's t for a conductor; the
-// weight from the half vector in float, the blend of the colours in mfloat).
-mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float share, float VoH) {
+// The Fresnel of an interface with an F90: F0 + (F90 - F0) w(VoH), w the
+// curve (substrate_fresnel_curve: chi for a dielectric, each channel's own for
+// a conductor; the weight from the half vector in float, the blend of the
+// colours in mfloat).
+mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve k, float VoH) {
   float t = substrate_pow5(1.0 - VoH);
-  float w = t + share * substrate_fresnel_delta(t);
+#if SUBSTRATE_USE_CONDUCTOR_CURVE
+  float s = sqrt(t);
+  float3 w = t + ((1.0 - t) * s) * (k.a + k.b * s);
+  return f0 + (f90 - f0) * SUBSTRATE_M3(w);
+#else
+  float w = t + k.share * substrate_fresnel_delta(t);
   return f0 + (f90 - f0) * SUBSTRATE_M(w);
+#endif
 }
 
 // An upper bound of the part of a lobe's albedo weighted by the Fresnel curve
@@ -486,13 +558,21 @@ mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, float share, float VoH) {
 // way); a stretched lobe, whose B_max and E_max (substrate_energy_aniso) the
 // fit does not cover, takes pull = 1: e (t + max(D(t), 0)). `share` is the
 // curve's (substrate_fresnel_share): e (t + share (D - pull min(D, 0))).
-// Returns it at `share` (x) and at share 1 (y: a closure's dielectric part,
-// substrate_dielectric_albedo), from one evaluation of the curve.
-float2 substrate_fresnel_b(float2 dfg, float e, float pull, float share) {
+// A conductor's curve (substrate_fresnel_curve) takes the same bound with
+// its own D per channel. Returns it per channel for the curve k (xyz) and for
+// chi (w: a closure's dielectric part, substrate_dielectric_albedo).
+float4 substrate_fresnel_b(float2 dfg, float e, float pull, SubstrateFresnelCurve k) {
   float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
   float d = substrate_fresnel_delta(t);
   float x = d - pull * min(d, 0.0);
-  return e * float2(t + share * x, t + x);
+#if SUBSTRATE_USE_CONDUCTOR_CURVE
+  float s = sqrt(t);
+  float3 dk = ((1.0 - t) * s) * (k.a + k.b * s);
+  float3 xk = dk - pull * min(dk, SUBSTRATE_SPLAT3(0.0));
+  return e * float4(t + xk, t + x);
+#else
+  return e * float4(SUBSTRATE_SPLAT3(t + k.share * x), t + x);
+#endif
 }
 
 // k(r) of substrate_fresnel_b: 0.43 below roughness 0.45, 0 from there (the
@@ -508,7 +588,7 @@ float substrate_fresnel_pull(float roughness) {
 // chi-weighted part; with Schlick's curve the pair's E - B bounded it).
 // In float (one conversion back): in half precision the clamp of the colour
 // difference cost lavapipe 25 % more executed instructions on row12_simple.
-mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
+mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float3 b) {
   float3 f0f = SUBSTRATE_F3(f0);
   return SUBSTRATE_M3(f0f * e + max(SUBSTRATE_F3(f90) - f0f, SUBSTRATE_SPLAT3(0.0)) * b);
 }
@@ -518,12 +598,6 @@ mfloat3 substrate_fresnel_albedo(mfloat3 f0, mfloat3 f90, float e, float b) {
 // at share 1): (d.x e + max(d.y - d.x, 0) b) (1 + d.x (1 - e) / e). Scalar.
 float substrate_dielectric_albedo(float2 d, float e, float b) {
   return saturate((d.x * e + max(d.y - d.x, 0.0) * b) * (1.0 + d.x * ((1.0 - e) / e)));
-}
-
-// How much of a closure of largest F0 f0max is read as a metalness mix (0 up
-// to SUBSTRATE_MIX_START, 1 from 0.25; substrate_closure_dielectric_part).
-float substrate_mix_share(float f0max) {
-  return saturate((f0max - SUBSTRATE_MIX_START) * SUBSTRATE_MIX_BLEND);
 }
 
 // The Fresnel ends (F0, F90) of the interface a closure's diffuse lies under:
@@ -615,15 +689,15 @@ float substrate_closure_dielectric_ms(SubstrateClosure c) {
 // energy: W E <= 1 and E_spec is never below the compensated lobe's true
 // albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
 // (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float msRate,
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd, mfloat3 f0w, float msRate,
                                   float NoV, float roughness, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float ms = msRate * roughness;
-  mfloat3 w = (SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e)) * SUBSTRATE_M(1.0 + share * ms);
-  float2 b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), share);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
-  dielectric = saturate(substrate_dielectric_albedo(fd, e, b.y) * (1.0 + ms));
+  mfloat3 w = (SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e)) * SUBSTRATE_M(1.0 + curve.share * ms);
+  float4 b = substrate_fresnel_b(dfg, e, substrate_fresnel_pull(roughness), curve);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.xyz) * w);
+  dielectric = saturate(substrate_dielectric_albedo(fd, e, b.w) * (1.0 + ms));
   return w;
 }
 
@@ -640,7 +714,7 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, float share, float2 f
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, float2 fd, mfloat3 f0w, float msRate,
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd, mfloat3 f0w, float msRate,
                                         float NoV, float roughness, float anisotropy, out mfloat3 albedo,
                                         out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
@@ -656,10 +730,10 @@ mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, float share, fl
   }
 #endif
   float ms = msRate * roughness;
-  mfloat3 w = (SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e)) * SUBSTRATE_M(1.0 + share * ms);
-  float2 b = substrate_fresnel_b(dfg, e, pull, share);
-  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.x) * w);
-  dielectric = saturate(substrate_dielectric_albedo(fd, e, b.y) * (1.0 + ms));
+  mfloat3 w = (SUBSTRATE_MSPLAT3(1.0) + f0w * SUBSTRATE_M((1.0 - e) / e)) * SUBSTRATE_M(1.0 + curve.share * ms);
+  float4 b = substrate_fresnel_b(dfg, e, pull, curve);
+  albedo = msaturate(substrate_fresnel_albedo(f0, f90, e, b.xyz) * w);
+  dielectric = saturate(substrate_dielectric_albedo(fd, e, b.w) * (1.0 + ms));
   return w;
 }
 
@@ -1414,8 +1488,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
 
   mfloat3 f0;
   mfloat3 f90;
-  float share;
-  substrate_closure_fresnel_ends(c, f0, f90, share);
+  SubstrateFresnelCurve curve;
+  substrate_closure_fresnel_ends(c, f0, f90, curve);
   float roughness = saturate(c.roughness);
 
   float anisotropy = 0.0;
@@ -1432,7 +1506,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   mfloat3 specAlbedo;
   float dielectric;
   mfloat3 w1 =
-      substrate_specular_energy_aniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo,
+      substrate_specular_energy_aniso(f0, f90, curve, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo,
                                       dielectric);
   float hazeWeight = 0.0;
   float hazeRoughness = roughness;
@@ -1446,7 +1520,7 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
   if (hazeWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    w2 = substrate_specular_energy_aniso(f0, f90, share, fd, f0w, msRate, NoV, hazeRoughness, anisotropy, specAlbedo2,
+    w2 = substrate_specular_energy_aniso(f0, f90, curve, fd, f0w, msRate, NoV, hazeRoughness, anisotropy, specAlbedo2,
                                          dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(hazeWeight));
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
@@ -1489,8 +1563,8 @@ float3 substrate_eval_closure(SubstrateClosure c, float3 V, float3 L) {
       lobe = lerp(lobe, SUBSTRATE_F3(w2) * (d2 * vis2 * NoLc), hazeWeight);
     }
     // Under layers: what their top sends back down instead of out.
-    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, share, VoH)) * lobe *
-           substrate_closure_coat_specular(c, f0, f90, fd, share, NoV, NoLc,
+    spec = SUBSTRATE_F3(substrate_fresnel(f0, f90, curve, VoH)) * lobe *
+           substrate_closure_coat_specular(c, f0, f90, fd, curve.share, NoV, NoLc,
                                            lerp(roughness, hazeRoughness, hazeWeight));
 #if SUBSTRATE_USE_GLINT
     if ((c.features & SUBSTRATE_FEATURE_GLINT) != 0u) {

@@ -143,6 +143,13 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_COAT_CONDUCTOR
 #define SUBSTRATE_USE_COAT_CONDUCTOR 1
 #endif
+// 1: some closure may read as a conductor (its largest F0 above 0.1), whose
+// Fresnel follows a curve of its own per channel (substrate_fresnel_curve):
+// the compiler clears it when every slab's F0 is a constant dielectric one,
+// whose curve is chi, the same for every channel (one scalar per light).
+#ifndef SUBSTRATE_USE_CONDUCTOR_CURVE
+#define SUBSTRATE_USE_CONDUCTOR_CURVE 1
+#endif
 // 1: some closure may lie under an isotropic rough top's floor
 // (SubstrateClosure.coatFloor, substrate_coat_floor): the compiler clears it
 // when no closure of the material gets one (several closures on top, a

@@ -128,6 +128,26 @@
 #define SUBSTRATE_FRESNEL_CURVE_A 0.18317
 #define SUBSTRATE_FRESNEL_CURVE_B -0.39315
 #define SUBSTRATE_FRESNEL_ROUGH_K 0.43
+// A conductor's curve (issue 19, step 23; substrate_fresnel_curve): the same
+// form t + (1 - t) s (a + b s), per channel, with a and b cubics in
+// x = sqrt(max(F0, MIN_F0)), a = A0 + x (A1 + x (A2 + x A3)), b likewise: the
+// ground truth's conductor (Gulbrandsen 2014 with the edge tint
+// 1 - (1 - F0)^2.75, F90 1) within 0.0063 in reflectance from F0 0.02 to
+// 0.95 (Schlick's curve, which conductors kept before: 0.040 at F0 0.12, 0.016
+// at 0.5). Least squares on the reflectance over 99 F0 and 801 cosines,
+// scripts/fit_conductor_fresnel.py. Below MIN_F0 a channel takes the curve of
+// MIN_F0 (the cubic's A0 < 0 would take it below 0 near F0 0); a is taken at
+// least 0 (it falls to -0.03 above F0 0.7, where D would turn convex in t and
+// substrate_fresnel_b no longer bound the lobe's albedo from above).
+#define SUBSTRATE_CONDUCTOR_CURVE_A0 -0.31556
+#define SUBSTRATE_CONDUCTOR_CURVE_A1 3.84345
+#define SUBSTRATE_CONDUCTOR_CURVE_A2 -7.09867
+#define SUBSTRATE_CONDUCTOR_CURVE_A3 3.54592
+#define SUBSTRATE_CONDUCTOR_CURVE_B0 -0.31076
+#define SUBSTRATE_CONDUCTOR_CURVE_B1 -0.09557
+#define SUBSTRATE_CONDUCTOR_CURVE_B2 -1.85667
+#define SUBSTRATE_CONDUCTOR_CURVE_B3 2.91601
+#define SUBSTRATE_CONDUCTOR_CURVE_MIN_F0 0.02
 #define SUBSTRATE_FRESNEL_ROUGH_END 0.45
 // substrate_closure_coat_diffuse's terms, for k = extraInterfaces 0..3:
 //   G_k: 2 int mu g(mu)^(1 + k) dmu, the cosine-weighted mean of the lighting's

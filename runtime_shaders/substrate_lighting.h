@@ -81,21 +81,21 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
 // What a closure's interface reflects at cosine NoV (its directional albedo,
 // E_spec = (F0 (E - B) + F90 B) W): the primary lobe's, lerped toward the haze
 // lobe's by the haze weight, from the closure's Fresnel ends f0, f90 and the
-// curve's share (substrate_closure_fresnel_ends). The environment and the translucency both
+// curve between them (substrate_closure_fresnel_ends). The environment and the translucency both
 // remove it from what reaches the diffuse or passes through. `dielectric`: the
 // same for the closure's dielectric part of ends fd (substrate_closure_dielectric_part,
 // for substrate_diffuse_transmission).
-mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, float share, float2 fd,
+mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd,
                                              float NoV, out float dielectric) {
   mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
   mfloat3 specAlbedo;
   float msRate = substrate_closure_dielectric_ms(c);
-  substrate_specular_energy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.roughness), specAlbedo, dielectric);
+  substrate_specular_energy(f0, f90, curve, fd, f0w, msRate, NoV, saturate(c.roughness), specAlbedo, dielectric);
 #if SUBSTRATE_USE_HAZE
   if ((c.features & SUBSTRATE_FEATURE_HAZE) != 0u && c.secondRoughnessWeight > 0.0) {
     mfloat3 specAlbedo2;
     float dielectric2;
-    substrate_specular_energy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.secondRoughness), specAlbedo2,
+    substrate_specular_energy(f0, f90, curve, fd, f0w, msRate, NoV, saturate(c.secondRoughness), specAlbedo2,
                               dielectric2);
     specAlbedo = mlerp(specAlbedo, specAlbedo2, SUBSTRATE_M(saturate(c.secondRoughnessWeight)));
     dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
@@ -108,10 +108,10 @@ mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfl
 mfloat3 substrate_closure_specular_albedo(SubstrateClosure c, float NoV) {
   mfloat3 f0;
   mfloat3 f90;
-  float share;
-  substrate_closure_fresnel_ends(c, f0, f90, share);
+  SubstrateFresnelCurve curve;
+  substrate_closure_fresnel_ends(c, f0, f90, curve);
   float dielectric;
-  return substrate_closure_specular_albedo_of(c, f0, f90, share, SUBSTRATE_SPLAT2(1.0), NoV, dielectric);
+  return substrate_closure_specular_albedo_of(c, f0, f90, curve, SUBSTRATE_SPLAT2(1.0), NoV, dielectric);
 }
 
 // ---------------------------------------------------------------------------
@@ -205,16 +205,16 @@ float3 substrate_env_split_sum(SubstrateClosure c, float3 V, float3 prefilteredR
   float NoV = clamp(NoVraw, SUBSTRATE_MIN_COS, 1.0);
   mfloat3 f0;
   mfloat3 f90;
-  float share;
-  substrate_closure_fresnel_ends(c, f0, f90, share);
+  SubstrateFresnelCurve curve;
+  substrate_closure_fresnel_ends(c, f0, f90, curve);
   float2 fd = substrate_closure_dielectric_part(c, f0, f90);
   float dielectric;
-  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, share, fd, NoV, dielectric);
+  mfloat3 specAlbedo = substrate_closure_specular_albedo_of(c, f0, f90, curve, fd, NoV, dielectric);
   // Radiance (HDR) is float; the weights that multiply it are mfloat. Under
   // layers: what their top sends back down (the light from the mirror
   // direction, at NoV).
   float3 spec = SUBSTRATE_F3(specAlbedo) *
-                substrate_closure_coat_specular(c, f0, f90, fd, share, NoV, NoV, substrate_env_roughness(c)) *
+                substrate_closure_coat_specular(c, f0, f90, fd, curve.share, NoV, NoV, substrate_env_roughness(c)) *
                 max(prefilteredRadiance, SUBSTRATE_SPLAT3(0.0));
 #if SUBSTRATE_USE_SPECULAR_PROFILE
   if ((c.features & SUBSTRATE_FEATURE_SPECULAR_PROFILE) != 0u && c.specularProfile > 0u) {

@@ -7,6 +7,7 @@
 #include <mutex>
 #include <random>
 
+#include "emit/material_emitter.h"
 #include "gpu/block_layout.h"
 #include "validate/runtime_files.h"
 
@@ -119,6 +120,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.isTop = c.isTop;
   o.coversLayers = c.coversLayers;
   o.metalnessMix = c.metalnessMix;
+  o.conductorCurve = c.conductorCurve;
   return o;
 }
 
@@ -201,7 +203,7 @@ template Shaded<float> lightClosures<float>(const std::vector<reference::Closure
 template Shaded<double> lightClosures<double>(const std::vector<reference::Closure<double>>&, const Sample&, int);
 
 reference::Closure<double> closureFromResults(const std::vector<float>& results, int stride, int i, int k,
-                                              bool metalnessMix) {
+                                              const CompileResult& r) {
   const float* p = &results[static_cast<std::size_t>(i) * stride + kResultHeaderFloats + kClosureFloats * k];
   auto v3 = [&](int at) { return std::array<double, 3>{p[at], p[at + 1], p[at + 2]}; };
   reference::Closure<double> c;
@@ -245,7 +247,8 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
     c.irisPlaneN = v3(kClosureIrisPlaneN);
     c.iris = {p[kClosureIris], p[kClosureIris + 1]};
   }
-  c.metalnessMix = metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
+  c.metalnessMix = r.material.metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
+  c.conductorCurve = usesConductorCurve(r.material, r.after);  // and its SUBSTRATE_USE_CONDUCTOR_CURVE
   return c;
 }
 

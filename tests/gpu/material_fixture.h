@@ -60,10 +60,11 @@ std::array<double, 3> glintSpread(const Shaded<double>& shaded, const Sample& s,
 template <class T>
 Shaded<T> lightClosures(const std::vector<reference::Closure<double>>& closures, const Sample& s, int diffuseModel);
 
-/// Closure `k` of sample `i` as the kernel wrote it (metalnessMix: the kernel's
-/// SUBSTRATE_USE_METALNESS_MIX, Material::metalnessMix, which the results do not hold).
+/// Closure `k` of sample `i` as the kernel of `r` wrote it, with the kernel's
+/// switches the results do not hold: SUBSTRATE_USE_METALNESS_MIX
+/// (Material::metalnessMix) and SUBSTRATE_USE_CONDUCTOR_CURVE (usesConductorCurve).
 reference::Closure<double> closureFromResults(const std::vector<float>& results, int stride, int i, int k,
-                                              bool metalnessMix);
+                                              const CompileResult& r);
 
 /// The GPU tests' comparison rule: |gpu − ref64| ≤ k·|ref32 − ref64| + abs + rel·|ref64|.
 struct Tolerance {

@@ -400,9 +400,9 @@ void MaterialOnGpu::deferredAgreesWithForwardWithinTheStorageBounds() {
           int kf = k;  // the forward closure stored as closure k: the one left, when simple here
           if (simpleHere)
             for (int j = 0; j < n; ++j)
-              if (closureFromResults(forward[set], stride, i, j, r_->material.metalnessMix).weight > 0) kf = j;
-          const auto f = closureFromResults(forward[set], stride, i, kf, r_->material.metalnessMix);
-          const auto d = closureFromResults(deferred[set], stride, i, k, r_->material.metalnessMix);
+              if (closureFromResults(forward[set], stride, i, j, *r_).weight > 0) kf = j;
+          const auto f = closureFromResults(forward[set], stride, i, kf, *r_);
+          const auto d = closureFromResults(deferred[set], stride, i, k, *r_);
           unpacked.push_back(d);
           const std::set<std::string>& stored = simpleHere ? simpleFields : storedStatically;
           const std::string pre = fmt::format("closure{}.", k);

@@ -294,8 +294,8 @@ TEST_F(SceneOnGpu, AMaterialWhoseInputsMakeItSimpleIsStoredSimpleAndLightsTheSam
           continue;
         }
         const int k = left[0];
-        const auto s = closureFromResults(on, stride, static_cast<int>(i), 0, r.material.metalnessMix);
-        const auto full = closureFromResults(off, stride, static_cast<int>(i), k, r.material.metalnessMix);
+        const auto s = closureFromResults(on, stride, static_cast<int>(i), 0, r);
+        const auto full = closureFromResults(off, stride, static_cast<int>(i), k, r);
         // The same codes for the three fields the SIMPLE layout stores...
         if (s.diffuseAlbedo != full.diffuseAlbedo || s.f0 != full.f0 || s.roughness != full.roughness)
           fail(fmt::format("sample {}: albedo, F0 or roughness differ from the static layout's", i));

@@ -447,7 +447,7 @@ TEST(LayeringEnergy, RandomStacksNeverGainEnergyInTheGeneratedShaders) {
         std::vector<reference::Closure<double>> gpuClosures;
         for (int q = 0; q < depth; ++q)
           gpuClosures.push_back(
-              gputest::closureFromResults(out, stride, static_cast<int>(i), q, r.material.metalnessMix));
+              gputest::closureFromResults(out, stride, static_cast<int>(i), q, r));
         closures += depth;
         const auto seed = static_cast<std::uint32_t>(101 + views++);
         const double a = furnace(gpuClosures, samples[i].geometry.V, seed);
@@ -532,8 +532,8 @@ TEST(LayeringEnergy, StacksLightTheSameForwardDeferredAndOnTheCpu) {
         std::vector<reference::Closure<double>> unpacked;
         const int count = static_cast<int>(def[kernel::kResultCount]);
         for (int k = 0; k < count; ++k) {
-          const auto f = gputest::closureFromResults(out[0], stride, static_cast<int>(i), k, r.material.metalnessMix);
-          const auto d = gputest::closureFromResults(out[1], stride, static_cast<int>(i), k, r.material.metalnessMix);
+          const auto f = gputest::closureFromResults(out[0], stride, static_cast<int>(i), k, r);
+          const auto d = gputest::closureFromResults(out[1], stride, static_cast<int>(i), k, r);
           const std::uint32_t want = ref.material.closures[static_cast<std::size_t>(k)].extraInterfaces;
           EXPECT_EQ(f.extraInterfaces, want) << "forward closure " << k;
           if (count == depth) EXPECT_EQ(d.extraInterfaces, want) << "deferred closure " << k;  // not dynamically simple

@@ -13,6 +13,11 @@
 #include <string>
 #include <string_view>
 
+#include "diag/diagnostics.h"
+#include "emit/material_emitter.h"
+#include "emit/syntax.h"
+#include "pipeline/pipeline.h"
+#include "test_util.h"
 #include "validate/runtime_files.h"
 #include "validate/shader_validate.h"
 
@@ -91,7 +96,7 @@ constexpr const char* kUseSwitches[] = {"SUBSTRATE_USE_F90",   "SUBSTRATE_USE_AN
                                         "SUBSTRATE_USE_FUZZ",  "SUBSTRATE_USE_SSS",        "SUBSTRATE_USE_GLINT",
                                         "SUBSTRATE_USE_SPECULAR_PROFILE", "SUBSTRATE_USE_EMISSIVE",
                                         "SUBSTRATE_USE_EXTRA_INTERFACES", "SUBSTRATE_USE_WRAP_UNDER_LAYERS",
-                                        "SUBSTRATE_USE_FUZZ_UNDER_LAYERS"};
+                                        "SUBSTRATE_USE_FUZZ_UNDER_LAYERS", "SUBSTRATE_USE_CONDUCTOR_CURVE"};
 
 struct Config {
   ShaderLanguage language;
@@ -183,6 +188,36 @@ TEST(RuntimeShaders, TablesInAUniformBufferAreNotConstants) {
   ASSERT_TRUE(buffer.ok && inlined.ok) << buffer.log << inlined.log;
   EXPECT_LT(countOpcode(buffer.spirv, kOpConstant), 500u);
   EXPECT_GT(countOpcode(inlined.spirv, kOpConstant), 2000u);
+}
+
+TEST(RuntimeShaders, AMaterialPaysForTheConductorCurveOnlyWhereASlabMayBeAConductor) {
+  // Issue 19, step 23: a conductor's Fresnel follows a curve per channel
+  // (substrate_fresnel_curve), three coefficients per light where a
+  // dielectric's chi is one. The material compiles it (SUBSTRATE_USE_CONDUCTOR_CURVE
+  // 1) only when some slab may be what the truth walks as a conductor: its F0
+  // not a constant of a dielectric (every channel at most 0.1), no medium, and
+  // no constant diffuse above 0 (a high-IOR dielectric over a diffuse there).
+  const auto define = [](const std::string& nodes, const std::string& inputs) {
+    Diagnostics d("m.json");
+    auto r = compileText("m.json", test::material(nodes, inputs), {}, d);
+    EXPECT_TRUE(r.has_value()) << d.formatAll();
+    if (!r) return std::string();
+    const std::string glsl = emitMaterial(r->material, r->tree, r->after, syntaxFor(Target::Glsl), {});
+    const std::size_t at = glsl.find("#define SUBSTRATE_USE_CONDUCTOR_CURVE ");
+    return at == std::string::npos ? std::string("none") : glsl.substr(at + 38, 1);
+  };
+  const auto slab = [](const std::string& albedo, const std::string& f0) {
+    return R"("root": {"kind": "slab", "roughness": 0.4, "diffuse_albedo": )" + albedo + R"(, "f0": )" + f0 + "}";
+  };
+  const std::string input = R"({"x": {"type": "float", "default": 0.04, "min": 0, "max": 1}})";
+  EXPECT_EQ(define(slab("0.5", "0.04"), "{}"), "0");
+  EXPECT_EQ(define(slab("0", "[0.1, 0.05, 0.02]"), "{}"), "0");
+  EXPECT_EQ(define(slab("0", "0.12"), "{}"), "1");
+  EXPECT_EQ(define(slab("0", "[0.9, 0.6, 0.3]"), "{}"), "1");
+  EXPECT_EQ(define(slab("0.5", "0.9"), "{}"), "0");
+  EXPECT_EQ(define(R"("root": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.9, "sss_mfp": 0.01})", "{}"), "0");
+  EXPECT_EQ(define(slab("0", R"("$x")"), input), "1");
+  EXPECT_EQ(define(slab(R"("$x")", "0.9"), input), "1");
 }
 
 }  // namespace

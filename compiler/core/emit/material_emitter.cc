@@ -54,25 +54,56 @@ std::string extraInterfacesDefine(const StorageLayout& layout) {
                      layered ? 1 : 0);
 }
 
+/// Whether slab `slab` may read as a conductor in the runtime: its F0 is not
+/// a constant whose largest channel is at most SUBSTRATE_COAT_DIELECTRIC_F0
+/// (where substrate_fresnel_share is exactly 1).
+bool mayReadAsConductor(const Material& m, int slab) {
+  const ValueId f0 = m.slabs[slab].pin(SlabPin::F0);
+  if (f0 == kNoValue || !m.values.isConst(f0)) return true;
+  const auto& k = m.values.node(f0).c;
+  const int channels = m.values.node(f0).type == VType::Float ? 1 : 3;
+  for (int i = 0; i < channels; ++i)
+    if (!(k[i] <= SUBSTRATE_COAT_DIELECTRIC_F0)) return true;
+  return false;
+}
+
+/// Whether slab `slab` may be what the ground truth walks as a conductor,
+/// whose Fresnel curve the runtime follows (substrate_closure_fresnel_ends):
+/// it may read as one, has no medium (a transmitting slab is a dielectric
+/// there) and its diffuse albedo is not a constant above 0, unless it is a
+/// metalness mix.
+bool mayWalkAsConductor(const Material& m, int slab) {
+  const Slab& s = m.slabs[slab];
+  if (!mayReadAsConductor(m, slab) || (s.features & (kFeatMedium | kFeatSss))) return false;
+  if (s.metalness) return true;
+  const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);
+  if (albedo == kNoValue || !m.values.isConst(albedo)) return true;
+  const auto& k = m.values.node(albedo).c;
+  const int channels = m.values.node(albedo).type == VType::Float ? 1 : 3;
+  for (int i = 0; i < channels; ++i)
+    if (k[i] > 0) return false;
+  return true;
+}
+
+bool usesConductorCurve(const Material& m, const StorageLayout& layout) {
+  for (const ClosureLayout& c : layout.closures)
+    if (c.slab < 0 || mayWalkAsConductor(m, c.slab)) return true;
+  return false;
+}
+
 /// SUBSTRATE_USE_COAT_CONDUCTOR: 1 when some closure under a layer may read
-/// as a conductor (its F0 not a constant whose largest channel is at most
-/// SUBSTRATE_COAT_DIELECTRIC_F0, the share of the dielectric curve below 1):
-/// substrate_closure_coat_specular returns exactly 1 for the others, so a
-/// material whose closures under layers are all dielectrics compiles none of it.
-std::string coatConductorDefine(const Material& m, const StorageLayout& layout) {
-  bool any = false;
-  for (const ClosureLayout& c : layout.closures) {
-    if (c.isTop || c.slab < 0) continue;
-    const ValueId f0 = m.slabs[c.slab].pin(SlabPin::F0);
-    if (f0 == kNoValue || !m.values.isConst(f0)) {
-      any = true;
-      continue;
-    }
-    const auto& k = m.values.node(f0).c;
-    const int channels = m.values.node(f0).type == VType::Float ? 1 : 3;
-    for (int i = 0; i < channels; ++i) any = any || !(k[i] <= SUBSTRATE_COAT_DIELECTRIC_F0);
-  }
-  return fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n", any ? 1 : 0);
+/// as a conductor (mayReadAsConductor): substrate_closure_coat_specular
+/// returns exactly 1 for the others, so a material whose closures under
+/// layers are all dielectrics compiles none of it.
+/// SUBSTRATE_USE_CONDUCTOR_CURVE: usesConductorCurve; the others' Fresnel
+/// curve is chi or Schlick's, the same in every channel, one scalar per
+/// light (substrate_fresnel).
+std::string conductorDefines(const Material& m, const StorageLayout& layout) {
+  bool underLayers = false;
+  for (const ClosureLayout& c : layout.closures)
+    underLayers = underLayers || (c.slab >= 0 && !c.isTop && mayReadAsConductor(m, c.slab));
+  return fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n#define SUBSTRATE_USE_CONDUCTOR_CURVE {}\n",
+                     underLayers ? 1 : 0, usesConductorCurve(m, layout) ? 1 : 0);
 }
 
 /// SUBSTRATE_USE_WRAP_UNDER_LAYERS and SUBSTRATE_USE_FUZZ_UNDER_LAYERS: 1 when
@@ -967,7 +998,7 @@ std::string Emitter::run() {
   line("// What this material uses: the runtime compiles nothing else.");
   out_ += useDefines(all);
   out_ += extraInterfacesDefine(L_);
-  out_ += coatConductorDefine(m_, L_);
+  out_ += conductorDefines(m_, L_);
   out_ += coatFloorDefine(m_, L_);
   out_ += underLayersDefines(m_, L_);
   line(fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}", m_.metalnessMix ? 1 : 0));

@@ -56,6 +56,13 @@ std::string useDefines(std::uint16_t features);
 /// `#define SUBSTRATE_USE_LAYERS 0|1`: 1 when a closure lies under a layer
 /// (not ClosureLayout::isTop), so the lighting compiles the layers' part.
 std::string extraInterfacesDefine(const StorageLayout& layout);
+/// SUBSTRATE_USE_CONDUCTOR_CURVE of the material `m` laid out as `layout`
+/// (issue 19, step 23): some closure may be what the ground truth walks as a
+/// conductor (its F0 not a constant of at most 0.1 in every channel, no
+/// medium, no constant diffuse above 0 unless a metalness mix; a closure
+/// without a slab counts as one), whose Fresnel follows a curve per channel
+/// (substrate_fresnel_curve). The CPU reference reads it too (Closure::conductorCurve).
+bool usesConductorCurve(const Material& m, const StorageLayout& layout);
 
 /// The pixel's top-layer roughness as the top-layer word stores it (docs/storage.md)
 /// and the lighting reads it for the layers above a closure

@@ -117,19 +117,56 @@ T fresnelShare(T f0max) {
   return T(1) - saturate((f0max - T(SUBSTRATE_COAT_DIELECTRIC_F0)) * T(SUBSTRATE_COAT_CONDUCTOR_BLEND));
 }
 
-// substrate_fresnel: F0 + (F90 - F0) (t + share D(t)), t = pow5(1 - VoH).
+// substrate_fresnel_curve: per channel, x = sqrt(max(F0, MIN_F0)), the conductor's
+// cubics max(a(x), 0), b(x) (SUBSTRATE_CONDUCTOR_CURVE_*) times `conductor` (toward Schlick's
+// (0, 0)), lerped toward chi's (A, B) by the share.
 template <class T>
-V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH) {
-  const T t = pow5(T(1) - VoH);
-  return f0 + (f90 - f0) * (t + share * fresnelDelta(t));
+FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor) {
+  FresnelCurve<T> k{share, {}, {}};
+  for (int i = 0; i < 3; ++i) {
+    const T x = std::sqrt(std::max(f0[i], T(SUBSTRATE_CONDUCTOR_CURVE_MIN_F0)));
+    const T a = std::max(T(SUBSTRATE_CONDUCTOR_CURVE_A0) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_A1) +
+                                                                x * (T(SUBSTRATE_CONDUCTOR_CURVE_A2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_A3))),
+                         T(0));
+    const T b = T(SUBSTRATE_CONDUCTOR_CURVE_B0) +
+                x * (T(SUBSTRATE_CONDUCTOR_CURVE_B1) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_B2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_B3)));
+    k.a[i] = lerp(a * conductor, T(SUBSTRATE_FRESNEL_CURVE_A), share);
+    k.b[i] = lerp(b * conductor, T(SUBSTRATE_FRESNEL_CURVE_B), share);
+  }
+  return k;
 }
 
-// substrate_fresnel_b: t = min(B / e, 1), d = D(t): e (t + share (d - pull min(d, 0))).
+// substrate_fresnel: F0 + (F90 - F0) w, w = t + (1 - t) s (a + b s) per channel,
+// t = pow5(1 - VoH), s = sqrt(t).
+template <class T>
+V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& k, T VoH) {
+  const T t = pow5(T(1) - VoH);
+  const T s = std::sqrt(t);
+  V3<T> w;
+  for (int i = 0; i < 3; ++i) w[i] = t + (T(1) - t) * s * (k.a[i] + k.b[i] * s);
+  return f0 + (f90 - f0) * w;
+}
+
+// substrate_fresnel_b, chi's part (w): t = min(B / e, 1), d = D(t): e (t + share (d - pull min(d, 0))).
 template <class T>
 T fresnelB(const V2<T>& dfg, T e, T pull, T share) {
   const T t = std::min(dfg[1] / e, T(1));
   const T d = fresnelDelta(t);
   return e * (t + share * (d - pull * std::min(d, T(0))));
+}
+
+// substrate_fresnel_b, the curve's part (xyz): the same with each channel's
+// d = (1 - t) s (a + b s), s = sqrt(t), and no share.
+template <class T>
+V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k) {
+  const T t = std::min(dfg[1] / e, T(1));
+  const T s = std::sqrt(t);
+  V3<T> out;
+  for (int i = 0; i < 3; ++i) {
+    const T d = (T(1) - t) * s * (k.a[i] + k.b[i] * s);
+    out[i] = e * (t + (d - pull * std::min(d, T(0))));
+  }
+  return out;
 }
 
 // substrate_fresnel_pull: 0.43 below roughness 0.45, else 0.
@@ -138,9 +175,9 @@ T fresnelPull(T roughness) {
   return roughness < T(SUBSTRATE_FRESNEL_ROUGH_END) ? T(SUBSTRATE_FRESNEL_ROUGH_K) : T(0);
 }
 
-// substrate_fresnel_albedo: F0 e + max(F90 - F0, 0) b.
+// substrate_fresnel_albedo: F0 e + max(F90 - F0, 0) b (b per channel).
 template <class T>
-V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b) {
+V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, const V3<T>& b) {
   return f0 * e + vmax(f90 - f0, splat3(T(0))) * b;
 }
 
@@ -161,11 +198,11 @@ T closureDielectricMs(const Closure<T>& c) {
 // A = min(|anisotropy|, 1): (e, B) -> (E_max, B_max)(NoV, r, A) (energyAniso),
 // B -> min(B_max, e), pull 1 (else fresnelPull(r));
 // W = (1 + F0w (1 - e) / e)(1 + share msRate r),
-// E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelB(dfg, e, pull, share)) W);
+// E_spec = sat(fresnelAlbedo(F0, F90, e, fresnelBCurve(dfg, e, pull, curve)) W);
 // the dielectric part's (ends fd) sat(dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)) (1 + msRate r)),
 // msRate = closureDielectricMs.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate,
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate,
                           T NoV, T roughness, T anisotropy, V3<T>& albedo, T& dielectric) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
@@ -178,17 +215,17 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T
     pull = T(1);
   }
   const T ms = msRate * roughness;
-  V3<T> w = (splat3(T(1)) + f0w * ((T(1) - e) / e)) * (T(1) + share * ms);
-  albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelB(dfg, e, pull, share)) * w);
+  V3<T> w = (splat3(T(1)) + f0w * ((T(1) - e) / e)) * (T(1) + curve.share * ms);
+  albedo = saturate(fresnelAlbedo(f0, f90, e, fresnelBCurve(dfg, e, pull, curve)) * w);
   dielectric = saturate(dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, T(1))) * (T(1) + ms));
   return w;
 }
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric) {
-  return specularEnergyAniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, T(0), albedo, dielectric);
+  return specularEnergyAniso(f0, f90, curve, fd, f0w, msRate, NoV, roughness, T(0), albedo, dielectric);
 }
 
 // substrate_diffuse_transmission: min(1 - min(E_spec, E_d), (1 - E_spec) / max(albedo, 1e-3)).
@@ -811,9 +848,10 @@ V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90) {
 // F0 and F90 scaled by the ratio of the largest channel's F0 relative to a dielectric of
 // F0 0.04 above, ((s - 0.2) / (1 - 0.2 s))^2, to itself: never above 1, only
 // in the dielectric range (back to 1 over F0 0.1 .. 0.2), lerped toward 1 by
-// coverageAbove.
+// coverageAbove. The curve: the conductor's own where the closure has no diffuse nor medium, or is a
+// metalness mix (mixShare), not under layers (times 1 - coverageAbove).
 template <class T>
-void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share) {
+void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, FresnelCurve<T>& curve) {
   f0 = saturate(c.f0);
   f90 = splat3(T(1));
   if (c.features & kFeatureF90) f90 = f90Effective(f0, saturate(c.f90));
@@ -827,7 +865,9 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share) {
   const T scale = lerp(T(1), rel / std::max(f, T(1e-4)), cover);
   f0 = f0 * scale;
   f90 = f90 * scale;
-  share = fresnelShare(f * scale);
+  T conductor = !c.conductorCurve || std::max(max3(saturate(c.diffuseAlbedo)), max3(c.sssMfp)) > T(0) ? T(0) : T(1);
+  if (c.metalnessMix) conductor = std::max(conductor, mixShare(f));
+  curve = fresnelCurve(f0, fresnelShare(f * scale), conductor * (T(1) - cover));
 }
 
 // substrate_closure_dielectric_part: lerp((max F0, max F90), (MIX_DIELECTRIC_F0, 1) relative
@@ -1015,8 +1055,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   T VoL = clampT(dot(V, L), T(-1), T(1));
 
   V3<T> f0, f90;
-  T share;
-  closureFresnelEnds(c, f0, f90, share);
+  FresnelCurve<T> curve;
+  closureFresnelEnds(c, f0, f90, curve);
   T roughness = saturate(c.roughness);
 
   T anisotropy = T(0);
@@ -1029,7 +1069,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   V3<T> specAlbedo;
   T dielectric;
   const T msRate = closureDielectricMs(c);
-  V3<T> w1 = specularEnergyAniso(f0, f90, share, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo, dielectric);
+  V3<T> w1 = specularEnergyAniso(f0, f90, curve, fd, f0w, msRate, NoV, roughness, anisotropy, specAlbedo, dielectric);
   T hazeWeight = T(0);
   T hazeRoughness = roughness;
   if (c.features & kFeatureHaze) {
@@ -1040,7 +1080,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   if (hazeWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    w2 = specularEnergyAniso(f0, f90, share, fd, f0w, msRate, NoV, hazeRoughness, anisotropy, specAlbedo2,
+    w2 = specularEnergyAniso(f0, f90, curve, fd, f0w, msRate, NoV, hazeRoughness, anisotropy, specAlbedo2,
                              dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, hazeWeight);
     dielectric = lerp(dielectric, dielectric2, hazeWeight);
@@ -1081,8 +1121,8 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
       lobe = lerp(lobe, w2 * (d2 * vis2 * NoLc), hazeWeight);
     }
     // Under layers: what the layers' top sends back down instead of out (a conductor's lobe).
-    spec = fresnel(f0, f90, share, VoH) * lobe *
-           closureCoatSpecular(c, f0, f90, fd, share, NoV, NoLc, lerp(roughness, hazeRoughness, hazeWeight));
+    spec = fresnel(f0, f90, curve, VoH) * lobe *
+           closureCoatSpecular(c, f0, f90, fd, curve.share, NoV, NoLc, lerp(roughness, hazeRoughness, hazeWeight));
     if (c.features & kFeatureGlint) spec = spec * glintFactor(c, d1, ToH, BoH, NoH);
     // Specular profile: SUBSTRATE_SPECULAR_PROFILE_SAMPLE's default tint is 1.
   }
@@ -1147,7 +1187,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
 #define SUBSTRATEC_INSTANTIATE(T)                                                                      \
   template V3<T> closureNormal<T>(const Closure<T>&);                                                  \
   template V3<T> fuzzDiffusePairMean<T>(const Closure<T>&, T, const V3<T>&);                          \
-  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, T&);                         \
+  template void closureFresnelEnds<T>(const Closure<T>&, V3<T>&, V3<T>&, FresnelCurve<T>&);                         \
   template V3<T> f90Effective<T>(const V3<T>&, const V3<T>&);                                          \
   template V3<T> closureCoatDiffuse<T>(const Closure<T>&, const V3<T>&, const V3<T>&, int);            \
   template V3<T> closureCoatSpecular<T>(const Closure<T>&, const V3<T>&, const V3<T>&, const V2<T>&, T, T, T, T); \
@@ -1177,13 +1217,15 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template void setCoversLayers<T>(std::vector<Closure<T>>&);                                         \
   template void setCoatInterface<T>(std::vector<Closure<T>>&);                                        \
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
+  template V3<T> fresnelBCurve<T>(const V2<T>&, T, T, const FresnelCurve<T>&);                          \
   template T fresnelShare<T>(T);                                                                       \
+  template FresnelCurve<T> fresnelCurve<T>(const V3<T>&, T, T);                                           \
   template T fresnelPull<T>(T);                                                                        \
-  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, T);                                  \
-  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, T, T);                                         \
+  template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, const V3<T>&);                       \
+  template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, T);                    \
   template T closureDielectricMs<T>(const Closure<T>&);                                                 \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, T, const V2<T>&, const V3<T>&, T, T, T, T, V3<T>&, \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, const V2<T>&, const V3<T>&, T, T, T, T, V3<T>&, \
                                         T&);                                                            \
   template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
   template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \

@@ -12,10 +12,18 @@ namespace substratec::reference {
 template <class T> V3<T> closureNormal(const Closure<T>& c);                                 // substrate_closure_normal
 template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>& Tn, V3<T>& Bn);  // substrate_closure_frame
 
+/// SubstrateFresnelCurve: the share of the dielectric curve chi (fresnelShare) and, per
+/// channel, the coefficients of w(t) = t + (1 - t) s (a + b s), s = sqrt(t).
+template <class T>
+struct FresnelCurve {
+  T share;
+  V3<T> a, b;
+};
+
 // Closures under layers (the layers above read as a dielectric of F0 0.04).
 /// substrate_closure_fresnel_ends: F0 and F90 (white without the F90 feature),
-/// relative to the layers above by coverageAbove, and the share of the dielectric curve (fresnelShare).
-template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, T& share);
+/// relative to the layers above by coverageAbove, and the curve between them (fresnelCurve).
+template <class T> void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, FresnelCurve<T>& curve);
 /// substrate_closure_coat_diffuse: lerp(D, P, C) / (D lerp(1, P, C)), P = (T_N G)^2, C = coverageAbove: what the diffuse gets back (1 / D under a full coverage).
 template <class T> V3<T> closureCoatDiffuse(const Closure<T>& c, const V3<T>& f0, const V3<T>& f90, int diffuseModel);
 /// substrate_closure_coat_specular: what a conductor's lobe under layers keeps, given back what their top
@@ -57,24 +65,27 @@ template <class T> T coatAnisoShare(const V2<T>& stretch);                      
 template <class T> T coatFloorAlong(const Closure<T>& c, T mu, const V3<T>& w);             // substrate_coat_floor_along
 template <class T> V3<T> coatMeanDirection(const Closure<T>& c, T mu);                      // substrate_coat_mean_direction
 template <class T> T coatInterface(const V3<T>& topF0);                                     // substrate_coat_interface
-template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b
+template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b (w)
+template <class T> V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k);  // substrate_fresnel_b (xyz)
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
+template <class T> FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor);     // substrate_fresnel_curve
 template <class T> V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90);                   // substrate_f90_effective
 template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull
 template <class T>
-V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, T b);                         // substrate_fresnel_albedo
-template <class T> V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, T share, T VoH);        // substrate_fresnel
+V3<T> fresnelAlbedo(const V3<T>& f0, const V3<T>& f90, T e, const V3<T>& b);             // substrate_fresnel_albedo
+template <class T>
+V3<T> fresnel(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& k, T VoH);          // substrate_fresnel
 /// substrate_closure_dielectric_ms: SUBSTRATE_DIELECTRIC_MS, 0 for a top over layers (coversLayers).
 template <class T> T closureDielectricMs(const Closure<T>& c);
-/// substrate_specular_energy: returns W = (1 + F0w (1 - E) / E)(1 + share msRate r); E_spec in
+/// substrate_specular_energy: returns W = (1 + F0w (1 - E) / E)(1 + curve.share msRate r); E_spec in
 /// `albedo`, and in `dielectric` the albedo of the closure's dielectric part (ends fd,
 /// closureDielectricPart), times 1 + msRate r.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, T share, const V2<T>& fd, const V3<T>& f0w, T msRate,
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate,
                           T NoV, T roughness, T anisotropy, V3<T>& albedo, T& dielectric);
 /// substrate_dielectric_albedo: the compensated albedo of a grey interface of ends d.
 template <class T> T dielectricAlbedo(const V2<T>& d, T e, T b);

@@ -37,17 +37,17 @@ T envRoughness(const Closure<T>& c) {
 template <class T>
 V3<T> specularAlbedo(const Closure<T>& c, T NoV, T& dielectric) {
   V3<T> f0, f90;
-  T share;
-  closureFresnelEnds(c, f0, f90, share);
+  FresnelCurve<T> curve;
+  closureFresnelEnds(c, f0, f90, curve);
   const V2<T> fd = closureDielectricPart(c, f0, f90);
   const V3<T> f0w = closureCompensatedF0(c, f0, fd);
   V3<T> specAlbedo;
   const T msRate = closureDielectricMs(c);
-  specularEnergy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.roughness), specAlbedo, dielectric);
+  specularEnergy(f0, f90, curve, fd, f0w, msRate, NoV, saturate(c.roughness), specAlbedo, dielectric);
   if ((c.features & kFeatureHaze) && c.secondRoughnessWeight > T(0)) {
     V3<T> specAlbedo2;
     T dielectric2;
-    specularEnergy(f0, f90, share, fd, f0w, msRate, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
+    specularEnergy(f0, f90, curve, fd, f0w, msRate, NoV, saturate(c.secondRoughness), specAlbedo2, dielectric2);
     specAlbedo = lerp(specAlbedo, specAlbedo2, saturate(c.secondRoughnessWeight));
     dielectric = lerp(dielectric, dielectric2, saturate(c.secondRoughnessWeight));
   }
@@ -129,14 +129,14 @@ V3<T> envSplitSum(const Closure<T>& c, const V3<T>& V, const V3<T>& prefilteredR
   if (!(NoVraw > -kNoVBias<T>)) return splat3(T(0));
   T NoV = clampT(NoVraw, K<T>::minCos, T(1));
   V3<T> f0, f90;
-  T share;
-  closureFresnelEnds(c, f0, f90, share);
+  FresnelCurve<T> curve;
+  closureFresnelEnds(c, f0, f90, curve);
   T dielectric;
   V3<T> specAlbedo = specularAlbedo(c, NoV, dielectric);
   const V2<T> fd = closureDielectricPart(c, f0, f90);
   // Under layers: what their top sends back down instead of out (substrate_closure_coat_specular;
   // the light comes from the mirror direction, at NoV).
-  V3<T> spec = specAlbedo * closureCoatSpecular(c, f0, f90, fd, share, NoV, NoV, envRoughness(c)) *
+  V3<T> spec = specAlbedo * closureCoatSpecular(c, f0, f90, fd, curve.share, NoV, NoV, envRoughness(c)) *
                vmax(prefilteredRadiance, splat3(T(0)));
   // Specular profile: the default tint is 1.
   V3<T> irr = vmax(irradiance, splat3(T(0))) * K<T>::invPi;

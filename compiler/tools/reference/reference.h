@@ -95,6 +95,10 @@ struct Closure {
   /// the deferred scene lighting always has it): false reads the diffuse under the whole
   /// interface (closureDielectricPart (1, 1)).
   bool metalnessMix = true;
+  /// SUBSTRATE_USE_CONDUCTOR_CURVE of the shader that lights it (usesConductorCurve; the
+  /// runtime's default, and the deferred scene lighting's, is 1): false keeps every
+  /// channel on chi or Schlick's curve (closureFresnelEnds).
+  bool conductorCurve = true;
 };
 
 /// One shading point, as SubstrateGeometry (world space; converted to T inside).

@@ -14,6 +14,7 @@
 #include <limits>
 #include <map>
 
+#include "emit/material_emitter.h"
 #include "ir/value_eval.h"
 #include "reference/bsdf.h"
 #include "reference/common.h"
@@ -153,7 +154,7 @@ class Walk {
  public:
   Walk(const CompileResult& r, const std::vector<std::array<double, 4>>& values, const Geometry& g)
       : m_(r.material), t_(r.tree), L_(r.after), vals_(values),
-        gN_(cast<T>(g.N)), gT_(cast<T>(g.T)), gV_(cast<T>(g.V)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
+        conductorCurve_(usesConductorCurve(r.material, r.after)), gN_(cast<T>(g.N)), gT_(cast<T>(g.T)), gV_(cast<T>(g.V)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
 
   MaterialResult<T> run() {
     const std::size_t n = m_.nodes.size();
@@ -324,6 +325,7 @@ class Walk {
     }
     c.features = bits;
     c.metalnessMix = m_.metalnessMix;  // the material's SUBSTRATE_USE_METALNESS_MIX
+    c.conductorCurve = conductorCurve_;  // and its SUBSTRATE_USE_CONDUCTOR_CURVE
     return c;
   }
 
@@ -412,6 +414,7 @@ class Walk {
     if (has(s.features, kFeatEmissive)) c.emissive = vec3(s.pin(SlabPin::Emissive));
     c.features = kFeatureHair;
     c.metalnessMix = m_.metalnessMix;
+    c.conductorCurve = conductorCurve_;
     return c;
   }
 
@@ -440,6 +443,7 @@ class Walk {
     if (has(s.features, kFeatSss)) sssPins(s, c);  // the sclera's subsurface scattering
     c.features = kFeatureEye;
     c.metalnessMix = m_.metalnessMix;
+    c.conductorCurve = conductorCurve_;
     return c;
   }
 
@@ -493,6 +497,7 @@ class Walk {
   const TreeInfo& t_;
   const StorageLayout& L_;
   const std::vector<std::array<double, 4>>& vals_;
+  bool conductorCurve_;  // the material's SUBSTRATE_USE_CONDUCTOR_CURVE
   V3<T> gN_, gT_, gV_;
   V4<T> uvDerivatives_;
   std::vector<T> C_;
