@@ -84,8 +84,9 @@ int main(int argc, char** argv) {
     for (double mu : {1.0, 0.8, 0.6, 0.4, 0.2, 0.1}) {
       V3<double> one{1, 1, 1}, specAlbedo;
       double dielectric = 0;
-      const double w = specularEnergyAniso<double>(one, one, fresnelCurve(one, fresnelShare(1.0), 1.0), V2<double>{1, 1}, one, 0.0, mu, r, A,
-                                                   specAlbedo, dielectric)[0];
+      const FresnelCurve<double> curve = fresnelCurve(one, fresnelShare(1.0), 1.0);
+      const double w =
+          specularEnergyAniso<double>(one, one, curve, V2<double>{1, 1}, one, 0.0, mu, r, A, specAlbedo, dielectric)[0];
       std::printf("NoV %.1f  1/W %.4f  E:", mu, 1 / w);
       for (int k = 0; k < 10; ++k) std::printf(" %.4f", albedo(mu, k * std::numbers::pi / 18, ax, ay, 256));
       std::printf("\n");
@@ -118,9 +119,9 @@ int main(int argc, char** argv) {
         }
         V3<double> one{1, 1, 1}, specAlbedo;
         double dielectric = 0;
-        const double w =
-            specularEnergyAniso<double>(one, one, fresnelCurve(one, fresnelShare(1.0), 1.0), V2<double>{1, 1}, one, 0.0, mu, r, A, specAlbedo,
-                                        dielectric)[0];
+        const FresnelCurve<double> curve = fresnelCurve(one, fresnelShare(1.0), 1.0);
+        const double w = specularEnergyAniso<double>(one, one, curve, V2<double>{1, 1}, one, 0.0, mu, r, A,
+                                                     specAlbedo, dielectric)[0];
         for (int k = 0; k < kPhis; ++k) {
           const double today = e[k] * w, ideal = e[k] / eMax;
           if (today < todayMin) todayMin = today, wr = r, wa = A, wphi = k * 90.0 / (kPhis - 1);

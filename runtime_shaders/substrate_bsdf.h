@@ -97,11 +97,10 @@ SubstrateFresnelCurve substrate_fresnel_curve(float3 f0, float share, float cond
   k.share = share;
 #if SUBSTRATE_USE_CONDUCTOR_CURVE
   float3 x = sqrt(max(f0, SUBSTRATE_SPLAT3(SUBSTRATE_CONDUCTOR_CURVE_MIN_F0)));
-  float3 a = max(SUBSTRATE_CONDUCTOR_CURVE_A0 +
-                     x * (SUBSTRATE_CONDUCTOR_CURVE_A1 + x * (SUBSTRATE_CONDUCTOR_CURVE_A2 + x * SUBSTRATE_CONDUCTOR_CURVE_A3)),
-                 SUBSTRATE_SPLAT3(0.0));
-  float3 b = SUBSTRATE_CONDUCTOR_CURVE_B0 +
-             x * (SUBSTRATE_CONDUCTOR_CURVE_B1 + x * (SUBSTRATE_CONDUCTOR_CURVE_B2 + x * SUBSTRATE_CONDUCTOR_CURVE_B3));
+  float3 a2 = SUBSTRATE_CONDUCTOR_CURVE_A2 + x * SUBSTRATE_CONDUCTOR_CURVE_A3;
+  float3 b2 = SUBSTRATE_CONDUCTOR_CURVE_B2 + x * SUBSTRATE_CONDUCTOR_CURVE_B3;
+  float3 a = max(SUBSTRATE_CONDUCTOR_CURVE_A0 + x * (SUBSTRATE_CONDUCTOR_CURVE_A1 + x * a2), SUBSTRATE_SPLAT3(0.0));
+  float3 b = SUBSTRATE_CONDUCTOR_CURVE_B0 + x * (SUBSTRATE_CONDUCTOR_CURVE_B1 + x * b2);
   k.a = lerp(a * conductor, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_A), share);
   k.b = lerp(b * conductor, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_B), share);
 #else
@@ -689,8 +688,8 @@ float substrate_closure_dielectric_ms(SubstrateClosure c) {
 // energy: W E <= 1 and E_spec is never below the compensated lobe's true
 // albedo. The table lookup and E are float; W (<= 1000) and E_spec are colours
 // (mfloat).
-mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd, mfloat3 f0w, float msRate,
-                                  float NoV, float roughness, out mfloat3 albedo, out float dielectric) {
+mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd, mfloat3 f0w,
+                                  float msRate, float NoV, float roughness, out mfloat3 albedo, out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);
   float ms = msRate * roughness;
@@ -714,8 +713,8 @@ mfloat3 substrate_specular_energy(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve
 // azimuth, E_max does.
 // Compiled only with SUBSTRATE_USE_ANISOTROPY (the optimizer does not remove
 // the branch for a constant A = 0). docs/stability.md, "Energy: the white furnace".
-mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd, mfloat3 f0w, float msRate,
-                                        float NoV, float roughness, float anisotropy, out mfloat3 albedo,
+mfloat3 substrate_specular_energy_aniso(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd, mfloat3 f0w,
+                                        float msRate, float NoV, float roughness, float anisotropy, out mfloat3 albedo,
                                         out float dielectric) {
   float2 dfg = substrate_energy_dfg(NoV, roughness);
   float e = clamp(dfg.x + dfg.y, 1e-3, 1.0);

@@ -85,8 +85,8 @@ float3 substrate_light_closures(SubstrateClosure closures[SUBSTRATE_MAX_CLOSURES
 // remove it from what reaches the diffuse or passes through. `dielectric`: the
 // same for the closure's dielectric part of ends fd (substrate_closure_dielectric_part,
 // for substrate_diffuse_transmission).
-mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve, float2 fd,
-                                             float NoV, out float dielectric) {
+mfloat3 substrate_closure_specular_albedo_of(SubstrateClosure c, mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve curve,
+                                             float2 fd, float NoV, out float dielectric) {
   mfloat3 f0w = substrate_closure_compensated_f0(c, f0, fd);
   mfloat3 specAlbedo;
   float msRate = substrate_closure_dielectric_ms(c);

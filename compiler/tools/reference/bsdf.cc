@@ -125,11 +125,10 @@ FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor) {
   FresnelCurve<T> k{share, {}, {}};
   for (int i = 0; i < 3; ++i) {
     const T x = std::sqrt(std::max(f0[i], T(SUBSTRATE_CONDUCTOR_CURVE_MIN_F0)));
-    const T a = std::max(T(SUBSTRATE_CONDUCTOR_CURVE_A0) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_A1) +
-                                                                x * (T(SUBSTRATE_CONDUCTOR_CURVE_A2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_A3))),
-                         T(0));
-    const T b = T(SUBSTRATE_CONDUCTOR_CURVE_B0) +
-                x * (T(SUBSTRATE_CONDUCTOR_CURVE_B1) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_B2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_B3)));
+    const T a2 = T(SUBSTRATE_CONDUCTOR_CURVE_A2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_A3);
+    const T b2 = T(SUBSTRATE_CONDUCTOR_CURVE_B2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_B3);
+    const T a = std::max(T(SUBSTRATE_CONDUCTOR_CURVE_A0) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_A1) + x * a2), T(0));
+    const T b = T(SUBSTRATE_CONDUCTOR_CURVE_B0) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_B1) + x * b2);
     k.a[i] = lerp(a * conductor, T(SUBSTRATE_FRESNEL_CURVE_A), share);
     k.b[i] = lerp(b * conductor, T(SUBSTRATE_FRESNEL_CURVE_B), share);
   }
@@ -202,7 +201,8 @@ T closureDielectricMs(const Closure<T>& c) {
 // the dielectric part's (ends fd) sat(dielectricAlbedo(fd, e, fresnelB(dfg, e, pull, 1)) (1 + msRate r)),
 // msRate = closureDielectricMs.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate,
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd,
+                          const V3<T>& f0w, T msRate,
                           T NoV, T roughness, T anisotropy, V3<T>& albedo, T& dielectric) {
   V2<T> dfg = energyDfg(NoV, roughness);
   T e = clampT(dfg[0] + dfg[1], T(1e-3), T(1));
@@ -223,7 +223,8 @@ V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<
 
 // substrate_specular_energy: the isotropic case.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd,
+                     const V3<T>& f0w, T msRate, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric) {
   return specularEnergyAniso(f0, f90, curve, fd, f0w, msRate, NoV, roughness, T(0), albedo, dielectric);
 }
@@ -1224,8 +1225,10 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, const V3<T>&);                       \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, T);                    \
   template T closureDielectricMs<T>(const Closure<T>&);                                                 \
-  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, const V2<T>&, const V3<T>&, T, T, T, V3<T>&, T&); \
-  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, const V2<T>&, const V3<T>&, T, T, T, T, V3<T>&, \
+  template V3<T> specularEnergy<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, const V2<T>&,         \
+                                   const V3<T>&, T, T, T, V3<T>&, T&);                                        \
+  template V3<T> specularEnergyAniso<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, const V2<T>&,    \
+                                        const V3<T>&, T, T, T, T, V3<T>&,                                     \
                                         T&);                                                            \
   template V3<T> diffuseTransmission<T>(const V3<T>&, const V3<T>&, T);                              \
   template T dielectricAlbedo<T>(const V2<T>&, T, T);                                                \

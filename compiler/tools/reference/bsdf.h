@@ -66,7 +66,8 @@ template <class T> T coatFloorAlong(const Closure<T>& c, T mu, const V3<T>& w); 
 template <class T> V3<T> coatMeanDirection(const Closure<T>& c, T mu);                      // substrate_coat_mean_direction
 template <class T> T coatInterface(const V3<T>& topF0);                                     // substrate_coat_interface
 template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);                     // substrate_fresnel_b (w)
-template <class T> V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k);  // substrate_fresnel_b (xyz)
+template <class T>
+V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k);                // substrate_fresnel_b (xyz)
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
 template <class T> FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor);     // substrate_fresnel_curve
 template <class T> V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90);                   // substrate_f90_effective
@@ -81,11 +82,13 @@ template <class T> T closureDielectricMs(const Closure<T>& c);
 /// `albedo`, and in `dielectric` the albedo of the closure's dielectric part (ends fd,
 /// closureDielectricPart), times 1 + msRate r.
 template <class T>
-V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate, T NoV,
+V3<T> specularEnergy(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd,
+                     const V3<T>& f0w, T msRate, T NoV,
                      T roughness, V3<T>& albedo, T& dielectric);
 /// substrate_specular_energy_aniso: the same with an anisotropic lobe's widened terms.
 template <class T>
-V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd, const V3<T>& f0w, T msRate,
+V3<T> specularEnergyAniso(const V3<T>& f0, const V3<T>& f90, const FresnelCurve<T>& curve, const V2<T>& fd,
+                          const V3<T>& f0w, T msRate,
                           T NoV, T roughness, T anisotropy, V3<T>& albedo, T& dielectric);
 /// substrate_dielectric_albedo: the compensated albedo of a grey interface of ends d.
 template <class T> T dielectricAlbedo(const V2<T>& d, T e, T b);

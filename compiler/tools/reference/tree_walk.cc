@@ -154,7 +154,8 @@ class Walk {
  public:
   Walk(const CompileResult& r, const std::vector<std::array<double, 4>>& values, const Geometry& g)
       : m_(r.material), t_(r.tree), L_(r.after), vals_(values),
-        conductorCurve_(usesConductorCurve(r.material, r.after)), gN_(cast<T>(g.N)), gT_(cast<T>(g.T)), gV_(cast<T>(g.V)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
+        conductorCurve_(usesConductorCurve(r.material, r.after)), gN_(cast<T>(g.N)), gT_(cast<T>(g.T)),
+        gV_(cast<T>(g.V)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
 
   MaterialResult<T> run() {
     const std::size_t n = m_.nodes.size();
