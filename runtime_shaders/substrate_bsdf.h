@@ -90,7 +90,8 @@ struct SubstrateFresnelCurve {
 // F0 0.02; Schlick's curve, which conductors followed before, reflected up to
 // 16 % less than it at cosine 0.4 for F0 0.14, 6 % for 0.3, so a grey
 // conductor of F0 0.14 read -11.6 % albedo at NoV 0.4), the coefficients
-// linear between. Once per closure. `conductor` (in [0, 1]) is how much of
+// linear between. With the Fresnel ends, at each evaluation of the closure
+// (per light and for the environment). `conductor` (in [0, 1]) is how much of
 // the conductor's own curve replaces Schlick's (substrate_closure_fresnel_ends).
 SubstrateFresnelCurve substrate_fresnel_curve(float3 f0, float share, float conductor) {
   SubstrateFresnelCurve k;

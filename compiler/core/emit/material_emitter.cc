@@ -54,17 +54,22 @@ std::string extraInterfacesDefine(const StorageLayout& layout) {
                      layered ? 1 : 0);
 }
 
+/// Whether value `v` may exceed `limit` in some channel: it is not a
+/// constant whose every channel is at most `limit` (NaN counts as above).
+bool mayExceed(const Material& m, ValueId v, double limit) {
+  if (v == kNoValue || !m.values.isConst(v)) return true;
+  const auto& k = m.values.node(v).c;
+  const int channels = m.values.node(v).type == VType::Float ? 1 : 3;
+  for (int i = 0; i < channels; ++i)
+    if (!(k[i] <= limit)) return true;
+  return false;
+}
+
 /// Whether slab `slab` may read as a conductor in the runtime: its F0 is not
 /// a constant whose largest channel is at most SUBSTRATE_COAT_DIELECTRIC_F0
 /// (where substrate_fresnel_share is exactly 1).
 bool mayReadAsConductor(const Material& m, int slab) {
-  const ValueId f0 = m.slabs[slab].pin(SlabPin::F0);
-  if (f0 == kNoValue || !m.values.isConst(f0)) return true;
-  const auto& k = m.values.node(f0).c;
-  const int channels = m.values.node(f0).type == VType::Float ? 1 : 3;
-  for (int i = 0; i < channels; ++i)
-    if (!(k[i] <= SUBSTRATE_COAT_DIELECTRIC_F0)) return true;
-  return false;
+  return mayExceed(m, m.slabs[slab].pin(SlabPin::F0), SUBSTRATE_COAT_DIELECTRIC_F0);
 }
 
 /// Whether slab `slab` may be what the ground truth walks as a conductor,
@@ -77,12 +82,8 @@ bool mayWalkAsConductor(const Material& m, int slab) {
   if (!mayReadAsConductor(m, slab) || (s.features & (kFeatMedium | kFeatSss))) return false;
   if (s.metalness) return true;
   const ValueId albedo = s.pin(SlabPin::DiffuseAlbedo);
-  if (albedo == kNoValue || !m.values.isConst(albedo)) return true;
-  const auto& k = m.values.node(albedo).c;
-  const int channels = m.values.node(albedo).type == VType::Float ? 1 : 3;
-  for (int i = 0; i < channels; ++i)
-    if (k[i] > 0) return false;
-  return true;
+  // An albedo that is not constant, or a constant 0 in every channel.
+  return albedo == kNoValue || !m.values.isConst(albedo) || !mayExceed(m, albedo, 0.0);
 }
 
 bool usesConductorCurve(const Material& m, const StorageLayout& layout) {
