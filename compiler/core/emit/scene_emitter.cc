@@ -101,6 +101,7 @@ SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialSh
       if (!full && !m.runtimeSimple) continue;
       k.materials.push_back(m.name);
       k.metalnessMix = k.metalnessMix || m.metalnessMix;
+      k.conductorCurve = k.conductorCurve || m.conductorCurve;
       if (!full) continue;
       k.noClosure = k.noClosure || m.closures == 0;
       k.features |= m.storedFeatures;
@@ -153,6 +154,9 @@ std::string sceneUseDefines(const SceneLightingClass& k) {
   // coat's coloured F0 over a diffuse was lit 7-25 % brighter deferred than
   // forward, RenderCorpus on open_pbr_pearl; docs/scenes.md.)
   s += fmt::format("#define SUBSTRATE_USE_METALNESS_MIX {}\n", k.metalnessMix ? 1 : 0);
+  // Nor which closures are conductors: a class compiles their curve when one of
+  // its materials does, so a material lit alone is lit deferred as forward.
+  s += fmt::format("#define SUBSTRATE_USE_CONDUCTOR_CURVE {}\n", k.conductorCurve ? 1 : 0);
   return s;
 }
 

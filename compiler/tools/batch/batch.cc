@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "batch/cache.h"
+#include "emit/material_emitter.h"
 #include "util/parallel.h"
 
 namespace substratec {
@@ -26,6 +27,7 @@ MaterialSummary summarize(const CompileResult& r) {
   s.maxClosures = r.maxClosures;
   s.simplificationSteps = static_cast<int>(r.steps.size());
   s.metalnessMix = r.material.metalnessMix;
+  s.conductorCurve = usesConductorCurve(r.material, r.after);
   return s;
 }
 
@@ -41,7 +43,8 @@ nlohmann::ordered_json summaryJson(const MaterialSummary& s) {
           {"budget_bytes", s.budgetBytes},
           {"max_closures", s.maxClosures},
           {"simplification_steps", s.simplificationSteps},
-          {"metalness_mix", s.metalnessMix}};
+          {"metalness_mix", s.metalnessMix},
+          {"conductor_curve", s.conductorCurve}};
 }
 
 std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) {
@@ -63,6 +66,7 @@ std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) 
     s.maxClosures = j.at("max_closures").get<int>();
     s.simplificationSteps = j.at("simplification_steps").get<int>();
     s.metalnessMix = j.at("metalness_mix").get<bool>();
+    s.conductorCurve = j.at("conductor_curve").get<bool>();
     const int leastClosures = s.layoutClass == LayoutClass::Volume ? 0 : 1;  // a volume has none
     if (!known || s.name.empty() || s.words < 1 || s.closures < leastClosures || s.closures > 8) return std::nullopt;
     return s;

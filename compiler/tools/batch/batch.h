@@ -34,9 +34,10 @@ struct MaterialSummary {
   int maxClosures = 0;
   int simplificationSteps = 0;
   bool metalnessMix = false;         // Material::metalnessMix
+  bool conductorCurve = false;       // usesConductorCurve (SUBSTRATE_USE_CONDUCTOR_CURVE)
 
   SceneMaterialShape shape() const {
-    return {name, layoutClass, runtimeSimple, storedFeatures, closures, words, metalnessMix};
+    return {name, layoutClass, runtimeSimple, storedFeatures, closures, words, metalnessMix, conductorCurve};
   }
 };
 
