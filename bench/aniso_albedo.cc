@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
     for (double mu : {1.0, 0.8, 0.6, 0.4, 0.2, 0.1}) {
       V3<double> one{1, 1, 1}, specAlbedo;
       double dielectric = 0;
-      const FresnelCurve<double> curve = fresnelCurve(one, fresnelShare(1.0), 1.0);
+      const FresnelCurve<double> curve = fresnelCurve(one, fresnelShare(1.0), 1.0, 1.0);
       const double w =
           specularEnergyAniso<double>(one, one, curve, V2<double>{1, 1}, one, 0.0, mu, r, A, specAlbedo, dielectric)[0];
       std::printf("NoV %.1f  1/W %.4f  E:", mu, 1 / w);
@@ -119,7 +119,7 @@ int main(int argc, char** argv) {
         }
         V3<double> one{1, 1, 1}, specAlbedo;
         double dielectric = 0;
-        const FresnelCurve<double> curve = fresnelCurve(one, fresnelShare(1.0), 1.0);
+        const FresnelCurve<double> curve = fresnelCurve(one, fresnelShare(1.0), 1.0, 1.0);
         const double w = specularEnergyAniso<double>(one, one, curve, V2<double>{1, 1}, one, 0.0, mu, r, A,
                                                      specAlbedo, dielectric)[0];
         for (int k = 0; k < kPhis; ++k) {

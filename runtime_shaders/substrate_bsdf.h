@@ -73,40 +73,63 @@ float substrate_mix_share(float f0max) {
 }
 
 // The Fresnel curve of a closure's interface between its ends: the share of
-// chi (substrate_fresnel_share) and, per channel, the coefficients (a, b) of
-// w(t) = t + (1 - t) s (a + b s), s = sqrt(t), t = (1 - c)^5 (chi's form,
-// substrate_fresnel_delta). With SUBSTRATE_USE_CONDUCTOR_CURVE 0 the curve is
-// t + share D(t) and a, b are unused.
+// the dielectric curve (substrate_fresnel_share), that curve's coefficients
+// d = (a, b) of D(t) = (1 - t) s (a + b s), s = sqrt(t), t = (1 - c)^5
+// (chi's (A, B), substrate_fresnel_delta, or a low-IOR interface's) and the
+// least share of a negative D(t) its albedo bound gives up (pull,
+// substrate_fresnel_b; 0 for chi), and per channel the coefficients of
+// w(t) = t + (1 - t) s (a + b s) (the conductor's and the dielectric's
+// blended by the share). Without SUBSTRATE_USE_CONDUCTOR_CURVE the curve is
+// t + share D(t), one weight per light, and a, b are unused; without
+// SUBSTRATE_USE_LOW_IOR_CURVE d is chi's and pull 0.
 struct SubstrateFresnelCurve {
   float share;
+  float2 d;
+  float pull;
   float3 a;
   float3 b;
 };
 
-// The curve of an interface of F0 f0 (per channel, in [0, 1]) and chi's share
-// (issue 19, step 23): chi where the share is 1 (a dielectric), each channel's
-// conductor curve where it is 0 (SUBSTRATE_CONDUCTOR_CURVE_*: the ground
-// truth's Gulbrandsen conductor of that F0, within 0.0063 in reflectance from
-// F0 0.02; Schlick's curve, which conductors followed before, reflected up to
-// 16 % less than it at cosine 0.4 for F0 0.14, 6 % for 0.3, so a grey
-// conductor of F0 0.14 read -11.6 % albedo at NoV 0.4), the coefficients
-// linear between. With the Fresnel ends, at each evaluation of the closure
-// (per light and for the environment). `conductor` (in [0, 1]) is how much of
-// the conductor's own curve replaces Schlick's (substrate_closure_fresnel_ends).
-SubstrateFresnelCurve substrate_fresnel_curve(float3 f0, float share, float conductor) {
+// The curve of an interface of F0 f0 (per channel, in [0, 1]) and the
+// dielectric curve's share.
+// - A dielectric (step 24), where the share is 1: the exact Fresnel of the IOR
+//   its largest channel's F0 reads (SUBSTRATE_DIELECTRIC_CURVE_*: chi from F0
+//   0.04 on; below it a curve that rises later toward grazing, where chi was
+//   0.069 above the exact one at F0 0.01 and 0.186 at 0.002), weighed by
+//   `lowIor` (in [0, 1]: chi elsewhere, substrate_closure_fresnel_ends). One
+//   curve for the three channels, as chi: a dielectric's F0 is grey.
+// - A conductor (issue 19, step 23), where the share is 0: per channel, the
+//   ground truth's Gulbrandsen conductor of that channel's F0
+//   (SUBSTRATE_CONDUCTOR_CURVE_*: within 0.0063 in reflectance from F0 0.02;
+//   Schlick's curve, which conductors followed before, reflected up to 16 %
+//   less than it at cosine 0.4 for F0 0.14, so a grey conductor of F0 0.14
+//   read -11.6 % albedo at NoV 0.4), weighed by `conductor` (in [0, 1]: how
+//   much of it replaces Schlick's, substrate_closure_fresnel_ends).
+// The coefficients linear between. With the Fresnel ends, at each evaluation
+// of the closure (per light and for the environment).
+SubstrateFresnelCurve substrate_fresnel_curve(float3 f0, float share, float conductor, float lowIor) {
   SubstrateFresnelCurve k;
   k.share = share;
+  k.d = float2(SUBSTRATE_FRESNEL_CURVE_A, SUBSTRATE_FRESNEL_CURVE_B);
+  k.pull = 0.0;
+#if SUBSTRATE_USE_LOW_IOR_CURVE
+  float y = min(sqrt(max(substrate_max3(f0), SUBSTRATE_DIELECTRIC_CURVE_MIN_F0)), SUBSTRATE_DIELECTRIC_CURVE_X);
+  float below = (y - SUBSTRATE_DIELECTRIC_CURVE_X) * lowIor;  // <= 0
+  k.d += below * float2(SUBSTRATE_DIELECTRIC_CURVE_P0 + y * (SUBSTRATE_DIELECTRIC_CURVE_P1 + y * SUBSTRATE_DIELECTRIC_CURVE_P2),
+                        SUBSTRATE_DIELECTRIC_CURVE_Q0 + y * (SUBSTRATE_DIELECTRIC_CURVE_Q1 + y * SUBSTRATE_DIELECTRIC_CURVE_Q2));
+  k.pull = min(SUBSTRATE_DIELECTRIC_CURVE_PULL_MAX, below * -SUBSTRATE_DIELECTRIC_CURVE_PULL_SLOPE);
+#endif
 #if SUBSTRATE_USE_CONDUCTOR_CURVE
   float3 x = sqrt(max(f0, SUBSTRATE_SPLAT3(SUBSTRATE_CONDUCTOR_CURVE_MIN_F0)));
   float3 a2 = SUBSTRATE_CONDUCTOR_CURVE_A2 + x * SUBSTRATE_CONDUCTOR_CURVE_A3;
   float3 b2 = SUBSTRATE_CONDUCTOR_CURVE_B2 + x * SUBSTRATE_CONDUCTOR_CURVE_B3;
   float3 a = max(SUBSTRATE_CONDUCTOR_CURVE_A0 + x * (SUBSTRATE_CONDUCTOR_CURVE_A1 + x * a2), SUBSTRATE_SPLAT3(0.0));
   float3 b = SUBSTRATE_CONDUCTOR_CURVE_B0 + x * (SUBSTRATE_CONDUCTOR_CURVE_B1 + x * b2);
-  k.a = lerp(a * conductor, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_A), share);
-  k.b = lerp(b * conductor, SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_B), share);
+  k.a = lerp(a * conductor, SUBSTRATE_SPLAT3(k.d.x), share);
+  k.b = lerp(b * conductor, SUBSTRATE_SPLAT3(k.d.y), share);
 #else
-  k.a = SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_A);
-  k.b = SUBSTRATE_SPLAT3(SUBSTRATE_FRESNEL_CURVE_B);
+  k.a = SUBSTRATE_SPLAT3(k.d.x);
+  k.b = SUBSTRATE_SPLAT3(k.d.y);
 #endif
   return k;
 }
@@ -146,6 +169,11 @@ float3 substrate_f90_effective(float3 f0, float3 f90) {
 // layers' terms for it (substrate_closure_coat_specular) were built on
 // Schlick's; with its own curve the control conductor_under_clear_coat rose
 // from +3.3 to +5.1 % at NoV 0.4.
+// A dielectric of F0 below 0.04 follows the curve of its own IOR (issue 19,
+// step 24) by `lowIor`: not under layers (1 - coverageAbove), whose relative F0
+// is read on chi (step 2), nor on top of them (coversLayers): the layers'
+// interface term lets 1 - chi through to what lies under the top (step 17: a
+// clear coat of IOR 1 on its own curve returned 0.44 of a white furnace).
 //
 // Under layers (coverageAbove > 0) the interface is relative to the layers
 // above, read as a dielectric of F0 0.04 (SUBSTRATE_COAT_SQRT_F0): a slab's F0
@@ -178,8 +206,10 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
 #if SUBSTRATE_USE_METALNESS_MIX
   conductor = max(conductor, substrate_mix_share(f));
 #endif
+  float lowIor = 1.0;
 #if SUBSTRATE_USE_LAYERS
   conductor *= 1.0 - saturate(c.coverageAbove);
+  lowIor = c.coversLayers ? 0.0 : 1.0 - saturate(c.coverageAbove);
   // No branch: at coverageAbove 0 the scale is exactly 1. In float: one
   // conversion per end in half precision.
   float s = sqrt(f);
@@ -191,7 +221,7 @@ void substrate_closure_fresnel_ends(SubstrateClosure c, out mfloat3 f0, out mflo
   f90f *= scale;
   f *= scale;
 #endif
-  curve = substrate_fresnel_curve(f0f, substrate_fresnel_share(f), conductor);
+  curve = substrate_fresnel_curve(f0f, substrate_fresnel_share(f), conductor, lowIor);
   f0 = SUBSTRATE_M3(f0f);
   f90 = SUBSTRATE_M3(f90f);
 }
@@ -389,6 +419,13 @@ float substrate_fresnel_delta(float t) {
   return (1.0 - t) * s * (SUBSTRATE_FRESNEL_CURVE_A + SUBSTRATE_FRESNEL_CURVE_B * s);
 }
 
+// D(t) of the form above with the coefficients d = (a, b) of a curve
+// (SubstrateFresnelCurve.d).
+float substrate_fresnel_delta_of(float t, float2 d) {
+  float s = sqrt(t);
+  return (1.0 - t) * s * (d.x + d.y * s);
+}
+
 // chi(c) (above), for c clamped to [0, 1]: in [0, 1] with no clamp of its
 // own (t + D(t) >= t - 0.21 (1 - t) s > 0 for t in (0, 1], and D(t) <= 1 - t).
 float substrate_fresnel_weight(float c) {
@@ -540,7 +577,7 @@ mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve k, floa
   float3 w = t + ((1.0 - t) * s) * (k.a + k.b * s);
   return f0 + (f90 - f0) * SUBSTRATE_M3(w);
 #else
-  float w = t + k.share * substrate_fresnel_delta(t);
+  float w = t + k.share * substrate_fresnel_delta_of(t, k.d);
   return f0 + (f90 - f0) * SUBSTRATE_M(w);
 #endif
 }
@@ -558,18 +595,28 @@ mfloat3 substrate_fresnel(mfloat3 f0, mfloat3 f90, SubstrateFresnelCurve k, floa
 // way); a stretched lobe, whose B_max and E_max (substrate_energy_aniso) the
 // fit does not cover, takes pull = 1: e (t + max(D(t), 0)). `share` is the
 // curve's (substrate_fresnel_share): e (t + share (D - pull min(D, 0))).
-// A conductor's curve (substrate_fresnel_curve) takes the same bound with
-// its own D per channel. Returns it per channel for the curve k (xyz) and for
-// chi (w: a closure's dielectric part, substrate_dielectric_albedo).
+// A low-IOR curve (substrate_fresnel_curve) takes the same bound with its own
+// D and a pull of at least its own (k.pull: such a curve is more convex in t
+// than chi); a conductor's with its own D per channel. Returns it per channel
+// for the curve k (xyz) and for chi (w: a closure's dielectric part,
+// substrate_dielectric_albedo).
 float4 substrate_fresnel_b(float2 dfg, float e, float pull, SubstrateFresnelCurve k) {
   float t = min(dfg.y / e, 1.0);  // dfg.y >= 0, e > 0
   float d = substrate_fresnel_delta(t);
   float x = d - pull * min(d, 0.0);
+#if SUBSTRATE_USE_LOW_IOR_CURVE
+  float pullk = max(pull, k.pull * k.share);
+#else
+  float pullk = pull;
+#endif
 #if SUBSTRATE_USE_CONDUCTOR_CURVE
   float s = sqrt(t);
   float3 dk = ((1.0 - t) * s) * (k.a + k.b * s);
-  float3 xk = dk - pull * min(dk, SUBSTRATE_SPLAT3(0.0));
+  float3 xk = dk - pullk * min(dk, SUBSTRATE_SPLAT3(0.0));
   return e * float4(t + xk, t + x);
+#elif SUBSTRATE_USE_LOW_IOR_CURVE
+  float dd = substrate_fresnel_delta_of(t, k.d);
+  return e * float4(SUBSTRATE_SPLAT3(t + k.share * (dd - pullk * min(dd, 0.0))), t + x);
 #else
   return e * float4(SUBSTRATE_SPLAT3(t + k.share * x), t + x);
 #endif

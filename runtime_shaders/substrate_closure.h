@@ -150,6 +150,14 @@ struct SubstrateGeometry {
 #ifndef SUBSTRATE_USE_CONDUCTOR_CURVE
 #define SUBSTRATE_USE_CONDUCTOR_CURVE 1
 #endif
+// 1: some closure may be a dielectric of F0 below 0.04 with no layers under
+// or over it, whose Fresnel follows the curve of its own IOR
+// (substrate_fresnel_curve; issue 19, step 24): the compiler clears it when
+// every slab's F0 is a constant of at least 0.04, or the material has layers,
+// whose closures keep chi.
+#ifndef SUBSTRATE_USE_LOW_IOR_CURVE
+#define SUBSTRATE_USE_LOW_IOR_CURVE 1
+#endif
 // 1: some closure may lie under an isotropic rough top's floor
 // (SubstrateClosure.coatFloor, substrate_coat_floor): the compiler clears it
 // when no closure of the material gets one (several closures on top, a

@@ -148,6 +148,31 @@
 #define SUBSTRATE_CONDUCTOR_CURVE_B2 -1.85667
 #define SUBSTRATE_CONDUCTOR_CURVE_B3 2.91601
 #define SUBSTRATE_CONDUCTOR_CURVE_MIN_F0 0.02
+// A low-F0 dielectric's curve (issue 19, step 24; substrate_fresnel_curve):
+// the ground truth reads a dielectric's IOR from its F0 and walks its exact
+// Fresnel, whose normalized curve rises later toward grazing the closer the
+// IOR is to 1 (chi, IOR 1.5's, was 0.069 above it at F0 0.01, 0.186 at
+// 0.002). The same form with, per channel, x = min(sqrt(max(F0, MIN_F0)), 0.2):
+// a = A + (x - 0.2) (P0 + x (P1 + x P2)), b = B + (x - 0.2) (Q0 + x (Q1 + x Q2)),
+// exactly chi from F0 0.04 (chi is within 0.008 of the exact curve up to
+// 0.1); within 0.006 in reflectance from F0 0.002 to 0.04, 0.021 at MIN_F0,
+// below which a channel takes MIN_F0's curve. Least squares on the
+// reflectance over 60 F0 and 801 cosines, scripts/fit_low_f0_fresnel.py.
+// Such a curve is more convex in t than chi: a rough lobe's mean of it lies
+// above substrate_fresnel_b's bound at pull 0 (by 0.057 in the albedo at F0
+// 0.001, roughness 0.45), so its pull is at least
+// min(PULL_MAX, PULL_SLOPE (0.2 - x)), 0 at chi's F0: the bound then holds at
+// 1,353 lobes of the tables and 13 F0 (the same script).
+#define SUBSTRATE_DIELECTRIC_CURVE_P0 -0.22765
+#define SUBSTRATE_DIELECTRIC_CURVE_P1 26.36756
+#define SUBSTRATE_DIELECTRIC_CURVE_P2 -119.68157
+#define SUBSTRATE_DIELECTRIC_CURVE_Q0 7.96407
+#define SUBSTRATE_DIELECTRIC_CURVE_Q1 -109.09286
+#define SUBSTRATE_DIELECTRIC_CURVE_Q2 386.54276
+#define SUBSTRATE_DIELECTRIC_CURVE_MIN_F0 0.001
+#define SUBSTRATE_DIELECTRIC_CURVE_X 0.2
+#define SUBSTRATE_DIELECTRIC_CURVE_PULL_MAX 0.32
+#define SUBSTRATE_DIELECTRIC_CURVE_PULL_SLOPE 6.5
 #define SUBSTRATE_FRESNEL_ROUGH_END 0.45
 // substrate_closure_coat_diffuse's terms, for k = extraInterfaces 0..3:
 //   G_k: 2 int mu g(mu)^(1 + k) dmu, the cosine-weighted mean of the lighting's

@@ -80,7 +80,7 @@ std::array<T, N> arrayOf(const std::array<double, N>& a) {
 template <class T>
 reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   // Every field is copied by name: a new one left out would keep its default here.
-  static_assert(sizeof(reference::Closure<double>) == 536,
+  static_assert(sizeof(reference::Closure<double>) == 544,
                 "Closure gained or lost a field: copy it below, then update the size");
   reference::Closure<T> o;
   o.diffuseAlbedo = arrayOf<T>(c.diffuseAlbedo);
@@ -121,6 +121,7 @@ reference::Closure<T> convertClosure(const reference::Closure<double>& c) {
   o.coversLayers = c.coversLayers;
   o.metalnessMix = c.metalnessMix;
   o.conductorCurve = c.conductorCurve;
+  o.lowIorCurve = c.lowIorCurve;
   return o;
 }
 
@@ -249,6 +250,7 @@ reference::Closure<double> closureFromResults(const std::vector<float>& results,
   }
   c.metalnessMix = r.material.metalnessMix;  // the kernel's SUBSTRATE_USE_METALNESS_MIX (not in the results)
   c.conductorCurve = usesConductorCurve(r.material, r.after);  // and its SUBSTRATE_USE_CONDUCTOR_CURVE
+  c.lowIorCurve = usesLowIorCurve(r.material, r.after);        // and SUBSTRATE_USE_LOW_IOR_CURVE
   return c;
 }
 

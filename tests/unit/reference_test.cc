@@ -451,7 +451,7 @@ D3 directionAt(const D3& N, double cosine, double azimuth) {
 template <class To>
 Closure<To> castClosure(const Closure<double>& c) {
   // Every field is copied by name: a new one left out would keep its default here.
-  static_assert(sizeof(Closure<double>) == 536, "Closure gained or lost a field: copy it below, then update the size");
+  static_assert(sizeof(Closure<double>) == 544, "Closure gained or lost a field: copy it below, then update the size");
   auto v = [](const auto& a) {
     std::array<To, std::tuple_size_v<std::decay_t<decltype(a)>>> r;
     for (std::size_t i = 0; i < r.size(); ++i) r[i] = static_cast<To>(a[i]);
@@ -496,6 +496,7 @@ Closure<To> castClosure(const Closure<double>& c) {
   o.coversLayers = c.coversLayers;
   o.metalnessMix = c.metalnessMix;
   o.conductorCurve = c.conductorCurve;
+  o.lowIorCurve = c.lowIorCurve;
   return o;
 }
 
@@ -708,10 +709,66 @@ TEST(ReferenceFresnel, TheCurveIsExactFresnelOfIor1_5) {
   EXPECT_NEAR(fresnelWeight(0.0), 1.0, 1e-12);
   EXPECT_NEAR(fresnelWeight(1.0), 0.0, 1e-12);
   const V3<double> f0{0.04, 0.04, 0.04}, one{1, 1, 1};
-  EXPECT_NEAR(fresnel(f0, one, fresnelCurve(f0, 1.0, 1.0), 0.6)[0], fresnelDielectric(0.6, 1.5), 1e-3);
+  EXPECT_NEAR(fresnel(f0, one, fresnelCurve(f0, 1.0, 1.0, 1.0), 0.6)[0], fresnelDielectric(0.6, 1.5), 1e-3);
   EXPECT_NEAR(fresnelDielectric(0.6, 1.5), 0.0645, 5e-4);
-  EXPECT_NEAR(fresnel(f0, one, fresnelCurve(f0, 1.0, 1.0), 0.1)[0], fresnelDielectric(0.1, 1.5), 1e-3);
+  EXPECT_NEAR(fresnel(f0, one, fresnelCurve(f0, 1.0, 1.0, 1.0), 0.1)[0], fresnelDielectric(0.1, 1.5), 1e-3);
   std::printf("[ reference ] Fresnel curve: within %.1e of exact Fresnel of IOR 1.5 over %d cosines\n", worst, cosines);
+}
+
+TEST(ReferenceFresnel, ALowF0DielectricFollowsTheFresnelOfItsOwnIor) {
+  // Issue 19, step 24: the truth reads a dielectric's IOR from its F0 and
+  // walks its exact Fresnel. Below F0 0.04 a closure's curve follows that IOR's
+  // (substrate_fresnel_curve, the largest channel's, as chi is one for the
+  // three; scripts/fit_low_f0_fresnel.py): within 0.007 in reflectance from F0
+  // 0.002, where chi (IOR 1.5's, every dielectric's before) is up to 0.186
+  // above it. From 0.04 on it is chi.
+  const V3<double> one{1, 1, 1};
+  double worst = 0, worstChi = 0;
+  int cases = 0;
+  for (double grey : {0.002, 0.005, 0.01, 0.02, 0.03, 0.039}) {
+    const V3<double> f0{grey, grey, grey};
+    Closure<double> c;
+    c.f0 = f0;
+    c.diffuseAlbedo = {0.5, 0.5, 0.5};
+    V3<double> e0, e90;
+    FresnelCurve<double> curve;
+    closureFresnelEnds(c, e0, e90, curve);
+    ASSERT_EQ(curve.share, 1.0);
+    for (int i = 0; i <= 2000; ++i) {
+      const double cosine = i / 2000.0;
+      const V3<double> f = fresnel(e0, e90, curve, cosine);
+      for (int ch = 0; ch < 3; ++ch) {
+        const double t = fresnelDielectric(cosine, iorFromF0(f0[ch]));
+        worst = std::max(worst, std::fabs(f[ch] - t));
+        worstChi = std::max(worstChi, std::fabs(f0[ch] + (1 - f0[ch]) * fresnelWeight(cosine) - t));
+        EXPECT_GE(f[ch], 0.0);
+        EXPECT_LE(f[ch], 1.0);
+        ++cases;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 6 * 2001 * 3);
+  EXPECT_LT(worst, 0.007);
+  EXPECT_GT(worstChi, 0.18);  // what the curve replaced
+  // Chi where the curve is not the closure's own: under layers (its F0 is read
+  // relative to them on chi), on top of layers (the layers' interface term lets
+  // 1 - chi through), and in a shader compiled without the switch.
+  const V3<double> low{0.005, 0.005, 0.005};
+  for (int where = 0; where < 3; ++where) {
+    Closure<double> c;
+    c.f0 = low;
+    c.diffuseAlbedo = {0.5, 0.5, 0.5};
+    c.coverageAbove = where == 0 ? 1.0 : 0.0;
+    c.coversLayers = where == 1;
+    c.lowIorCurve = where != 2;
+    V3<double> e0, e90;
+    FresnelCurve<double> curve;
+    closureFresnelEnds(c, e0, e90, curve);
+    for (int i = 0; i <= 100; ++i) {
+      const double cosine = i / 100.0;
+      EXPECT_NEAR(fresnel(V3<double>{0, 0, 0}, one, curve, cosine)[1], fresnelWeight(cosine), 1e-12) << where;
+    }
+  }
 }
 
 TEST(ReferenceFresnel, AConductorFollowsTheCurveOfItsOwnF0) {
@@ -759,7 +816,7 @@ TEST(ReferenceFresnel, AConductorFollowsTheCurveOfItsOwnF0) {
   EXPECT_GT(worstSchlick, 0.03);  // what the curve replaced
   // A dielectric (largest F0 up to 0.1) keeps chi in every channel.
   const V3<double> glass{0.04, 0.04, 0.04};
-  const FresnelCurve<double> chi = fresnelCurve(glass, fresnelShare(0.04), 1.0);
+  const FresnelCurve<double> chi = fresnelCurve(glass, fresnelShare(0.04), 1.0, 1.0);
   for (int i = 0; i <= 100; ++i)
     EXPECT_NEAR(fresnel(glass, one, chi, i / 100.0)[1], 0.04 + 0.96 * fresnelWeight(i / 100.0), 1e-12);
   // The truth walks a conductor where a slab has no diffuse and no medium; a
@@ -792,8 +849,8 @@ TEST(ReferenceFresnel, AConductorFollowsTheCurveOfItsOwnF0) {
   EXPECT_EQ(kept, 404);
   EXPECT_GT(curveAt(0, false, 0, 0.4) - (0.3 + 0.7 * std::pow(0.6, 5)), 0.01);  // the conductor's bulge
   // Between (F0 0.15, share 0.5), the coefficients half way.
-  const FresnelCurve<double> half = fresnelCurve(V3<double>{0.15, 0.15, 0.15}, fresnelShare(0.15), 1.0);
-  const FresnelCurve<double> metal = fresnelCurve(V3<double>{0.15, 0.15, 0.15}, 0.0, 1.0);
+  const FresnelCurve<double> half = fresnelCurve(V3<double>{0.15, 0.15, 0.15}, fresnelShare(0.15), 1.0, 1.0);
+  const FresnelCurve<double> metal = fresnelCurve(V3<double>{0.15, 0.15, 0.15}, 0.0, 1.0, 1.0);
   EXPECT_NEAR(half.a[0], 0.5 * (metal.a[0] + SUBSTRATE_FRESNEL_CURVE_A), 1e-12);
   EXPECT_NEAR(half.b[2], 0.5 * (metal.b[2] + SUBSTRATE_FRESNEL_CURVE_B), 1e-12);
   std::printf("[ reference ] conductor curve: within %.4f of the truth's conductor over %d cases (Schlick's %.4f)\n",

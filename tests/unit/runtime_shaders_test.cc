@@ -190,6 +190,23 @@ TEST(RuntimeShaders, TablesInAUniformBufferAreNotConstants) {
   EXPECT_GT(countOpcode(inlined.spirv, kOpConstant), 2000u);
 }
 
+/// The value of `#define NAME ` in the generated GLSL of a material of `nodes`
+/// and `inputs` ("none" without it).
+std::string materialDefine(const std::string& name, const std::string& nodes, const std::string& inputs) {
+  Diagnostics d("m.json");
+  auto r = compileText("m.json", test::material(nodes, inputs), {}, d);
+  EXPECT_TRUE(r.has_value()) << d.formatAll();
+  if (!r) return std::string();
+  const std::string glsl = emitMaterial(r->material, r->tree, r->after, syntaxFor(Target::Glsl), {});
+  const std::string key = "#define " + name + " ";
+  const std::size_t at = glsl.find(key);
+  return at == std::string::npos ? std::string("none") : glsl.substr(at + key.size(), 1);
+}
+
+std::string slabNode(const std::string& albedo, const std::string& f0) {
+  return R"("root": {"kind": "slab", "roughness": 0.4, "diffuse_albedo": )" + albedo + R"(, "f0": )" + f0 + "}";
+}
+
 TEST(RuntimeShaders, AMaterialPaysForTheConductorCurveOnlyWhereASlabMayBeAConductor) {
   // Issue 19, step 23: a conductor's Fresnel follows a curve per channel
   // (substrate_fresnel_curve), three coefficients per light where a
@@ -198,26 +215,41 @@ TEST(RuntimeShaders, AMaterialPaysForTheConductorCurveOnlyWhereASlabMayBeAConduc
   // not a constant of a dielectric (every channel at most 0.1), no medium, and
   // no constant diffuse above 0 (a high-IOR dielectric over a diffuse there).
   const auto define = [](const std::string& nodes, const std::string& inputs) {
-    Diagnostics d("m.json");
-    auto r = compileText("m.json", test::material(nodes, inputs), {}, d);
-    EXPECT_TRUE(r.has_value()) << d.formatAll();
-    if (!r) return std::string();
-    const std::string glsl = emitMaterial(r->material, r->tree, r->after, syntaxFor(Target::Glsl), {});
-    const std::size_t at = glsl.find("#define SUBSTRATE_USE_CONDUCTOR_CURVE ");
-    return at == std::string::npos ? std::string("none") : glsl.substr(at + 38, 1);
-  };
-  const auto slab = [](const std::string& albedo, const std::string& f0) {
-    return R"("root": {"kind": "slab", "roughness": 0.4, "diffuse_albedo": )" + albedo + R"(, "f0": )" + f0 + "}";
+    return materialDefine("SUBSTRATE_USE_CONDUCTOR_CURVE", nodes, inputs);
   };
   const std::string input = R"({"x": {"type": "float", "default": 0.04, "min": 0, "max": 1}})";
-  EXPECT_EQ(define(slab("0.5", "0.04"), "{}"), "0");
-  EXPECT_EQ(define(slab("0", "[0.1, 0.05, 0.02]"), "{}"), "0");
-  EXPECT_EQ(define(slab("0", "0.12"), "{}"), "1");
-  EXPECT_EQ(define(slab("0", "[0.9, 0.6, 0.3]"), "{}"), "1");
-  EXPECT_EQ(define(slab("0.5", "0.9"), "{}"), "0");
+  EXPECT_EQ(define(slabNode("0.5", "0.04"), "{}"), "0");
+  EXPECT_EQ(define(slabNode("0", "[0.1, 0.05, 0.02]"), "{}"), "0");
+  EXPECT_EQ(define(slabNode("0", "0.12"), "{}"), "1");
+  EXPECT_EQ(define(slabNode("0", "[0.9, 0.6, 0.3]"), "{}"), "1");
+  EXPECT_EQ(define(slabNode("0.5", "0.9"), "{}"), "0");
   EXPECT_EQ(define(R"("root": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.9, "sss_mfp": 0.01})", "{}"), "0");
-  EXPECT_EQ(define(slab("0", R"("$x")"), input), "1");
-  EXPECT_EQ(define(slab(R"("$x")", "0.9"), input), "1");
+  EXPECT_EQ(define(slabNode("0", R"("$x")"), input), "1");
+  EXPECT_EQ(define(slabNode(R"("$x")", "0.9"), input), "1");
+}
+
+TEST(RuntimeShaders, AMaterialPaysForTheLowIorCurveOnlyWhereADielectricMayHaveALowF0) {
+  // Issue 19, step 24: a dielectric of F0 below 0.04 follows the curve of its
+  // own IOR (substrate_fresnel_curve), whose coefficients are computed per
+  // evaluation where chi's are constants. The material compiles it
+  // (SUBSTRATE_USE_LOW_IOR_CURVE 1) only when it has no layers (under them,
+  // and on top of them, the curve is chi) and some slab's F0 may fall below
+  // 0.04 in its largest channel.
+  const auto define = [](const std::string& nodes, const std::string& inputs) {
+    return materialDefine("SUBSTRATE_USE_LOW_IOR_CURVE", nodes, inputs);
+  };
+  const std::string input = R"({"x": {"type": "float", "default": 0.04, "min": 0, "max": 1}})";
+  EXPECT_EQ(define(slabNode("0.5", "0.04"), "{}"), "0");
+  EXPECT_EQ(define(slabNode("0", "[0.1, 0.05, 0.02]"), "{}"), "0");
+  EXPECT_EQ(define(slabNode("0.5", "0.9"), "{}"), "0");
+  EXPECT_EQ(define(slabNode("0.5", "0.005"), "{}"), "1");
+  EXPECT_EQ(define(slabNode("0.5", "[0.03, 0.02, 0.01]"), "{}"), "1");
+  EXPECT_EQ(define(slabNode("0.5", "0"), "{}"), "1");
+  EXPECT_EQ(define(slabNode("0.5", R"("$x")"), input), "1");
+  const std::string coat = R"("coat": {"kind": "slab", "diffuse_albedo": 0, "f0": 0.02, "roughness": 0.1, "sss_mfp": 10},
+    "base": {"kind": "slab", "diffuse_albedo": 0.5, "f0": 0.02, "roughness": 0.5},
+    "root": {"kind": "vertical", "top": "coat", "base": "base", "thickness": 0.1})";
+  EXPECT_EQ(define(coat, "{}"), "0");
 }
 
 }  // namespace

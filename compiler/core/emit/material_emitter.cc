@@ -86,9 +86,33 @@ bool mayWalkAsConductor(const Material& m, int slab) {
   return albedo == kNoValue || !m.values.isConst(albedo) || !mayExceed(m, albedo, 0.0);
 }
 
+/// Whether the largest channel of value `v` may fall below `limit`: it is not
+/// a constant with a channel of at least `limit` (NaN counts as below).
+bool largestMayFallBelow(const Material& m, ValueId v, double limit) {
+  if (v == kNoValue || !m.values.isConst(v)) return true;
+  const auto& k = m.values.node(v).c;
+  const int channels = m.values.node(v).type == VType::Float ? 1 : 3;
+  for (int i = 0; i < channels; ++i)
+    if (std::isnan(k[i])) return true;
+  for (int i = 0; i < channels; ++i)
+    if (k[i] >= limit) return false;
+  return true;
+}
+
 bool usesConductorCurve(const Material& m, const StorageLayout& layout) {
   for (const ClosureLayout& c : layout.closures)
     if (c.slab < 0 || mayWalkAsConductor(m, c.slab)) return true;
+  return false;
+}
+
+bool usesLowIorCurve(const Material& m, const StorageLayout& layout) {
+  // Chi from F0 SUBSTRATE_DIELECTRIC_CURVE_X^2 = 0.04 on (a relative 1e-6 below it, so that a
+  // constant 0.04 folds to chi whatever the rounding).
+  constexpr double kChiF0 = SUBSTRATE_DIELECTRIC_CURVE_X * SUBSTRATE_DIELECTRIC_CURVE_X * (1 - 1e-6);
+  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
+  if (!std::all_of(layout.closures.begin(), layout.closures.end(), isTop)) return false;
+  for (const ClosureLayout& c : layout.closures)
+    if (c.slab < 0 || largestMayFallBelow(m, m.slabs[c.slab].pin(SlabPin::F0), kChiF0)) return true;
   return false;
 }
 
@@ -99,12 +123,16 @@ bool usesConductorCurve(const Material& m, const StorageLayout& layout) {
 /// SUBSTRATE_USE_CONDUCTOR_CURVE: usesConductorCurve; the others' Fresnel
 /// curve is chi or Schlick's, the same in every channel, one scalar per
 /// light (substrate_fresnel).
+/// SUBSTRATE_USE_LOW_IOR_CURVE: usesLowIorCurve; the others' dielectric
+/// curve is chi, whose coefficients are constants.
 std::string conductorDefines(const Material& m, const StorageLayout& layout) {
   bool underLayers = false;
   for (const ClosureLayout& c : layout.closures)
     underLayers = underLayers || (c.slab >= 0 && !c.isTop && mayReadAsConductor(m, c.slab));
-  return fmt::format("#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n#define SUBSTRATE_USE_CONDUCTOR_CURVE {}\n",
-                     underLayers ? 1 : 0, usesConductorCurve(m, layout) ? 1 : 0);
+  return fmt::format(
+      "#define SUBSTRATE_USE_COAT_CONDUCTOR {}\n#define SUBSTRATE_USE_CONDUCTOR_CURVE {}\n"
+      "#define SUBSTRATE_USE_LOW_IOR_CURVE {}\n",
+      underLayers ? 1 : 0, usesConductorCurve(m, layout) ? 1 : 0, usesLowIorCurve(m, layout) ? 1 : 0);
 }
 
 /// SUBSTRATE_USE_WRAP_UNDER_LAYERS and SUBSTRATE_USE_FUZZ_UNDER_LAYERS: 1 when

@@ -63,6 +63,13 @@ std::string extraInterfacesDefine(const StorageLayout& layout);
 /// without a slab counts as one), whose Fresnel follows a curve per channel
 /// (substrate_fresnel_curve). The CPU reference reads it too (Closure::conductorCurve).
 bool usesConductorCurve(const Material& m, const StorageLayout& layout);
+/// SUBSTRATE_USE_LOW_IOR_CURVE of `m` laid out as `layout` (issue 19, step 24):
+/// no closure lies under layers (under them, and on top of them, the
+/// dielectric curve is chi) and some closure's F0 may fall below 0.04 in its
+/// largest channel (a closure without a slab counts as one): its dielectric
+/// curve is that of its own IOR (substrate_fresnel_curve). The CPU reference reads it
+/// too (Closure::lowIorCurve).
+bool usesLowIorCurve(const Material& m, const StorageLayout& layout);
 
 /// The pixel's top-layer roughness as the top-layer word stores it (docs/storage.md)
 /// and the lighting reads it for the layers above a closure

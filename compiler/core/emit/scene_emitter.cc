@@ -102,6 +102,7 @@ SceneShape sceneShape(const std::string& name, const std::vector<SceneMaterialSh
       k.materials.push_back(m.name);
       k.metalnessMix = k.metalnessMix || m.metalnessMix;
       k.conductorCurve = k.conductorCurve || m.conductorCurve;
+      k.lowIorCurve = k.lowIorCurve || m.lowIorCurve;
       if (!full) continue;
       k.noClosure = k.noClosure || m.closures == 0;
       k.features |= m.storedFeatures;
@@ -157,6 +158,8 @@ std::string sceneUseDefines(const SceneLightingClass& k) {
   // Nor which closures are conductors: a class compiles their curve when one of
   // its materials does, so a material lit alone is lit deferred as forward.
   s += fmt::format("#define SUBSTRATE_USE_CONDUCTOR_CURVE {}\n", k.conductorCurve ? 1 : 0);
+  // Nor which are dielectrics of low IOR with no layers: likewise.
+  s += fmt::format("#define SUBSTRATE_USE_LOW_IOR_CURVE {}\n", k.lowIorCurve ? 1 : 0);
   return s;
 }
 

@@ -54,6 +54,7 @@ struct SceneMaterialShape {
   int words = 2;
   bool metalnessMix = false;        // its shaders read conductor-like F0 as a metalness mix (Material::metalnessMix)
   bool conductorCurve = false;      // its shaders follow a conductor's own Fresnel curve (usesConductorCurve)
+  bool lowIorCurve = false;         // and a low-IOR dielectric's (usesLowIorCurve)
 };
 
 /// One lighting shader: the pixels of tiles of `cls`, which may hold any class up to it.
@@ -65,6 +66,7 @@ struct SceneLightingClass {
   std::vector<std::string> materials;  // those materials (names, scene order)
   bool metalnessMix = false;           // some of them is a metalness mix (SUBSTRATE_USE_METALNESS_MIX)
   bool conductorCurve = false;         // some of them follows a conductor's curve (SUBSTRATE_USE_CONDUCTOR_CURVE)
+  bool lowIorCurve = false;            // some of them a low-IOR dielectric's (SUBSTRATE_USE_LOW_IOR_CURVE)
   bool noClosure = false;              // some of them has no closure (unlit only: SUBSTRATE_USE_NO_CLOSURE)
 };
 

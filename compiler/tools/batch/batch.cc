@@ -28,6 +28,7 @@ MaterialSummary summarize(const CompileResult& r) {
   s.simplificationSteps = static_cast<int>(r.steps.size());
   s.metalnessMix = r.material.metalnessMix;
   s.conductorCurve = usesConductorCurve(r.material, r.after);
+  s.lowIorCurve = usesLowIorCurve(r.material, r.after);
   return s;
 }
 
@@ -44,7 +45,8 @@ nlohmann::ordered_json summaryJson(const MaterialSummary& s) {
           {"max_closures", s.maxClosures},
           {"simplification_steps", s.simplificationSteps},
           {"metalness_mix", s.metalnessMix},
-          {"conductor_curve", s.conductorCurve}};
+          {"conductor_curve", s.conductorCurve},
+          {"low_ior_curve", s.lowIorCurve}};
 }
 
 std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) {
@@ -67,6 +69,7 @@ std::optional<MaterialSummary> summaryFromJson(const nlohmann::ordered_json& j) 
     s.simplificationSteps = j.at("simplification_steps").get<int>();
     s.metalnessMix = j.at("metalness_mix").get<bool>();
     s.conductorCurve = j.at("conductor_curve").get<bool>();
+    s.lowIorCurve = j.at("low_ior_curve").get<bool>();
     const int leastClosures = s.layoutClass == LayoutClass::Volume ? 0 : 1;  // a volume has none
     if (!known || s.name.empty() || s.words < 1 || s.closures < leastClosures || s.closures > 8) return std::nullopt;
     return s;

@@ -35,9 +35,11 @@ struct MaterialSummary {
   int simplificationSteps = 0;
   bool metalnessMix = false;         // Material::metalnessMix
   bool conductorCurve = false;       // usesConductorCurve (SUBSTRATE_USE_CONDUCTOR_CURVE)
+  bool lowIorCurve = false;          // usesLowIorCurve (SUBSTRATE_USE_LOW_IOR_CURVE)
 
   SceneMaterialShape shape() const {
-    return {name, layoutClass, runtimeSimple, storedFeatures, closures, words, metalnessMix, conductorCurve};
+    return {name,  layoutClass,  runtimeSimple,  storedFeatures, closures,
+            words, metalnessMix, conductorCurve, lowIorCurve};
   }
 };
 

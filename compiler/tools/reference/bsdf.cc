@@ -117,20 +117,33 @@ T fresnelShare(T f0max) {
   return T(1) - saturate((f0max - T(SUBSTRATE_COAT_DIELECTRIC_F0)) * T(SUBSTRATE_COAT_CONDUCTOR_BLEND));
 }
 
-// substrate_fresnel_curve: per channel, x = sqrt(max(F0, MIN_F0)), the conductor's
-// cubics max(a(x), 0), b(x) (SUBSTRATE_CONDUCTOR_CURVE_*) times `conductor` (toward Schlick's
-// (0, 0)), lerped toward chi's (A, B) by the share.
+// substrate_fresnel_curve: the dielectric curve's (a, b): chi's (A, B) plus (y - 0.2) lowIor times
+// the quadratics in y = min(sqrt(max(max3 F0, DIELECTRIC_CURVE_MIN_F0)), 0.2)
+// (SUBSTRATE_DIELECTRIC_CURVE_*), its pull min(PULL_MAX, PULL_SLOPE (0.2 - y) lowIor); per
+// channel, the conductor's cubics max(a(x), 0), b(x) at x = sqrt(max(F0, CONDUCTOR_CURVE_MIN_F0))
+// (SUBSTRATE_CONDUCTOR_CURVE_*) times `conductor` (toward Schlick's (0, 0)), lerped toward the
+// dielectric's by the share.
 template <class T>
-FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor) {
-  FresnelCurve<T> k{share, {}, {}};
+FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor, T lowIor) {
+  FresnelCurve<T> k{share, {}, {}, T(0)};
+  const T y = std::min(std::sqrt(std::max(max3(f0), T(SUBSTRATE_DIELECTRIC_CURVE_MIN_F0))),
+                       T(SUBSTRATE_DIELECTRIC_CURVE_X));
+  const T below = (y - T(SUBSTRATE_DIELECTRIC_CURVE_X)) * lowIor;  // <= 0
+  const T da = T(SUBSTRATE_FRESNEL_CURVE_A) +
+               below * (T(SUBSTRATE_DIELECTRIC_CURVE_P0) +
+                        y * (T(SUBSTRATE_DIELECTRIC_CURVE_P1) + y * T(SUBSTRATE_DIELECTRIC_CURVE_P2)));
+  const T db = T(SUBSTRATE_FRESNEL_CURVE_B) +
+               below * (T(SUBSTRATE_DIELECTRIC_CURVE_Q0) +
+                        y * (T(SUBSTRATE_DIELECTRIC_CURVE_Q1) + y * T(SUBSTRATE_DIELECTRIC_CURVE_Q2)));
+  k.pull = std::min(T(SUBSTRATE_DIELECTRIC_CURVE_PULL_MAX), below * -T(SUBSTRATE_DIELECTRIC_CURVE_PULL_SLOPE));
   for (int i = 0; i < 3; ++i) {
     const T x = std::sqrt(std::max(f0[i], T(SUBSTRATE_CONDUCTOR_CURVE_MIN_F0)));
     const T a2 = T(SUBSTRATE_CONDUCTOR_CURVE_A2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_A3);
     const T b2 = T(SUBSTRATE_CONDUCTOR_CURVE_B2) + x * T(SUBSTRATE_CONDUCTOR_CURVE_B3);
     const T a = std::max(T(SUBSTRATE_CONDUCTOR_CURVE_A0) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_A1) + x * a2), T(0));
     const T b = T(SUBSTRATE_CONDUCTOR_CURVE_B0) + x * (T(SUBSTRATE_CONDUCTOR_CURVE_B1) + x * b2);
-    k.a[i] = lerp(a * conductor, T(SUBSTRATE_FRESNEL_CURVE_A), share);
-    k.b[i] = lerp(b * conductor, T(SUBSTRATE_FRESNEL_CURVE_B), share);
+    k.a[i] = lerp(a * conductor, da, share);
+    k.b[i] = lerp(b * conductor, db, share);
   }
   return k;
 }
@@ -155,7 +168,8 @@ T fresnelB(const V2<T>& dfg, T e, T pull, T share) {
 }
 
 // substrate_fresnel_b, the curve's part (xyz): the same with each channel's
-// d = (1 - t) s (a + b s), s = sqrt(t), and no share.
+// d = (1 - t) s (a + b s), s = sqrt(t), its pull at least the dielectric curve's times the
+// share, and no share.
 template <class T>
 V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k) {
   const T t = std::min(dfg[1] / e, T(1));
@@ -163,7 +177,7 @@ V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k) {
   V3<T> out;
   for (int i = 0; i < 3; ++i) {
     const T d = (T(1) - t) * s * (k.a[i] + k.b[i] * s);
-    out[i] = e * (t + (d - pull * std::min(d, T(0))));
+    out[i] = e * (t + (d - std::max(pull, k.pull * k.share) * std::min(d, T(0))));
   }
   return out;
 }
@@ -850,7 +864,8 @@ V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90) {
 // F0 0.04 above, ((s - 0.2) / (1 - 0.2 s))^2, to itself: never above 1, only
 // in the dielectric range (back to 1 over F0 0.1 .. 0.2), lerped toward 1 by
 // coverageAbove. The curve: the conductor's own where the closure has no diffuse nor medium, or is a
-// metalness mix (mixShare), not under layers (times 1 - coverageAbove).
+// metalness mix (mixShare), not under layers (times 1 - coverageAbove); the low-F0 dielectric's own
+// not under layers either, nor on top of them (coversLayers).
 template <class T>
 void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, FresnelCurve<T>& curve) {
   f0 = saturate(c.f0);
@@ -868,7 +883,8 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, FresnelCurve
   f90 = f90 * scale;
   T conductor = !c.conductorCurve || std::max(max3(saturate(c.diffuseAlbedo)), max3(c.sssMfp)) > T(0) ? T(0) : T(1);
   if (c.metalnessMix) conductor = std::max(conductor, mixShare(f));
-  curve = fresnelCurve(f0, fresnelShare(f * scale), conductor * (T(1) - cover));
+  const T lowIor = c.lowIorCurve && !c.coversLayers ? T(1) - cover : T(0);
+  curve = fresnelCurve(f0, fresnelShare(f * scale), conductor * (T(1) - cover), lowIor);
 }
 
 // substrate_closure_dielectric_part: lerp((max F0, max F90), (MIX_DIELECTRIC_F0, 1) relative
@@ -1220,7 +1236,7 @@ V3<T> evalClosure(const Closure<T>& c, const V3<T>& V, const V3<T>& L, int diffu
   template T fresnelB<T>(const V2<T>&, T, T, T);                                                       \
   template V3<T> fresnelBCurve<T>(const V2<T>&, T, T, const FresnelCurve<T>&);                          \
   template T fresnelShare<T>(T);                                                                       \
-  template FresnelCurve<T> fresnelCurve<T>(const V3<T>&, T, T);                                           \
+  template FresnelCurve<T> fresnelCurve<T>(const V3<T>&, T, T, T);                                         \
   template T fresnelPull<T>(T);                                                                        \
   template V3<T> fresnelAlbedo<T>(const V3<T>&, const V3<T>&, T, const V3<T>&);                       \
   template V3<T> fresnel<T>(const V3<T>&, const V3<T>&, const FresnelCurve<T>&, T);                    \

@@ -12,12 +12,14 @@ namespace substratec::reference {
 template <class T> V3<T> closureNormal(const Closure<T>& c);                                 // substrate_closure_normal
 template <class T> void closureFrame(const Closure<T>& c, const V3<T>& N, V3<T>& Tn, V3<T>& Bn);  // substrate_closure_frame
 
-/// SubstrateFresnelCurve: the share of the dielectric curve chi (fresnelShare) and, per
-/// channel, the coefficients of w(t) = t + (1 - t) s (a + b s), s = sqrt(t).
+/// SubstrateFresnelCurve: the share of the dielectric curve (fresnelShare), per channel the
+/// coefficients of w(t) = t + (1 - t) s (a + b s), s = sqrt(t), and the least pull of the
+/// dielectric curve's albedo bound (fresnelBCurve; 0 for chi).
 template <class T>
 struct FresnelCurve {
   T share;
   V3<T> a, b;
+  T pull;
 };
 
 // Closures under layers (the layers above read as a dielectric of F0 0.04).
@@ -69,7 +71,7 @@ template <class T> T fresnelB(const V2<T>& dfg, T e, T pull, T share);          
 template <class T>
 V3<T> fresnelBCurve(const V2<T>& dfg, T e, T pull, const FresnelCurve<T>& k);                // substrate_fresnel_b (xyz)
 template <class T> T fresnelShare(T f0max);                                                // substrate_fresnel_share
-template <class T> FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor);     // substrate_fresnel_curve
+template <class T> FresnelCurve<T> fresnelCurve(const V3<T>& f0, T share, T conductor, T lowIor);  // substrate_fresnel_curve
 template <class T> V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90);                   // substrate_f90_effective
 template <class T> T fresnelPull(T roughness);                                              // substrate_fresnel_pull
 template <class T>

@@ -99,6 +99,9 @@ struct Closure {
   /// runtime's default, and the deferred scene lighting's, is 1): false keeps every
   /// channel on chi or Schlick's curve (closureFresnelEnds).
   bool conductorCurve = true;
+  /// SUBSTRATE_USE_LOW_IOR_CURVE of the shader that lights it (usesLowIorCurve; the runtime's
+  /// default is 1): false keeps every dielectric on chi (closureFresnelEnds).
+  bool lowIorCurve = true;
 };
 
 /// One shading point, as SubstrateGeometry (world space; converted to T inside).

@@ -154,7 +154,8 @@ class Walk {
  public:
   Walk(const CompileResult& r, const std::vector<std::array<double, 4>>& values, const Geometry& g)
       : m_(r.material), t_(r.tree), L_(r.after), vals_(values),
-        conductorCurve_(usesConductorCurve(r.material, r.after)), gN_(cast<T>(g.N)), gT_(cast<T>(g.T)),
+        conductorCurve_(usesConductorCurve(r.material, r.after)), lowIorCurve_(usesLowIorCurve(r.material, r.after)),
+        gN_(cast<T>(g.N)), gT_(cast<T>(g.T)),
         gV_(cast<T>(g.V)), uvDerivatives_(cast<T>(g.uvDerivatives)) {}
 
   MaterialResult<T> run() {
@@ -327,6 +328,7 @@ class Walk {
     c.features = bits;
     c.metalnessMix = m_.metalnessMix;  // the material's SUBSTRATE_USE_METALNESS_MIX
     c.conductorCurve = conductorCurve_;  // and its SUBSTRATE_USE_CONDUCTOR_CURVE
+    c.lowIorCurve = lowIorCurve_;        // and SUBSTRATE_USE_LOW_IOR_CURVE
     return c;
   }
 
@@ -416,6 +418,7 @@ class Walk {
     c.features = kFeatureHair;
     c.metalnessMix = m_.metalnessMix;
     c.conductorCurve = conductorCurve_;
+    c.lowIorCurve = lowIorCurve_;
     return c;
   }
 
@@ -445,6 +448,7 @@ class Walk {
     c.features = kFeatureEye;
     c.metalnessMix = m_.metalnessMix;
     c.conductorCurve = conductorCurve_;
+    c.lowIorCurve = lowIorCurve_;
     return c;
   }
 
@@ -499,6 +503,7 @@ class Walk {
   const StorageLayout& L_;
   const std::vector<std::array<double, 4>>& vals_;
   bool conductorCurve_;  // the material's SUBSTRATE_USE_CONDUCTOR_CURVE
+  bool lowIorCurve_;     // and SUBSTRATE_USE_LOW_IOR_CURVE
   V3<T> gN_, gT_, gV_;
   V4<T> uvDerivatives_;
   std::vector<T> C_;
