@@ -691,11 +691,10 @@ TEST(Accuracy, ALowIorDielectricFollowsItsOwnFresnelCurve) {
   // Issue 19, step 24 (bench/materials/low_ior_dielectric.json): a dielectric
   // of F0 0.005 (IOR 1.15) over a Lambertian of albedo 0.05 at roughness 0.5.
   // The truth walks the exact Fresnel of that IOR, which rises toward grazing
-  // later than chi (IOR 1.5's), every interface's curve before: +5.8 / +18.9 /
-  // +33.8 / +34.8 / +30.4 % at NoV 0.8 … 0.1 (step 17, 32,768 walks); with
-  // its own curve per channel (substrate_fresnel_curve) within 1.5 %. The
-  // bound (5 %) holds that, with the walks' noise at 8,192; chi fails it from
-  // NoV 0.6.
+  // later than chi (IOR 1.5's), every interface's curve before: +7.1 / +21.4 /
+  // +36.6 / +40.3 / +36.5 % at NoV 0.8 … 0.1 (32,768 walks); with its own
+  // curve (substrate_fresnel_curve) within 1.5 %. The bound (5 %) holds that,
+  // with the walks' noise at 8,192; chi fails it from NoV 0.8.
   const CompileResult r =
       compileSlab(R"({"kind": "slab", "diffuse_albedo": 0.05, "f0": 0.005, "roughness": 0.5})");
   accuracy::Options o = cheap(2);
