@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cctype>
 #include <map>
+#include <optional>
 #include <set>
 
 #include <fmt/format.h>
@@ -44,25 +45,32 @@ std::string useDefines(std::uint16_t features) {
   return s;
 }
 
+/// Whether some closure of `layout` lies under a layer (not ClosureLayout::isTop).
+bool hasLayers(const StorageLayout& layout) {
+  return std::any_of(layout.closures.begin(), layout.closures.end(), [](const ClosureLayout& c) { return !c.isTop; });
+}
+
 std::string extraInterfacesDefine(const StorageLayout& layout) {
-  bool any = false, layered = false;
-  for (const ClosureLayout& c : layout.closures) {
-    any = any || c.extraInterfaces > 0;
-    layered = layered || !c.isTop;
-  }
+  const bool any = std::any_of(layout.closures.begin(), layout.closures.end(),
+                               [](const ClosureLayout& c) { return c.extraInterfaces > 0; });
   return fmt::format("#define SUBSTRATE_USE_EXTRA_INTERFACES {}\n#define SUBSTRATE_USE_LAYERS {}\n", any ? 1 : 0,
-                     layered ? 1 : 0);
+                     hasLayers(layout) ? 1 : 0);
+}
+
+/// The channels of value `v` when it is a constant (one for a float, three for a
+/// colour); nothing when it is absent or not a constant.
+std::optional<std::vector<double>> constantChannels(const Material& m, ValueId v) {
+  if (v == kNoValue || !m.values.isConst(v)) return std::nullopt;
+  const auto& k = m.values.node(v).c;
+  const int channels = m.values.node(v).type == VType::Float ? 1 : 3;
+  return std::vector<double>(k.begin(), k.begin() + channels);
 }
 
 /// Whether value `v` may exceed `limit` in some channel: it is not a
 /// constant whose every channel is at most `limit` (NaN counts as above).
 bool mayExceed(const Material& m, ValueId v, double limit) {
-  if (v == kNoValue || !m.values.isConst(v)) return true;
-  const auto& k = m.values.node(v).c;
-  const int channels = m.values.node(v).type == VType::Float ? 1 : 3;
-  for (int i = 0; i < channels; ++i)
-    if (!(k[i] <= limit)) return true;
-  return false;
+  const auto k = constantChannels(m, v);
+  return !k || std::any_of(k->begin(), k->end(), [&](double x) { return !(x <= limit); });
 }
 
 /// Whether slab `slab` may read as a conductor in the runtime: its F0 is not
@@ -89,14 +97,9 @@ bool mayWalkAsConductor(const Material& m, int slab) {
 /// Whether the largest channel of value `v` may fall below `limit`: it is not
 /// a constant with a channel of at least `limit` (NaN counts as below).
 bool largestMayFallBelow(const Material& m, ValueId v, double limit) {
-  if (v == kNoValue || !m.values.isConst(v)) return true;
-  const auto& k = m.values.node(v).c;
-  const int channels = m.values.node(v).type == VType::Float ? 1 : 3;
-  for (int i = 0; i < channels; ++i)
-    if (std::isnan(k[i])) return true;
-  for (int i = 0; i < channels; ++i)
-    if (k[i] >= limit) return false;
-  return true;
+  const auto k = constantChannels(m, v);
+  return !k || std::any_of(k->begin(), k->end(), [](double x) { return std::isnan(x); }) ||
+         std::none_of(k->begin(), k->end(), [&](double x) { return x >= limit; });
 }
 
 bool usesConductorCurve(const Material& m, const StorageLayout& layout) {
@@ -109,8 +112,7 @@ bool usesLowIorCurve(const Material& m, const StorageLayout& layout) {
   // Chi from F0 SUBSTRATE_DIELECTRIC_CURVE_X^2 = 0.04 on (a relative 1e-6 below it, so that a
   // constant 0.04 folds to chi whatever the rounding).
   constexpr double kChiF0 = SUBSTRATE_DIELECTRIC_CURVE_X * SUBSTRATE_DIELECTRIC_CURVE_X * (1 - 1e-6);
-  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
-  if (!std::all_of(layout.closures.begin(), layout.closures.end(), isTop)) return false;
+  if (hasLayers(layout)) return false;
   for (const ClosureLayout& c : layout.closures)
     if (c.slab < 0 || largestMayFallBelow(m, m.slabs[c.slab].pin(SlabPin::F0), kChiF0)) return true;
   return false;
@@ -934,8 +936,7 @@ void Emitter::emitEmission() {
 /// such a top's lobe takes no dielectric multiple scattering, which the layers'
 /// interface term under it does not take away (substrate_closure_dielectric_ms).
 void Emitter::emitCoversLayers() {
-  const auto isTop = [](const ClosureLayout& c) { return c.isTop; };
-  if (std::all_of(L_.closures.begin(), L_.closures.end(), isTop)) return;
+  if (!hasLayers(L_)) return;
   for (std::size_t i = 0; i < L_.closures.size(); ++i)
     if (L_.closures[i].isTop) line(fmt::format("closures[{}].coversLayers = true;", i));
 }
