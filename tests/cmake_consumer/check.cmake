@@ -94,7 +94,10 @@ endif()
 # Editing brick recompiles brick alone: one new cache entry; chrome's outputs
 # keep their old modification time, so what consumes them does not rerun.
 set(cache "${out}/substratec_cache/mobile_shaders")
-file(GLOB entriesBefore "${cache}/*")
+# Entries live in subfolders named by their key's first two hex digits
+# (MaterialCache::entryPath): count the entries, not the subfolders (a new
+# entry in an existing subfolder counted 0).
+file(GLOB_RECURSE entriesBefore "${cache}/*.entry")
 list(LENGTH entriesBefore entriesBefore)
 file(GLOB chromeOutputs "${out}/mobile_shaders/chrome.*")
 run(COMMAND touch -d "@1000000000" ${chromeOutputs} "${out}/chrome_forward_copy.frag")
@@ -106,7 +109,7 @@ if(edited STREQUAL brick)
 endif()
 file(WRITE "${WORK_DIR}/src/materials/brick.json" "${edited}")
 run(COMMAND "${NINJA}" -C "${WORK_DIR}/build" OUTPUT rebuilt)
-file(GLOB entriesAfter "${cache}/*")
+file(GLOB_RECURSE entriesAfter "${cache}/*.entry")
 list(LENGTH entriesAfter entriesAfter)
 math(EXPR added "${entriesAfter} - ${entriesBefore}")
 if(NOT added EQUAL 1)
