@@ -111,7 +111,8 @@
 // dielectric; linear between. Under the layers above (coverageAbove 1) the
 // dielectric part is relative to them, as substrate_closure_fresnel_ends
 // makes a dielectric: ((sqrt(0.04) - 0.2) / (1 - 0.2 sqrt(0.04)))^2 = 0,
-// index-matched.
+// index-matched; so is its share of the mixed F0 and F90 under them
+// (substrate_closure_mix_under, issue 19 step 25).
 #define SUBSTRATE_MIX_START 0.18
 #define SUBSTRATE_MIX_BLEND 14.285714
 #define SUBSTRATE_MIX_DIELECTRIC_F0 0.04

@@ -860,10 +860,26 @@ V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90) {
   return hue + (f90 - hue) * share;
 }
 
+// substrate_closure_mix_under: per channel, weight times the dielectric part's share of a
+// metalness mix of F0 f0 (against air) and diffuse A: A / b, b = min((s + sqrt(max(s^2 - 4 d A,
+// 0))) / 2, 1), s = f0 + A, d = SUBSTRATE_MIX_DIELECTRIC_F0; at most weight.
+template <class T>
+V3<T> closureMixUnder(const Closure<T>& c, const V3<T>& f0, T weight) {
+  const V3<T> a = saturate(c.diffuseAlbedo);
+  V3<T> r;
+  for (int i = 0; i < 3; ++i) {
+    const T s = f0[i] + a[i];
+    const T b = T(0.5) * (s + std::sqrt(std::max(s * s - T(4 * SUBSTRATE_MIX_DIELECTRIC_F0) * a[i], T(0))));
+    r[i] = std::min(a[i] / std::max(b, T(1e-4)), T(1)) * weight;
+  }
+  return r;
+}
+
 // F0 and F90 scaled by the ratio of the largest channel's F0 relative to a dielectric of
 // F0 0.04 above, ((s - 0.2) / (1 - 0.2 s))^2, to itself: never above 1, only
 // in the dielectric range (back to 1 over F0 0.1 .. 0.2), lerped toward 1 by
-// coverageAbove. The curve: the conductor's own where the closure has no diffuse nor medium, or is a
+// coverageAbove; a metalness mix's dielectric part then relative too (closureMixUnder: its share
+// of F0 0.04 lowered to MIX_DIELECTRIC_F0_UNDER, of F90 scaled by UNDER / 0.04). The curve: the conductor's own where the closure has no diffuse nor medium, or is a
 // metalness mix (mixShare), not under layers (times 1 - coverageAbove); the low-F0 dielectric's own
 // not under layers either, nor on top of them (coversLayers).
 template <class T>
@@ -881,6 +897,11 @@ void closureFresnelEnds(const Closure<T>& c, V3<T>& f0, V3<T>& f90, FresnelCurve
   const T scale = lerp(T(1), rel / std::max(f, T(1e-4)), cover);
   f0 = f0 * scale;
   f90 = f90 * scale;
+  if (c.metalnessMix) {
+    const V3<T> part = closureMixUnder(c, f0, mixShare(f) * cover);
+    f0 = vmax(f0 - part * T(SUBSTRATE_MIX_DIELECTRIC_F0 - SUBSTRATE_MIX_DIELECTRIC_F0_UNDER), splat3(T(0)));
+    f90 = f90 * (splat3(T(1)) - part * T(1 - SUBSTRATE_MIX_DIELECTRIC_F0_UNDER / SUBSTRATE_MIX_DIELECTRIC_F0));
+  }
   T conductor = !c.conductorCurve || std::max(max3(saturate(c.diffuseAlbedo)), max3(c.sssMfp)) > T(0) ? T(0) : T(1);
   if (c.metalnessMix) conductor = std::max(conductor, mixShare(f));
   const T lowIor = c.lowIorCurve && !c.coversLayers ? T(1) - cover : T(0);
