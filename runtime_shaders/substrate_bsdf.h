@@ -150,20 +150,27 @@ float3 substrate_f90_effective(float3 f0, float3 f90) {
   return lerp(hue, f90, substrate_fresnel_share(substrate_max3(f0)));
 }
 
+// The F0 b of a metalness mix's conductor part, per channel, from the mixed
+// F0 f and the diffuse A = b (1 - m) beside a dielectric part of F0 d: the
+// mixed F0 is f = d + m (b - d), so b is the larger root of
+// b^2 - (f + A) b + d A = 0 (issue 19, step 15). Not clamped.
+float3 substrate_mix_conductor_f0(float3 f, float3 a, float d) {
+  float3 s = f + a;
+  return 0.5 * (s + sqrt(max(s * s - (4.0 * d) * a, SUBSTRATE_SPLAT3(0.0))));
+}
+
 // The dielectric part of a metalness mix under layers (issue 19, step 25):
 // per channel, `weight` times its share 1 - m = A / b of a mix of F0 f0
-// (against air) and diffuse A, b its conductor part's F0, the larger root of
-// b^2 - (f0 + A) b + d A = 0 (d = SUBSTRATE_MIX_DIELECTRIC_F0; the mixed F0
-// is d + m (b - d) and A = b (1 - m); substrate_closure_compensated_f0);
-// at most `weight`. Under a coat that part is index-matched (F0 and F90 0,
+// (against air) and diffuse A, b its conductor part's F0
+// (substrate_mix_conductor_f0 at d = SUBSTRATE_MIX_DIELECTRIC_F0); at most
+// `weight`. Under a coat that part is index-matched (F0 and F90 0,
 // SUBSTRATE_MIX_DIELECTRIC_F0_UNDER) where the mix kept its 1 - m share of
 // F0 0.04 and of F90 1 against air: car_paint (metallic 0.6 under a clear
 // coat) read +8.8 / +7.2 % at NoV 1 / 0.4, its parts alone +1.9 and +5.7 %
 // head-on.
 float3 substrate_closure_mix_under(SubstrateClosure c, float3 f0, float weight) {
   float3 a = saturate(c.diffuseAlbedo);
-  float3 s = f0 + a;
-  float3 b = 0.5 * (s + sqrt(max(s * s - (4.0 * SUBSTRATE_MIX_DIELECTRIC_F0) * a, SUBSTRATE_SPLAT3(0.0))));
+  float3 b = substrate_mix_conductor_f0(f0, a, SUBSTRATE_MIX_DIELECTRIC_F0);
   return min(a / max(b, SUBSTRATE_SPLAT3(1e-4)), SUBSTRATE_SPLAT3(1.0)) * weight;
 }
 
@@ -713,8 +720,7 @@ mfloat3 substrate_closure_compensated_f0(SubstrateClosure c, mfloat3 f0, float2 
 #if SUBSTRATE_USE_METALNESS_MIX
   float3 f = SUBSTRATE_F3(f0);
   float3 a = saturate(c.diffuseAlbedo);
-  float3 s = f + a;
-  float3 b = min(0.5 * (s + sqrt(max(s * s - (4.0 * fd.x) * a, SUBSTRATE_SPLAT3(0.0)))), SUBSTRATE_SPLAT3(1.0));
+  float3 b = min(substrate_mix_conductor_f0(f, a, fd.x), SUBSTRATE_SPLAT3(1.0));
   float3 var = max(f - SUBSTRATE_SPLAT3(fd.x), SUBSTRATE_SPLAT3(0.0)) * max(b - f, SUBSTRATE_SPLAT3(0.0));
   return SUBSTRATE_M3(f + substrate_mix_share(substrate_max3(f)) * var / max(f, SUBSTRATE_SPLAT3(1e-4)));
 #else

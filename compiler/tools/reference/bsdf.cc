@@ -860,16 +860,23 @@ V3<T> f90Effective(const V3<T>& f0, const V3<T>& f90) {
   return hue + (f90 - hue) * share;
 }
 
+// substrate_mix_conductor_f0, one channel: the larger root of b^2 - (f + A) b + d A = 0,
+// (s + sqrt(max(s^2 - 4 d A, 0))) / 2, s = f + A. Not clamped.
+template <class T>
+T mixConductorF0(T f, T a, T d) {
+  const T s = f + a;
+  return T(0.5) * (s + std::sqrt(std::max(s * s - (T(4) * d) * a, T(0))));
+}
+
 // substrate_closure_mix_under: per channel, weight times the dielectric part's share of a
-// metalness mix of F0 f0 (against air) and diffuse A: A / b, b = min((s + sqrt(max(s^2 - 4 d A,
-// 0))) / 2, 1), s = f0 + A, d = SUBSTRATE_MIX_DIELECTRIC_F0; at most weight.
+// metalness mix of F0 f0 (against air) and diffuse A: A / b, b = mixConductorF0(f0, A,
+// SUBSTRATE_MIX_DIELECTRIC_F0); at most weight.
 template <class T>
 V3<T> closureMixUnder(const Closure<T>& c, const V3<T>& f0, T weight) {
   const V3<T> a = saturate(c.diffuseAlbedo);
   V3<T> r;
   for (int i = 0; i < 3; ++i) {
-    const T s = f0[i] + a[i];
-    const T b = T(0.5) * (s + std::sqrt(std::max(s * s - T(4 * SUBSTRATE_MIX_DIELECTRIC_F0) * a[i], T(0))));
+    const T b = mixConductorF0(f0[i], a[i], T(SUBSTRATE_MIX_DIELECTRIC_F0));
     r[i] = std::min(a[i] / std::max(b, T(1e-4)), T(1)) * weight;
   }
   return r;
@@ -923,7 +930,7 @@ V2<T> closureDielectricPart(const Closure<T>& c, const V3<T>& f0, const V3<T>& f
 }
 
 // substrate_closure_compensated_f0: F + t (F - d)^+ (b - F)^+ / max(F, 1e-4) per channel, d = fd.x,
-// b = min((s + sqrt(max(s^2 - 4 d A, 0))) / 2, 1), s = F + A, A the saturated diffuse albedo,
+// b = min(mixConductorF0(F, A, d), 1), A the saturated diffuse albedo,
 // t = mixShare(max F0); F without a metalness mix.
 template <class T>
 V3<T> closureCompensatedF0(const Closure<T>& c, const V3<T>& f0, const V2<T>& fd) {
@@ -932,8 +939,7 @@ V3<T> closureCompensatedF0(const Closure<T>& c, const V3<T>& f0, const V2<T>& fd
   const V3<T> a = saturate(c.diffuseAlbedo);
   V3<T> r;
   for (int i = 0; i < 3; ++i) {
-    const T s = f0[i] + a[i];
-    const T b = std::min(T(0.5) * (s + std::sqrt(std::max(s * s - T(4) * fd[0] * a[i], T(0)))), T(1));
+    const T b = std::min(mixConductorF0(f0[i], a[i], fd[0]), T(1));
     const T var = std::max(f0[i] - fd[0], T(0)) * std::max(b - f0[i], T(0));
     r[i] = f0[i] + t * var / std::max(f0[i], T(1e-4));
   }
